@@ -1,0 +1,107 @@
+//! The common shape of every 2D sampler in brdf-lab.
+//!
+//! A sampler draws points `x` of a planar domain (a rectangle or the unit disc) with a
+//! probability density `p(x)` **with respect to area (Lebesgue measure) on that domain**.
+//! Samplers never own a random generator: they consume caller-given uniform numbers from a
+//! [`UniformSource`], so pseudo-random, quasi-random and stratified streams all work.
+
+use rand::Rng;
+
+/// A point of the plane, `[x, y]`.
+pub type Point2 = [f64; 2];
+
+/// One drawn point with its density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample2 {
+    /// The point, inside the sampler's domain.
+    pub point: Point2,
+    /// Probability density of `point` with respect to area on the domain.
+    pub pdf: f64,
+}
+
+/// A stream of independent uniform numbers in `[0, 1)`.
+///
+/// Implemented for every [`rand::Rng`] and for [`UniformSequence`] (a caller-given slice, e.g.
+/// quasi-Monte Carlo points). Inversion samplers consume exactly two numbers per sample;
+/// rejection samplers consume a random, bounded-in-mean number of them.
+pub trait UniformSource {
+    /// The next uniform number in `[0, 1)`.
+    fn next_uniform(&mut self) -> f64;
+}
+
+impl<R: Rng + ?Sized> UniformSource for R {
+    #[inline]
+    fn next_uniform(&mut self) -> f64 {
+        // 53 random mantissa bits: uniform on [0, 1) with spacing 2^-53.
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// Uniform numbers read from a caller-given slice, in order.
+///
+/// When the slice is exhausted the stream wraps around to its start, so a sampler never
+/// panics on a short sequence (a caller who cares checks [`UniformSequence::consumed`]).
+#[derive(Debug, Clone)]
+pub struct UniformSequence<'a> {
+    values: &'a [f64],
+    next: usize,
+    consumed: usize,
+}
+
+impl<'a> UniformSequence<'a> {
+    /// A stream over `values`; each value should lie in `[0, 1)`.
+    pub fn new(values: &'a [f64]) -> Self {
+        Self { values, next: 0, consumed: 0 }
+    }
+
+    /// How many numbers have been read so far.
+    pub fn consumed(&self) -> usize {
+        self.consumed
+    }
+}
+
+impl UniformSource for UniformSequence<'_> {
+    #[inline]
+    fn next_uniform(&mut self) -> f64 {
+        if self.values.is_empty() {
+            return 0.5;
+        }
+        let v = self.values[self.next];
+        self.next = (self.next + 1) % self.values.len();
+        self.consumed += 1;
+        v
+    }
+}
+
+/// A sampler of a planar density: `sample(u) -> (point, pdf)`, `pdf(point)`, `bytes_used()`.
+///
+/// Built samplers are immutable and `Sync`: one instance serves every thread.
+pub trait Sampler2D: Sync {
+    /// Draws one point from uniforms taken from `u`.
+    fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2;
+
+    /// Density of `p` with respect to area on the domain (0 outside the support).
+    fn pdf(&self, p: Point2) -> f64;
+
+    /// Heap and inline bytes of the structures the sampler needs to draw samples.
+    fn bytes_used(&self) -> usize;
+}
+
+/// A sampler that is a bijective warp of the unit square: exactly two uniforms per sample.
+pub trait InvertibleSampler2D: Sampler2D {
+    /// Warps `u ∈ [0,1)²` to a point and its density.
+    fn sample_square(&self, u: Point2) -> Sample2;
+
+    /// The `u` that [`InvertibleSampler2D::sample_square`] maps to `p`, when `p` is in the support.
+    fn invert(&self, p: Point2) -> Option<Point2>;
+}
+
+/// Adapts any [`Sampler2D`] to [`rand::distr::Distribution`], yielding [`Sample2`].
+#[derive(Debug, Clone, Copy)]
+pub struct AsDistribution<'a, S: ?Sized>(pub &'a S);
+
+impl<S: Sampler2D + ?Sized> rand::distr::Distribution<Sample2> for AsDistribution<'_, S> {
+    fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> Sample2 {
+        self.0.sample(rng)
+    }
+}
