@@ -1,3 +1,76 @@
-//! Generic 2D adaptive-partition sampler (stub: being written).
+//! Generic 2D adaptive-partition sampler (Montes, Ureña et al., GRAPP 2008 / CEIG 2008).
+//!
+//! A density `f ≥ 0` on a rectangle or on the unit disc is partitioned by a quadtree whose
+//! cells are split until rejection sampling inside each leaf needs at most `n_max` trials on
+//! average. Samples are drawn by choosing a leaf and doing rejection in its (disc-clipped)
+//! rectangle under the leaf bound `M_i`. The crate knows nothing about BRDFs or images: it
+//! needs only a [`RegionStats`] provider giving an upper bound `M_i` and the integral `I_i` of
+//! `f` on a rectangle:
+//!
+//! * [`TabulatedDensity`]: piecewise-constant grids (optionally times a smooth row factor such
+//!   as [`SinPiRows`] for latitude–longitude maps), exact `M_i`, `I_i` from pyramids;
+//! * [`SampledGridDensity`]: any [`Density`] evaluated on a dense grid (the papers' "image
+//!   map"), bounds with a safety factor, audited while sampling;
+//! * [`UserBoundDensity`]: caller-supplied bounds, integrals by quadrature.
+//!
+//! All pdfs are with respect to **area on the domain** ([`Sampler2D`]). The default
+//! [`Scheme::Envelope`] is exact whenever the bounds hold; [`Scheme::Paper`] is the papers'
+//! scheme. See [`QuadTreeSampler`] for what `pdf` returns.
+//!
+//! ```
+//! use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, SinPiRows, TabulatedDensity};
+//! use rand::{SeedableRng, rngs::Xoshiro256PlusPlus};
+//!
+//! // A 8 × 4 latitude–longitude luminance map over (u, v) ∈ [0, 1]², one bright texel.
+//! let mut lum = vec![1.0; 8 * 4];
+//! lum[2 * 8 + 5] = 1000.0;
+//! let density = TabulatedDensity::new(8, 4, lum, Rect::UNIT)?.with_row_factor(SinPiRows)?;
+//! let sampler = QuadTreeBuilder::new().build(density)?;
+//!
+//! let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+//! let s = sampler.sample(&mut rng);
+//! assert!(Rect::UNIT.contains(s.point) && s.pdf > 0.0);
+//! assert!((sampler.pdf(s.point) - s.pdf).abs() <= 1e-12 * s.pdf);
+//! let stats = sampler.stats();
+//! assert!(stats.expected_mean_trials <= 2.0 && stats.bound_violations == 0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod alias;
+pub mod allocate;
+mod audit;
+mod builder;
+mod density;
+mod error;
+mod persist;
+mod pyramid;
+mod rect;
+mod sampled;
 pub mod sampler;
-pub use sampler::{AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource};
+mod sampler_impl;
+mod tabulated;
+mod tree;
+mod user_bound;
+
+pub use allocate::{AllocationMode, allocate, stratum_weights};
+pub use audit::{Audit, FLUSH_EVERY};
+pub use builder::{
+    DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, DEFAULT_VOLUME_TOLERANCE, MAX_DEPTH_LIMIT, QuadTreeBuilder,
+};
+pub use density::{
+    Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
+};
+pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
+pub use persist::FORMAT_VERSION;
+pub use rect::{Domain, Rect};
+pub use sampled::{DEFAULT_SAFETY_FACTOR, SampledGridDensity};
+pub use sampler::{
+    AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
+};
+pub use sampler_impl::{
+    Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, PAR_CHUNK, QuadTreeSampler, SamplerStats,
+    chunk_seed,
+};
+pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
+pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
+pub use user_bound::UserBoundDensity;

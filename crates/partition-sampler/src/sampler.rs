@@ -51,7 +51,11 @@ pub struct UniformSequence<'a> {
 impl<'a> UniformSequence<'a> {
     /// A stream over `values`; each value should lie in `[0, 1)`.
     pub fn new(values: &'a [f64]) -> Self {
-        Self { values, next: 0, consumed: 0 }
+        Self {
+            values,
+            next: 0,
+            consumed: 0,
+        }
     }
 
     /// How many numbers have been read so far.

@@ -1,0 +1,127 @@
+//! Shared kernels: validation, normalised CDF construction and CDF search.
+
+use super::TabulatedError;
+
+/// The largest `f64` below 1.
+pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
+
+/// Maps any number to `[0, 1)`: NaN and negatives to 0, values ≥ 1 to [`ONE_MINUS_EPSILON`].
+#[inline]
+pub(crate) fn clamp_unit(u: f64) -> f64 {
+    if u >= 0.0 {
+        u.min(ONE_MINUS_EPSILON)
+    } else {
+        0.0
+    }
+}
+
+/// Checks that every value is finite and non-negative; `width` names columns in errors.
+pub(crate) fn validate_values(values: &[f64], width: usize) -> Result<(), TabulatedError> {
+    for (i, &value) in values.iter().enumerate() {
+        let (column, row) = (i % width.max(1), i / width.max(1));
+        if !value.is_finite() {
+            return Err(TabulatedError::NonFinite { column, row, value });
+        }
+        if !(value >= 0.0) {
+            return Err(TabulatedError::Negative { column, row, value });
+        }
+    }
+    Ok(())
+}
+
+/// Writes the normalised CDF of `values` into `cdf` (length `values.len() + 1`) and returns
+/// the plain sum. `cdf[0] = 0`, `cdf[n] = 1`, non-decreasing. With a zero sum the CDF is
+/// that of the uniform distribution (such a row is never selected by a 2D sampler).
+pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
+    let n = values.len();
+    debug_assert_eq!(cdf.len(), n + 1);
+    let mut acc = 0.0;
+    cdf[0] = 0.0;
+    for (c, &v) in cdf[1..].iter_mut().zip(values) {
+        acc += v;
+        *c = acc;
+    }
+    if acc > 0.0 {
+        let inv = 1.0 / acc;
+        for c in &mut cdf[1..n] {
+            // Division keeps the order (rounding is monotone); clamp guards inv-rounding.
+            *c = (*c * inv).min(1.0);
+        }
+    } else {
+        let inv_n = 1.0 / n as f64;
+        for (i, c) in cdf[1..n].iter_mut().enumerate() {
+            *c = (i + 1) as f64 * inv_n;
+        }
+    }
+    cdf[n] = 1.0;
+    acc
+}
+
+/// Finds the cell `i` with `cdf[i] ≤ u < cdf[i+1]` for `u ∈ [0,1)`, and the position
+/// `du ∈ [0,1)` of `u` inside it. The interval found always has positive width.
+#[inline]
+pub(crate) fn find_cell(cdf: &[f64], u: f64) -> (usize, f64) {
+    let n = cdf.len() - 1;
+    // Interior entries ≤ u: cdf[0] = 0 ≤ u and cdf[n] = 1 > u are implied.
+    let i = cdf[1..n].partition_point(|&c| c <= u);
+    let (lo, hi) = (cdf[i], cdf[i + 1]);
+    let du = ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
+    (i, du)
+}
+
+/// The uniform number mapped by the CDF to position `du ∈ [0,1]` inside cell `i`.
+#[inline]
+pub(crate) fn invert_cell(cdf: &[f64], i: usize, du: f64) -> f64 {
+    let (lo, hi) = (cdf[i], cdf[i + 1]);
+    (lo + du * (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON)
+}
+
+/// Index of the cell of `t ∈ [0, n]` (scaled coordinate) and its fractional part, clamped.
+#[inline]
+pub(crate) fn cell_of(t: f64, n: usize) -> (usize, f64) {
+    let i = (t.max(0.0) as usize).min(n - 1);
+    (i, (t - i as f64).clamp(0.0, 1.0))
+}
+
+/// The coordinate at fraction `t ∈ [0,1)` of cell `i` of an axis from `lo` to `hi`, nudged
+/// to the cell centre in the (probability ~1e-16) event that rounding puts it in another cell
+/// as [`cell_of`] sees it, or on the excluded upper edge `hi`: so `pdf(point)` always reads
+/// the sampled cell and points stay in `[lo, hi)`.
+#[inline]
+pub(crate) fn place(lo: f64, hi: f64, size: f64, inv_size: f64, i: usize, t: f64) -> f64 {
+    let x = lo + (i as f64 + t) * size;
+    if x < hi && ((x - lo) * inv_size).max(0.0) as usize == i {
+        x
+    } else {
+        lo + (i as f64 + 0.5) * size
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cdf_is_normalised_and_monotone() {
+        let mut cdf = vec![0.0; 5];
+        let s = fill_cdf(&[1.0, 0.0, 2.0, 1.0], &mut cdf);
+        assert_eq!(s, 4.0);
+        assert_eq!(cdf, vec![0.0, 0.25, 0.25, 0.75, 1.0]);
+    }
+
+    #[test]
+    fn find_cell_skips_empty_cells() {
+        let cdf = [0.0, 0.25, 0.25, 0.75, 1.0];
+        assert_eq!(find_cell(&cdf, 0.0), (0, 0.0));
+        assert_eq!(find_cell(&cdf, 0.25).0, 2);
+        assert_eq!(find_cell(&cdf, 0.5), (2, 0.5));
+        assert_eq!(find_cell(&cdf, ONE_MINUS_EPSILON).0, 3);
+    }
+
+    #[test]
+    fn clamp_unit_handles_nan_and_one() {
+        assert_eq!(clamp_unit(f64::NAN), 0.0);
+        assert_eq!(clamp_unit(-1.0), 0.0);
+        assert!(clamp_unit(1.0) < 1.0);
+    }
+}

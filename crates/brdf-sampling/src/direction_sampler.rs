@@ -1,0 +1,40 @@
+//! The common shape of every direction sampler: `sample(wo, u) -> (wi, pdf)`, `pdf(wo, wi)`.
+
+use brdf::Vec3;
+use partition_sampler::UniformSource;
+
+/// One sampled incident direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirSample {
+    /// The sampled direction `ωi` (unit vector, local frame, normal = +z). It may lie below the
+    /// horizon for samplers whose support is the whole sphere; such a sample contributes zero.
+    pub wi: Vec3,
+    /// Density of `wi` with respect to **solid angle**.
+    pub pdf: f64,
+}
+
+/// A sampler of incident directions given an outgoing direction `ωo`.
+///
+/// The pdf is always with respect to solid angle on the sphere of directions. Samplers consume
+/// caller-given uniforms (so QMC streams work) and are immutable and `Sync` once built. The trait
+/// is object-safe: the CLI and the validation suite hold samplers as `Box<dyn DirectionSampler>`.
+pub trait DirectionSampler: Send + Sync {
+    /// Short name as used on the command line (e.g. `adaptive`, `cosine`).
+    fn name(&self) -> &str;
+
+    /// Draws `ωi` for the outgoing direction `wo` (unit, `wo.z > 0`).
+    fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample;
+
+    /// Density of `wi` given `wo`, w.r.t. solid angle; the same value `sample` reports.
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64;
+
+    /// Draws `n` directions for one `wo` as a batch. The default draws `n` independent samples;
+    /// batch-mode samplers (stratified leaf allocation) override it. Each returned pdf is the
+    /// one-sample density of that direction, so `(1/n) Σ f/pdf` stays the estimator.
+    fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
+        (0..n).map(|_| self.sample(wo, u)).collect()
+    }
+
+    /// Bytes of the precomputed structures this sampler needs.
+    fn bytes_used(&self) -> usize;
+}

@@ -1,0 +1,85 @@
+//! The [`Brdf`] trait shared by every reflectance model.
+
+use crate::geometry::Vec3;
+use std::sync::Arc;
+
+/// Rec. 709 luminance weights used to turn RGB reflectance into the scalar that is sampled.
+pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B` of a linear RGB triple.
+#[inline]
+pub fn luminance(rgb: [f64; 3]) -> f64 {
+    LUMINANCE_WEIGHTS[0] * rgb[0] + LUMINANCE_WEIGHTS[1] * rgb[1] + LUMINANCE_WEIGHTS[2] * rgb[2]
+}
+
+/// A bidirectional reflectance distribution function `f_r(ωo, ωi)` in units of 1/sr.
+///
+/// Frame: the surface normal is `n = (0, 0, 1)`, the tangent (anisotropy direction) is `x`.
+/// Both `wo` (towards the viewer) and `wi` (towards the light) are **unit** vectors pointing
+/// away from the surface. Reflected radiance is `L_r(ωo) = ∫_Ω f_r(ωo, ωi) L_i(ωi) cosθi dσ(ωi)`.
+///
+/// Contract for implementors: `eval` is finite and `≥ 0` for all unit vectors in the open upper
+/// hemisphere and returns `0` when `wo.z ≤ 0` or `wi.z ≤ 0` (or either is NaN). It must not
+/// allocate: samplers call it millions of times.
+pub trait Brdf: Send + Sync {
+    /// Scalar BRDF value in 1/sr. For coloured models this is the luminance of
+    /// [`eval_rgb`](Brdf::eval_rgb) (see [`luminance`]).
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64;
+
+    /// Linear RGB BRDF value in 1/sr. The default is grey: `[eval; 3]`.
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        let y = self.eval(wo, wi);
+        [y, y, y]
+    }
+
+    /// True when `f_r` is invariant under a common rotation of `wo` and `wi` about the normal.
+    /// Default `false` (the safe answer for samplers).
+    fn is_isotropic(&self) -> bool {
+        false
+    }
+
+    /// True when `f_r(ωo, ωi) = f_r(ωi, ωo)` (Helmholtz reciprocity). Default `false`.
+    fn is_reciprocal(&self) -> bool {
+        false
+    }
+
+    /// True when the directional albedo `∫_Ω f_r(ωo, ωi) cosθi dσ(ωi) ≤ 1` for every `ωo`
+    /// (with the current parameters). Default `false`.
+    fn conserves_energy(&self) -> bool {
+        false
+    }
+
+    /// Short model name (the registry key, e.g. `"phong"`).
+    fn name(&self) -> &str {
+        "custom"
+    }
+}
+
+macro_rules! forward_brdf {
+    ($($ty:ty),*) => {$(
+        impl<T: Brdf + ?Sized> Brdf for $ty {
+            #[inline]
+            fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+                (**self).eval(wo, wi)
+            }
+            #[inline]
+            fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+                (**self).eval_rgb(wo, wi)
+            }
+            fn is_isotropic(&self) -> bool {
+                (**self).is_isotropic()
+            }
+            fn is_reciprocal(&self) -> bool {
+                (**self).is_reciprocal()
+            }
+            fn conserves_energy(&self) -> bool {
+                (**self).conserves_energy()
+            }
+            fn name(&self) -> &str {
+                (**self).name()
+            }
+        }
+    )*};
+}
+
+forward_brdf!(Box<T>, Arc<T>, &T);

@@ -1,0 +1,87 @@
+//! Lewis (1993), "Making shaders more physically plausible": the half-vector (Blinn) lobe with
+//! Lewis' normalisation.
+//!
+//! `f_r = kd/π + ks · (n+2) / (4π (2 − 2^{−n/2})) · (n·h)^n`. The constant makes the lobe
+//! integrate to `ks` over solid angle *without* the cosine at normal incidence
+//! (`∫ (n·h)^n dσ = 4π(2 − 2^{−n/2})/(n+2)`), so the albedo is at most `ks`: the model conserves
+//! energy iff `kd + ks ≤ 1`. Parameters `n ∈ [0, 10⁵]` (default 50), `ks` (default 0.6), `kd`
+//! (default 0.4). Reciprocal and isotropic. (Lewis' normalisation of the mirror-direction lobe,
+//! `(n+2)/(2π)`, is the [`Phong`](super::Phong) model of this crate.)
+
+use super::phong::PhongParams;
+use crate::brdf::Brdf;
+use crate::geometry::{Vec3, both_above};
+use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+pub(crate) const NAME: &str = "lewis";
+
+pub(crate) const PARAMS: &[ParamInfo] = &[
+    param("n", 50.0, Range::closed(0.0, 1e5), "half-vector exponent"),
+    param("ks", 0.6, Range::closed(0.0, 1.0), "specular coefficient"),
+    param("kd", 0.4, Range::closed(0.0, 1.0), "diffuse albedo"),
+];
+
+/// Lewis-normalised Blinn–Phong BRDF.
+#[derive(Debug, Clone)]
+pub struct Lewis {
+    params: PhongParams,
+    diffuse: f64,
+    spec_scale: f64,
+}
+
+/// Default parameters of [`Lewis`] (n = 50, ks = 0.6, kd = 0.4).
+pub fn lewis_defaults() -> PhongParams {
+    let [n, ks, kd] = defaults(PARAMS);
+    PhongParams { n, ks, kd }
+}
+
+impl Lewis {
+    /// Validate the parameters and build the model.
+    pub fn new(params: PhongParams) -> Result<Self, ParamError> {
+        validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
+        let n = params.n;
+        let norm = (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()));
+        Ok(Self { params, diffuse: params.kd * FRAC_1_PI, spec_scale: params.ks * norm })
+    }
+
+    /// The parameters this model was built with.
+    pub fn params(&self) -> &PhongParams {
+        &self.params
+    }
+
+    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
+        let [n, ks, kd] = super::take(v);
+        Self::new(PhongParams { n, ks, kd })
+    }
+}
+
+impl Default for Lewis {
+    fn default() -> Self {
+        super::expect_default(Self::new(lewis_defaults()))
+    }
+}
+
+impl Brdf for Lewis {
+    #[inline]
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        if !both_above(wo, wi) {
+            return 0.0;
+        }
+        let h = wo + wi;
+        let nh = h.z / h.norm();
+        self.diffuse + self.spec_scale * nh.powf(self.params.n)
+    }
+    fn is_isotropic(&self) -> bool {
+        true
+    }
+    fn is_reciprocal(&self) -> bool {
+        true
+    }
+    fn conserves_energy(&self) -> bool {
+        self.params.kd + self.params.ks <= 1.0
+    }
+    fn name(&self) -> &str {
+        NAME
+    }
+}

@@ -1,0 +1,56 @@
+//! Analytic reflectance models (one module per model; each documents its formula, parameters,
+//! defaults and reference).
+
+pub mod ashikhmin_shirley;
+pub mod beard_maxwell;
+pub mod blinn;
+pub mod cook_torrance;
+pub mod coupled;
+pub mod htsg;
+pub mod lafortune;
+pub mod lambert;
+pub mod lewis;
+pub mod microfacet;
+pub mod minnaert;
+pub mod oren_nayar;
+pub mod phong;
+pub mod poulin_fournier;
+pub mod schlick;
+pub mod strauss;
+pub mod ward;
+
+pub use ashikhmin_shirley::{AshikhminShirley, AshikhminShirleyParams};
+pub use beard_maxwell::{BeardMaxwell, BeardMaxwellParams};
+pub use blinn::{Blinn, blinn_defaults};
+pub use cook_torrance::{CookTorrance, CookTorranceParams};
+pub use coupled::{Coupled, CoupledParams};
+pub use htsg::{Htsg, HtsgParams};
+pub use lafortune::{Lafortune, LafortuneLobe, LafortuneParams};
+pub use lambert::{Lambert, LambertParams};
+pub use lewis::{Lewis, lewis_defaults};
+pub use microfacet::{Microfacet, MicrofacetParams, NormalDistribution};
+pub use minnaert::{Minnaert, MinnaertParams};
+pub use oren_nayar::{OrenNayar, OrenNayarParams};
+pub use phong::{Phong, PhongParams};
+pub use poulin_fournier::{PoulinFournier, PoulinFournierParams};
+pub use schlick::{Schlick, SchlickParams};
+pub use strauss::{Strauss, StraussParams};
+pub use ward::{Ward, WardNormalisation, WardParams};
+
+/// Copy the first `N` values (missing ones become NaN, which validation rejects).
+pub(crate) fn take<const N: usize>(v: &[f64]) -> [f64; N] {
+    let mut out = [f64::NAN; N];
+    for (o, x) in out.iter_mut().zip(v) {
+        *o = *x;
+    }
+    out
+}
+
+/// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
+/// unit tests, so an error here is a bug in this crate, never a consequence of user input.
+pub(crate) fn expect_default<T>(r: Result<T, crate::params::ParamError>) -> T {
+    match r {
+        Ok(v) => v,
+        Err(e) => panic!("built-in default parameters are invalid: {e}"),
+    }
+}

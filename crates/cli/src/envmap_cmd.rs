@@ -1,0 +1,299 @@
+//! `brdf-lab envmap`: sample directions ∝ luminance per solid angle of a lat-long map.
+
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme};
+use partition_sampler::{DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, Sample2, chunk_seed};
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+
+use crate::error::{CliError, CliResult};
+use crate::output::{num, write_atomically};
+use crate::progress;
+
+/// Width and height of the built-in procedural sky.
+const SKY_SIZE: (usize, usize) = (1024, 512);
+/// Samples generated per block (each block seeded from (seed, block index): thread-independent).
+const BLOCK: usize = 1 << 20;
+
+/// Arguments of `brdf-lab envmap`.
+#[derive(Debug, Args)]
+pub(crate) struct EnvmapArgs {
+    /// Lat-long map (.hdr, .exr or .pfm); without it a built-in procedural sky with a sun is used.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// Number of samples to draw.
+    #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(1..))]
+    n: u64,
+    /// Seed of the random streams (the samples depend only on it, not on the thread count).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Write the samples as CSV `u,v,pdf_uv,pdf_sa` (written atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Also time and compare every sampler variant and the piecewise-constant CDF baseline.
+    #[arg(long)]
+    compare: bool,
+    /// Sampler producing the samples.
+    #[arg(long, value_enum, default_value_t = EnvSamplerName::Adaptive)]
+    sampler: EnvSamplerName,
+    /// Split threshold n_max ≥ 1 of the adaptive sampler (mean trials per sample ≤ n_max).
+    #[arg(long, default_value_t = DEFAULT_N_MAX)]
+    n_max: f64,
+    /// Maximum quadtree depth of the adaptive sampler.
+    #[arg(long, default_value_t = DEFAULT_MAX_DEPTH)]
+    max_depth: u32,
+    /// Leaf choice of the adaptive sampler.
+    #[arg(long, value_enum, default_value_t = LeafChoiceName::Alias)]
+    leaf_choice: LeafChoiceName,
+}
+
+/// Sampler names accepted by `envmap --sampler`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum EnvSamplerName {
+    /// Adaptive partition, envelope scheme (exact).
+    Adaptive,
+    /// Adaptive partition, the papers' scheme.
+    AdaptivePaper,
+    /// Classic marginal/conditional piecewise-constant CDF.
+    TabulatedCdf,
+}
+
+/// Leaf-choice names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum LeafChoiceName {
+    /// Flattened leaves with an alias table (O(1)).
+    Alias,
+    /// The papers' per-node CDF descent from the root.
+    Descent,
+}
+
+fn sampler_kind(name: EnvSamplerName, args: &EnvmapArgs, leaf: LeafChoiceName) -> SamplerKind {
+    let leaf_choice = match leaf {
+        LeafChoiceName::Alias => LeafChoice::Alias,
+        LeafChoiceName::Descent => LeafChoice::Descent,
+    };
+    let options = |scheme| AdaptiveOptions { scheme, leaf_choice, n_max: args.n_max, max_depth: args.max_depth };
+    match name {
+        EnvSamplerName::Adaptive => SamplerKind::Adaptive(options(Scheme::Envelope)),
+        EnvSamplerName::AdaptivePaper => SamplerKind::Adaptive(options(Scheme::Paper)),
+        EnvSamplerName::TabulatedCdf => SamplerKind::PiecewiseConstant,
+    }
+}
+
+/// Runs `brdf-lab envmap`.
+pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
+    if !(args.n_max >= 1.0 && args.n_max.is_finite()) {
+        return Err(CliError::input(format!("--n-max must be a finite number ≥ 1, got {}", args.n_max)));
+    }
+    let (map, map_name) = match &args.map {
+        Some(path) => {
+            let map = EnvMap::load(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+            (map, path.display().to_string())
+        }
+        None => {
+            let map = envmap::procedural_sky(SKY_SIZE.0, SKY_SIZE.1).map_err(CliError::input)?;
+            (map, "built-in procedural sky with a sun".to_string())
+        }
+    };
+    println!("map        {map_name} ({} x {} pixels)", map.width(), map.height());
+
+    let kind = sampler_kind(args.sampler, args, args.leaf_choice);
+    let sampler = EnvMapSampler::new(&map, kind).map_err(CliError::input)?;
+    print_sampler_summary(&sampler);
+
+    let n = usize::try_from(args.n).map_err(CliError::input)?;
+    let exact = exact_luminance_integral(&map);
+    let started = Instant::now();
+    let mut estimate = KahanMean::default();
+    let pb = progress::bar(n.div_ceil(BLOCK) as u64, "sampling");
+    let mut blocks: Vec<Vec<Sample2>> = Vec::new();
+    for (b, start) in (0..n).step_by(BLOCK).enumerate() {
+        let len = BLOCK.min(n - start);
+        let block = sampler.sample_uv_par(len, chunk_seed(args.seed, b as u64));
+        for s in &block {
+            let pdf_sa = envmap::latlong::pdf_uv_to_solid_angle(s.pdf, s.point[1]);
+            let y = envmap::luminance(map.radiance_uv(s.point[0], s.point[1]));
+            estimate.add(if pdf_sa > 0.0 { y / pdf_sa } else { 0.0 });
+        }
+        if args.out.is_some() {
+            blocks.push(block);
+        }
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    let elapsed = started.elapsed().as_secs_f64();
+    println!(
+        "samples    {n} in {:.3} s ({:.2} M samples/s on {} threads, incl. the estimator)",
+        elapsed,
+        n as f64 / elapsed / 1e6,
+        rayon::current_num_threads()
+    );
+    if let Some(stats) = sampler.stats() {
+        let measured = stats.measured_mean_trials.map_or("n/a".to_string(), |t| format!("{t:.4}"));
+        println!("trials     measured {measured} per sample; bound violations {}", stats.bound_violations);
+    }
+    let mean = estimate.mean();
+    println!(
+        "check      ∫ Y dω: estimate {mean:.6e} vs exact {exact:.6e} (relative error {:.2e})",
+        ((mean - exact) / exact).abs()
+    );
+
+    if let Some(path) = &args.out {
+        write_samples(path, &blocks)?;
+        println!("wrote      {} ({n} rows: u,v,pdf_uv,pdf_sa)", path.display());
+    }
+    if args.compare {
+        compare(&map, args)?;
+    }
+    Ok(())
+}
+
+fn print_sampler_summary(sampler: &EnvMapSampler) {
+    println!(
+        "sampler    {} built in {:.3} ms, {} bytes",
+        sampler.kind().name(),
+        sampler.build_time().as_secs_f64() * 1e3,
+        sampler.bytes_used()
+    );
+    if let Some(s) = sampler.stats() {
+        println!(
+            "tree       {} nodes, {} leaves, depth {}, expected mean trials {:.4}, integral {:.6e} ({:?}{})",
+            s.nodes,
+            s.leaves,
+            s.depth,
+            s.expected_mean_trials,
+            s.integral,
+            s.integral_source,
+            s.integral_rel_err.map_or(String::new(), |e| format!(", rel. err. {e:.1e}"))
+        );
+    }
+}
+
+/// ∫ Y dω over the sphere for a piecewise-constant lat-long map: Σ Y_ij (2π/W)(cos θ_i − cos θ_{i+1}).
+fn exact_luminance_integral(map: &EnvMap) -> f64 {
+    let (w, h) = (map.width(), map.height());
+    let lum = map.luminance();
+    let mut total = 0.0;
+    for row in 0..h {
+        let band = envmap::latlong::sin_integral(row as f64 / h as f64, (row + 1) as f64 / h as f64);
+        let row_sum: f64 = lum[row * w..(row + 1) * w].iter().sum();
+        // ∫ over the band of sinθ dθ dφ with θ = πv, φ = 2πu: (2π/W)·π·∫ sin(πv) dv per pixel.
+        total += row_sum * (2.0 * std::f64::consts::PI / w as f64) * std::f64::consts::PI * band;
+    }
+    total
+}
+
+/// A compensated running mean (order-fixed, so results do not depend on threads).
+#[derive(Default)]
+struct KahanMean {
+    sum: f64,
+    comp: f64,
+    n: u64,
+}
+
+impl KahanMean {
+    fn add(&mut self, x: f64) {
+        let y = x - self.comp;
+        let t = self.sum + y;
+        self.comp = (t - self.sum) - y;
+        self.sum = t;
+        self.n += 1;
+    }
+    fn mean(&self) -> f64 {
+        if self.n == 0 { 0.0 } else { self.sum / self.n as f64 }
+    }
+}
+
+fn write_samples(path: &std::path::Path, blocks: &[Vec<Sample2>]) -> CliResult<()> {
+    let total: usize = blocks.iter().map(Vec::len).sum();
+    let pb = progress::bar(total as u64, "writing");
+    let result = write_atomically(path, |w| {
+        writeln!(w, "u,v,pdf_uv,pdf_sa")?;
+        for block in blocks {
+            for s in block {
+                let [u, v] = s.point;
+                let pdf_sa = envmap::latlong::pdf_uv_to_solid_angle(s.pdf, v);
+                writeln!(w, "{},{},{},{}", num(u), num(v), num(s.pdf), num(pdf_sa))?;
+            }
+            pb.inc(block.len() as u64);
+        }
+        Ok(())
+    });
+    pb.finish_and_clear();
+    result
+}
+
+
+/// `--compare`: build time, memory, mean trials and samples/s (1 thread and all threads) of
+/// every variant, measured in this run.
+fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
+    let variants: [(EnvSamplerName, LeafChoiceName); 5] = [
+        (EnvSamplerName::Adaptive, LeafChoiceName::Alias),
+        (EnvSamplerName::Adaptive, LeafChoiceName::Descent),
+        (EnvSamplerName::AdaptivePaper, LeafChoiceName::Alias),
+        (EnvSamplerName::AdaptivePaper, LeafChoiceName::Descent),
+        (EnvSamplerName::TabulatedCdf, LeafChoiceName::Alias),
+    ];
+    let n = usize::try_from(args.n).map_err(CliError::input)?.clamp(100_000, 4_000_000);
+    let threads = rayon::current_num_threads();
+    println!();
+    println!("compare    {n} samples per variant, median of 5 builds, {threads} threads for the parallel column");
+    println!(
+        "{:<16} {:<8} {:>10} {:>12} {:>8} {:>14} {:>14}",
+        "sampler", "leaves", "build ms", "memory KiB", "trials", "M/s 1 thread", format!("M/s {threads} thr")
+    );
+    let pb = progress::bar(variants.len() as u64, "comparing");
+    let mut rows = Vec::new();
+    for (name, leaf) in variants {
+        let kind = sampler_kind(name, args, leaf);
+        let mut builds = Vec::new();
+        let mut sampler = None;
+        for _ in 0..5 {
+            let s = EnvMapSampler::new(map, kind).map_err(CliError::input)?;
+            builds.push(s.build_time().as_secs_f64() * 1e3);
+            sampler = Some(s);
+        }
+        let Some(sampler) = sampler else { continue };
+        builds.sort_by(f64::total_cmp);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(args.seed);
+        let t = Instant::now();
+        let mut sink = 0.0;
+        for _ in 0..n {
+            sink += sampler.sample_uv(&mut rng).pdf;
+        }
+        let single = n as f64 / t.elapsed().as_secs_f64() / 1e6;
+        let t = Instant::now();
+        let par = sampler.sample_uv_par(n, args.seed);
+        let multi = n as f64 / t.elapsed().as_secs_f64() / 1e6;
+        std::hint::black_box((sink, par.len()));
+        let trials = sampler
+            .stats()
+            .and_then(|s| s.measured_mean_trials)
+            .map_or("1 (exact)".to_string(), |t| format!("{t:.4}"));
+        let leaf_name = match (name, leaf) {
+            (EnvSamplerName::TabulatedCdf, _) => "-",
+            (_, LeafChoiceName::Alias) => "alias",
+            (_, LeafChoiceName::Descent) => "descent",
+        };
+        rows.push(format!(
+            "{:<16} {:<8} {:>10.3} {:>12.1} {:>8} {:>14.2} {:>14.2}",
+            sampler.kind().name(),
+            leaf_name,
+            builds[builds.len() / 2],
+            sampler.bytes_used() as f64 / 1024.0,
+            trials,
+            single,
+            multi
+        ));
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    for row in rows {
+        println!("{row}");
+    }
+    Ok(())
+}

@@ -1,0 +1,305 @@
+//! Importance samplers of a lat-long map: directions ∝ luminance per solid angle.
+
+use std::time::{Duration, Instant};
+
+use baselines::PiecewiseConstant2D;
+use partition_sampler::{
+    DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, LeafChoice, MemoryReport, Point2, QuadTreeBuilder,
+    QuadTreeSampler, Rect, Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity,
+    UniformSource,
+};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
+use crate::{EnvMap, EnvMapError};
+
+/// Parameters of the adaptive-partition sampler.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AdaptiveOptions {
+    /// [`Scheme::Envelope`] (default, exact) or [`Scheme::Paper`].
+    pub scheme: Scheme,
+    /// [`LeafChoice::Alias`] (default, O(1)) or [`LeafChoice::Descent`] (the papers').
+    pub leaf_choice: LeafChoice,
+    /// Split threshold `n_max ≥ 1` (default [`DEFAULT_N_MAX`]).
+    pub n_max: f64,
+    /// Maximum quadtree depth (default [`DEFAULT_MAX_DEPTH`]).
+    pub max_depth: u32,
+}
+
+impl Default for AdaptiveOptions {
+    fn default() -> Self {
+        Self {
+            scheme: Scheme::Envelope,
+            leaf_choice: LeafChoice::Alias,
+            n_max: DEFAULT_N_MAX,
+            max_depth: DEFAULT_MAX_DEPTH,
+        }
+    }
+}
+
+/// Which sampler an [`EnvMapSampler`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum SamplerKind {
+    /// The adaptive-partition (quadtree + rejection) sampler of the exact target density
+    /// `Y(pixel) · sin(πv)`.
+    Adaptive(AdaptiveOptions),
+    /// The classic marginal/conditional CDF over `Y(pixel) · sin(π v_centre)` per pixel.
+    PiecewiseConstant,
+}
+
+impl SamplerKind {
+    /// The CLI name: `adaptive`, `adaptive-paper` or `tabulated-cdf`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Adaptive(o) if o.scheme == Scheme::Paper => "adaptive-paper",
+            Self::Adaptive(_) => "adaptive",
+            Self::PiecewiseConstant => "tabulated-cdf",
+        }
+    }
+}
+
+/// One sampled direction of an environment map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvSample {
+    /// Lat-long column coordinate in `[0, 1)` (φ = 2πu).
+    pub u: f64,
+    /// Lat-long row coordinate in `[0, 1)` (θ = πv, v = 0 at the zenith `+z`).
+    pub v: f64,
+    /// Density w.r.t. area on `[0,1]²` at `(u, v)`.
+    pub pdf_uv: f64,
+    /// Density w.r.t. solid angle at `direction`: `pdf_uv / (2π² sin(πv))` (0 exactly at a pole).
+    pub pdf_sa: f64,
+    /// Unit direction `(sinθ cosφ, sinθ sinφ, cosθ)`.
+    pub direction: [f64; 3],
+}
+
+impl EnvSample {
+    /// Completes a planar sample of `[0,1]²` with its direction and solid-angle pdf.
+    #[inline]
+    pub fn from_uv(s: Sample2) -> Self {
+        let [u, v] = s.point;
+        Self {
+            u,
+            v,
+            pdf_uv: s.pdf,
+            pdf_sa: pdf_uv_to_solid_angle(s.pdf, v),
+            direction: uv_to_direction(u, v),
+        }
+    }
+}
+
+#[derive(Debug)]
+enum Inner {
+    Adaptive(Box<QuadTreeSampler<TabulatedDensity<SinPiRows>>>),
+    PiecewiseConstant(PiecewiseConstant2D),
+}
+
+/// An importance sampler of directions ∝ luminance per solid angle for one [`EnvMap`].
+///
+/// It samples `(u, v) ∈ [0,1)²` with density `pdf_uv` (w.r.t. area on the square) and maps them
+/// to directions; `pdf_sa = pdf_uv / (2π² sin(πv))` w.r.t. solid angle.
+///
+/// * [`SamplerKind::Adaptive`]: target `Y(pixel)·sin(πv)` exactly (the sine varies inside a
+///   pixel); `pdf_uv = Y·sin(πv)/Î` with `Î` the exact integral, so `pdf_sa = Y/(2π²Î)` is
+///   constant on a pixel.
+/// * [`SamplerKind::PiecewiseConstant`]: the classic approximation `Y(pixel)·sin(π v_c)`,
+///   constant per pixel (`v_c` = the pixel row's centre); its `pdf_uv` is that step function
+///   normalised, and `pdf_sa` is converted with the exact `sin(πv)` of the sample, so the pair
+///   `(sample, pdf)` is consistent (unbiased estimators) even though the target is approximate.
+///
+/// Immutable and `Sync`; `sample_par` is reproducible (depends only on `n` and `seed`).
+#[derive(Debug)]
+pub struct EnvMapSampler {
+    inner: Inner,
+    kind: SamplerKind,
+    width: usize,
+    height: usize,
+    build_time: Duration,
+}
+
+impl EnvMapSampler {
+    /// Builds the sampler of `kind` for `map` (timed: see [`EnvMapSampler::build_time`]).
+    pub fn new(map: &EnvMap, kind: SamplerKind) -> Result<Self, EnvMapError> {
+        match kind {
+            SamplerKind::Adaptive(options) => Self::adaptive(map, options),
+            SamplerKind::PiecewiseConstant => Self::piecewise_constant(map),
+        }
+    }
+
+    /// The adaptive-partition sampler: a [`TabulatedDensity`] of the pixel luminances times
+    /// [`SinPiRows`] on `[0,1]²`, partitioned by a [`QuadTreeBuilder`] with `options`.
+    /// The build time includes computing the luminance table.
+    pub fn adaptive(map: &EnvMap, options: AdaptiveOptions) -> Result<Self, EnvMapError> {
+        let start = Instant::now();
+        let density =
+            TabulatedDensity::new(map.width(), map.height(), map.luminance(), Rect::UNIT)?
+                .with_row_factor(SinPiRows)?;
+        let sampler = QuadTreeBuilder::new()
+            .n_max(options.n_max)
+            .max_depth(options.max_depth)
+            .scheme(options.scheme)
+            .leaf_choice(options.leaf_choice)
+            .build(density)?;
+        Ok(Self {
+            inner: Inner::Adaptive(Box::new(sampler)),
+            kind: SamplerKind::Adaptive(options),
+            width: map.width(),
+            height: map.height(),
+            build_time: start.elapsed(),
+        })
+    }
+
+    /// The piecewise-constant CDF sampler ([`PiecewiseConstant2D`]) of
+    /// `Y(pixel) · sin(π (y + ½)/H)` on `[0,1]²`. The build time includes the table.
+    pub fn piecewise_constant(map: &EnvMap) -> Result<Self, EnvMapError> {
+        let start = Instant::now();
+        let (w, h) = (map.width(), map.height());
+        let row_weight: Vec<f64> = (0..h)
+            .map(|y| (std::f64::consts::PI * (y as f64 + 0.5) / h as f64).sin())
+            .collect();
+        let values: Vec<f64> = map
+            .rgb()
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| crate::luminance(p) * row_weight[i / w])
+            .collect();
+        let table = PiecewiseConstant2D::new(w, h, values, Rect::UNIT)?;
+        Ok(Self {
+            inner: Inner::PiecewiseConstant(table),
+            kind: SamplerKind::PiecewiseConstant,
+            width: w,
+            height: h,
+            build_time: start.elapsed(),
+        })
+    }
+
+    /// What this sampler is.
+    pub fn kind(&self) -> SamplerKind {
+        self.kind
+    }
+
+    /// Width of the map it was built from, in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height of the map it was built from, in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Wall-clock time the constructor took.
+    pub fn build_time(&self) -> Duration {
+        self.build_time
+    }
+
+    /// Bytes of the sampling structures (for the adaptive sampler: quadtree + density tables,
+    /// see [`EnvMapSampler::memory`]; for the CDF sampler: values and CDF arrays).
+    pub fn bytes_used(&self) -> usize {
+        match &self.inner {
+            Inner::Adaptive(s) => s.bytes_used(),
+            Inner::PiecewiseConstant(t) => t.bytes_used(),
+        }
+    }
+
+    /// Per-structure memory of the adaptive sampler; `None` for the CDF sampler.
+    pub fn memory(&self) -> Option<MemoryReport> {
+        match &self.inner {
+            Inner::Adaptive(s) => Some(s.memory()),
+            Inner::PiecewiseConstant(_) => None,
+        }
+    }
+
+    /// Structure and cost figures of the adaptive sampler (expected and measured mean trials,
+    /// bound violations, `Î`...); `None` for the CDF sampler (always exactly one "trial").
+    pub fn stats(&self) -> Option<SamplerStats> {
+        match &self.inner {
+            Inner::Adaptive(s) => Some(s.stats()),
+            Inner::PiecewiseConstant(_) => None,
+        }
+    }
+
+    /// The adaptive sampler itself, for callers that need its full API.
+    pub fn as_adaptive(&self) -> Option<&QuadTreeSampler<TabulatedDensity<SinPiRows>>> {
+        match &self.inner {
+            Inner::Adaptive(s) => Some(s),
+            Inner::PiecewiseConstant(_) => None,
+        }
+    }
+
+    /// The CDF sampler itself, for callers that need its full API (e.g. inversion).
+    pub fn as_piecewise_constant(&self) -> Option<&PiecewiseConstant2D> {
+        match &self.inner {
+            Inner::Adaptive(_) => None,
+            Inner::PiecewiseConstant(t) => Some(t),
+        }
+    }
+
+    /// One planar sample `(u, v)` with its pdf w.r.t. area on `[0,1]²` (no trigonometry).
+    #[inline]
+    pub fn sample_uv<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2 {
+        match &self.inner {
+            Inner::Adaptive(s) => s.sample(u),
+            Inner::PiecewiseConstant(t) => t.sample(u),
+        }
+    }
+
+    /// One direction with both pdfs.
+    #[inline]
+    pub fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> EnvSample {
+        EnvSample::from_uv(self.sample_uv(u))
+    }
+
+    /// `n` planar samples drawn in parallel in fixed chunks of `partition_sampler::PAR_CHUNK`,
+    /// chunk `c` with `Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, c))`:
+    /// the result depends only on `(n, seed)`, never on the thread count.
+    pub fn sample_uv_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
+        match &self.inner {
+            Inner::Adaptive(s) => s.sample_par(n, seed),
+            Inner::PiecewiseConstant(t) => t.sample_par(n, seed),
+        }
+    }
+
+    /// `n` directions drawn in parallel: [`EnvMapSampler::sample_uv_par`] completed (also in
+    /// parallel) with directions and solid-angle pdfs.
+    pub fn sample_par(&self, n: usize, seed: u64) -> Vec<EnvSample> {
+        self.sample_uv_par(n, seed)
+            .into_par_iter()
+            .map(EnvSample::from_uv)
+            .collect()
+    }
+
+    /// Density w.r.t. area on `[0,1]²` at `(u, v)` (0 outside the square).
+    pub fn pdf_uv(&self, u: f64, v: f64) -> f64 {
+        match &self.inner {
+            Inner::Adaptive(s) => s.pdf([u, v]),
+            Inner::PiecewiseConstant(t) => t.pdf([u, v]),
+        }
+    }
+
+    /// Density w.r.t. solid angle of the direction `d` (normalised here):
+    /// `pdf_uv(u, v) / (2π² sin(πv))` at its lat-long coordinates; 0 at the poles and for the
+    /// zero vector.
+    pub fn pdf_sa(&self, d: [f64; 3]) -> f64 {
+        let (u, v) = direction_to_uv(d);
+        pdf_uv_to_solid_angle(self.pdf_uv(u, v), v)
+    }
+}
+
+impl Sampler2D for EnvMapSampler {
+    /// See [`EnvMapSampler::sample_uv`].
+    #[inline]
+    fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2 {
+        self.sample_uv(u)
+    }
+
+    /// Density w.r.t. area on `[0,1]²`.
+    fn pdf(&self, p: Point2) -> f64 {
+        self.pdf_uv(p[0], p[1])
+    }
+
+    fn bytes_used(&self) -> usize {
+        EnvMapSampler::bytes_used(self)
+    }
+}

@@ -1,0 +1,152 @@
+//! Densities and region-statistics providers (upper bound `M_i` and integral `I_i` of a cell).
+
+use serde::{Deserialize, Serialize};
+
+use crate::rect::{Domain, Rect};
+use crate::sampler::Point2;
+
+/// A non-negative function `f` on the plane, evaluated pointwise.
+///
+/// `f` need not be normalised. Samplers treat `f` as zero outside their domain.
+/// Implemented for every closure `Fn(Point2) -> f64 + Sync`.
+pub trait Density: Sync {
+    /// `f(p) ≥ 0`.
+    fn eval(&self, p: Point2) -> f64;
+}
+
+impl<F: Fn(Point2) -> f64 + Sync> Density for F {
+    #[inline]
+    fn eval(&self, p: Point2) -> f64 {
+        self(p)
+    }
+}
+
+/// What a provider knows about a region `R` (a quadtree cell intersected with the domain).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RegionEstimate {
+    /// `M ≥ sup_{x ∈ R ∩ D} f(x)` (exact for tabulated densities, an estimate with a safety
+    /// factor for sampled ones: the sampler audits it).
+    pub max_bound: f64,
+    /// `I ≈ ∫_{R ∩ D} f dA` (area measure on the domain).
+    pub integral: f64,
+    /// Estimated relative error of `integral`, when the provider knows one.
+    pub integral_rel_err: Option<f64>,
+}
+
+/// How a provider obtains integrals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum IntegralSource {
+    /// Exact up to floating-point rounding (tabulated densities).
+    Exact,
+    /// Midpoint rule on a dense grid (the papers' "image map"), with a Richardson error estimate.
+    GridEstimate,
+    /// Per-cell quadrature at a caller-given resolution.
+    Quadrature,
+}
+
+/// Which provider built a tree: used to check that a stored tree is re-attached to a
+/// compatible density.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ProviderKind {
+    /// [`crate::TabulatedDensity`].
+    Tabulated,
+    /// [`crate::SampledGridDensity`].
+    SampledGrid,
+    /// [`crate::UserBoundDensity`].
+    UserBound,
+    /// Any other implementation of [`RegionStats`].
+    Custom,
+}
+
+/// Identity of a density as far as a stored tree is concerned.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DensityShape {
+    /// The provider type.
+    pub kind: ProviderKind,
+    /// The domain.
+    pub domain: Domain,
+    /// Grid dimensions (width, height), or quadrature resolution, or `[0, 0]`.
+    pub dims: [u64; 2],
+    /// A provider-defined fingerprint of the data (e.g. the bits of the total integral);
+    /// 0 when the provider has none.
+    pub fingerprint: u64,
+}
+
+/// A density that can also bound and integrate itself over rectangles: what the quadtree
+/// builder needs.
+///
+/// Contract: `region(cell)` describes `f` on `cell ∩ domain()`; `max_bound` must be an upper
+/// bound of `f` there for the sampler to be exact (violations are counted by the sampler's
+/// audit); integrals are with respect to area.
+pub trait RegionStats: Density {
+    /// The domain `D` of the density (`f` is taken as 0 outside it).
+    fn domain(&self) -> Domain;
+
+    /// Upper bound and integral of `f` on `cell ∩ D`.
+    fn region(&self, cell: &Rect) -> RegionEstimate;
+
+    /// How integrals are obtained.
+    fn integral_source(&self) -> IntegralSource;
+
+    /// Estimated relative error of the integral over the whole domain, when known globally.
+    fn total_rel_err(&self) -> Option<f64> {
+        None
+    }
+
+    /// Smallest useful cell `[width, height]`: the builder never splits a cell into children
+    /// smaller than this (e.g. the fine-grid cell of a sampled density).
+    fn min_cell_size(&self) -> Option<[f64; 2]> {
+        None
+    }
+
+    /// Shape and fingerprint, checked when a stored tree is re-attached.
+    fn shape(&self) -> DensityShape;
+
+    /// Heap and inline bytes held by the provider.
+    fn bytes_used(&self) -> usize;
+}
+
+/// A density shared between samplers: `SharedDensity(Arc<T>)` implements [`Density`] and
+/// [`RegionStats`] by delegation (a blanket impl for `&T` or `Arc<T>` would overlap with the
+/// one for closures).
+#[derive(Debug, Clone)]
+pub struct SharedDensity<T: ?Sized>(pub std::sync::Arc<T>);
+
+impl<T> SharedDensity<T> {
+    /// Wraps `value` in an `Arc`.
+    pub fn new(value: T) -> Self {
+        Self(std::sync::Arc::new(value))
+    }
+}
+
+impl<T: Density + Send + ?Sized> Density for SharedDensity<T> {
+    #[inline]
+    fn eval(&self, p: Point2) -> f64 {
+        self.0.eval(p)
+    }
+}
+
+impl<T: RegionStats + Send + ?Sized> RegionStats for SharedDensity<T> {
+    fn domain(&self) -> Domain {
+        self.0.domain()
+    }
+    fn region(&self, cell: &Rect) -> RegionEstimate {
+        self.0.region(cell)
+    }
+    fn integral_source(&self) -> IntegralSource {
+        self.0.integral_source()
+    }
+    fn total_rel_err(&self) -> Option<f64> {
+        self.0.total_rel_err()
+    }
+    fn min_cell_size(&self) -> Option<[f64; 2]> {
+        self.0.min_cell_size()
+    }
+    fn shape(&self) -> DensityShape {
+        self.0.shape()
+    }
+    /// Bytes of the shared provider (counted by every sampler that holds it).
+    fn bytes_used(&self) -> usize {
+        self.0.bytes_used()
+    }
+}

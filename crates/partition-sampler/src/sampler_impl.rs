@@ -1,0 +1,463 @@
+//! [`QuadTreeSampler`]: rejection sampling on the leaves of a built [`QuadTree`].
+
+use std::sync::Arc;
+
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+
+use crate::allocate::{AllocationMode, allocate, stratum_weights};
+use crate::audit::{Audit, Counters, flush_local, record_one};
+use crate::density::{IntegralSource, RegionStats};
+use crate::error::AttachError;
+use crate::rect::Domain;
+use crate::sampler::{Point2, Sample2, Sampler2D, UniformSource};
+use crate::tree::{EMPTY, LEAF, Leaf, LeafChoice, QuadTree, Scheme};
+
+/// A sample is abandoned (returned with pdf 0 and counted as exhausted) after this many
+/// rejection trials. Only reachable when the bounds or integrals badly contradict `f`.
+pub const MAX_TRIALS_PER_SAMPLE: u64 = 1 << 20;
+
+/// Samples per chunk of [`QuadTreeSampler::sample_par`]; each chunk has its own generator.
+pub const PAR_CHUNK: usize = 4096;
+
+/// The adaptive-partition sampler of a density `D` (seed 003 §3, seed 000 §3).
+///
+/// **pdf.** Both [`Sampler2D::sample`] and [`Sampler2D::pdf`] report
+/// `p(x) = f(x) / Î` with respect to area on the domain, where `Î = Σ I_i` is the tree's
+/// integral estimate ([`SamplerStats::integral`], with its source and estimated relative
+/// error), for `x` in a sampleable leaf, and 0 elsewhere (outside the domain, in dropped
+/// cells, in leaves of zero weight).
+/// * [`Scheme::Envelope`] (default): the samples' true density is exactly `f / ∫_D f` when the
+///   bounds hold, so `p` is exact up to the global factor `∫_D f / Î` (1 for tabulated data).
+/// * [`Scheme::Paper`]: the true density is `(I_i / Î) · f(x) / ∫_{leaf i} f`; `p` equals it
+///   when the `I_i` are exact, and is otherwise off by the per-leaf factor
+///   `I_i / ∫_{leaf i} f`.
+///
+/// There is no inverse: rejection sampling is not a warp of the unit square.
+pub struct QuadTreeSampler<D> {
+    tree: QuadTree,
+    density: D,
+    counters: Arc<Counters>,
+    disc: bool,
+    inv_integral: f64,
+}
+
+impl<D> std::fmt::Debug for QuadTreeSampler<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("QuadTreeSampler")
+            .field("params", &self.tree.params)
+            .field("counts", &self.tree.counts)
+            .field("integral", &self.tree.integral)
+            .field("density", &std::any::type_name::<D>())
+            .finish_non_exhaustive()
+    }
+}
+
+/// Summary of a sampler: structure, cost and accuracy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplerStats {
+    /// Nodes visited by the builder (internal + leaves).
+    pub nodes: usize,
+    /// Leaves (sampleable or not).
+    pub leaves: usize,
+    /// Leaves with positive selection weight.
+    pub active_leaves: usize,
+    /// Deepest leaf (root = 0).
+    pub depth: u32,
+    /// `Σ V_i / Σ I_i`: expected rejection trials per sample.
+    pub expected_mean_trials: f64,
+    /// Trials per sample measured so far (flushed counts only), if any sample was drawn.
+    pub measured_mean_trials: Option<f64>,
+    /// Samples counted so far.
+    pub samples: u64,
+    /// Trials with `f(x) > M_i` counted so far.
+    pub bound_violations: u64,
+    /// Samples abandoned after [`MAX_TRIALS_PER_SAMPLE`] trials (returned with pdf 0).
+    pub exhausted: u64,
+    /// Bytes of the tree and the density ([`Sampler2D::bytes_used`]).
+    pub bytes: usize,
+    /// `Î = Σ I_i`, the normaliser of the pdf.
+    pub integral: f64,
+    /// How `Î` was obtained.
+    pub integral_source: IntegralSource,
+    /// Estimated relative error of `Î`, when known.
+    pub integral_rel_err: Option<f64>,
+}
+
+/// Bytes per structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MemoryReport {
+    /// Leaf array: rejection rectangles, bounds, alias entries, leaf integrals.
+    pub leaves: usize,
+    /// Internal nodes: child codes and descent CDFs.
+    pub nodes: usize,
+    /// The density provider (grid values, pyramids).
+    pub density: usize,
+    /// Everything, including the inline struct sizes.
+    pub total: usize,
+}
+
+/// The result of [`QuadTreeSampler::sample_batch`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Batch {
+    /// The samples, grouped by leaf; `pdf` is the one-sample pdf `f(x) / Î`.
+    pub samples: Vec<Sample2>,
+    /// Per-sample stratum weights `N p_i / n_i` ([`AllocationMode::Hamilton`] only): the
+    /// estimator is `(1/N) Σ w_k g(x_k) / pdf(x_k)`.
+    pub weights: Option<Vec<f64>>,
+    /// Samples per leaf `n_i` (leaf storage order).
+    pub counts: Vec<usize>,
+}
+
+impl<D: RegionStats> QuadTreeSampler<D> {
+    pub(crate) fn from_valid_parts(tree: QuadTree, density: D) -> Self {
+        let disc = matches!(tree.shape.domain, Domain::UnitDisc);
+        let inv_integral = 1.0 / tree.integral;
+        Self {
+            tree,
+            density,
+            counters: Arc::new(Counters::default()),
+            disc,
+            inv_integral,
+        }
+    }
+
+    /// Re-attaches a density to a stored tree, checking that the density's
+    /// [`crate::DensityShape`] (provider kind, domain, dimensions, data fingerprint) is the
+    /// one the tree was built for and that the tree is structurally sound.
+    pub fn from_parts(tree: QuadTree, density: D) -> Result<Self, AttachError> {
+        tree.validate().map_err(AttachError::Corrupt)?;
+        let found = density.shape();
+        if found != tree.shape {
+            return Err(AttachError::ShapeMismatch {
+                expected: Box::new(tree.shape),
+                found: Box::new(found),
+            });
+        }
+        Ok(Self::from_valid_parts(tree, density))
+    }
+
+    /// Splits into the tree and the density.
+    pub fn into_parts(self) -> (QuadTree, D) {
+        (self.tree, self.density)
+    }
+
+    /// The tree.
+    pub fn tree(&self) -> &QuadTree {
+        &self.tree
+    }
+
+    /// The density.
+    pub fn density(&self) -> &D {
+        &self.density
+    }
+
+    /// The same sampler with another leaf-selection method (the tree is unchanged).
+    pub fn with_leaf_choice(mut self, choice: LeafChoice) -> Self {
+        self.tree.params.leaf_choice = choice;
+        self
+    }
+
+    /// `Î`, the pdf normaliser.
+    pub fn integral(&self) -> f64 {
+        self.tree.integral
+    }
+
+    /// Bytes per structure.
+    pub fn memory(&self) -> MemoryReport {
+        let density = self.density.bytes_used();
+        MemoryReport {
+            leaves: self.tree.leaf_bytes(),
+            nodes: self.tree.node_bytes(),
+            density,
+            total: self.tree.bytes_used() + density + std::mem::size_of::<Self>()
+                - std::mem::size_of::<QuadTree>(),
+        }
+    }
+
+    /// Structure, cost and accuracy figures. Flushes the calling thread's buffered counts.
+    pub fn stats(&self) -> SamplerStats {
+        flush_local(&self.counters);
+        let a = self.counters.snapshot();
+        let c = self.tree.counts;
+        SamplerStats {
+            nodes: c.nodes,
+            leaves: c.leaves,
+            active_leaves: c.active_leaves,
+            depth: c.depth,
+            expected_mean_trials: self.tree.expected_mean_trials(),
+            measured_mean_trials: (a.samples > 0).then(|| a.trials as f64 / a.samples as f64),
+            samples: a.samples,
+            bound_violations: a.violations,
+            exhausted: a.exhausted,
+            bytes: self.bytes_used(),
+            integral: self.tree.integral,
+            integral_source: self.tree.integral_source,
+            integral_rel_err: self.tree.integral_rel_err,
+        }
+    }
+
+    /// Zeroes the shared counters (buffered counts of other threads may arrive later).
+    pub fn reset_stats(&self) {
+        flush_local(&self.counters);
+        self.counters.reset();
+    }
+
+    /// Draws one sample, counting trials and violations into `audit` only (no shared state is
+    /// touched; merge later with [`QuadTreeSampler::record_audit`] if wanted).
+    pub fn sample_audited<U: UniformSource + ?Sized>(
+        &self,
+        u: &mut U,
+        audit: &mut Audit,
+    ) -> Sample2 {
+        self.draw(u, audit)
+    }
+
+    /// Adds locally gathered counts to the sampler's statistics.
+    pub fn record_audit(&self, audit: &Audit) {
+        self.counters.add(audit);
+    }
+
+    /// Leaf selection probabilities `p_i = I_i / Î` of batch mode (leaf storage order).
+    pub fn leaf_probabilities(&self) -> Vec<f64> {
+        self.tree
+            .leaf_integral
+            .iter()
+            .map(|i| i * self.inv_integral)
+            .collect()
+    }
+
+    /// The papers' batch mode (seed 000 §3.6): `n` samples split over the leaves with
+    /// `n_i ≈ n · I_i / Î` by [`allocate`], then `n_i` samples drawn by rejection inside leaf
+    /// `i`. Each sample's `pdf` is the one-sample pdf `f(x)/Î` (= `p_i f(x) / I_i`).
+    ///
+    /// Unbiasedness: with [`AllocationMode::RandomizedRemainder`] `E[n_i] = n p_i`, so
+    /// `(1/n) Σ g/pdf` is unbiased whenever the `I_i` are exact (for estimated `I_i` the
+    /// per-leaf factor `I_i / ∫_leaf f` remains, as in [`Scheme::Paper`]). With
+    /// [`AllocationMode::Hamilton`] use the returned weights; leaves with `n p_i < 1` may get
+    /// no sample, which biases the estimate (their mass is missed).
+    pub fn sample_batch<U: UniformSource + ?Sized>(
+        &self,
+        n: usize,
+        mode: AllocationMode,
+        u: &mut U,
+    ) -> Batch {
+        let counts = allocate(n, &self.tree.leaf_integral, mode, u)
+            .unwrap_or_else(|_| vec![0; self.tree.leaves.len()]);
+        let mut samples = Vec::with_capacity(n);
+        let mut a = Audit::default();
+        for (leaf, &k) in self.tree.leaves.iter().zip(&counts) {
+            for _ in 0..k {
+                samples.push(self.draw_in_leaf(leaf, u, &mut a));
+            }
+        }
+        self.counters.add(&a);
+        let weights = match mode {
+            AllocationMode::Hamilton => {
+                let w = stratum_weights(n, &self.tree.leaf_integral, &counts);
+                Some(
+                    counts
+                        .iter()
+                        .zip(w)
+                        .flat_map(|(&k, wi)| std::iter::repeat_n(wi, k))
+                        .collect(),
+                )
+            }
+            AllocationMode::RandomizedRemainder => None,
+        };
+        Batch {
+            samples,
+            weights,
+            counts,
+        }
+    }
+
+    /// `n` samples drawn in parallel (rayon) in fixed chunks of [`PAR_CHUNK`]; chunk `c` uses a
+    /// `Xoshiro256PlusPlus` seeded from `(seed, c)` through SplitMix64, so the output depends
+    /// only on `seed` and `n`, never on the thread count.
+    pub fn sample_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
+        let mut out = vec![
+            Sample2 {
+                point: [0.0; 2],
+                pdf: 0.0
+            };
+            n
+        ];
+        out.par_chunks_mut(PAR_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
+                let mut a = Audit::default();
+                for s in chunk.iter_mut() {
+                    *s = self.draw(&mut rng, &mut a);
+                }
+                self.counters.add(&a);
+            });
+        out
+    }
+
+    #[inline(always)]
+    fn pick_leaf<U: UniformSource + ?Sized>(&self, u: &mut U) -> Option<&Leaf> {
+        let leaves = &self.tree.leaves;
+        match self.tree.params.leaf_choice {
+            LeafChoice::Alias => {
+                let n = leaves.len();
+                let s = u.next_uniform() * n as f64;
+                let i = (s as usize).min(n - 1);
+                let leaf = leaves.get(i)?;
+                if s - (i as f64) < leaf.prob {
+                    Some(leaf)
+                } else {
+                    leaves.get(leaf.alias as usize)
+                }
+            }
+            LeafChoice::Descent => {
+                let mut code = self.tree.root_code;
+                loop {
+                    if code == EMPTY {
+                        return None;
+                    }
+                    if code & LEAF != 0 {
+                        return leaves.get((code & !LEAF) as usize);
+                    }
+                    let node = self.tree.nodes.get(code as usize)?;
+                    let r = u.next_uniform();
+                    let k = if r < node.cdf[0] {
+                        0
+                    } else if r < node.cdf[1] {
+                        1
+                    } else if r < node.cdf[2] {
+                        2
+                    } else {
+                        3
+                    };
+                    code = node.children[k];
+                }
+            }
+        }
+    }
+
+    /// One rejection trial in `leaf`: `Some((x, f(x)))` when accepted.
+    #[inline(always)]
+    fn trial<U: UniformSource + ?Sized>(
+        &self,
+        leaf: &Leaf,
+        u: &mut U,
+        a: &mut Audit,
+    ) -> (Point2, Option<f64>) {
+        let x = leaf.x0 + u.next_uniform() * leaf.w;
+        let y = leaf.y0 + u.next_uniform() * leaf.h;
+        let z = u.next_uniform() * leaf.m;
+        a.trials += 1;
+        if self.disc && x * x + y * y > 1.0 {
+            return ([x, y], None);
+        }
+        let f = self.density.eval([x, y]);
+        if f > leaf.m {
+            a.violations += 1;
+        }
+        ([x, y], (z < f).then_some(f))
+    }
+
+    fn exhausted(&self, p: Point2, a: &mut Audit) -> Sample2 {
+        a.exhausted += 1;
+        a.samples += 1;
+        Sample2 { point: p, pdf: 0.0 }
+    }
+
+    /// Rejection inside one leaf until acceptance (batch mode and [`Scheme::Paper`]); counts
+    /// the sample in `a`.
+    #[inline(always)]
+    fn draw_in_leaf<U: UniformSource + ?Sized>(
+        &self,
+        leaf: &Leaf,
+        u: &mut U,
+        a: &mut Audit,
+    ) -> Sample2 {
+        let start = a.trials;
+        loop {
+            let (p, acc) = self.trial(leaf, u, a);
+            if let Some(f) = acc {
+                a.samples += 1;
+                return Sample2 {
+                    point: p,
+                    pdf: f * self.inv_integral,
+                };
+            }
+            if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
+                return self.exhausted(p, a);
+            }
+        }
+    }
+
+    /// One sample of the configured scheme (counts the sample in `a`).
+    #[inline]
+    fn draw<U: UniformSource + ?Sized>(&self, u: &mut U, a: &mut Audit) -> Sample2 {
+        let start = a.trials;
+        let mut last = self.tree.root.center();
+        loop {
+            let Some(leaf) = self.pick_leaf(u) else {
+                a.trials += 1;
+                if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
+                    return self.exhausted(last, a);
+                }
+                continue;
+            };
+            match self.tree.params.scheme {
+                Scheme::Envelope => {
+                    let (p, acc) = self.trial(leaf, u, a);
+                    if let Some(f) = acc {
+                        a.samples += 1;
+                        return Sample2 {
+                            point: p,
+                            pdf: f * self.inv_integral,
+                        };
+                    }
+                    last = p;
+                    if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
+                        return self.exhausted(last, a);
+                    }
+                }
+                Scheme::Paper => return self.draw_in_leaf(leaf, u, a),
+            }
+        }
+    }
+}
+
+impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
+    /// One sample of the configured scheme and leaf choice; pdf `f(x)/Î` (see the type docs).
+    #[inline]
+    fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2 {
+        let mut a = Audit::default();
+        let s = self.draw(u, &mut a);
+        record_one(&self.counters, &a);
+        s
+    }
+
+    /// `f(p)/Î` when `p` is in the domain and in a sampleable leaf, else 0.
+    fn pdf(&self, p: Point2) -> f64 {
+        if !self.tree.shape.domain.contains(p) || self.tree.locate(p).is_none() {
+            return 0.0;
+        }
+        self.density.eval(p) * self.inv_integral
+    }
+
+    fn bytes_used(&self) -> usize {
+        self.memory().total
+    }
+}
+
+/// SplitMix64 finaliser.
+#[inline]
+pub(crate) fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Seed of chunk `c` of a run seeded with `seed`.
+pub fn chunk_seed(seed: u64, c: u64) -> u64 {
+    splitmix64(splitmix64(seed) ^ splitmix64(c.wrapping_add(0x632B_E59B_D9B4_E019)))
+}

@@ -1,0 +1,323 @@
+//! The built quadtree: flat arrays of leaves (rejection rectangles, bounds, alias entries) and
+//! internal nodes (child codes and per-node CDFs for the papers' descent). Serialisable.
+
+use serde::{Deserialize, Serialize};
+
+use crate::density::{DensityShape, IntegralSource};
+use crate::rect::{Domain, Rect};
+use crate::sampler::Point2;
+
+/// How a leaf is chosen for a rejection trial, and what the pdf is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Scheme {
+    /// **Default, exact with approximate integrals.** A leaf is chosen ∝ `V_i = area(rect_i) · M_i`,
+    /// a point uniform in its rejection rectangle and a height uniform in `[0, M_i)`; on
+    /// rejection the whole trial restarts from the leaf choice. Accepted points have density
+    /// exactly `f(x) / ∫_D f` whenever every `M_i` bounds `f` on its leaf; mean trials per
+    /// sample `Σ V_i / Σ I_i ≤ n_max` (up to leaves capped by the maximum depth).
+    #[default]
+    Envelope,
+    /// The papers' scheme: a leaf is chosen ∝ `I_i`, then rejection is repeated inside that
+    /// leaf. The true density is `(I_i / Σ I) · f(x) / ∫_{leaf i} f`, which equals `f(x) / Σ I`
+    /// only when every `I_i` is exact (tabulated densities).
+    Paper,
+}
+
+/// How the leaf of a trial is selected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum LeafChoice {
+    /// **Default.** Flattened leaves with a Vose alias table: one uniform, O(1).
+    #[default]
+    Alias,
+    /// The papers' walk from the root with the per-node CDFs `F_ik`: one uniform per level.
+    Descent,
+}
+
+/// Parameters a tree was built with.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TreeParams {
+    /// Split threshold: a cell is split while `n_max · I_i / V_i < 1`.
+    pub n_max: f64,
+    /// Maximum depth (root = 0).
+    pub max_depth: u32,
+    /// Cells are not split into children narrower or lower than this (domain units).
+    pub min_leaf_size: f64,
+    /// Cells with `V_i ≤ volume_tolerance · I_root` are not split (they cannot add more than
+    /// `volume_tolerance` trials per sample each); 0 disables the rule.
+    pub volume_tolerance: f64,
+    /// Sampling scheme.
+    pub scheme: Scheme,
+    /// Leaf selection.
+    pub leaf_choice: LeafChoice,
+}
+
+/// A CDF entry larger than any uniform in `[0, 1)`: the walk stops at this child at the latest.
+pub(crate) const CDF_SKIP: f64 = 2.0;
+
+/// Child code: no sampleable content.
+pub(crate) const EMPTY: u32 = u32::MAX;
+/// Child code flag: the low 31 bits index `leaves`.
+pub(crate) const LEAF: u32 = 1 << 31;
+
+/// One sampleable leaf: rejection rectangle, bound, and its alias-table entry (one cache line).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[repr(C, align(64))]
+pub(crate) struct Leaf {
+    pub(crate) x0: f64,
+    pub(crate) y0: f64,
+    pub(crate) w: f64,
+    pub(crate) h: f64,
+    /// `M_i`.
+    pub(crate) m: f64,
+    /// Alias threshold.
+    pub(crate) prob: f64,
+    /// Alias target.
+    pub(crate) alias: u32,
+}
+
+/// An internal node: four child codes (quadrants x-major: 0 = (lo, lo), 1 = (hi, lo),
+/// 2 = (lo, hi), 3 = (hi, hi)) and the cumulative child probabilities `F_i0..F_i2`
+/// ([`CDF_SKIP`] from the last child of positive weight on).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Node {
+    pub(crate) children: [u32; 4],
+    pub(crate) cdf: [f64; 3],
+}
+
+/// Counts describing a tree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct TreeCounts {
+    /// All nodes visited by the builder (internal + leaves, dropped cells excluded).
+    pub nodes: usize,
+    /// Internal nodes.
+    pub internal: usize,
+    /// Leaves (sampleable or not).
+    pub leaves: usize,
+    /// Leaves with positive selection weight.
+    pub active_leaves: usize,
+    /// Cells dropped because they do not meet the domain (disc).
+    pub dropped: usize,
+    /// Deepest leaf (root = 0).
+    pub depth: u32,
+}
+
+/// Geometry and statistics of one sampleable leaf.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LeafInfo {
+    /// Rejection rectangle (the cell, or the bounding box of cell ∩ disc).
+    pub rect: Rect,
+    /// `M_i`.
+    pub max_bound: f64,
+    /// `I_i`.
+    pub integral: f64,
+    /// `V_i = area(rect) · M_i`.
+    pub volume: f64,
+}
+
+/// A built adaptive partition, without its density: what is persisted.
+///
+/// Re-attach a density with [`crate::QuadTreeSampler::from_parts`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QuadTree {
+    pub(crate) params: TreeParams,
+    pub(crate) shape: DensityShape,
+    pub(crate) root: Rect,
+    pub(crate) leaves: Vec<Leaf>,
+    pub(crate) leaf_integral: Vec<f64>,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) root_code: u32,
+    pub(crate) counts: TreeCounts,
+    /// `Î = Σ I_i` over sampleable leaves.
+    pub(crate) integral: f64,
+    /// `Σ V_i` over sampleable leaves.
+    pub(crate) volume: f64,
+    pub(crate) integral_source: IntegralSource,
+    pub(crate) integral_rel_err: Option<f64>,
+}
+
+/// `[x0, x1) × [y0, y1)` of cell `(ix, iy)` at depth `d` (the same arithmetic everywhere, so
+/// neighbouring cells share bit-identical edges).
+#[inline]
+pub(crate) fn cell_rect(root: &Rect, d: u32, ix: u64, iy: u64) -> Rect {
+    let sw = root.width() * 0.5f64.powi(d as i32);
+    let sh = root.height() * 0.5f64.powi(d as i32);
+    Rect {
+        x0: root.x0 + ix as f64 * sw,
+        x1: root.x0 + (ix + 1) as f64 * sw,
+        y0: root.y0 + iy as f64 * sh,
+        y1: root.y0 + (iy + 1) as f64 * sh,
+    }
+}
+
+impl QuadTree {
+    /// Build parameters.
+    pub fn params(&self) -> &TreeParams {
+        &self.params
+    }
+
+    /// Shape of the density the tree was built for.
+    pub fn shape(&self) -> &DensityShape {
+        &self.shape
+    }
+
+    /// The domain.
+    pub fn domain(&self) -> Domain {
+        self.shape.domain
+    }
+
+    /// Node and leaf counts.
+    pub fn counts(&self) -> TreeCounts {
+        self.counts
+    }
+
+    /// `Î = Σ I_i` over sampleable leaves.
+    pub fn integral(&self) -> f64 {
+        self.integral
+    }
+
+    /// `Σ V_i` over sampleable leaves.
+    pub fn volume(&self) -> f64 {
+        self.volume
+    }
+
+    /// Expected trials per sample, `Σ V_i / Σ I_i` (both schemes).
+    pub fn expected_mean_trials(&self) -> f64 {
+        self.volume / self.integral
+    }
+
+    /// The sampleable leaves in storage order.
+    pub fn leaves(&self) -> impl ExactSizeIterator<Item = LeafInfo> + '_ {
+        self.leaves
+            .iter()
+            .zip(&self.leaf_integral)
+            .map(|(l, &i)| LeafInfo {
+                rect: Rect {
+                    x0: l.x0,
+                    y0: l.y0,
+                    x1: l.x0 + l.w,
+                    y1: l.y0 + l.h,
+                },
+                max_bound: l.m,
+                integral: i,
+                volume: l.w * l.h * l.m,
+            })
+    }
+
+    /// Bytes of the leaf array (rectangles, bounds and alias entries).
+    pub fn leaf_bytes(&self) -> usize {
+        self.leaves.capacity() * std::mem::size_of::<Leaf>() + self.leaf_integral.capacity() * 8
+    }
+
+    /// Bytes of the internal nodes (child codes and descent CDFs).
+    pub fn node_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>()
+    }
+
+    /// Total bytes of the tree.
+    pub fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>() + self.leaf_bytes() + self.node_bytes()
+    }
+
+    /// Index of the sampleable leaf whose cell contains `p`, if any.
+    pub(crate) fn locate(&self, p: Point2) -> Option<usize> {
+        let (rw, rh) = (self.root.width(), self.root.height());
+        let (mut ix, mut iy, mut d) = (0u64, 0u64, 0i32);
+        let mut code = self.root_code;
+        loop {
+            if code == EMPTY {
+                return None;
+            }
+            if code & LEAF != 0 {
+                return Some((code & !LEAF) as usize);
+            }
+            let node = self.nodes.get(code as usize)?;
+            if d >= 62 {
+                return None;
+            }
+            d += 1;
+            let s = 0.5f64.powi(d);
+            let hx = u64::from(p[0] >= self.root.x0 + (2 * ix + 1) as f64 * (rw * s));
+            let hy = u64::from(p[1] >= self.root.y0 + (2 * iy + 1) as f64 * (rh * s));
+            ix = 2 * ix + hx;
+            iy = 2 * iy + hy;
+            code = node.children[(hy << 1 | hx) as usize];
+        }
+    }
+
+    /// Structural checks (so decoded bytes can never make sampling index out of range or loop).
+    pub(crate) fn validate(&self) -> Result<(), &'static str> {
+        let p = &self.params;
+        if !(p.n_max.is_finite() && p.n_max >= 1.0) || p.max_depth > crate::builder::MAX_DEPTH_LIMIT
+        {
+            return Err("invalid parameters");
+        }
+        let finite_nonneg = |x: f64| x.is_finite() && x >= 0.0;
+        if !finite_nonneg(p.min_leaf_size) || !finite_nonneg(p.volume_tolerance) {
+            return Err("invalid parameters");
+        }
+        if !self.root.is_valid() || self.root != self.shape.domain.bounding_rect() {
+            return Err("invalid root rectangle");
+        }
+        let n = self.leaves.len();
+        if n == 0
+            || n >= LEAF as usize
+            || self.nodes.len() >= LEAF as usize
+            || self.leaf_integral.len() != n
+        {
+            return Err("leaf array sizes");
+        }
+        for l in &self.leaves {
+            let ok = l.x0.is_finite()
+                && l.y0.is_finite()
+                && l.w.is_finite()
+                && l.w > 0.0
+                && l.h.is_finite()
+                && l.h > 0.0
+                && l.m.is_finite()
+                && l.m > 0.0
+                && (0.0..=1.0).contains(&l.prob)
+                && (l.alias as usize) < n;
+            if !ok {
+                return Err("invalid leaf");
+            }
+        }
+        if !self
+            .leaf_integral
+            .iter()
+            .all(|i| i.is_finite() && *i >= 0.0)
+        {
+            return Err("invalid leaf integral");
+        }
+        let code_ok = |c: u32, parent: Option<usize>| -> bool {
+            if c == EMPTY {
+                true
+            } else if c & LEAF != 0 {
+                ((c & !LEAF) as usize) < n
+            } else {
+                (c as usize) < self.nodes.len() && parent.is_none_or(|q| c as usize > q)
+            }
+        };
+        if !code_ok(self.root_code, None) {
+            return Err("invalid root code");
+        }
+        for (k, node) in self.nodes.iter().enumerate() {
+            if !node.children.iter().all(|&c| code_ok(c, Some(k))) {
+                return Err("invalid child code");
+            }
+            if !node.cdf.iter().all(|c| (0.0..=CDF_SKIP).contains(c)) {
+                return Err("invalid cdf");
+            }
+        }
+        if !(self.integral.is_finite()
+            && self.integral > 0.0
+            && self.volume.is_finite()
+            && self.volume > 0.0)
+        {
+            return Err("invalid totals");
+        }
+        if self.counts.depth > p.max_depth {
+            return Err("depth exceeds max_depth");
+        }
+        Ok(())
+    }
+}
