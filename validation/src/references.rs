@@ -18,19 +18,20 @@ pub fn environment(w: Dir3) -> f64 {
 pub const REFERENCE_BINS: [usize; 2] = [16, 32];
 
 /// Absolute tolerance of the reference quadrature (shared by all bins).
-pub const REFERENCE_TOLERANCE: f64 = 1e-10;
+pub const REFERENCE_TOLERANCE: f64 = 1e-8;
 
 /// Description of the reference rule, stored with every reference.
 pub const REFERENCE_RULE: &str = "adaptive tensor Gauss-Legendre quadrature (stats::integrate) of the integrand w.r.t. \
-solid angle over the upper hemisphere in (cos theta, phi), 16 x 32 bins, order 8, refinement depth <= 14, \
-total absolute tolerance 1e-10";
+solid angle over the upper hemisphere in (cos theta, phi), 16 x 32 bins, order 8, refinement depth <= 12, \
+total absolute tolerance 1e-8";
 
 fn reference_options() -> QuadratureOptions {
     QuadratureOptions {
         order: 8,
         min_depth: 1,
-        max_depth: 14,
+        max_depth: 12,
         rel_floor: 1e-13,
+        max_evaluations_per_bin: 2_000_000,
         ..QuadratureOptions::default()
     }
 }

@@ -41,6 +41,12 @@ pub trait SamplerUnderTest<P>: Send + Sync {
     fn bound_violations(&self) -> Option<u64> {
         None
     }
+
+    /// The sampler's own estimate of the relative error of its pdf normaliser (e.g. the grid
+    /// integral `Î` of a quadtree, for which the pdf is `f/Î`), when it declares one.
+    fn normaliser_rel_err(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// An integral with an accurately known value, and how the value was obtained.

@@ -100,9 +100,16 @@ impl Density for DiscBrdf {
 /// the grid the tree was built from. It evaluates pointwise only; region queries return an
 /// infinite bound, so it can never be used to build a tree (that needs the grid).
 #[derive(Clone, Debug)]
-pub(crate) struct SliceDensity {
+pub struct SliceDensity {
     pub(crate) f: DiscBrdf,
     pub(crate) shape: DensityShape,
+}
+
+impl SliceDensity {
+    /// The disc density `x ↦ f_r(ωo_slice, h⁻¹(x))`.
+    pub fn disc_brdf(&self) -> &DiscBrdf {
+        &self.f
+    }
 }
 
 impl Density for SliceDensity {

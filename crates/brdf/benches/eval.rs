@@ -21,8 +21,21 @@ fn bench_eval(c: &mut Criterion) {
     let pairs = pairs();
     let mut group = c.benchmark_group("eval");
     group.throughput(Throughput::Elements(pairs.len() as u64));
-    for spec in ["lambert", "phong", "ward", "ggx", "beckmann", "cook-torrance", "oren-nayar", "ashikhmin-shirley", "poulin-fournier", "htsg"] {
-        let Ok(model) = parse_spec(spec) else { continue };
+    for spec in [
+        "lambert",
+        "phong",
+        "ward",
+        "ggx",
+        "beckmann",
+        "cook-torrance",
+        "oren-nayar",
+        "ashikhmin-shirley",
+        "poulin-fournier",
+        "htsg",
+    ] {
+        let Ok(model) = parse_spec(spec) else {
+            continue;
+        };
         group.bench_function(spec, |b| {
             b.iter(|| {
                 let mut s = 0.0;

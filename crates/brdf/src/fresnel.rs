@@ -21,10 +21,18 @@ pub fn fresnel_conductor(cos: f64, n: f64, kappa: f64) -> f64 {
     let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
     let t1 = a2b2 + c2;
     let t2 = 2.0 * a * c;
-    let rs = if t1 + t2 > 0.0 { (t1 - t2) / (t1 + t2) } else { 1.0 };
+    let rs = if t1 + t2 > 0.0 {
+        (t1 - t2) / (t1 + t2)
+    } else {
+        1.0
+    };
     let t3 = c2 * a2b2 + s2 * s2;
     let t4 = t2 * s2;
-    let rp = if t3 + t4 > 0.0 { rs * (t3 - t4) / (t3 + t4) } else { rs };
+    let rp = if t3 + t4 > 0.0 {
+        rs * (t3 - t4) / (t3 + t4)
+    } else {
+        rs
+    };
     (0.5 * (rs + rp)).clamp(0.0, 1.0)
 }
 

@@ -92,6 +92,10 @@ mod tests {
         assert_relative_eq!(p, 10f64.to_radians() + 0.7, epsilon = 1e-12);
         // rotate_y by θ moves the normal towards +x.
         let n = rotate_y(&Vec3::new(0.0, 0.0, 1.0), 0.3);
-        assert_relative_eq!(n, Vec3::new(0.3f64.sin(), 0.0, 0.3f64.cos()), epsilon = 1e-15);
+        assert_relative_eq!(
+            n,
+            Vec3::new(0.3f64.sin(), 0.0, 0.3f64.cos()),
+            epsilon = 1e-15
+        );
     }
 }

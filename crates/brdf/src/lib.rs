@@ -13,7 +13,7 @@
 //!
 //! # Specs
 //! `name` or `name:key=value,...` (e.g. `phong:n=50,ks=0.7,kd=0.3`), or `merl:PATH`; see
-//! [`parse_spec`] and [`models`] for the registry (keys, defaults, ranges).
+//! [`parse_spec`] and [`models()`] for the registry (keys, defaults, ranges).
 //!
 //! # Example
 //! ```
@@ -33,6 +33,9 @@
 //! assert!(err.contains("valid keys: n, ks, kd"));
 //! # Ok::<(), brdf::SpecError>(())
 //! ```
+
+// `!(x > 0.0)` is the house style for checks that must also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod brdf;
 pub mod fresnel;

@@ -162,9 +162,17 @@ pub fn index_from_angles(theta_h: f64, theta_d: f64, phi_d: f64) -> MerlIndex {
     } else {
         0
     };
-    let td = if theta_d > 0.0 { (theta_d / FRAC_PI_2 * RES_THETA_D as f64) as usize } else { 0 };
+    let td = if theta_d > 0.0 {
+        (theta_d / FRAC_PI_2 * RES_THETA_D as f64) as usize
+    } else {
+        0
+    };
     let p = if phi_d < 0.0 { phi_d + PI } else { phi_d };
-    let pd = if p > 0.0 { (p / PI * RES_PHI_D as f64) as usize } else { 0 };
+    let pd = if p > 0.0 {
+        (p / PI * RES_PHI_D as f64) as usize
+    } else {
+        0
+    };
     MerlIndex {
         theta_h: th.min(RES_THETA_H - 1),
         theta_d: td.min(RES_THETA_D - 1),
@@ -210,7 +218,10 @@ impl std::fmt::Debug for MerlBrdf {
 impl MerlBrdf {
     /// Read and validate a MERL binary file.
     pub fn load(path: &Path) -> Result<Self, MerlError> {
-        let bytes = fs::read(path).map_err(|source| MerlError::Io { path: path.to_path_buf(), source })?;
+        let bytes = fs::read(path).map_err(|source| MerlError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let mut m = Self::from_bytes(&bytes)?;
         m.source = Some(path.to_path_buf());
         Ok(m)
@@ -219,7 +230,10 @@ impl MerlBrdf {
     /// Parse and validate the bytes of a MERL file (dims, size, finiteness).
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, MerlError> {
         let Some(header) = bytes.get(..HEADER_BYTES) else {
-            return Err(MerlError::Truncated { expected: HEADER_BYTES, actual: bytes.len() });
+            return Err(MerlError::Truncated {
+                expected: HEADER_BYTES,
+                actual: bytes.len(),
+            });
         };
         let mut dims = [0i32; 3];
         for (d, chunk) in dims.iter_mut().zip(header.chunks_exact(4)) {
@@ -233,10 +247,16 @@ impl MerlBrdf {
             return Err(MerlError::WrongDims { dims });
         }
         if bytes.len() < FILE_BYTES {
-            return Err(MerlError::Truncated { expected: FILE_BYTES, actual: bytes.len() });
+            return Err(MerlError::Truncated {
+                expected: FILE_BYTES,
+                actual: bytes.len(),
+            });
         }
         if bytes.len() > FILE_BYTES {
-            return Err(MerlError::WrongSize { expected: FILE_BYTES, actual: bytes.len() });
+            return Err(MerlError::WrongSize {
+                expected: FILE_BYTES,
+                actual: bytes.len(),
+            });
         }
         let data = &bytes[HEADER_BYTES..];
         let mut cells = vec![[0.0f64; 3]; CELLS];
@@ -246,7 +266,11 @@ impl MerlBrdf {
             let v = f64::from_le_bytes(b);
             let (channel, index) = (k / CELLS, k % CELLS);
             if !v.is_finite() {
-                return Err(MerlError::NonFinite { channel, index, value: v });
+                return Err(MerlError::NonFinite {
+                    channel,
+                    index,
+                    value: v,
+                });
             }
             cells[index][channel] = v * CHANNEL_SCALE[channel];
         }
@@ -256,13 +280,20 @@ impl MerlBrdf {
     /// Build from the raw stored table: `3 × 1,458,000` unscaled values, channel-major.
     pub fn from_raw(raw: &[f64]) -> Result<Self, MerlError> {
         if raw.len() != 3 * CELLS {
-            return Err(MerlError::RawLength { expected: 3 * CELLS, actual: raw.len() });
+            return Err(MerlError::RawLength {
+                expected: 3 * CELLS,
+                actual: raw.len(),
+            });
         }
         let mut cells = vec![[0.0f64; 3]; CELLS];
         for (k, &v) in raw.iter().enumerate() {
             let (channel, index) = (k / CELLS, k % CELLS);
             if !v.is_finite() {
-                return Err(MerlError::NonFinite { channel, index, value: v });
+                return Err(MerlError::NonFinite {
+                    channel,
+                    index,
+                    value: v,
+                });
             }
             cells[index][channel] = v * CHANNEL_SCALE[channel];
         }
@@ -289,13 +320,21 @@ impl MerlBrdf {
     pub fn tabulate(brdf: &(impl Brdf + ?Sized)) -> Self {
         Self::from_fn(|th, td, pd| {
             let (wo, wi) = half_diff_to_directions(th, td, pd);
-            if both_above(&wo, &wi) { brdf.eval_rgb(&wo, &wi) } else { [-1.0; 3] }
+            if both_above(&wo, &wi) {
+                brdf.eval_rgb(&wo, &wi)
+            } else {
+                [-1.0; 3]
+            }
         })
     }
 
     fn from_cells(cells: Vec<[f64; 3]>) -> Self {
         let unmeasured = cells.iter().filter(|c| c.iter().any(|&v| v < 0.0)).count();
-        Self { cells, unmeasured, source: None }
+        Self {
+            cells,
+            unmeasured,
+            source: None,
+        }
     }
 
     /// File this table was loaded from, if any.
@@ -358,12 +397,18 @@ static TMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
 
 /// Write `bytes` to `path` via a temporary sibling file and a rename.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), MerlError> {
-    let io = |source| MerlError::Io { path: path.to_path_buf(), source };
+    let io = |source| MerlError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(
         ".{name}.tmp-{}-{}",
         std::process::id(),

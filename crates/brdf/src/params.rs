@@ -20,12 +20,22 @@ pub struct Range {
 impl Range {
     /// Closed interval `[min, max]`.
     pub const fn closed(min: f64, max: f64) -> Self {
-        Self { min, max, min_open: false, max_open: false }
+        Self {
+            min,
+            max,
+            min_open: false,
+            max_open: false,
+        }
     }
 
     /// Half-open interval `(min, max]`.
     pub const fn left_open(min: f64, max: f64) -> Self {
-        Self { min, max, min_open: true, max_open: false }
+        Self {
+            min,
+            max,
+            min_open: true,
+            max_open: false,
+        }
     }
 
     /// True when `x` is finite and inside the interval (NaN is never inside).
@@ -33,8 +43,16 @@ impl Range {
         if !x.is_finite() {
             return false;
         }
-        let lo = if self.min_open { x > self.min } else { x >= self.min };
-        let hi = if self.max_open { x < self.max } else { x <= self.max };
+        let lo = if self.min_open {
+            x > self.min
+        } else {
+            x >= self.min
+        };
+        let hi = if self.max_open {
+            x < self.max
+        } else {
+            x <= self.max
+        };
         lo && hi
     }
 }
@@ -116,7 +134,12 @@ pub(crate) fn validate(
 ) -> Result<(), ParamError> {
     for (p, &v) in params.iter().zip(values) {
         if !p.range.contains(v) {
-            return Err(ParamError::OutOfRange { model, key: p.key, value: v, range: p.range });
+            return Err(ParamError::OutOfRange {
+                model,
+                key: p.key,
+                value: v,
+                range: p.range,
+            });
         }
     }
     Ok(())
@@ -130,9 +153,12 @@ pub(crate) fn validate_key(
     value: f64,
 ) -> Result<(), ParamError> {
     match params.iter().find(|p| p.key == key) {
-        Some(p) if !p.range.contains(value) => {
-            Err(ParamError::OutOfRange { model, key: p.key, value, range: p.range })
-        }
+        Some(p) if !p.range.contains(value) => Err(ParamError::OutOfRange {
+            model,
+            key: p.key,
+            value,
+            range: p.range,
+        }),
         _ => Ok(()),
     }
 }
@@ -163,7 +189,12 @@ pub(crate) const fn param(
     range: Range,
     doc: &'static str,
 ) -> ParamInfo {
-    ParamInfo { key, default: ParamDefault::Value(default), range, doc }
+    ParamInfo {
+        key,
+        default: ParamDefault::Value(default),
+        range,
+        doc,
+    }
 }
 
 #[cfg(test)]

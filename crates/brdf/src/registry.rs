@@ -107,7 +107,11 @@ impl ModelInfo {
         if self.params.is_empty() {
             return "(none)".to_string();
         }
-        self.params.iter().map(|p| p.key).collect::<Vec<_>>().join(", ")
+        self.params
+            .iter()
+            .map(|p| p.key)
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -459,11 +463,16 @@ mod tests {
             let b = parse_spec(m.name).unwrap_or_else(|e| panic!("{}: {e}", m.name));
             assert_eq!(b.name(), m.name);
             match m.isotropic {
-                Isotropy::Always | Isotropy::WhenParamsEqual => assert!(b.is_isotropic(), "{}", m.name),
+                Isotropy::Always | Isotropy::WhenParamsEqual => {
+                    assert!(b.is_isotropic(), "{}", m.name)
+                }
                 Isotropy::Never => assert!(!b.is_isotropic(), "{}", m.name),
             }
             for a in m.aliases {
-                assert_eq!(parse_spec(a).map(|b| b.name().to_string()).ok().as_deref(), Some(m.name));
+                assert_eq!(
+                    parse_spec(a).map(|b| b.name().to_string()).ok().as_deref(),
+                    Some(m.name)
+                );
             }
         }
     }
@@ -472,14 +481,21 @@ mod tests {
     fn names_are_unique_kebab_case() {
         let mut all: Vec<&str> = Vec::new();
         for m in models() {
-            assert!(m.name.chars().all(|c| c.is_ascii_lowercase() || c == '-'), "{}", m.name);
+            assert!(
+                m.name.chars().all(|c| c.is_ascii_lowercase() || c == '-'),
+                "{}",
+                m.name
+            );
             all.push(m.name);
             all.extend(m.aliases.iter());
             for p in m.params {
                 assert!(p.range.contains(match p.default {
                     ParamDefault::Value(v) => v,
                     ParamDefault::SameAs(k) => match m.params.iter().find(|q| q.key == k) {
-                        Some(ParamInfo { default: ParamDefault::Value(v), .. }) => *v,
+                        Some(ParamInfo {
+                            default: ParamDefault::Value(v),
+                            ..
+                        }) => *v,
                         _ => panic!("{}: bad SameAs", m.name),
                     },
                 }));

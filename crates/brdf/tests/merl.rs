@@ -20,7 +20,11 @@ fn index_table() -> Vec<f64> {
             for pd in 0..RES_PHI_D {
                 let idx = pd + RES_PHI_D * td + RES_PHI_D * RES_THETA_D * th;
                 raw[idx] = idx as f64;
-                raw[CELLS + idx] = if idx % 7 == 0 { -(th as f64) - 1.0 } else { th as f64 };
+                raw[CELLS + idx] = if idx.is_multiple_of(7) {
+                    -(th as f64) - 1.0
+                } else {
+                    th as f64
+                };
                 raw[2 * CELLS + idx] = (1000 * td + pd) as f64;
             }
         }
@@ -37,7 +41,11 @@ fn expected_bin(wo: &Vec3, wi: &Vec3) -> Option<(usize, usize, usize)> {
     let h = s / s.norm();
     let theta_h = (h.x.hypot(h.y)).atan2(h.z);
     let phi_h = h.y.atan2(h.x);
-    let u = Vec3::new(theta_h.cos() * phi_h.cos(), theta_h.cos() * phi_h.sin(), -theta_h.sin());
+    let u = Vec3::new(
+        theta_h.cos() * phi_h.cos(),
+        theta_h.cos() * phi_h.sin(),
+        -theta_h.sin(),
+    );
     let v = Vec3::new(-phi_h.sin(), phi_h.cos(), 0.0);
     let (du, dv, dh) = (wi.dot(&u), wi.dot(&v), wi.dot(&h));
     let theta_d = (du.hypot(dv)).atan2(dh);
@@ -52,7 +60,11 @@ fn expected_bin(wo: &Vec3, wi: &Vec3) -> Option<(usize, usize, usize)> {
     if near_edge(xh) || near_edge(xd) || near_edge(xp) {
         return None;
     }
-    Some(((xh as usize).min(89), (xd as usize).min(89), (xp as usize).min(179)))
+    Some((
+        (xh as usize).min(89),
+        (xd as usize).min(89),
+        (xp as usize).min(179),
+    ))
 }
 
 fn random_dir(rng: &mut Xoshiro256PlusPlus) -> Vec3 {
@@ -85,22 +97,35 @@ fn lookup_matches_independent_index_computation() {
     let mut small_theta_h = 0;
     for _ in 0..20_000 {
         let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
-        let Some((th, td, pd)) = expected_bin(&wo, &wi) else { continue };
+        let Some((th, td, pd)) = expected_bin(&wo, &wi) else {
+            continue;
+        };
         let idx = pd + 180 * td + 180 * 90 * th;
         let raw = m.lookup_raw_rgb(&wo, &wi);
-        assert_eq!(raw[0], idx as f64 * CHANNEL_SCALE[0], "R (flat index) for {wo:?} {wi:?}");
-        let g = if idx % 7 == 0 { -(th as f64) - 1.0 } else { th as f64 };
+        assert_eq!(
+            raw[0],
+            idx as f64 * CHANNEL_SCALE[0],
+            "R (flat index) for {wo:?} {wi:?}"
+        );
+        let g = if idx.is_multiple_of(7) {
+            -(th as f64) - 1.0
+        } else {
+            th as f64
+        };
         assert_eq!(raw[1], g * CHANNEL_SCALE[1]);
         assert_eq!(raw[2], (1000 * td + pd) as f64 * CHANNEL_SCALE[2]);
         // Clamping policy and the measured flag.
-        assert_eq!(m.is_measured(&wo, &wi), idx % 7 != 0);
+        assert_eq!(m.is_measured(&wo, &wi), !idx.is_multiple_of(7));
         let rgb = m.eval_rgb(&wo, &wi);
         assert_eq!(rgb[1], g.max(0.0) * CHANNEL_SCALE[1]);
         assert_eq!(m.eval(&wo, &wi), luminance(rgb));
         // Reciprocity and isotropy of the lookup.
         assert_eq!(merl::index_of(&wi, &wo), merl::index_of(&wo, &wi));
         let a = rng.random_range(0.0..2.0 * PI);
-        assert_eq!(merl::index_of(&rotate_z(&wo, a), &rotate_z(&wi, a)), merl::index_of(&wo, &wi));
+        assert_eq!(
+            merl::index_of(&rotate_z(&wo, a), &rotate_z(&wi, a)),
+            merl::index_of(&wo, &wi)
+        );
         if th < 10 {
             small_theta_h += 1;
         }
@@ -118,20 +143,39 @@ fn theta_h_index_is_nonlinear_and_phi_d_folds() {
         let mid = FRAC_PI_2 * ((i as f64 + 0.5) / 90.0).powi(2);
         assert_eq!(merl::index_from_angles(mid, 0.3, 0.1).theta_h, i);
         if i > 0 {
-            assert_eq!(merl::index_from_angles(start * (1.0 + 1e-9), 0.3, 0.1).theta_h, i);
-            assert_eq!(merl::index_from_angles(start * (1.0 - 1e-9), 0.3, 0.1).theta_h, i - 1);
+            assert_eq!(
+                merl::index_from_angles(start * (1.0 + 1e-9), 0.3, 0.1).theta_h,
+                i
+            );
+            assert_eq!(
+                merl::index_from_angles(start * (1.0 - 1e-9), 0.3, 0.1).theta_h,
+                i - 1
+            );
         }
     }
     // First bin spans about 0.011°.
-    assert_eq!(merl::index_from_angles(0.0111f64.to_radians(), 0.0, 0.0).theta_h, 0);
-    assert_eq!(merl::index_from_angles(0.0112f64.to_radians(), 0.0, 0.0).theta_h, 1);
+    assert_eq!(
+        merl::index_from_angles(0.0111f64.to_radians(), 0.0, 0.0).theta_h,
+        0
+    );
+    assert_eq!(
+        merl::index_from_angles(0.0112f64.to_radians(), 0.0, 0.0).theta_h,
+        1
+    );
     // φd < 0 folds by +π.
     let a = merl::index_from_angles(0.5, 0.5, -0.25);
     let b = merl::index_from_angles(0.5, 0.5, PI - 0.25);
     assert_eq!(a, b);
     // Clamping at the ends.
     let e = merl::index_from_angles(FRAC_PI_2, FRAC_PI_2, PI);
-    assert_eq!(e, MerlIndex { theta_h: 89, theta_d: 89, phi_d: 179 });
+    assert_eq!(
+        e,
+        MerlIndex {
+            theta_h: 89,
+            theta_d: 89,
+            phi_d: 179
+        }
+    );
     assert_eq!(MerlIndex::from_flat(e.flat()), e);
 }
 
@@ -188,7 +232,11 @@ fn below_horizon_cells_are_unmeasured_and_read_as_zero() {
     merl::write_merl(&p, &|th, _td, _pd| [th, 2.0 * th, -1.0]).unwrap();
     let back = MerlBrdf::load(&p).unwrap();
     assert_eq!(back.unmeasured_count(), CELLS);
-    let idx = MerlIndex { theta_h: 30, theta_d: 5, phi_d: 7 };
+    let idx = MerlIndex {
+        theta_h: 30,
+        theta_d: 5,
+        phi_d: 7,
+    };
     let (th, _, _) = merl::bin_center(idx);
     let c = back.cell(idx);
     assert!((c[0] - th).abs() < 1e-15 && (c[1] - 2.0 * th).abs() < 1e-15 && c[2] < 0.0);
@@ -207,13 +255,22 @@ fn every_error_variant() {
         Err(MerlError::Truncated { expected: FILE_BYTES, actual }) if actual == FILE_BYTES - 100
     ));
     let p = write_bytes(dir.path(), "header", &good[..5]);
-    assert!(matches!(MerlBrdf::load(&p), Err(MerlError::Truncated { expected: 12, actual: 5 })));
+    assert!(matches!(
+        MerlBrdf::load(&p),
+        Err(MerlError::Truncated {
+            expected: 12,
+            actual: 5
+        })
+    ));
 
     // Trailing bytes.
     let mut longer = good.clone();
     longer.extend_from_slice(&[0u8; 8]);
     let p = write_bytes(dir.path(), "long", &longer);
-    assert!(matches!(MerlBrdf::load(&p), Err(MerlError::WrongSize { .. })));
+    assert!(matches!(
+        MerlBrdf::load(&p),
+        Err(MerlError::WrongSize { .. })
+    ));
 
     // Dims whose product is wrong, negative dims, and a permuted layout.
     let with_dims = |d: [i32; 3]| {
@@ -224,11 +281,25 @@ fn every_error_variant() {
         b
     };
     let p = write_bytes(dir.path(), "dims", &with_dims([90, 90, 90]));
-    assert!(matches!(MerlBrdf::load(&p), Err(MerlError::DimsProduct { product: 729_000, .. })));
+    assert!(matches!(
+        MerlBrdf::load(&p),
+        Err(MerlError::DimsProduct {
+            product: 729_000,
+            ..
+        })
+    ));
     let p = write_bytes(dir.path(), "neg", &with_dims([-90, -90, 180]));
-    assert!(matches!(MerlBrdf::load(&p), Err(MerlError::DimsProduct { .. })));
+    assert!(matches!(
+        MerlBrdf::load(&p),
+        Err(MerlError::DimsProduct { .. })
+    ));
     let p = write_bytes(dir.path(), "perm", &with_dims([180, 90, 90]));
-    assert!(matches!(MerlBrdf::load(&p), Err(MerlError::WrongDims { dims: [180, 90, 90] })));
+    assert!(matches!(
+        MerlBrdf::load(&p),
+        Err(MerlError::WrongDims {
+            dims: [180, 90, 90]
+        })
+    ));
 
     // NaN and infinity, reported with channel and cell.
     for (value, channel, cell) in [(f64::NAN, 1usize, 12_345usize), (f64::INFINITY, 2, 0)] {
@@ -237,7 +308,9 @@ fn every_error_variant() {
         b[off..off + 8].copy_from_slice(&value.to_le_bytes());
         let p = write_bytes(dir.path(), "nan", &b);
         match MerlBrdf::load(&p) {
-            Err(MerlError::NonFinite { channel: c, index, .. }) => {
+            Err(MerlError::NonFinite {
+                channel: c, index, ..
+            }) => {
                 assert_eq!((c, index), (channel, cell));
             }
             other => panic!("expected NonFinite, got {other:?}"),
@@ -245,12 +318,25 @@ fn every_error_variant() {
     }
 
     // Missing file; raw table of the wrong length; writing into a missing directory.
-    assert!(matches!(MerlBrdf::load(&dir.path().join("none")), Err(MerlError::Io { .. })));
-    assert!(matches!(MerlBrdf::from_raw(&[0.0; 10]), Err(MerlError::RawLength { .. })));
+    assert!(matches!(
+        MerlBrdf::load(&dir.path().join("none")),
+        Err(MerlError::Io { .. })
+    ));
+    assert!(matches!(
+        MerlBrdf::from_raw(&[0.0; 10]),
+        Err(MerlError::RawLength { .. })
+    ));
     let bad = dir.path().join("no/such/dir/out.binary");
-    assert!(matches!(MerlBrdf::from_fn(|_, _, _| [0.0; 3]).write(&bad), Err(MerlError::Io { .. })));
+    assert!(matches!(
+        MerlBrdf::from_fn(|_, _, _| [0.0; 3]).write(&bad),
+        Err(MerlError::Io { .. })
+    ));
     // Error messages name the problem.
-    let msg = MerlError::DimsProduct { dims: [1, 2, 3], product: 6 }.to_string();
+    let msg = MerlError::DimsProduct {
+        dims: [1, 2, 3],
+        product: 6,
+    }
+    .to_string();
     assert!(msg.contains("1458000"), "{msg}");
 }
 

@@ -22,7 +22,11 @@ fn accepted_forms() {
     assert_eq!(parse_spec("schlick-d").unwrap().name(), "schlick-diffuse");
     // `alpha_y` defaults to `alpha`; giving it makes the model anisotropic.
     assert!(parse_spec("ggx:alpha=0.3").unwrap().is_isotropic());
-    assert!(!parse_spec("ggx:alpha=0.3,alpha_y=0.1").unwrap().is_isotropic());
+    assert!(
+        !parse_spec("ggx:alpha=0.3,alpha_y=0.1")
+            .unwrap()
+            .is_isotropic()
+    );
     assert!(parse_spec("ward:alpha_y=0.15").unwrap().is_isotropic());
     assert!(parse_spec("ward:alpha_x=0.2").unwrap().is_isotropic());
 }
@@ -41,11 +45,20 @@ fn typed_errors() {
     match err("phong:q=1") {
         e @ SpecError::UnknownKey { .. } => {
             let msg = e.to_string();
-            assert!(msg.contains("`q`") && msg.contains("valid keys: n, ks, kd"), "{msg}");
+            assert!(
+                msg.contains("`q`") && msg.contains("valid keys: n, ks, kd"),
+                "{msg}"
+            );
         }
         e => panic!("{e}"),
     }
-    for bad in ["phong:n=abc", "phong:n=", "phong:n=nan", "phong:n=inf", "phong:n=1,2"] {
+    for bad in [
+        "phong:n=abc",
+        "phong:n=",
+        "phong:n=nan",
+        "phong:n=inf",
+        "phong:n=1,2",
+    ] {
         let e = err(bad);
         assert!(
             matches!(e, SpecError::BadNumber { .. } | SpecError::Malformed { .. }),
@@ -54,7 +67,10 @@ fn typed_errors() {
     }
     assert!(matches!(err("phong:n=abc"), SpecError::BadNumber { ref key, .. } if key == "n"));
     assert!(matches!(err("phong:n"), SpecError::Malformed { .. }));
-    assert!(matches!(err("phong:n=1,,ks=0.2"), SpecError::Malformed { .. }));
+    assert!(matches!(
+        err("phong:n=1,,ks=0.2"),
+        SpecError::Malformed { .. }
+    ));
     assert!(matches!(err("phong:=3"), SpecError::Malformed { .. }));
     match err("phong:ks=1.5") {
         e @ SpecError::OutOfRange { .. } => {
@@ -67,13 +83,21 @@ fn typed_errors() {
     assert!(matches!(err("phong:n=3,n=4"), SpecError::DuplicateKey { ref key, .. } if key == "n"));
     assert!(matches!(err("merl"), SpecError::MissingPath));
     assert!(matches!(err("merl:  "), SpecError::MissingPath));
-    assert!(matches!(err("merl:/nonexistent/dir/file.binary"), SpecError::Merl(brdf::MerlError::Io { .. })));
+    assert!(matches!(
+        err("merl:/nonexistent/dir/file.binary"),
+        SpecError::Merl(brdf::MerlError::Io { .. })
+    ));
 }
 
 #[test]
 fn registry_lists_required_keys() {
     let keys = |name: &str| -> Vec<&str> {
-        find_model(name).unwrap().params.iter().map(|p| p.key).collect()
+        find_model(name)
+            .unwrap()
+            .params
+            .iter()
+            .map(|p| p.key)
+            .collect()
     };
     assert_eq!(keys("phong"), ["n", "ks", "kd"]);
     assert_eq!(keys("blinn"), ["n", "ks", "kd"]);
@@ -86,9 +110,22 @@ fn registry_lists_required_keys() {
     assert!(find_model("lafortune").is_some());
     // The seed papers' sixteen models are all present.
     for name in [
-        "ashikhmin-shirley", "beard-maxwell", "blinn", "coupled", "htsg", "lafortune", "lewis",
-        "minnaert", "oren-nayar", "phong", "poulin-fournier", "schlick-diffuse", "schlick-specular",
-        "strauss", "cook-torrance", "ward",
+        "ashikhmin-shirley",
+        "beard-maxwell",
+        "blinn",
+        "coupled",
+        "htsg",
+        "lafortune",
+        "lewis",
+        "minnaert",
+        "oren-nayar",
+        "phong",
+        "poulin-fournier",
+        "schlick-diffuse",
+        "schlick-specular",
+        "strauss",
+        "cook-torrance",
+        "ward",
     ] {
         assert!(find_model(name).is_some(), "{name}");
     }

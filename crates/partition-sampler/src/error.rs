@@ -114,7 +114,7 @@ pub enum BuildError {
     TooManyNodes,
 }
 
-/// [`crate::allocate`] was given invalid input.
+/// [`crate::allocate()`] was given invalid input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AllocationError {
     /// A probability (weight) is NaN, negative or infinite.

@@ -17,6 +17,14 @@
 //! [`Scheme::Envelope`] is exact whenever the bounds hold; [`Scheme::Paper`] is the papers'
 //! scheme. See [`QuadTreeSampler`] for what `pdf` returns.
 //!
+//! Beyond one-sample draws: the papers' batch mode ([`QuadTreeSampler::sample_batch`] on top
+//! of the reusable [`allocate()`]), reproducible parallel batches
+//! ([`QuadTreeSampler::sample_par`], identical for any thread count), a bound audit
+//! ([`SamplerStats::bound_violations`], [`QuadTreeSampler::sample_audited`]), versioned
+//! persistence of the tree ([`QuadTree::to_bytes`], [`QuadTreeSampler::from_parts`]) and
+//! memory reports ([`QuadTreeSampler::memory`]). Wrap a provider in [`SharedDensity`] to
+//! build several trees over one copy of it.
+//!
 //! ```
 //! use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, SinPiRows, TabulatedDensity};
 //! use rand::{SeedableRng, rngs::Xoshiro256PlusPlus};

@@ -403,15 +403,28 @@ mod tests {
     fn disc_integrals_and_error_estimate() {
         // ∫_D 1 = π, ∫_D x² = π/4.
         let one = SampledGridDensity::new(|_: Point2| 1.0, Domain::UnitDisc, 64).unwrap();
-        assert!((one.total_integral() - std::f64::consts::PI).abs() < 2e-3, "{}", one.total_integral());
+        assert!(
+            (one.total_integral() - std::f64::consts::PI).abs() < 2e-3,
+            "{}",
+            one.total_integral()
+        );
         let x2 = SampledGridDensity::new(|p: Point2| p[0] * p[0], Domain::UnitDisc, 128).unwrap();
-        let err = (x2.total_integral() - std::f64::consts::FRAC_PI_4).abs() / std::f64::consts::FRAC_PI_4;
+        let err =
+            (x2.total_integral() - std::f64::consts::FRAC_PI_4).abs() / std::f64::consts::FRAC_PI_4;
         assert!(err < 1e-3, "{err}");
         // The estimate has the right order of magnitude (within a factor of 30 either way).
         let est = x2.estimated_rel_err();
-        assert!(est > err / 30.0 && est < err * 30.0 + 1e-6, "estimate {est} vs actual {err}");
+        assert!(
+            est > err / 30.0 && est < err * 30.0 + 1e-6,
+            "estimate {est} vs actual {err}"
+        );
         // Regions: the four quadrants sum to the total; bounds include the safety factor.
-        let q = [Rect::new(-1.0, -1.0, 0.0, 0.0), Rect::new(0.0, -1.0, 1.0, 0.0), Rect::new(-1.0, 0.0, 0.0, 1.0), Rect::new(0.0, 0.0, 1.0, 1.0)];
+        let q = [
+            Rect::new(-1.0, -1.0, 0.0, 0.0),
+            Rect::new(0.0, -1.0, 1.0, 0.0),
+            Rect::new(-1.0, 0.0, 0.0, 1.0),
+            Rect::new(0.0, 0.0, 1.0, 1.0),
+        ];
         let s: f64 = q.iter().map(|r| x2.region(r).integral).sum();
         assert!((s - x2.total_integral()).abs() < 1e-12);
         assert!(x2.region(&q[3]).max_bound >= DEFAULT_SAFETY_FACTOR * (1.0 - 1e-3));
@@ -422,8 +435,16 @@ mod tests {
         let f = |p: Point2| (p[0] * 3.0).sin().abs() + p[1];
         let r = Rect::new(0.0, 0.0, 1.0, 2.0);
         let exact = (1.0 - 3f64.cos()) / 3.0 * 2.0 + 2.0;
-        let e32 = (SampledGridDensity::new(f, Domain::Rect(r), 32).unwrap().total_integral() - exact).abs();
-        let e64 = (SampledGridDensity::new(f, Domain::Rect(r), 64).unwrap().total_integral() - exact).abs();
+        let e32 = (SampledGridDensity::new(f, Domain::Rect(r), 32)
+            .unwrap()
+            .total_integral()
+            - exact)
+            .abs();
+        let e64 = (SampledGridDensity::new(f, Domain::Rect(r), 64)
+            .unwrap()
+            .total_integral()
+            - exact)
+            .abs();
         assert!(e64 < e32 / 3.0, "{e32} {e64}");
     }
 }

@@ -1,29 +1,36 @@
 //! Tabulated CDFs of 1D projections, built by quadrature of a density.
 //!
 //! The CDF of the projection of a 2D density onto a parameter axis (`cos θ` or `φ` for
-//! directions; columns `x` or rows `y` of an image) is `F(t) = ∫_{u ≤ t} pdf dμ`. It is
-//! tabulated at knots and interpolated linearly. Knots start as 32 equal slabs; a slab
-//! `[a, b]` is halved while the linear interpolant misses the integrated midpoint value
-//! `F(mid)` by more than `ε = accuracy / √n` (the KS noise level is `≈ 1/√n`); slab masses are
-//! integrated with an absolute tolerance `ε/4 · (b − a)/(range)`, so the accumulated error of
-//! `F` stays below `ε/4`. Values are normalised by the total mass (a density that does not
-//! integrate to one is the normalisation test's business).
+//! directions; columns `x` or rows `y` of an image) is `F(t) = ∫_{u ≤ t} pdf dμ`, the integral
+//! of the marginal density `f(t)`. It is tabulated at knots and interpolated by monotone cubic
+//! Hermite polynomials (slopes: `f` at the knots), with
+//! target accuracy `ε = accuracy / √n` (the KS noise level is `≈ 1/√n`). Knots start as equal
+//! slabs (32, or one per grid cell along the axis if more); each slab's mass is compared with the sum
+//! over its quarters (Gauss–Legendre rules of `f`), and the slab is halved until the masses
+//! agree within `ε/4 · (b − a)/range` (so the accumulated error of `F` stays below `ε/4`) and
+//! the interpolant reproduces the integrated `F` at the slab's midpoint and quarter points
+//! within `ε`. Values are normalised by the total mass (a density that does not integrate to
+//! one is the normalisation test's business); the accuracy assumes a mass of order one.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::binning::{Axis, Binning};
 use crate::error::StatsError;
-use crate::quadrature::{GaussLegendre, QuadratureOptions, integrate_1d, integrate_rect};
+use crate::quadrature::{GaussLegendre, QuadratureOptions, integrate_1d};
 
-const INITIAL_SLABS: usize = 32;
+const MIN_INITIAL_SLABS: usize = 32;
 const MAX_KNOT_DEPTH: u32 = 24;
 
-/// A monotone piecewise-linear CDF on `[knots₀, knots_last]`: 0 below, 1 above.
+/// A monotone CDF tabulated on `[knots₀, knots_last]` (0 below, 1 above): piecewise linear, or
+/// piecewise cubic Hermite when the density at the knots is known (with the Fritsch–Carlson
+/// limiter, so it stays monotone).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TabulatedCdf {
     knots: Vec<f64>,
     values: Vec<f64>,
+    /// Normalised density at the knots (cubic Hermite slopes), if known.
+    slopes: Option<Vec<f64>>,
     total_mass: f64,
 }
 
@@ -62,8 +69,34 @@ impl TabulatedCdf {
         Ok(Self {
             knots,
             values,
+            slopes: None,
             total_mass: total,
         })
+    }
+
+    /// Like [`TabulatedCdf::new`], interpolating by monotone cubic Hermite with the density
+    /// `densities[i] = F'(knots[i])` (unnormalised, like `values`).
+    ///
+    /// # Errors
+    /// As [`TabulatedCdf::new`], plus a length mismatch or a negative or non-finite density.
+    pub fn with_densities(
+        knots: Vec<f64>,
+        values: Vec<f64>,
+        densities: Vec<f64>,
+    ) -> Result<Self, StatsError> {
+        if densities.len() != knots.len() {
+            return Err(StatsError::LengthMismatch {
+                observed: densities.len(),
+                expected: knots.len(),
+            });
+        }
+        if let Some(index) = densities.iter().position(|d| !(*d >= 0.0 && d.is_finite())) {
+            return Err(StatsError::NonMonotoneCdf { index });
+        }
+        let mut cdf = Self::new(knots, values)?;
+        let total = cdf.total_mass;
+        cdf.slopes = Some(densities.iter().map(|d| d / total).collect());
+        Ok(cdf)
     }
 
     /// `F(x)`: 0 below the first knot, 1 above the last, linear in between.
@@ -78,7 +111,10 @@ impl TabulatedCdf {
         let i = self.knots.partition_point(|&k| k <= x).clamp(1, n - 1);
         let (x0, x1) = (self.knots[i - 1], self.knots[i]);
         let (f0, f1) = (self.values[i - 1], self.values[i]);
-        f0 + (f1 - f0) * ((x - x0) / (x1 - x0))
+        match &self.slopes {
+            Some(d) => hermite(x0, x1, f0, f1, d[i - 1], d[i], x),
+            None => f0 + (f1 - f0) * ((x - x0) / (x1 - x0)),
+        }
     }
 
     /// The knots (strictly increasing).
@@ -110,12 +146,34 @@ impl TabulatedCdf {
     ) -> Result<Self, StatsError> {
         opts.validate()?;
         check_range(range)?;
-        let rule = GaussLegendre::new(opts.order);
-        let mass = |a: f64, b: f64, tol: f64| {
-            integrate_1d(f, [a, b], tol, &rule, opts.max_depth.max(20)).value
-        };
-        build(range, n_samples, opts, &mass)
+        build(range, n_samples, opts, MIN_INITIAL_SLABS, f)
     }
+}
+
+/// Monotone cubic Hermite interpolation on `[x0, x1]` between `(x0, f0)` and `(x1, f1)` with
+/// end slopes `d0`, `d1` (Fritsch–Carlson: slopes scaled so that `α² + β² ≤ 9`), clamped to
+/// `[f0, f1]`.
+fn hermite(x0: f64, x1: f64, f0: f64, f1: f64, d0: f64, d1: f64, x: f64) -> f64 {
+    let h = x1 - x0;
+    let delta = (f1 - f0) / h;
+    if !(delta > 0.0) {
+        return f0;
+    }
+    let (mut d0, mut d1) = (d0.max(0.0), d1.max(0.0));
+    let (a, b) = (d0 / delta, d1 / delta);
+    let r2 = a * a + b * b;
+    if r2 > 9.0 {
+        let tau = 3.0 / r2.sqrt();
+        d0 *= tau;
+        d1 *= tau;
+    }
+    let s = (x - x0) / h;
+    let (s2, s3) = (s * s, s * s * s);
+    let y = (2.0 * s3 - 3.0 * s2 + 1.0) * f0
+        + (s3 - 2.0 * s2 + s) * h * d0
+        + (-2.0 * s3 + 3.0 * s2) * f1
+        + (s3 - s2) * h * d1;
+    y.clamp(f0, f1)
 }
 
 fn check_range(range: [f64; 2]) -> Result<(), StatsError> {
@@ -131,6 +189,10 @@ fn check_range(range: [f64; 2]) -> Result<(), StatsError> {
 /// CDF of the projection of `pdf` (a density with respect to the binning's measure) onto
 /// parameter axis `axis`, accurate enough for a KS test with `n_samples` samples.
 ///
+/// The marginal density `f(t) = ∫ pdf J d(other)` over the section [`Binning::section`] is
+/// integrated by adaptive Gauss–Legendre quadrature (one piece per grid cell spanned, times
+/// `2^min_depth`, to absolute accuracy `ε / (8 · range)`), then tabulated as in the module docs.
+///
 /// # Errors
 /// Invalid options, or a density whose mass is not finite and positive or that is negative
 /// somewhere.
@@ -142,98 +204,178 @@ pub fn projection_cdf<B: Binning + ?Sized>(
     opts: &QuadratureOptions,
 ) -> Result<TabulatedCdf, StatsError> {
     opts.validate()?;
+    let rule = GaussLegendre::new(opts.order);
     let grid = binning.grid();
-    let (range, other) = match axis {
-        Axis::U => (grid.u_range(), grid.v_range()),
-        Axis::V => (grid.v_range(), grid.u_range()),
+    let (range, other, other_cells, own_cells) = match axis {
+        Axis::U => (grid.u_range(), grid.v_range(), grid.nv(), grid.nu()),
+        Axis::V => (grid.v_range(), grid.u_range(), grid.nu(), grid.nv()),
     };
-    let mass = |a: f64, b: f64, tol: f64| {
-        let (u, v) = match axis {
-            Axis::U => ([a, b], other),
-            Axis::V => (other, [a, b]),
-        };
-        // The tolerance is always valid (positive, finite) by construction.
-        integrate_rect(pdf, binning, u, v, tol, opts).map_or(f64::NAN, |r| r.value)
+    let eps = epsilon(n_samples, opts);
+    let inner_tol = 0.125 * eps / (range[1] - range[0]);
+    let marginal = |t: f64| -> f64 {
+        binning
+            .section(axis, t)
+            .into_iter()
+            .map(|[c0, c1]| {
+                let frac = ((c1 - c0) / (other[1] - other[0])).clamp(0.0, 1.0);
+                let pieces =
+                    ((frac * other_cells as f64).ceil().max(1.0) as usize) << opts.min_depth;
+                let g = |s: f64| {
+                    let uv = match axis {
+                        Axis::U => [t, s],
+                        Axis::V => [s, t],
+                    };
+                    pdf(binning.point_at(uv)) * binning.jacobian(uv)
+                };
+                integrate_1d(
+                    &g,
+                    [c0, c1],
+                    inner_tol,
+                    &rule,
+                    opts.max_depth.max(20),
+                    pieces,
+                )
+                .value
+            })
+            .sum()
     };
-    build(range, n_samples, opts, &mass)
+    build(
+        range,
+        n_samples,
+        opts,
+        own_cells.max(MIN_INITIAL_SLABS),
+        &marginal,
+    )
 }
 
-/// Builds knots by adaptive halving; `mass(a, b, tol)` integrates the density over `[a, b]`.
+fn epsilon(n_samples: u64, opts: &QuadratureOptions) -> f64 {
+    opts.accuracy / (n_samples.max(1) as f64).sqrt()
+}
+
+/// Tabulates the CDF of the 1D density `f` on `range` by adaptive slabs.
 fn build(
     range: [f64; 2],
     n_samples: u64,
     opts: &QuadratureOptions,
-    mass: &(dyn Fn(f64, f64, f64) -> f64 + Sync),
+    initial_slabs: usize,
+    f: &(dyn Fn(f64) -> f64 + Sync),
 ) -> Result<TabulatedCdf, StatsError> {
-    let eps = opts.accuracy / (n_samples.max(1) as f64).sqrt();
-    let width = range[1] - range[0];
-    let slab_mass = |a: f64, b: f64| mass(a, b, (0.25 * eps * (b - a) / width).max(1e-300));
-    let slabs: Vec<Vec<(f64, f64)>> = (0..INITIAL_SLABS)
+    let rule = GaussLegendre::new(opts.order);
+    let ctx = Refine {
+        eps: epsilon(n_samples, opts),
+        width: range[1] - range[0],
+        rule: &rule,
+        f,
+    };
+    let at = |k: usize| {
+        if k == initial_slabs {
+            range[1]
+        } else {
+            range[0] + ctx.width * (k as f64 / initial_slabs as f64)
+        }
+    };
+    let edge_density: Vec<f64> = (0..=initial_slabs)
+        .into_par_iter()
+        .map(|k| f(at(k)))
+        .collect();
+    let slabs: Vec<Vec<Knot>> = (0..initial_slabs)
         .into_par_iter()
         .map(|i| {
-            let a = range[0] + width * (i as f64 / INITIAL_SLABS as f64);
-            let b = if i + 1 == INITIAL_SLABS {
-                range[1]
-            } else {
-                range[0] + width * ((i + 1) as f64 / INITIAL_SLABS as f64)
-            };
+            let (a, b) = (at(i), at(i + 1));
             let mut out = Vec::new();
-            refine(a, b, slab_mass(a, b), eps, MAX_KNOT_DEPTH, &slab_mass, &mut out);
+            let ends = (edge_density[i], edge_density[i + 1]);
+            ctx.refine(a, b, ctx.mass(a, b), ends, MAX_KNOT_DEPTH, &mut out);
             out
         })
         .collect();
     let mut knots = vec![range[0]];
     let mut values = vec![0.0];
+    let mut densities = vec![edge_density[0]];
     let mut acc = 0.0;
-    for (b, m) in slabs.into_iter().flatten() {
-        if !m.is_finite() {
-            return Err(StatsError::InvalidMass { mass: m });
+    for k in slabs.into_iter().flatten() {
+        if !(k.mass.is_finite() && k.density.is_finite()) {
+            return Err(StatsError::InvalidMass { mass: k.mass });
         }
-        acc += m;
-        knots.push(b);
+        acc += k.mass;
+        knots.push(k.at);
         values.push(acc);
+        densities.push(k.density.max(0.0));
     }
-    TabulatedCdf::new(knots, values)
+    TabulatedCdf::with_densities(knots, values, densities)
 }
 
-/// Appends `(right knot, mass)` pairs covering `[a, b]` (whose mass is `m`).
-///
-/// A slab is accepted when its mass is at most `eps` (linear interpolation cannot then be off by
-/// more than `eps`), or when linear interpolation predicts the integrated CDF at the midpoint
-/// *and* at both quarter points within `eps` (the quarter check guards against a feature
-/// centred on the midpoint); it then contributes knots at its quarters. Otherwise both halves
-/// are refined.
-fn refine(
-    a: f64,
-    b: f64,
-    m: f64,
+/// The right end of an accepted slab.
+struct Knot {
+    at: f64,
+    mass: f64,
+    density: f64,
+}
+
+struct Refine<'a> {
     eps: f64,
-    depth_left: u32,
-    slab_mass: &(dyn Fn(f64, f64) -> f64 + Sync),
-    out: &mut Vec<(f64, f64)>,
-) {
-    let h = b - a;
-    let (x1, x2, x3) = (a + 0.25 * h, a + 0.5 * h, a + 0.75 * h);
-    if m.abs() <= eps || depth_left == 0 || !m.is_finite() || !(a < x1 && x3 < b) {
-        out.push((b, m));
-        return;
+    width: f64,
+    rule: &'a GaussLegendre,
+    f: &'a (dyn Fn(f64) -> f64 + Sync),
+}
+
+impl Refine<'_> {
+    fn mass(&self, a: f64, b: f64) -> f64 {
+        self.rule.integrate_1d(self.f, a, b)
     }
-    let q = [
-        slab_mass(a, x1),
-        slab_mass(x1, x2),
-        slab_mass(x2, x3),
-        slab_mass(x3, b),
-    ];
-    let (ml, mr) = (q[0] + q[1], q[2] + q[3]);
-    let pass = 0.5 * (ml - mr).abs() <= eps
-        && 0.5 * (q[0] - q[1]).abs() <= eps
-        && 0.5 * (q[2] - q[3]).abs() <= eps;
-    if pass {
-        out.extend([(x1, q[0]), (x2, q[1]), (x3, q[2]), (b, q[3])]);
-        return;
+
+    /// Appends the accepted slabs covering `[a, b]` (mass estimate `m`, densities `ends` at the
+    /// end points).
+    ///
+    /// The slab's quarters are integrated; it is accepted when (1) the quarters' sum agrees
+    /// with `m` within `ε/4 · (b − a)/range` (so the masses are accurate) and (2) the slab mass
+    /// is at most `ε`, or the monotone cubic Hermite interpolant over the slab reproduces the
+    /// integrated CDF at the midpoint and both quarter points within `ε`. Otherwise it is halved.
+    fn refine(
+        &self,
+        a: f64,
+        b: f64,
+        m: f64,
+        ends: (f64, f64),
+        depth_left: u32,
+        out: &mut Vec<Knot>,
+    ) {
+        let h = b - a;
+        let (x1, x2, x3) = (a + 0.25 * h, a + 0.5 * h, a + 0.75 * h);
+        let accept = |mass: f64, out: &mut Vec<Knot>| {
+            out.push(Knot {
+                at: b,
+                mass,
+                density: ends.1,
+            })
+        };
+        if !(a < x1 && x1 < x2 && x2 < x3 && x3 < b) {
+            accept(m, out);
+            return;
+        }
+        let q = [
+            self.mass(a, x1),
+            self.mass(x1, x2),
+            self.mass(x2, x3),
+            self.mass(x3, b),
+        ];
+        let total = q.iter().sum::<f64>();
+        let eps = self.eps;
+        let mass_ok = (total - m).abs() <= 0.25 * eps * h / self.width;
+        let small = total.abs() <= eps;
+        let interp_ok = total > 0.0 && {
+            let predict = |x: f64| hermite(a, b, 0.0, total, ends.0, ends.1, x);
+            (predict(x1) - q[0]).abs() <= eps
+                && (predict(x2) - q[0] - q[1]).abs() <= eps
+                && (predict(x3) - (total - q[3])).abs() <= eps
+        };
+        if (mass_ok && (small || interp_ok)) || depth_left == 0 || !total.is_finite() {
+            accept(total, out);
+            return;
+        }
+        let fm = (self.f)(x2);
+        self.refine(a, x2, q[0] + q[1], (ends.0, fm), depth_left - 1, out);
+        self.refine(x2, b, q[2] + q[3], (fm, ends.1), depth_left - 1, out);
     }
-    refine(a, x2, ml, eps, depth_left - 1, slab_mass, out);
-    refine(x2, b, mr, eps, depth_left - 1, slab_mass, out);
 }
 
 /// Parameter coordinates of points along an axis.

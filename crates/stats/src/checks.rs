@@ -283,7 +283,9 @@ pub fn mean_z_test(values: &[f64], reference: f64, alpha: f64) -> Result<TestOut
     let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
     // Floor the standard error at the rounding level of the values, so a zero-variance
     // estimator is compared with the reference to floating-point accuracy.
-    let se = (var / n).sqrt().max(1e-12 * mean.abs().max(reference.abs()));
+    let se = (var / n)
+        .sqrt()
+        .max(1e-12 * mean.abs().max(reference.abs()));
     let z = if se > 0.0 {
         (mean - reference) / se
     } else if mean == reference {

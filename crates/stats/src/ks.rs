@@ -332,7 +332,11 @@ fn lattice_inside(n: usize, m: usize, t: i64) -> f64 {
                 } else {
                     0.0
                 };
-                let from_below = if j > lo { prob[ju - 1] * (mi - j + 1) as f64 / rem } else { 0.0 };
+                let from_below = if j > lo {
+                    prob[ju - 1] * (mi - j + 1) as f64 / rem
+                } else {
+                    0.0
+                };
                 from_left + from_below
             };
             prob[ju] = v;

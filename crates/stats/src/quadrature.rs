@@ -132,7 +132,8 @@ pub fn expected_masses<B: Binning + ?Sized>(
     let opts = QuadratureOptions::default();
     let rule = GaussLegendre::new(opts.order);
     let n = n_samples.max(1) as f64;
-    let tol = |m: f64| (opts.accuracy * (n * m.abs()).max(1.0).sqrt() / n).max(opts.rel_floor * m.abs());
+    let tol =
+        |m: f64| (opts.accuracy * (n * m.abs()).max(1.0).sqrt() / n).max(opts.rel_floor * m.abs());
     integrate_all_bins(pdf, binning, &rule, &opts, &tol).masses
 }
 
@@ -149,7 +150,8 @@ pub fn expected_masses_with<B: Binning + ?Sized>(
     opts.validate()?;
     let rule = GaussLegendre::new(opts.order);
     let n = n_samples.max(1) as f64;
-    let tol = |m: f64| (opts.accuracy * (n * m.abs()).max(1.0).sqrt() / n).max(opts.rel_floor * m.abs());
+    let tol =
+        |m: f64| (opts.accuracy * (n * m.abs()).max(1.0).sqrt() / n).max(opts.rel_floor * m.abs());
     Ok(integrate_all_bins(pdf, binning, &rule, opts, &tol))
 }
 
@@ -206,7 +208,14 @@ pub fn integrate_rect<B: Binning + ?Sized>(
     }
     let rule = GaussLegendre::new(opts.order);
     let tol = |m: f64| abs_tol.max(opts.rel_floor * m.abs());
-    Ok(integrate_patches(f, binning, &binning.clip(u, v), &rule, opts, &tol))
+    Ok(integrate_patches(
+        f,
+        binning,
+        &binning.clip(u, v),
+        &rule,
+        opts,
+        &tol,
+    ))
 }
 
 /// `∫ f dμ` over the whole domain of `binning`, to total absolute tolerance `abs_tol`
@@ -529,13 +538,16 @@ fn adapt(
     sum
 }
 
-/// `∫_a^b f` by 1D adaptive Gauss–Legendre (halving, children get half the tolerance).
+/// `∫_a^b f` by 1D adaptive Gauss–Legendre: `pieces` equal initial pieces (tolerance shared
+/// equally), then halving where a piece and its halves disagree; children get half the
+/// tolerance.
 pub(crate) fn integrate_1d(
     f: &dyn Fn(f64) -> f64,
     range: [f64; 2],
     abs_tol: f64,
     rule: &GaussLegendre,
     max_depth: u32,
+    pieces: usize,
 ) -> Integral {
     #[allow(clippy::too_many_arguments)]
     fn rec(
@@ -567,9 +579,23 @@ pub(crate) fn integrate_1d(
         budget: u64::MAX,
         ..Tally::default()
     };
-    let coarse = rule.integrate_1d(f, range[0], range[1]);
-    tally.evals += rule.len();
-    let value = rec(f, rule, range[0], range[1], coarse, abs_tol, max_depth, &mut tally);
+    let pieces = pieces.max(1);
+    let mut value = 0.0;
+    for i in 0..pieces {
+        let [a, b] = split(range, pieces, i);
+        let coarse = rule.integrate_1d(f, a, b);
+        tally.evals += rule.len();
+        value += rec(
+            f,
+            rule,
+            a,
+            b,
+            coarse,
+            abs_tol / pieces as f64,
+            max_depth,
+            &mut tally,
+        );
+    }
     Integral {
         value,
         error_estimate: tally.err,
@@ -590,9 +616,16 @@ mod tests {
             let wsum: f64 = rule.points().map(|(_, w)| w).sum();
             assert_relative_eq!(wsum, 2.0, max_relative = 1e-13);
             for deg in 0..(2 * n) {
-                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
                 let got = rule.integrate_1d(&|x: f64| x.powi(deg as i32), -1.0, 1.0);
-                assert!((got - exact).abs() < 1e-13, "n={n} deg={deg}: {got} vs {exact}");
+                assert!(
+                    (got - exact).abs() < 1e-13,
+                    "n={n} deg={deg}: {got} vs {exact}"
+                );
             }
         }
     }
@@ -601,7 +634,7 @@ mod tests {
     fn adaptive_1d_handles_a_kink() {
         let rule = GaussLegendre::new(5);
         let f = |x: f64| (x - 0.3).abs();
-        let r = integrate_1d(&f, [0.0, 1.0], 1e-12, &rule, 40);
+        let r = integrate_1d(&f, [0.0, 1.0], 1e-12, &rule, 40, 1);
         assert!(r.converged);
         assert!((r.value - (0.045 + 0.245)).abs() < 1e-11, "{}", r.value);
     }

@@ -21,13 +21,20 @@ fn check(name: &str, c: &Calibration) {
         "{name}: {} / {} rejections at alpha = {} (rate {:.3}), binomial p = {:.3}, mean p-value {:.3}, KS uniformity p = {:.3}",
         c.rejections, c.runs, c.alpha, c.rate, c.binomial_p_value, mean_p, unif.p_value
     );
-    assert!(c.binomial_p_value > 1e-3, "{name}: rejection rate {} vs nominal {}", c.rate, c.alpha);
+    assert!(
+        c.binomial_p_value > 1e-3,
+        "{name}: rejection rate {} vs nominal {}",
+        c.rate,
+        c.alpha
+    );
 }
 
 fn chi_square_rect(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
     let bins = RectBinning::new(RECT_X, RECT_Y, 8, 8).unwrap();
-    let expected: Vec<f64> =
-        expected_masses(&product_pdf, &bins, n as u64).iter().map(|m| m * n as f64).collect();
+    let expected: Vec<f64> = expected_masses(&product_pdf, &bins, n as u64)
+        .iter()
+        .map(|m| m * n as f64)
+        .collect();
     calibrate(seeds, alpha, |seed| {
         let h = histogram(&bins, &product_points(seed, n));
         Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)
@@ -38,8 +45,14 @@ fn chi_square_rect(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
 fn ks_cos_theta(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
     let bins = SphereBinning::sphere(10, 20).unwrap();
     let lobe = test_lobe();
-    let cdf = projection_cdf(&bins, &|d| lobe.pdf(d), Axis::U, n as u64, &QuadratureOptions::default())
-        .unwrap();
+    let cdf = projection_cdf(
+        &bins,
+        &|d| lobe.pdf(d),
+        Axis::U,
+        n as u64,
+        &QuadratureOptions::default(),
+    )
+    .unwrap();
     calibrate(seeds, alpha, |seed| {
         let x = project(&bins, &lobe.points(seed, n), Axis::U).values;
         Ok(ks_onesample(&x, &|t| cdf.eval(t))?.p_value)
@@ -50,7 +63,10 @@ fn ks_cos_theta(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
 fn ks_two(seeds: &[u64], alpha: f64, n: usize, m: usize) -> Calibration {
     calibrate(seeds, alpha, |seed| {
         let a: Vec<f64> = cosine_points(2 * seed, n).iter().map(|d| d[2]).collect();
-        let b: Vec<f64> = cosine_points_inversion(2 * seed + 1, m).iter().map(|d| d[2]).collect();
+        let b: Vec<f64> = cosine_points_inversion(2 * seed + 1, m)
+            .iter()
+            .map(|d| d[2])
+            .collect();
         Ok(ks_twosample(&a, &b)?.p_value)
     })
     .unwrap()
@@ -71,21 +87,29 @@ fn a_test_that_never_rejects_is_flagged() {
     let c = calibrate(&(0..60).collect::<Vec<u64>>(), 0.2, |_| Ok(0.9)).unwrap();
     assert_eq!(c.rejections, 0);
     assert!(c.binomial_p_value < 1e-3);
-    let e = calibrate(&[1, 2], 0.2, |s| if s == 2 { Err(StatsError::InvalidAlpha(0.0)) } else { Ok(0.5) });
+    let e = calibrate(&[1, 2], 0.2, |s| {
+        if s == 2 {
+            Err(StatsError::InvalidAlpha(0.0))
+        } else {
+            Ok(0.5)
+        }
+    });
     assert!(e.is_err());
     assert!(calibrate(&[], 0.2, |_| Ok(0.5)).is_err());
 }
 
 #[test]
-#[ignore = "calibration run: ~1 minute in release mode"]
+#[ignore = "calibration run: ~3 minutes in release mode"]
 fn false_rejection_rates_are_nominal_over_200_seeds() {
     let seeds: Vec<u64> = (1000..1200).collect();
     // Chi-square on a narrow lobe with 10⁶ samples: the regime where a fixed per-bin rule fails.
     let bins = SphereBinning::sphere(20, 40).unwrap();
     let lobe = test_lobe();
     let n = 1_000_000;
-    let expected: Vec<f64> =
-        expected_masses(&|d| lobe.pdf(d), &bins, n as u64).iter().map(|m| m * n as f64).collect();
+    let expected: Vec<f64> = expected_masses(&|d| lobe.pdf(d), &bins, n as u64)
+        .iter()
+        .map(|m| m * n as f64)
+        .collect();
     let lobe_chi2 = calibrate(&seeds, 0.05, |seed| {
         let h = histogram(&bins, &lobe.points(seed, n));
         Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)
@@ -93,11 +117,20 @@ fn false_rejection_rates_are_nominal_over_200_seeds() {
     .unwrap();
     let runs = [
         ("chi-square lobe N=1e6", lobe_chi2),
-        ("chi-square rect N=1e5", chi_square_rect(&seeds, 0.05, 100_000)),
+        (
+            "chi-square rect N=1e5",
+            chi_square_rect(&seeds, 0.05, 100_000),
+        ),
         ("KS exact n=50", ks_cos_theta(&seeds, 0.05, 50)),
         ("KS asymptotic n=1e5", ks_cos_theta(&seeds, 0.05, 100_000)),
-        ("KS two-sample exact 1e4 x 1.5e4", ks_two(&seeds, 0.05, 10_000, 15_000)),
-        ("KS two-sample asymptotic 1e5 x 1e5", ks_two(&seeds, 0.05, 100_000, 100_000)),
+        (
+            "KS two-sample exact 1e4 x 1.5e4",
+            ks_two(&seeds, 0.05, 10_000, 15_000),
+        ),
+        (
+            "KS two-sample asymptotic 1e5 x 1e5",
+            ks_two(&seeds, 0.05, 100_000, 100_000),
+        ),
     ];
     for (name, c) in &runs {
         check(name, c);
@@ -106,14 +139,16 @@ fn false_rejection_rates_are_nominal_over_200_seeds() {
 }
 
 #[test]
-#[ignore = "calibration run at 10⁷ samples: ~1 minute in release mode"]
+#[ignore = "calibration run at 10⁷ samples: ~3 minutes in release mode"]
 fn chi_square_is_calibrated_at_ten_million_samples() {
     let seeds: Vec<u64> = (5000..5100).collect();
     let bins = SphereBinning::sphere(20, 40).unwrap();
     let lobe = test_lobe();
     let n = 10_000_000;
-    let expected: Vec<f64> =
-        expected_masses(&|d| lobe.pdf(d), &bins, n as u64).iter().map(|m| m * n as f64).collect();
+    let expected: Vec<f64> = expected_masses(&|d| lobe.pdf(d), &bins, n as u64)
+        .iter()
+        .map(|m| m * n as f64)
+        .collect();
     let c = calibrate(&seeds, 0.1, |seed| {
         let h = histogram(&bins, &lobe.points(seed, n));
         Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)

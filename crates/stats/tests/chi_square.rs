@@ -14,7 +14,11 @@ fn p_values_match_published_quantiles() {
         (124.342113, 100, 0.05),
         (135.806723, 100, 0.01),
     ] {
-        assert!((chi_square_sf(x, dof) - p).abs() < 1e-6, "dof {dof}: {}", chi_square_sf(x, dof));
+        assert!(
+            (chi_square_sf(x, dof) - p).abs() < 1e-6,
+            "dof {dof}: {}",
+            chi_square_sf(x, dof)
+        );
     }
     // dof = 2 has the closed form exp(−x/2).
     assert!((chi_square_sf(7.0, 2) - (-3.5f64).exp()).abs() < 1e-14);
@@ -37,7 +41,10 @@ fn zero_expected_with_observations_is_an_immediate_rejection() {
     assert_eq!(r.p_value, 0.0);
     assert!(r.statistic.is_infinite());
     assert_eq!(r.zero_mass_samples, 1);
-    assert!(r.summary().contains("samples where the pdf integrates to zero"));
+    assert!(
+        r.summary()
+            .contains("samples where the pdf integrates to zero")
+    );
     assert!(!r.outcome("chi2", 1e-9).passed);
     // Empty zero-expected cells are simply ignored.
     let r = chi_square_gof(&[10, 10, 0], &[10.0, 10.0, 0.0], DEFAULT_MIN_EXPECTED).unwrap();
@@ -46,7 +53,10 @@ fn zero_expected_with_observations_is_an_immediate_rejection() {
 
 #[test]
 fn invalid_inputs_are_errors() {
-    assert!(matches!(chi_square_gof(&[1, 2], &[1.0], 5.0), Err(StatsError::LengthMismatch { .. })));
+    assert!(matches!(
+        chi_square_gof(&[1, 2], &[1.0], 5.0),
+        Err(StatsError::LengthMismatch { .. })
+    ));
     assert!(matches!(
         chi_square_gof(&[1, 2], &[1.0, -1.0], 5.0),
         Err(StatsError::InvalidExpected { index: 1, .. })
@@ -55,10 +65,19 @@ fn invalid_inputs_are_errors() {
         chi_square_gof(&[1, 2], &[f64::NAN, 1.0], 5.0),
         Err(StatsError::InvalidExpected { index: 0, .. })
     ));
-    assert!(matches!(chi_square_gof(&[1, 2], &[1.0, 1.0], 0.0), Err(StatsError::InvalidMinExpected(_))));
-    assert!(matches!(chi_square_gof(&[10], &[10.0], 5.0), Err(StatsError::TooFewCells { cells: 1 })));
+    assert!(matches!(
+        chi_square_gof(&[1, 2], &[1.0, 1.0], 0.0),
+        Err(StatsError::InvalidMinExpected(_))
+    ));
+    assert!(matches!(
+        chi_square_gof(&[10], &[10.0], 5.0),
+        Err(StatsError::TooFewCells { cells: 1 })
+    ));
     // Everything pooled into one cell: nothing to test.
-    assert!(matches!(chi_square_gof(&[1, 2], &[1.0, 2.0], 5.0), Err(StatsError::TooFewCells { .. })));
+    assert!(matches!(
+        chi_square_gof(&[1, 2], &[1.0, 2.0], 5.0),
+        Err(StatsError::TooFewCells { .. })
+    ));
 }
 
 proptest! {

@@ -3,10 +3,6 @@
 mod common;
 
 use common::*;
-use stats::{
-    KsMethod, StatsError, kolmogorov_cdf, kolmogorov_sf, ks_onesample, ks_onesample_p_value,
-    ks_statistic, ks_twosample, ks_twosample_p_value,
-};
 use statrs::distribution::Uniform;
 use statrs::function::factorial::{binomial, ln_binomial};
 use statrs::stats_tests::NaNPolicy;
@@ -14,13 +10,26 @@ use statrs::stats_tests::ks_test::{
     KSOneSampleAlternativeMethod, KSTwoSampleAlternativeMethod, ks_onesample as statrs_ks1,
     ks_twosample as statrs_ks2,
 };
+use stats::{
+    KsMethod, StatsError, kolmogorov_cdf, kolmogorov_sf, ks_onesample, ks_onesample_p_value,
+    ks_statistic, ks_twosample, ks_twosample_p_value,
+};
 
 #[test]
 fn kolmogorov_distribution_quantiles() {
     // Classical critical values of √n D: 1.2238 (90 %), 1.3581 (95 %), 1.6276 (99 %),
     // and the median 0.8276.
-    for (x, p) in [(1.2238, 0.90), (1.3581, 0.95), (1.6276, 0.99), (0.8276, 0.5)] {
-        assert!((kolmogorov_cdf(x) - p).abs() < 1e-4, "K({x}) = {}", kolmogorov_cdf(x));
+    for (x, p) in [
+        (1.2238, 0.90),
+        (1.3581, 0.95),
+        (1.6276, 0.99),
+        (0.8276, 0.5),
+    ] {
+        assert!(
+            (kolmogorov_cdf(x) - p).abs() < 1e-4,
+            "K({x}) = {}",
+            kolmogorov_cdf(x)
+        );
         assert!((kolmogorov_sf(x) - (1.0 - p)).abs() < 1e-4);
     }
     assert_eq!(kolmogorov_cdf(0.0), 0.0);
@@ -31,7 +40,9 @@ fn kolmogorov_distribution_quantiles() {
 fn kolmogorov_mean_is_sqrt_half_pi_ln2() {
     // E[K] = ∫ P(K > x) dx = √(π/2) ln 2: an independent check of the whole curve.
     let h = 1e-4;
-    let mean: f64 = (0..100_000).map(|i| kolmogorov_sf((i as f64 + 0.5) * h) * h).sum();
+    let mean: f64 = (0..100_000)
+        .map(|i| kolmogorov_sf((i as f64 + 0.5) * h) * h)
+        .sum();
     let exact = (std::f64::consts::PI / 2.0).sqrt() * std::f64::consts::LN_2;
     assert!((mean - exact).abs() < 1e-8, "{mean} vs {exact}");
 }
@@ -100,13 +111,25 @@ fn large_statistics_match_doubled_smirnov_and_statrs() {
     // For d ≥ ½ the events D⁺ ≥ d and D⁻ ≥ d are disjoint: P(D ≥ d) = 2 P(D⁺ ≥ d) exactly.
     let unif = Uniform::new(0.0, 1.0).unwrap();
     for n in [3usize, 8, 20] {
-        let x: Vec<f64> = uniform_sample(n as u64, n).iter().map(|u| 0.35 * u).collect();
+        let x: Vec<f64> = uniform_sample(n as u64, n)
+            .iter()
+            .map(|u| 0.35 * u)
+            .collect();
         let r = ks_onesample(&x, &|t| t).unwrap();
         assert!(r.statistic >= 0.5);
-        let (_, p) = statrs_ks1(x, &unif, KSOneSampleAlternativeMethod::TwoSidedExact, NaNPolicy::Error)
-            .unwrap();
+        let (_, p) = statrs_ks1(
+            x,
+            &unif,
+            KSOneSampleAlternativeMethod::TwoSidedExact,
+            NaNPolicy::Error,
+        )
+        .unwrap();
         let smirnov = 2.0 * smirnov_plus(r.statistic, n);
-        assert!((r.p_value - smirnov).abs() <= 1e-12 * smirnov.max(1e-300), "{} vs {smirnov}", r.p_value);
+        assert!(
+            (r.p_value - smirnov).abs() <= 1e-12 * smirnov.max(1e-300),
+            "{} vs {smirnov}",
+            r.p_value
+        );
         assert!((r.p_value - p).abs() <= 1e-9 * p + 1e-15);
     }
 }
@@ -127,7 +150,10 @@ fn exact_one_sample_matches_simulation() {
         let emp = ds.iter().filter(|&&v| v >= d).count() as f64 / reps as f64;
         let p = ks_onesample_p_value(d, n);
         let sd = (p * (1.0 - p) / reps as f64).sqrt();
-        assert!((emp - p).abs() < 4.0 * sd, "d = {d}: simulated {emp}, exact {p}");
+        assert!(
+            (emp - p).abs() < 4.0 * sd,
+            "d = {d}: simulated {emp}, exact {p}"
+        );
     }
     // Marsaglia, Tsang & Wang's worked example: P(D_10 < 0.274) = 0.6284796154565043.
     assert!((1.0 - ks_onesample_p_value(0.274, 10) - 0.628_479_615_456_504_3).abs() < 1e-12);
@@ -145,11 +171,20 @@ fn asymptotic_branch_agrees_with_the_exact_distribution_near_the_switch() {
             .collect();
         let ours = ks_onesample(&x, &|t| t).unwrap();
         assert_eq!(ours.method, KsMethod::Asymptotic);
-        let (_, exact) =
-            statrs_ks1(x, &unif, KSOneSampleAlternativeMethod::TwoSidedExact, NaNPolicy::Error).unwrap();
+        let (_, exact) = statrs_ks1(
+            x,
+            &unif,
+            KSOneSampleAlternativeMethod::TwoSidedExact,
+            NaNPolicy::Error,
+        )
+        .unwrap();
         if exact > 1e-5 {
             let rel = (ours.p_value - exact).abs() / exact;
-            assert!(rel < 0.03 || (ours.p_value - exact).abs() < 2e-3, "seed {seed}: {} vs {exact}", ours.p_value);
+            assert!(
+                rel < 0.03 || (ours.p_value - exact).abs() < 2e-3,
+                "seed {seed}: {} vs {exact}",
+                ours.p_value
+            );
         }
     }
 }
@@ -186,7 +221,10 @@ fn exact_two_sample_matches_enumeration() {
             let emp = all.iter().filter(|&&v| v >= t).count() as f64 / all.len() as f64;
             let d = t as f64 / (n * m) as f64;
             let p = ks_twosample_p_value(d, n, m);
-            assert!((p - emp).abs() < 1e-12, "n = {n}, m = {m}, D = {d}: {p} vs {emp}");
+            assert!(
+                (p - emp).abs() < 1e-12,
+                "n = {n}, m = {m}, D = {d}: {p} vs {emp}"
+            );
         }
     }
 }
@@ -198,7 +236,8 @@ fn gnedenko_korolyuk(n: usize, k: usize) -> f64 {
     while j * k <= n {
         let sign = if j % 2 == 1 { 1.0 } else { -1.0 };
         s += sign
-            * (ln_binomial(2 * n as u64, (n - j * k) as u64) - ln_binomial(2 * n as u64, n as u64)).exp();
+            * (ln_binomial(2 * n as u64, (n - j * k) as u64) - ln_binomial(2 * n as u64, n as u64))
+                .exp();
         j += 1;
     }
     2.0 * s
@@ -213,7 +252,10 @@ fn exact_two_sample_matches_gnedenko_korolyuk() {
             let k = (x * (2.0 * n as f64).sqrt()).round() as usize;
             let exact = gnedenko_korolyuk(n, k);
             let r = ks_twosample_p_value(k as f64 / n as f64, n, n);
-            assert!((r - exact).abs() < 1e-9 * exact.max(1e-6), "n = {n}, k = {k}: {r} vs {exact}");
+            assert!(
+                (r - exact).abs() < 1e-9 * exact.max(1e-6),
+                "n = {n}, k = {k}: {r} vs {exact}"
+            );
             exact_seen = true;
         }
         assert!(exact_seen);
@@ -231,22 +273,42 @@ fn asymptotic_two_sample_agrees_with_gnedenko_korolyuk_at_large_n() {
         let k = (x * (2.0 * n as f64).sqrt()).round() as usize;
         let exact = gnedenko_korolyuk(n, k);
         let p = ks_twosample_p_value(k as f64 / n as f64, n, n);
-        assert!((p - exact).abs() < 0.01 * exact, "k = {k}: asymptotic {p} vs exact {exact}");
+        assert!(
+            (p - exact).abs() < 0.01 * exact,
+            "k = {k}: asymptotic {p} vs exact {exact}"
+        );
     }
 }
 
 #[test]
 fn two_sample_matches_statrs_and_handles_ties() {
-    let a: Vec<f64> = uniform_sample(1, 30).iter().map(|u| (u * 20.0).floor()).collect();
-    let b: Vec<f64> = uniform_sample(2, 50).iter().map(|u| (u * 20.0).floor() + 1.0).collect();
+    let a: Vec<f64> = uniform_sample(1, 30)
+        .iter()
+        .map(|u| (u * 20.0).floor())
+        .collect();
+    let b: Vec<f64> = uniform_sample(2, 50)
+        .iter()
+        .map(|u| (u * 20.0).floor() + 1.0)
+        .collect();
     let ours = ks_twosample(&a, &b).unwrap();
-    let (d, _) = statrs_ks2(a.clone(), b.clone(), KSTwoSampleAlternativeMethod::TwoSidedExact, NaNPolicy::Error)
-        .unwrap();
+    let (d, _) = statrs_ks2(
+        a.clone(),
+        b.clone(),
+        KSTwoSampleAlternativeMethod::TwoSidedExact,
+        NaNPolicy::Error,
+    )
+    .unwrap();
     assert!((ours.statistic - d).abs() < 1e-12);
     let x = uniform_sample(3, 40);
     let y: Vec<f64> = uniform_sample(4, 60).iter().map(|u| u * 1.2).collect();
     let ours = ks_twosample(&x, &y).unwrap();
-    let (d, p) = statrs_ks2(x, y, KSTwoSampleAlternativeMethod::TwoSidedExact, NaNPolicy::Error).unwrap();
+    let (d, p) = statrs_ks2(
+        x,
+        y,
+        KSTwoSampleAlternativeMethod::TwoSidedExact,
+        NaNPolicy::Error,
+    )
+    .unwrap();
     assert!((ours.statistic - d).abs() < 1e-12);
     assert!((ours.p_value - p).abs() < 1e-9, "{} vs {p}", ours.p_value);
     assert_eq!(ours.method, KsMethod::Exact);
@@ -263,12 +325,18 @@ fn identical_samples_give_p_one_without_hanging() {
 
 #[test]
 fn invalid_inputs_are_errors() {
-    assert!(matches!(ks_onesample(&[], &|t| t), Err(StatsError::TooFewSamples { .. })));
+    assert!(matches!(
+        ks_onesample(&[], &|t| t),
+        Err(StatsError::TooFewSamples { .. })
+    ));
     assert!(matches!(
         ks_onesample(&[0.2, f64::NAN], &|t| t),
         Err(StatsError::NonFiniteSample { index: 1 })
     ));
-    assert!(matches!(ks_onesample(&[0.2], &|t| 3.0 * t + 0.5), Err(StatsError::InvalidCdfValue { .. })));
+    assert!(matches!(
+        ks_onesample(&[0.2], &|t| 3.0 * t + 0.5),
+        Err(StatsError::InvalidCdfValue { .. })
+    ));
     assert!(ks_twosample(&[1.0], &[]).is_err());
     assert!(ks_twosample(&[1.0, f64::INFINITY], &[0.0]).is_err());
 }

@@ -27,7 +27,13 @@ fn chi_square_accepts_exact_samplers() {
     assert!(r.p_value >= ALPHA, "product density: {}", r.summary());
 
     let disc = DiscBinning::new(20, 20).unwrap();
-    let r = chi_square_test(&disc, &uniform_disc_pdf, &disc_points(2, 100_000, 1.0), &opts()).unwrap();
+    let r = chi_square_test(
+        &disc,
+        &uniform_disc_pdf,
+        &disc_points(2, 100_000, 1.0),
+        &opts(),
+    )
+    .unwrap();
     assert!(r.p_value >= ALPHA, "uniform disc: {}", r.summary());
 
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
@@ -44,7 +50,13 @@ fn chi_square_accepts_exact_samplers() {
 #[test]
 fn chi_square_rejects_cosine_samples_reported_as_uniform() {
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
-    let r = chi_square_test(&hemi, &uniform_hemisphere_pdf, &cosine_points(3, 10_000), &opts()).unwrap();
+    let r = chi_square_test(
+        &hemi,
+        &uniform_hemisphere_pdf,
+        &cosine_points(3, 10_000),
+        &opts(),
+    )
+    .unwrap();
     assert!(r.p_value < ALPHA, "{}", r.summary());
 }
 
@@ -73,7 +85,13 @@ fn chi_square_rejects_a_lobe_tilted_by_two_degrees() {
 fn chi_square_rejects_samples_outside_the_support() {
     // The disc shrunk by 1 %: an empty ring where the pdf expects samples.
     let disc = DiscBinning::new(20, 20).unwrap();
-    let r = chi_square_test(&disc, &uniform_disc_pdf, &disc_points(7, 100_000, 0.99), &opts()).unwrap();
+    let r = chi_square_test(
+        &disc,
+        &uniform_disc_pdf,
+        &disc_points(7, 100_000, 0.99),
+        &opts(),
+    )
+    .unwrap();
     assert!(r.p_value < ALPHA, "{}", r.summary());
     // Directions below the horizon for a hemisphere pdf: samples where the pdf integrates to zero.
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
@@ -108,8 +126,15 @@ fn ks_projections_accept_exact_samplers() {
 #[test]
 fn ks_projection_rejects_cosine_samples_reported_as_uniform() {
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
-    let o = ks_projection_test(&hemi, &uniform_hemisphere_pdf, &cosine_points(14, 2_000), Axis::U, ALPHA, &opts())
-        .unwrap();
+    let o = ks_projection_test(
+        &hemi,
+        &uniform_hemisphere_pdf,
+        &cosine_points(14, 2_000),
+        Axis::U,
+        ALPHA,
+        &opts(),
+    )
+    .unwrap();
     assert!(!o.passed, "{o}");
 }
 
@@ -118,7 +143,10 @@ fn ks_projection_rejects_a_slightly_shifted_distribution() {
     // Product-density samples shifted by +0.01 in x (0.3 % of the range).
     let rect = RectBinning::new(RECT_X, RECT_Y, 8, 8).unwrap();
     let good = product_points(15, 100_000);
-    let shifted: Vec<[f64; 2]> = good.iter().map(|p| [(p[0] + 0.01).min(RECT_X[1]), p[1]]).collect();
+    let shifted: Vec<[f64; 2]> = good
+        .iter()
+        .map(|p| [(p[0] + 0.01).min(RECT_X[1]), p[1]])
+        .collect();
     let o = ks_projection_test(&rect, &product_pdf, &good, Axis::U, ALPHA, &opts()).unwrap();
     assert!(o.passed, "{o}");
     let o = ks_projection_test(&rect, &product_pdf, &shifted, Axis::U, ALPHA, &opts()).unwrap();
@@ -174,7 +202,10 @@ fn pdf_consistency_accepts_matching_and_rejects_mismatching_pdfs() {
     let mut zero = good.clone();
     zero[3] = ([1.0, 0.0, 0.0], 0.0);
     let o = pdf_consistency(&zero, &cosine_pdf, 1e-6).unwrap();
-    assert!(!o.passed && o.detail.contains("1 samples with pdf <= 0"), "{o}");
+    assert!(
+        !o.passed && o.detail.contains("1 samples with pdf <= 0"),
+        "{o}"
+    );
     assert!(pdf_consistency::<[f64; 3]>(&[], &cosine_pdf, 1e-6).is_err());
 }
 
@@ -190,7 +221,11 @@ fn normalisation_accepts_unit_mass_and_rejects_three_percent_errors() {
     assert!(!o.passed && (o.statistic - 0.015).abs() < 1e-9, "{o}");
     let sphere = SphereBinning::sphere(10, 20).unwrap();
     let lobe = test_lobe();
-    assert!(normalisation(&sphere, &|d| lobe.pdf(d), 1.0, 1e-6, &opts()).unwrap().passed);
+    assert!(
+        normalisation(&sphere, &|d| lobe.pdf(d), 1.0, 1e-6, &opts())
+            .unwrap()
+            .passed
+    );
     // On the hemisphere the lobe loses the (tiny) part below the horizon.
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
     let o = normalisation(&hemi, &uniform_hemisphere_pdf, 1.0, 1e-9, &opts()).unwrap();
@@ -210,7 +245,11 @@ fn support_coverage_finds_holes_in_the_pdf() {
     let lobe = test_lobe();
     let truncated = |d: [f64; 3]| {
         let c = lobe.axis[0] * d[0] + lobe.axis[1] * d[1] + lobe.axis[2] * d[2];
-        if c > 80f64.to_radians().cos() { lobe.pdf(d) } else { 0.0 }
+        if c > 80f64.to_radians().cos() {
+            lobe.pdf(d)
+        } else {
+            0.0
+        }
     };
     let o = support_coverage(&hemi, &target, &truncated, 2, &opts()).unwrap();
     assert!(!o.passed && o.statistic > 0.01, "{o}");
@@ -218,7 +257,11 @@ fn support_coverage_finds_holes_in_the_pdf() {
     let disc = DiscBinning::new(16, 16).unwrap();
     let holed = |p: [f64; 2]| {
         let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-        if r > 0.995 && r < 0.999 { 0.0 } else { uniform_disc_pdf(p) }
+        if r > 0.995 && r < 0.999 {
+            0.0
+        } else {
+            uniform_disc_pdf(p)
+        }
     };
     let o = support_coverage(&disc, &uniform_disc_pdf, &holed, 4, &opts()).unwrap();
     assert!(!o.passed, "{o}");
@@ -242,7 +285,10 @@ fn z_test_accepts_unbiased_and_rejects_biased_estimators() {
     let o = mean_z_test(&biased, exact, ALPHA).unwrap();
     assert!(!o.passed, "{o}");
     // Zero-variance estimator (cosine sampling of cos θ) is exact.
-    let cos_vals: Vec<f64> = cosine_points(24, 1000).iter().map(|d| d[2] / cosine_pdf(*d)).collect();
+    let cos_vals: Vec<f64> = cosine_points(24, 1000)
+        .iter()
+        .map(|d| d[2] / cosine_pdf(*d))
+        .collect();
     assert!(mean_z_test(&cos_vals, PI, ALPHA).unwrap().passed);
     assert!(!mean_z_test(&cos_vals, PI * 1.001, ALPHA).unwrap().passed);
     // A single infinite value (pdf = 0 where f > 0) fails outright.
@@ -259,7 +305,11 @@ fn suite_applies_the_sidak_correction() {
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
     let pts = cosine_points(25, 50_000);
     let mut suite = Suite::new(0.01).unwrap();
-    suite.push(chi_square_test(&hemi, &cosine_pdf, &pts, &opts()).unwrap().outcome("chi2", 0.01));
+    suite.push(
+        chi_square_test(&hemi, &cosine_pdf, &pts, &opts())
+            .unwrap()
+            .outcome("chi2", 0.01),
+    );
     for axis in [Axis::U, Axis::V] {
         suite.push(ks_projection_test(&hemi, &cosine_pdf, &pts, axis, 0.01, &opts()).unwrap());
     }
@@ -274,11 +324,28 @@ fn suite_applies_the_sidak_correction() {
     // p = 0.006 rejects a lone test at α = 0.01, but with m = 2 the per-test level is
     // 1 − 0.99^½ ≈ 0.005013 and it passes. Deterministic outcomes do not count in m.
     let mut s = Suite::new(0.01).unwrap();
-    s.push(stats::TestOutcome::with_p_value("a", 1.0, 0.006, 0.01, String::new()));
+    s.push(stats::TestOutcome::with_p_value(
+        "a",
+        1.0,
+        0.006,
+        0.01,
+        String::new(),
+    ));
     assert!(!s.report().passed);
-    s.push(stats::TestOutcome::with_p_value("b", 1.0, 0.9, 0.01, String::new()));
+    s.push(stats::TestOutcome::with_p_value(
+        "b",
+        1.0,
+        0.9,
+        0.01,
+        String::new(),
+    ));
     assert!(s.report().passed);
-    s.push(stats::TestOutcome::deterministic("c", 0.0, false, String::new()));
+    s.push(stats::TestOutcome::deterministic(
+        "c",
+        0.0,
+        false,
+        String::new(),
+    ));
     let r = s.report();
     assert_eq!(r.m, 2);
     assert!(!r.passed && r.failures().map(|o| o.name.as_str()).collect::<Vec<_>>() == ["c"]);

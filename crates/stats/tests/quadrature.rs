@@ -24,14 +24,18 @@ fn product_density_masses_are_accurate_at_huge_sample_counts() {
     let exact: Vec<f64> = (0..bins.n_bins())
         .map(|b| {
             let (u, v) = bins.grid().cell(b).unwrap();
-            (product_cdf_x(u[1]) - product_cdf_x(u[0])) * (product_cdf_y(v[1]) - product_cdf_y(v[0]))
+            (product_cdf_x(u[1]) - product_cdf_x(u[0]))
+                * (product_cdf_y(v[1]) - product_cdf_y(v[0]))
         })
         .collect();
     for n in [1e4, 1e7, 1e10] {
         let masses = expected_masses(&product_pdf, &bins, n as u64);
         let worst = worst_noise_fraction(&masses, &exact, n);
         // Target is 0.01 √E; allow the estimate's slack but stay far below the noise.
-        assert!(worst < 0.02, "N = {n}: error is {worst} of the Poisson noise");
+        assert!(
+            worst < 0.02,
+            "N = {n}: error is {worst} of the Poisson noise"
+        );
     }
 }
 
@@ -39,19 +43,37 @@ fn product_density_masses_are_accurate_at_huge_sample_counts() {
 #[test]
 fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
     // Exponent 2000: the lobe (width ~0.02 rad) is much narrower than a bin, so refinement is needed.
-    let lobe = Lobe { axis: dir(0.5, 1.0), exponent: 2000.0 };
+    let lobe = Lobe {
+        axis: dir(0.5, 1.0),
+        exponent: 2000.0,
+    };
     let pdf = |d: [f64; 3]| lobe.pdf(d);
     let bins = SphereBinning::sphere(10, 20).unwrap();
-    let tight = QuadratureOptions { accuracy: 1e-7, max_depth: 16, min_depth: 3, ..Default::default() };
+    let tight = QuadratureOptions {
+        accuracy: 1e-7,
+        max_depth: 16,
+        min_depth: 3,
+        ..Default::default()
+    };
     let reference = expected_masses_with(&pdf, &bins, 1e12 as u64, &tight).unwrap();
     assert_eq!(reference.unconverged_bins, 0);
-    assert!((reference.total() - 1.0).abs() < 1e-11, "total {}", reference.total());
+    assert!(
+        (reference.total() - 1.0).abs() < 1e-11,
+        "total {}",
+        reference.total()
+    );
     let mut evals = 0;
     for n in [1e4, 1e6, 1e8, 1e10] {
         let t = expected_masses_with(&pdf, &bins, n as u64, &QuadratureOptions::default()).unwrap();
         let worst = worst_noise_fraction(&t.masses, &reference.masses, n);
-        assert!(worst < 0.02, "N = {n}: error is {worst} of the Poisson noise");
-        assert!(t.evaluations >= evals, "more samples must not mean less work");
+        assert!(
+            worst < 0.02,
+            "N = {n}: error is {worst} of the Poisson noise"
+        );
+        assert!(
+            t.evaluations >= evals,
+            "more samples must not mean less work"
+        );
         evals = t.evaluations;
     }
 }
@@ -60,10 +82,18 @@ fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
 fn a_fixed_coarse_rule_would_not_be_accurate_enough() {
     // Sanity check of the premise: the same lobe on a 4 x 4 midpoint rule per bin is off by
     // more than √E at N = 1e9, so the test above is not trivially satisfied.
-    let lobe = Lobe { axis: dir(0.5, 1.0), exponent: 2000.0 };
+    let lobe = Lobe {
+        axis: dir(0.5, 1.0),
+        exponent: 2000.0,
+    };
     let bins = SphereBinning::sphere(10, 20).unwrap();
     let pdf = |d: [f64; 3]| lobe.pdf(d);
-    let tight = QuadratureOptions { accuracy: 1e-7, max_depth: 16, min_depth: 3, ..Default::default() };
+    let tight = QuadratureOptions {
+        accuracy: 1e-7,
+        max_depth: 16,
+        min_depth: 3,
+        ..Default::default()
+    };
     let reference = expected_masses_with(&pdf, &bins, 1e12 as u64, &tight).unwrap();
     let coarse: Vec<f64> = (0..bins.n_bins())
         .map(|b| {
@@ -130,8 +160,16 @@ fn exact_clipped_area(u: [f64; 2], v: [f64; 2]) -> f64 {
         let xm = 0.5 * (x0 + x1);
         let c = (1.0 - xm * xm).sqrt();
         // Upper edge integral.
-        let up = if v[1] < c { v[1] * (x1 - x0) } else { arc(x1) - arc(x0) };
-        let lo = if v[0] > -c { v[0] * (x1 - x0) } else { -(arc(x1) - arc(x0)) };
+        let up = if v[1] < c {
+            v[1] * (x1 - x0)
+        } else {
+            arc(x1) - arc(x0)
+        };
+        let lo = if v[0] > -c {
+            v[0] * (x1 - x0)
+        } else {
+            -(arc(x1) - arc(x0))
+        };
         if up - lo > 0.0 {
             area += up - lo;
         }
@@ -148,7 +186,10 @@ fn disc_cells_are_clipped_exactly() {
         for (b, m) in masses.iter().enumerate() {
             let (u, v) = bins.grid().cell(b).unwrap();
             let exact = exact_clipped_area(u, v) / PI;
-            assert!((m - exact).abs() < 1e-12, "n = {n}, bin {b}: {m} vs {exact}");
+            assert!(
+                (m - exact).abs() < 1e-12,
+                "n = {n}, bin {b}: {m} vs {exact}"
+            );
             total += m;
         }
         assert!((total - 1.0).abs() < 1e-12);
@@ -169,9 +210,18 @@ fn disc_moments_of_a_smooth_density() {
 #[test]
 fn a_discontinuity_inside_a_bin_is_resolved() {
     // Step at x = 0.3 (not a grid line): p = 0.5 below, 1.5 above... normalised on [0,1]².
-    let step = |p: [f64; 2]| if p[0] < 0.3 { 0.5 } else { 1.0 + 0.5 * 0.3 / 0.7 };
+    let step = |p: [f64; 2]| {
+        if p[0] < 0.3 {
+            0.5
+        } else {
+            1.0 + 0.5 * 0.3 / 0.7
+        }
+    };
     let bins = RectBinning::unit_square(4, 4).unwrap();
-    let opts = QuadratureOptions { max_depth: 20, ..Default::default() };
+    let opts = QuadratureOptions {
+        max_depth: 20,
+        ..Default::default()
+    };
     let t = expected_masses_with(&step, &bins, 100_000, &opts).unwrap();
     assert_eq!(t.unconverged_bins, 0);
     for (b, m) in t.masses.iter().enumerate() {
@@ -180,7 +230,11 @@ fn a_discontinuity_inside_a_bin_is_resolved() {
         let above = (u[1] - 0.3f64.max(u[0])).max(0.0);
         let exact = (0.5 * below + (1.0 + 0.5 * 0.3 / 0.7) * above) * (v[1] - v[0]);
         let e = 1e5 * exact;
-        assert!((m * 1e5 - e).abs() < 0.02 * e.sqrt(), "bin {b}: {} vs {e}", m * 1e5);
+        assert!(
+            (m * 1e5 - e).abs() < 0.02 * e.sqrt(),
+            "bin {b}: {} vs {e}",
+            m * 1e5
+        );
     }
 }
 
@@ -194,7 +248,9 @@ fn results_do_not_depend_on_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| expected_masses_with(&pdf, &bins, 1_000_000, &QuadratureOptions::default()).unwrap())
+            .install(|| {
+                expected_masses_with(&pdf, &bins, 1_000_000, &QuadratureOptions::default()).unwrap()
+            })
     };
     assert_eq!(run(1), run(2));
 }
@@ -212,10 +268,22 @@ fn bad_options_are_rejected() {
     let bins = RectBinning::unit_square(2, 2).unwrap();
     let f = |_: [f64; 2]| 1.0;
     for opts in [
-        QuadratureOptions { order: 1, ..Default::default() },
-        QuadratureOptions { max_depth: 31, ..Default::default() },
-        QuadratureOptions { accuracy: f64::NAN, ..Default::default() },
-        QuadratureOptions { rel_floor: 0.0, ..Default::default() },
+        QuadratureOptions {
+            order: 1,
+            ..Default::default()
+        },
+        QuadratureOptions {
+            max_depth: 31,
+            ..Default::default()
+        },
+        QuadratureOptions {
+            accuracy: f64::NAN,
+            ..Default::default()
+        },
+        QuadratureOptions {
+            rel_floor: 0.0,
+            ..Default::default()
+        },
     ] {
         assert!(expected_masses_with(&f, &bins, 10, &opts).is_err());
     }

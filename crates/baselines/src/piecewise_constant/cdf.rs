@@ -61,10 +61,16 @@ pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
 /// `du ∈ [0,1)` of `u` inside it. The interval found always has positive width.
 #[inline]
 pub(crate) fn find_cell(cdf: &[f64], u: f64) -> (usize, f64) {
+    find_cell_by(cdf, |&c| c, u)
+}
+
+/// [`find_cell`] over entries whose CDF value is `key(entry)`.
+#[inline(always)]
+pub(crate) fn find_cell_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, u: f64) -> (usize, f64) {
     let n = cdf.len() - 1;
     // Interior entries ≤ u: cdf[0] = 0 ≤ u and cdf[n] = 1 > u are implied.
-    let i = cdf[1..n].partition_point(|&c| c <= u);
-    let (lo, hi) = (cdf[i], cdf[i + 1]);
+    let i = cdf[1..n].partition_point(|c| key(c) <= u);
+    let (lo, hi) = (key(&cdf[i]), key(&cdf[i + 1]));
     let du = ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
     (i, du)
 }
@@ -72,7 +78,12 @@ pub(crate) fn find_cell(cdf: &[f64], u: f64) -> (usize, f64) {
 /// The uniform number mapped by the CDF to position `du ∈ [0,1]` inside cell `i`.
 #[inline]
 pub(crate) fn invert_cell(cdf: &[f64], i: usize, du: f64) -> f64 {
-    let (lo, hi) = (cdf[i], cdf[i + 1]);
+    invert_in(cdf[i], cdf[i + 1], du)
+}
+
+/// The uniform number at position `du ∈ [0,1]` of the CDF interval `[lo, hi]`.
+#[inline]
+pub(crate) fn invert_in(lo: f64, hi: f64, du: f64) -> f64 {
     (lo + du * (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON)
 }
 

@@ -4,7 +4,10 @@ use partition_sampler::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, U
 use serde::{Deserialize, Serialize};
 
 use super::TabulatedError;
-use super::cdf::{cell_of, clamp_unit, fill_cdf, find_cell, invert_cell, place, validate_values};
+use super::cdf::{
+    cell_of, clamp_unit, fill_cdf, find_cell, find_cell_by, invert_cell, invert_in, place,
+    validate_values,
+};
 
 /// A density on a rectangle proportional to a `width × height` grid of non-negative values,
 /// constant on each cell, sampled by inverting the marginal CDF of the rows and then the
@@ -35,10 +38,11 @@ pub struct PiecewiseConstant2D {
     width: usize,
     height: usize,
     domain: Rect,
-    /// Row-major cell values.
-    values: Vec<f64>,
-    /// `height` conditional CDFs of `width + 1` entries each, concatenated.
-    conditional: Vec<f64>,
+    /// `height` rows of `width + 1` entries `[cdf_k, value_k]`, concatenated: the conditional
+    /// CDF of the row at its column boundaries, interleaved with the cell values (the last
+    /// entry's value is 0) so that the value of the sampled cell shares a cache line with the
+    /// CDF entries the binary search just read.
+    conditional: Vec<[f64; 2]>,
     /// Marginal CDF over rows, `height + 1` entries.
     marginal: Vec<f64>,
     /// `1 / ∫f`: the pdf of a cell is its value times this.
@@ -85,13 +89,16 @@ impl PiecewiseConstant2D {
         }
         validate_values(&values, width)?;
 
-        let mut conditional = vec![0.0; height * (width + 1)];
+        let mut conditional = Vec::with_capacity(height * (width + 1));
         let mut row_sums = Vec::with_capacity(height);
-        for (row, cdf) in values
-            .chunks_exact(width)
-            .zip(conditional.chunks_exact_mut(width + 1))
-        {
-            row_sums.push(fill_cdf(row, cdf));
+        let mut cdf = vec![0.0; width + 1];
+        for row in values.chunks_exact(width) {
+            row_sums.push(fill_cdf(row, &mut cdf));
+            conditional.extend(
+                cdf.iter()
+                    .zip(row.iter().chain([&0.0]))
+                    .map(|(&c, &v)| [c, v]),
+            );
         }
         let mut marginal = vec![0.0; height + 1];
         let total = fill_cdf(&row_sums, &mut marginal);
@@ -110,7 +117,6 @@ impl PiecewiseConstant2D {
             width,
             height,
             domain,
-            values,
             conditional,
             marginal,
             inv_integral: 1.0 / integral,
@@ -134,9 +140,25 @@ impl PiecewiseConstant2D {
         self.domain
     }
 
+    /// The value of cell `(column, row)` as given; 0 out of range.
+    pub fn value(&self, column: usize, row: usize) -> f64 {
+        if column >= self.width || row >= self.height {
+            return 0.0;
+        }
+        self.entry(column, row)[1]
+    }
+
     /// The cell values as given (row-major).
-    pub fn values(&self) -> &[f64] {
-        &self.values
+    pub fn values(&self) -> Vec<f64> {
+        self.conditional
+            .chunks_exact(self.width + 1)
+            .flat_map(|r| r[..self.width].iter().map(|e| e[1]))
+            .collect()
+    }
+
+    #[inline]
+    fn entry(&self, column: usize, row: usize) -> [f64; 2] {
+        self.conditional[row * (self.width + 1) + column]
     }
 
     /// `∫f` over the domain of the unnormalised step function (`Σ f · Δx·Δy`).
@@ -149,7 +171,7 @@ impl PiecewiseConstant2D {
         if column >= self.width || row >= self.height {
             return 0.0;
         }
-        self.values[row * self.width + column] * self.inv_integral * self.cell[0] * self.cell[1]
+        self.entry(column, row)[1] * self.inv_integral * self.cell[0] * self.cell[1]
     }
 
     /// Column and row of the cell containing `p`, `None` outside the (closed) domain.
@@ -184,15 +206,15 @@ impl Sampler2D for PiecewiseConstant2D {
     /// `f_rc / ∫f` w.r.t. area for `p` in cell `(c, r)`; 0 outside the domain.
     fn pdf(&self, p: Point2) -> f64 {
         match self.locate(p) {
-            Some(((c, _), (r, _))) => self.values[r * self.width + c] * self.inv_integral,
+            Some(((c, _), (r, _))) => self.entry(c, r)[1] * self.inv_integral,
             None => 0.0,
         }
     }
 
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
-            + (self.values.capacity() + self.conditional.capacity() + self.marginal.capacity())
-                * std::mem::size_of::<f64>()
+            + self.conditional.capacity() * std::mem::size_of::<[f64; 2]>()
+            + self.marginal.capacity() * std::mem::size_of::<f64>()
     }
 }
 
@@ -202,11 +224,9 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
     fn sample_square(&self, u: Point2) -> Sample2 {
         let (row, dv) = find_cell(&self.marginal, clamp_unit(u[1]));
         let start = row * (self.width + 1);
-        let (col, du) = find_cell(
-            &self.conditional[start..start + self.width + 1],
-            clamp_unit(u[0]),
-        );
-        let value = self.values[row * self.width + col];
+        let entries = &self.conditional[start..start + self.width + 1];
+        let (col, du) = find_cell_by(entries, |e| e[0], clamp_unit(u[0]));
+        let value = entries[col][1];
         let d = &self.domain;
         Sample2 {
             point: [
@@ -220,11 +240,11 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
     /// `None` outside the domain and on zero-density cells (where the warp is not bijective).
     fn invert(&self, p: Point2) -> Option<Point2> {
         let ((c, du), (r, dv)) = self.locate(p)?;
-        if self.values[r * self.width + c] == 0.0 {
+        let [lo, value] = self.entry(c, r);
+        if value == 0.0 {
             return None;
         }
-        let start = r * (self.width + 1);
-        let u0 = invert_cell(&self.conditional[start..start + self.width + 1], c, du);
+        let u0 = invert_in(lo, self.entry(c + 1, r)[0], du);
         let u1 = invert_cell(&self.marginal, r, dv);
         Some([u0, u1])
     }
@@ -264,7 +284,7 @@ impl From<PiecewiseConstant2D> for Table2DData {
             width: t.width,
             height: t.height,
             domain: [x0, y0, x1, y1],
-            values: t.values,
+            values: t.values(),
         }
     }
 }

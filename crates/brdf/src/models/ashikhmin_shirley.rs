@@ -20,14 +20,24 @@ use std::f64::consts::PI;
 pub(crate) const NAME: &str = "ashikhmin-shirley";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("nu", 100.0, Range::closed(0.0, 1e5), "Phong exponent along the tangent x"),
+    param(
+        "nu",
+        100.0,
+        Range::closed(0.0, 1e5),
+        "Phong exponent along the tangent x",
+    ),
     ParamInfo {
         key: "nv",
         default: ParamDefault::SameAs("nu"),
         range: Range::closed(0.0, 1e5),
         doc: "Phong exponent along the bitangent y",
     },
-    param("rs", 0.3, Range::closed(0.0, 1.0), "specular reflectance at normal incidence"),
+    param(
+        "rs",
+        0.3,
+        Range::closed(0.0, 1.0),
+        "specular reflectance at normal incidence",
+    ),
     param("rd", 0.6, Range::closed(0.0, 1.0), "diffuse reflectance"),
 ];
 

@@ -29,14 +29,54 @@ use std::f64::consts::{FRAC_1_PI, PI};
 pub(crate) const NAME: &str = "beard-maxwell";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("rs", 0.7, Range::closed(0.0, 1.0), "first-surface (specular) reflectance"),
-    param("rd", 0.5, Range::closed(0.0, 1.0), "volumetric Lambertian reflectance"),
-    param("rv", 0.2, Range::closed(0.0, 1.0), "volumetric directional reflectance"),
-    param("sigma", 0.15, Range::closed(0.005, 1.0), "facet tilt spread σ (radians)"),
-    param("omega", 1.0, Range::left_open(0.0, 90.0), "obscuration constant Ω (degrees)"),
-    param("tau", 0.0, Range::closed(0.0, 90.0), "shadowing decay τ (degrees; 0 = no shadowing recovery)"),
-    param("ior", 0.2, Range::left_open(0.0, 100.0), "refractive index, real part"),
-    param("kappa", 3.0, Range::closed(0.0, 100.0), "refractive index, imaginary part"),
+    param(
+        "rs",
+        0.7,
+        Range::closed(0.0, 1.0),
+        "first-surface (specular) reflectance",
+    ),
+    param(
+        "rd",
+        0.5,
+        Range::closed(0.0, 1.0),
+        "volumetric Lambertian reflectance",
+    ),
+    param(
+        "rv",
+        0.2,
+        Range::closed(0.0, 1.0),
+        "volumetric directional reflectance",
+    ),
+    param(
+        "sigma",
+        0.15,
+        Range::closed(0.005, 1.0),
+        "facet tilt spread σ (radians)",
+    ),
+    param(
+        "omega",
+        1.0,
+        Range::left_open(0.0, 90.0),
+        "obscuration constant Ω (degrees)",
+    ),
+    param(
+        "tau",
+        0.0,
+        Range::closed(0.0, 90.0),
+        "shadowing decay τ (degrees; 0 = no shadowing recovery)",
+    ),
+    param(
+        "ior",
+        0.2,
+        Range::left_open(0.0, 100.0),
+        "refractive index, real part",
+    ),
+    param(
+        "kappa",
+        3.0,
+        Range::closed(0.0, 100.0),
+        "refractive index, imaginary part",
+    ),
 ];
 
 /// Parameters of [`BeardMaxwell`].
@@ -63,7 +103,16 @@ pub struct BeardMaxwellParams {
 impl Default for BeardMaxwellParams {
     fn default() -> Self {
         let [rs, rd, rv, sigma, omega, tau, ior, kappa] = defaults(PARAMS);
-        Self { rs, rd, rv, sigma, omega, tau, ior, kappa }
+        Self {
+            rs,
+            rd,
+            rv,
+            sigma,
+            omega,
+            tau,
+            ior,
+            kappa,
+        }
     }
 }
 
@@ -80,13 +129,18 @@ impl BeardMaxwell {
     /// Validate the parameters and build the model.
     pub fn new(params: BeardMaxwellParams) -> Result<Self, ParamError> {
         let p = params;
-        validate(NAME, PARAMS, &[p.rs, p.rd, p.rv, p.sigma, p.omega, p.tau, p.ior, p.kappa])?;
+        validate(
+            NAME,
+            PARAMS,
+            &[p.rs, p.rd, p.rv, p.sigma, p.omega, p.tau, p.ior, p.kappa],
+        )?;
         let r0 = fresnel_conductor(1.0, p.ior, p.kappa);
         if !(r0 > 0.0) {
             return Err(ParamError::Constraint {
                 model: NAME,
-                message: "normal-incidence Fresnel reflectance R(0) must be > 0 (ior ≠ 1 or kappa > 0)"
-                    .into(),
+                message:
+                    "normal-incidence Fresnel reflectance R(0) must be > 0 (ior ≠ 1 or kappa > 0)"
+                        .into(),
             });
         }
         Ok(Self {
@@ -104,7 +158,16 @@ impl BeardMaxwell {
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [rs, rd, rv, sigma, omega, tau, ior, kappa] = super::take(v);
-        Self::new(BeardMaxwellParams { rs, rd, rv, sigma, omega, tau, ior, kappa })
+        Self::new(BeardMaxwellParams {
+            rs,
+            rd,
+            rv,
+            sigma,
+            omega,
+            tau,
+            ior,
+            kappa,
+        })
     }
 }
 
@@ -128,7 +191,11 @@ impl Brdf for BeardMaxwell {
         let ratio = fresnel_conductor(cos_b, p.ior, p.kappa) * self.inv_r0;
         let rho_fs = self.fs_scale * (-theta_n * theta_n * self.inv_sigma2).exp();
         let tilt = theta_n.to_degrees() / p.omega;
-        let recovery = if p.tau > 0.0 { (-2.0 * cos_b.acos().to_degrees() / p.tau).exp() } else { 0.0 };
+        let recovery = if p.tau > 0.0 {
+            (-2.0 * cos_b.acos().to_degrees() / p.tau).exp()
+        } else {
+            0.0
+        };
         let so = (1.0 + tilt * recovery) / (1.0 + tilt);
         let first = ratio * rho_fs * cos_n * cos_n / (ci * co) * so;
         let vol = p.rd * FRAC_1_PI + 2.0 * p.rv * FRAC_1_PI / (ci + co);

@@ -18,7 +18,12 @@ pub(crate) const NAME: &str = "blinn";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
     param("n", 100.0, Range::closed(0.0, 1e5), "half-vector exponent"),
-    param("ks", 0.6, Range::closed(0.0, 1.0), "specular albedo at normal incidence"),
+    param(
+        "ks",
+        0.6,
+        Range::closed(0.0, 1.0),
+        "specular albedo at normal incidence",
+    ),
     param("kd", 0.4, Range::closed(0.0, 1.0), "diffuse albedo"),
 ];
 
@@ -42,7 +47,11 @@ impl Blinn {
         validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
         let n = params.n;
         let norm = (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()));
-        Ok(Self { params, diffuse: params.kd * FRAC_1_PI, spec_scale: params.ks * norm })
+        Ok(Self {
+            params,
+            diffuse: params.kd * FRAC_1_PI,
+            spec_scale: params.ks * norm,
+        })
     }
 
     /// The parameters this model was built with.

@@ -22,8 +22,18 @@ use std::f64::consts::{FRAC_1_PI, PI};
 pub(crate) const NAME: &str = "cook-torrance";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("m", 0.2, Range::closed(0.001, 2.0), "RMS microfacet slope (Beckmann)"),
-    param("ior", 1.5, Range::left_open(1.0, 100.0), "relative index of refraction (Fresnel)"),
+    param(
+        "m",
+        0.2,
+        Range::closed(0.001, 2.0),
+        "RMS microfacet slope (Beckmann)",
+    ),
+    param(
+        "ior",
+        1.5,
+        Range::left_open(1.0, 100.0),
+        "relative index of refraction (Fresnel)",
+    ),
     param("ks", 0.8, Range::closed(0.0, 1.0), "specular weight"),
     param("kd", 0.2, Range::closed(0.0, 1.0), "diffuse albedo"),
 ];
@@ -62,7 +72,12 @@ impl CookTorrance {
     pub fn new(params: CookTorranceParams) -> Result<Self, ParamError> {
         validate(NAME, PARAMS, &[params.m, params.ior, params.ks, params.kd])?;
         let m2 = params.m * params.m;
-        Ok(Self { params, diffuse: params.kd * FRAC_1_PI, inv_m2: 1.0 / m2, d_scale: 1.0 / (PI * m2) })
+        Ok(Self {
+            params,
+            diffuse: params.kd * FRAC_1_PI,
+            inv_m2: 1.0 / m2,
+            d_scale: 1.0 / (PI * m2),
+        })
     }
 
     /// The parameters this model was built with.

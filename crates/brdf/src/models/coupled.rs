@@ -27,8 +27,18 @@ use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 pub(crate) const NAME: &str = "coupled";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("m", 0.2, Range::closed(0.01, 1.0), "RMS microfacet slope (Beckmann)"),
-    param("f0", 0.1, Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence"),
+    param(
+        "m",
+        0.2,
+        Range::closed(0.01, 1.0),
+        "RMS microfacet slope (Beckmann)",
+    ),
+    param(
+        "f0",
+        0.1,
+        Range::closed(0.0, 1.0),
+        "Fresnel reflectance at normal incidence",
+    ),
     param("kd", 0.8, Range::closed(0.0, 1.0), "matte albedo"),
 ];
 
@@ -105,13 +115,17 @@ impl Coupled {
             let (a0, a1) = (table[i], table[i + 1]);
             // ∫ (a0 + (a1−a0)(μ−m0)/h) μ dμ over [m0, m1]
             abar += a0 * 0.5 * (m1 * m1 - m0 * m0)
-                + (a1 - a0) / h * ((m1.powi(3) - m0.powi(3)) / 3.0 - m0 * 0.5 * (m1 * m1 - m0 * m0));
+                + (a1 - a0) / h
+                    * ((m1.powi(3) - m0.powi(3)) / 3.0 - m0 * 0.5 * (m1 * m1 - m0 * m0));
         }
         abar *= 2.0;
         model.albedo = table;
         model.max_raw_albedo = max_raw;
-        model.matte_scale =
-            if abar < 1.0 { params.kd * FRAC_1_PI / (1.0 - abar) } else { 0.0 };
+        model.matte_scale = if abar < 1.0 {
+            params.kd * FRAC_1_PI / (1.0 - abar)
+        } else {
+            0.0
+        };
         Ok(model)
     }
 

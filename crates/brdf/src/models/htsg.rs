@@ -40,11 +40,36 @@ use std::f64::consts::{FRAC_1_PI, PI};
 pub(crate) const NAME: &str = "htsg";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("sigma", 0.5, Range::left_open(0.0, 10.0), "RMS surface height σ0 (µm)"),
-    param("tau", 3.0, Range::left_open(0.0, 100.0), "autocorrelation length τ (µm)"),
-    param("lambda", 800.0, Range::closed(100.0, 10_000.0), "wavelength λ (nm)"),
-    param("ior", 1.5, Range::left_open(0.0, 100.0), "refractive index, real part"),
-    param("kappa", 0.0, Range::closed(0.0, 100.0), "refractive index, imaginary part (extinction)"),
+    param(
+        "sigma",
+        0.5,
+        Range::left_open(0.0, 10.0),
+        "RMS surface height σ0 (µm)",
+    ),
+    param(
+        "tau",
+        3.0,
+        Range::left_open(0.0, 100.0),
+        "autocorrelation length τ (µm)",
+    ),
+    param(
+        "lambda",
+        800.0,
+        Range::closed(100.0, 10_000.0),
+        "wavelength λ (nm)",
+    ),
+    param(
+        "ior",
+        1.5,
+        Range::left_open(0.0, 100.0),
+        "refractive index, real part",
+    ),
+    param(
+        "kappa",
+        0.0,
+        Range::closed(0.0, 100.0),
+        "refractive index, imaginary part (extinction)",
+    ),
     param("kd", 0.0, Range::closed(0.0, 1.0), "uniform-diffuse albedo"),
 ];
 
@@ -75,7 +100,14 @@ pub struct HtsgParams {
 impl Default for HtsgParams {
     fn default() -> Self {
         let [sigma, tau, lambda, ior, kappa, kd] = defaults(PARAMS);
-        Self { sigma, tau, lambda, ior, kappa, kd }
+        Self {
+            sigma,
+            tau,
+            lambda,
+            ior,
+            kappa,
+            kd,
+        }
     }
 }
 
@@ -94,7 +126,14 @@ pub struct Htsg {
 impl Htsg {
     /// Validate the parameters and build the model.
     pub fn new(params: HtsgParams) -> Result<Self, ParamError> {
-        let HtsgParams { sigma, tau, lambda, ior, kappa, kd } = params;
+        let HtsgParams {
+            sigma,
+            tau,
+            lambda,
+            ior,
+            kappa,
+            kd,
+        } = params;
         validate(NAME, PARAMS, &[sigma, tau, lambda, ior, kappa, kd])?;
         let lambda_um = lambda * 1e-3;
         Ok(Self {
@@ -112,7 +151,14 @@ impl Htsg {
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [sigma, tau, lambda, ior, kappa, kd] = super::take(v);
-        Self::new(HtsgParams { sigma, tau, lambda, ior, kappa, kd })
+        Self::new(HtsgParams {
+            sigma,
+            tau,
+            lambda,
+            ior,
+            kappa,
+            kd,
+        })
     }
 
     /// Single-direction shadowing `S1(θ)` for `cosθ = c`.
@@ -221,5 +267,76 @@ impl Brdf for Htsg {
     }
     fn name(&self) -> &str {
         NAME
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::direction_from_angles;
+    use crate::models::{Microfacet, MicrofacetParams};
+
+    #[test]
+    fn series_matches_rough_limit_for_large_g() {
+        for a in [0.0, 10.0, 100.0, 400.0] {
+            let (s, l) = (Htsg::series(150.0, a), (-a / 150.0f64).exp() / 150.0);
+            assert!((s - l).abs() < 0.02 * l, "a={a}: series {s} limit {l}");
+        }
+        // Small g: only the first terms matter,
+        // Σ ≈ e^{-g}(g e^{-a} + g²/4 e^{-a/2} + g³/18 e^{-a/3}).
+        let (g, a) = (1e-3f64, 0.5f64);
+        let expect = (-g).exp()
+            * (g * (-a).exp()
+                + g * g / 4.0 * (-a / 2.0).exp()
+                + g.powi(3) / 18.0 * (-a / 3.0).exp());
+        assert!((Htsg::series(g, a) - expect).abs() < 1e-9 * expect);
+    }
+
+    /// In the rough, near-normal regime HTSG reduces to a Beckmann microfacet BRDF with
+    /// RMS slope m = 2σ0/τ (checks the prefactor, G and S algebra independently).
+    #[test]
+    fn geometric_optics_limit_is_beckmann_microfacet() {
+        let p = HtsgParams {
+            sigma: 2.0,
+            tau: 12.0,
+            lambda: 500.0,
+            ior: 20.0,
+            kappa: 0.0,
+            kd: 0.0,
+        };
+        let h = Htsg::new(p).unwrap();
+        let m = 2.0 * p.sigma / p.tau;
+        let mf = Microfacet::beckmann(MicrofacetParams {
+            alpha_x: m,
+            alpha_y: m,
+            f0: 1.0,
+        })
+        .unwrap();
+        let wo = direction_from_angles(15.0, 0.0);
+        for (t, phi) in [(15.0, 180.0), (10.0, 170.0), (25.0, 190.0), (18.0, 150.0)] {
+            let wi = direction_from_angles(t, phi);
+            let half = (wo + wi).normalize();
+            let g1 = 1.0 / ((1.0 + mf.lambda(&wo)) * (1.0 + mf.lambda(&wi)));
+            let f = fresnel_conductor(wi.dot(&half), p.ior, p.kappa);
+            let expect = f * mf.d(&half) * g1 / (4.0 * wo.z * wi.z);
+            let got = h.eval(&wo, &wi);
+            assert!(
+                (got - expect).abs() < 0.02 * expect,
+                "θi={t}: {got} vs {expect}"
+            );
+        }
+    }
+
+    #[test]
+    fn effective_roughness_shrinks_at_grazing() {
+        let h = Htsg::default();
+        assert!((h.effective_sigma(1.0, 1.0) - 0.5).abs() < 1e-12);
+        let s = h.effective_sigma(0.05, 0.05);
+        assert!(s < 0.5 && s > 0.0);
+        // x e^{x²/2} = q is solved accurately.
+        let (ci, co) = (0.05, 0.3);
+        let q = (h.k_fn(ci) + h.k_fn(co)) / (8.0 * PI).sqrt();
+        let x = (((0.5 / h.effective_sigma(ci, co)).powi(2)) - 1.0).sqrt();
+        assert!((x * (0.5 * x * x).exp() - q).abs() < 1e-9 * q);
     }
 }

@@ -28,10 +28,30 @@ const MAX_LOG_LOBE: f64 = 600.0;
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
     param("kd", 0.3, Range::closed(0.0, 1.0), "diffuse albedo"),
-    param("ks", 0.6, Range::closed(0.0, 1.0), "lobe albedo scale (normal-incidence albedo when C = (−1,−1,1))"),
-    param("cx", -1.0, Range::closed(-10.0, 10.0), "lobe coefficient Cx (tangent)"),
-    param("cy", -1.0, Range::closed(-10.0, 10.0), "lobe coefficient Cy (bitangent)"),
-    param("cz", 0.95, Range::closed(-10.0, 10.0), "lobe coefficient Cz (normal)"),
+    param(
+        "ks",
+        0.6,
+        Range::closed(0.0, 1.0),
+        "lobe albedo scale (normal-incidence albedo when C = (−1,−1,1))",
+    ),
+    param(
+        "cx",
+        -1.0,
+        Range::closed(-10.0, 10.0),
+        "lobe coefficient Cx (tangent)",
+    ),
+    param(
+        "cy",
+        -1.0,
+        Range::closed(-10.0, 10.0),
+        "lobe coefficient Cy (bitangent)",
+    ),
+    param(
+        "cz",
+        0.95,
+        Range::closed(-10.0, 10.0),
+        "lobe coefficient Cz (normal)",
+    ),
     param("n", 20.0, Range::closed(0.0, 1e5), "lobe exponent"),
 ];
 
@@ -62,7 +82,10 @@ pub struct LafortuneParams {
 impl Default for LafortuneParams {
     fn default() -> Self {
         let [kd, ks, cx, cy, cz, n] = defaults(PARAMS);
-        Self { kd, lobes: vec![LafortuneLobe { ks, cx, cy, cz, n }] }
+        Self {
+            kd,
+            lobes: vec![LafortuneLobe { ks, cx, cy, cz, n }],
+        }
     }
 }
 
@@ -110,7 +133,11 @@ impl Lafortune {
                 n: l.n,
             });
         }
-        Ok(Self { diffuse: params.kd * FRAC_1_PI, lobes, params })
+        Ok(Self {
+            diffuse: params.kd * FRAC_1_PI,
+            lobes,
+            params,
+        })
     }
 
     /// The parameters this model was built with.
@@ -120,7 +147,10 @@ impl Lafortune {
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [kd, ks, cx, cy, cz, n] = super::take(v);
-        Self::new(LafortuneParams { kd, lobes: vec![LafortuneLobe { ks, cx, cy, cz, n }] })
+        Self::new(LafortuneParams {
+            kd,
+            lobes: vec![LafortuneLobe { ks, cx, cy, cz, n }],
+        })
     }
 }
 
@@ -155,7 +185,11 @@ impl Brdf for Lafortune {
     fn conserves_energy(&self) -> bool {
         let ks: f64 = self.params.lobes.iter().map(|l| l.ks).sum();
         self.params.kd + ks <= 1.0
-            && self.params.lobes.iter().all(|l| l.cx.abs() <= 1.0 && l.cy.abs() <= 1.0 && l.cz.abs() <= 1.0)
+            && self
+                .params
+                .lobes
+                .iter()
+                .all(|l| l.cx.abs() <= 1.0 && l.cy.abs() <= 1.0 && l.cz.abs() <= 1.0)
     }
     fn name(&self) -> &str {
         NAME

@@ -10,8 +10,12 @@ use std::f64::consts::FRAC_1_PI;
 
 pub(crate) const NAME: &str = "lambert";
 
-pub(crate) const PARAMS: &[ParamInfo] =
-    &[param("rho", 0.8, Range::closed(0.0, 1.0), "diffuse albedo ρ")];
+pub(crate) const PARAMS: &[ParamInfo] = &[param(
+    "rho",
+    0.8,
+    Range::closed(0.0, 1.0),
+    "diffuse albedo ρ",
+)];
 
 /// Parameters of [`Lambert`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,7 +42,10 @@ impl Lambert {
     /// Validate the parameters and build the model.
     pub fn new(params: LambertParams) -> Result<Self, ParamError> {
         validate(NAME, PARAMS, &[params.rho])?;
-        Ok(Self { params, value: params.rho * FRAC_1_PI })
+        Ok(Self {
+            params,
+            value: params.rho * FRAC_1_PI,
+        })
     }
 
     /// The parameters this model was built with.
@@ -55,7 +62,10 @@ impl Lambert {
 impl Default for Lambert {
     fn default() -> Self {
         let p = LambertParams::default();
-        Self { params: p, value: p.rho * FRAC_1_PI }
+        Self {
+            params: p,
+            value: p.rho * FRAC_1_PI,
+        }
     }
 }
 

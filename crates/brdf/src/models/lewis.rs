@@ -3,8 +3,9 @@
 //!
 //! `f_r = kd/π + ks · (n+2) / (4π (2 − 2^{−n/2})) · (n·h)^n`. The constant makes the lobe
 //! integrate to `ks` over solid angle *without* the cosine at normal incidence
-//! (`∫ (n·h)^n dσ = 4π(2 − 2^{−n/2})/(n+2)`), so the albedo is at most `ks`: the model conserves
-//! energy iff `kd + ks ≤ 1`. Parameters `n ∈ [0, 10⁵]` (default 50), `ks` (default 0.6), `kd`
+//! (`∫ (n·h)^n dσ = 4π(2 − 2^{−n/2})/(n+2)`). The cosine-weighted albedo of the lobe is then
+//! below `ks` at normal incidence and decreases with θo (checked numerically in the tests), so the
+//! model conserves energy iff `kd + ks ≤ 1`. Parameters `n ∈ [0, 10⁵]` (default 50), `ks` (default 0.6), `kd`
 //! (default 0.4). Reciprocal and isotropic. (Lewis' normalisation of the mirror-direction lobe,
 //! `(n+2)/(2π)`, is the [`Phong`](super::Phong) model of this crate.)
 
@@ -42,7 +43,11 @@ impl Lewis {
         validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
         let n = params.n;
         let norm = (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()));
-        Ok(Self { params, diffuse: params.kd * FRAC_1_PI, spec_scale: params.ks * norm })
+        Ok(Self {
+            params,
+            diffuse: params.kd * FRAC_1_PI,
+            spec_scale: params.ks * norm,
+        })
     }
 
     /// The parameters this model was built with.

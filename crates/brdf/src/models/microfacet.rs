@@ -27,14 +27,24 @@ pub(crate) const NAME_BECKMANN: &str = "beckmann";
 pub(crate) const NAME_GGX: &str = "ggx";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("alpha", 0.2, Range::closed(0.001, 2.0), "roughness α along the tangent x"),
+    param(
+        "alpha",
+        0.2,
+        Range::closed(0.001, 2.0),
+        "roughness α along the tangent x",
+    ),
     ParamInfo {
         key: "alpha_y",
         default: ParamDefault::SameAs("alpha"),
         range: Range::closed(0.001, 2.0),
         doc: "roughness α along the bitangent y",
     },
-    param("f0", 1.0, Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence (Schlick)"),
+    param(
+        "f0",
+        1.0,
+        Range::closed(0.0, 1.0),
+        "Fresnel reflectance at normal incidence (Schlick)",
+    ),
 ];
 
 /// Microfacet normal distribution.
@@ -60,7 +70,11 @@ pub struct MicrofacetParams {
 impl Default for MicrofacetParams {
     fn default() -> Self {
         let [alpha_x, alpha_y, f0] = defaults(PARAMS);
-        Self { alpha_x, alpha_y, f0 }
+        Self {
+            alpha_x,
+            alpha_y,
+            f0,
+        }
     }
 }
 
@@ -152,7 +166,14 @@ impl Microfacet {
 
     pub(crate) fn from_values(v: &[f64], dist: NormalDistribution) -> Result<Self, ParamError> {
         let [alpha_x, alpha_y, f0] = super::take(v);
-        Self::new(MicrofacetParams { alpha_x, alpha_y, f0 }, dist)
+        Self::new(
+            MicrofacetParams {
+                alpha_x,
+                alpha_y,
+                f0,
+            },
+            dist,
+        )
     }
 }
 

@@ -15,8 +15,18 @@ use std::f64::consts::PI;
 pub(crate) const NAME: &str = "minnaert";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("rho", 0.8, Range::closed(0.0, 1.0), "albedo at normal incidence"),
-    param("k", 0.7, Range::closed(0.0, 2.0), "Minnaert limb-darkening exponent"),
+    param(
+        "rho",
+        0.8,
+        Range::closed(0.0, 1.0),
+        "albedo at normal incidence",
+    ),
+    param(
+        "k",
+        0.7,
+        Range::closed(0.0, 2.0),
+        "Minnaert limb-darkening exponent",
+    ),
 ];
 
 /// Parameters of [`Minnaert`].
@@ -46,7 +56,10 @@ impl Minnaert {
     /// Validate the parameters and build the model.
     pub fn new(params: MinnaertParams) -> Result<Self, ParamError> {
         validate(NAME, PARAMS, &[params.rho, params.k])?;
-        Ok(Self { params, scale: params.rho * (params.k + 1.0) / (2.0 * PI) })
+        Ok(Self {
+            params,
+            scale: params.rho * (params.k + 1.0) / (2.0 * PI),
+        })
     }
 
     /// The parameters this model was built with.

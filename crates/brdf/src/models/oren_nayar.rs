@@ -20,7 +20,12 @@ pub(crate) const NAME: &str = "oren-nayar";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
     param("rho", 0.8, Range::closed(0.0, 1.0), "albedo ρ"),
-    param("sigma", 0.5, Range::closed(0.0, FRAC_PI_2), "facet slope deviation σ (radians)"),
+    param(
+        "sigma",
+        0.5,
+        Range::closed(0.0, FRAC_PI_2),
+        "facet slope deviation σ (radians)",
+    ),
 ];
 
 /// Parameters of [`OrenNayar`].
@@ -53,7 +58,11 @@ impl OrenNayar {
         validate(NAME, PARAMS, &[params.rho, params.sigma])?;
         let s2 = params.sigma * params.sigma;
         let k = params.rho * FRAC_1_PI;
-        Ok(Self { params, a: k * (1.0 - 0.5 * s2 / (s2 + 0.33)), b: k * 0.45 * s2 / (s2 + 0.09) })
+        Ok(Self {
+            params,
+            a: k * (1.0 - 0.5 * s2 / (s2 + 0.33)),
+            b: k * 0.45 * s2 / (s2 + 0.09),
+        })
     }
 
     /// The parameters this model was built with.
@@ -80,7 +89,11 @@ impl Brdf for OrenNayar {
             return 0.0;
         }
         let dxy = wi.x * wo.x + wi.y * wo.y;
-        if dxy > 0.0 { self.a + self.b * dxy / wi.z.max(wo.z) } else { self.a }
+        if dxy > 0.0 {
+            self.a + self.b * dxy / wi.z.max(wo.z)
+        } else {
+            self.a
+        }
     }
     fn is_isotropic(&self) -> bool {
         true

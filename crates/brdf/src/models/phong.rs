@@ -17,7 +17,12 @@ pub(crate) const NAME: &str = "phong";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
     param("n", 50.0, Range::closed(0.0, 1e5), "specular exponent"),
-    param("ks", 0.7, Range::closed(0.0, 1.0), "specular albedo at normal incidence"),
+    param(
+        "ks",
+        0.7,
+        Range::closed(0.0, 1.0),
+        "specular albedo at normal incidence",
+    ),
     param("kd", 0.3, Range::closed(0.0, 1.0), "diffuse albedo"),
 ];
 
@@ -82,7 +87,11 @@ impl Brdf for Phong {
             return 0.0;
         }
         let c = -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z;
-        let spec = if c > 0.0 { self.spec_scale * c.powf(self.params.n) } else { 0.0 };
+        let spec = if c > 0.0 {
+            self.spec_scale * c.powf(self.params.n)
+        } else {
+            0.0
+        };
         self.diffuse + spec
     }
     fn is_isotropic(&self) -> bool {

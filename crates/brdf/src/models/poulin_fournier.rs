@@ -35,10 +35,30 @@ use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 pub(crate) const NAME: &str = "poulin-fournier";
 
 pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("d", 2.0, Range::closed(2.0, 100.0), "cylinder spacing in radii (2 = touching)"),
-    param("n", 20.0, Range::closed(0.0, 1e4), "Phong exponent of the cylinder surface"),
-    param("ks", 0.6, Range::closed(0.0, 1.0), "specular albedo of the cylinder surface"),
-    param("kd", 0.4, Range::closed(0.0, 1.0), "diffuse albedo of the cylinder surface"),
+    param(
+        "d",
+        2.0,
+        Range::closed(2.0, 100.0),
+        "cylinder spacing in radii (2 = touching)",
+    ),
+    param(
+        "n",
+        20.0,
+        Range::closed(0.0, 1e4),
+        "Phong exponent of the cylinder surface",
+    ),
+    param(
+        "ks",
+        0.6,
+        Range::closed(0.0, 1.0),
+        "specular albedo of the cylinder surface",
+    ),
+    param(
+        "kd",
+        0.4,
+        Range::closed(0.0, 1.0),
+        "diffuse albedo of the cylinder surface",
+    ),
 ];
 
 /// Gauss–Legendre nodes/weights on [−1, 1] (12 points) for the specular panels.
@@ -112,7 +132,11 @@ impl PoulinFournier {
         let up2 = (d * a.sin()).clamp(-1.0, 1.0).acos();
         // Blocked set: {δ > up1} ∩ {|δ| > up2}. For d ≥ 2, up1 < −up2 only when up2 = 0.
         let upper = if up1 >= -up2 { up1.max(up2) } else { up1 }.min(FRAC_PI_2);
-        if psi >= 0.0 { (psi - FRAC_PI_2, psi + upper) } else { (psi - upper, psi + FRAC_PI_2) }
+        if psi >= 0.0 {
+            (psi - FRAC_PI_2, psi + upper)
+        } else {
+            (psi - upper, psi + FRAC_PI_2)
+        }
     }
 
     /// `∫_{a}^{b} f_spec(γ)(n·ωi)(n·ωo) dγ` by Gauss–Legendre on one panel.
@@ -157,7 +181,8 @@ impl Brdf for PoulinFournier {
         // Diffuse: ∫ (n·ωi)(n·ωo) dγ with n·ω = |ω_yz| cos(γ − ψ).
         let (ri, psi_i) = (wi.y.hypot(wi.z), wi.y.atan2(wi.z));
         let (ro, psi_o) = (wo.y.hypot(wo.z), wo.y.atan2(wo.z));
-        let prim = |g: f64| 0.5 * (g * (psi_i - psi_o).cos() + 0.5 * (2.0 * g - psi_i - psi_o).sin());
+        let prim =
+            |g: f64| 0.5 * (g * (psi_i - psi_o).cos() + 0.5 * (2.0 * g - psi_i - psi_o).sin());
         let diffuse = self.params.kd * FRAC_1_PI * ri * ro * (prim(g1) - prim(g0));
         // Specular: panels split at the peak γ_h and ± the lobe width.
         let mut spec = 0.0;
@@ -187,5 +212,74 @@ impl Brdf for PoulinFournier {
     }
     fn name(&self) -> &str {
         NAME
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute-force visibility of the cross-section point at angle γ from 2D direction angle ψ:
+    /// self-facing and no intersection with the neighbouring circles k = ±1..±8.
+    fn visible_brute(d: f64, psi: f64, gamma: f64) -> bool {
+        let (py, pz) = (gamma.sin(), gamma.cos());
+        let (uy, uz) = (psi.sin(), psi.cos());
+        if py * uy + pz * uz <= 0.0 {
+            return false;
+        }
+        for k in (-8..=8).filter(|&k| k != 0) {
+            let cy = k as f64 * d;
+            // Ray P + t u hits the unit circle at (cy, 0) for some t > 0?
+            let (oy, oz) = (py - cy, pz);
+            let b = oy * uy + oz * uz;
+            let c = oy * oy + oz * oz - 1.0;
+            let disc = b * b - c;
+            if disc > 0.0 && -b + disc.sqrt() > 0.0 && -b - disc.sqrt() > 1e-12 {
+                return false;
+            }
+        }
+        true
+    }
+
+    #[test]
+    fn visible_range_matches_ray_casting() {
+        for d in [2.0, 2.3, 3.0, 5.0] {
+            let pf = PoulinFournier::new(PoulinFournierParams {
+                d,
+                ..Default::default()
+            })
+            .unwrap();
+            for i in 0..60 {
+                let psi = -1.55 + 3.1 * i as f64 / 59.0;
+                let w = Vec3::new(0.0, psi.sin(), psi.cos());
+                let (lo, hi) = pf.visible_range(&w);
+                for j in 0..400 {
+                    let gamma = -PI + 2.0 * PI * (j as f64 + 0.5) / 400.0;
+                    if (gamma - lo).abs() < 1e-6 || (gamma - hi).abs() < 1e-6 {
+                        continue;
+                    }
+                    let inside = gamma > lo && gamma < hi;
+                    assert_eq!(
+                        inside,
+                        visible_brute(d, psi, gamma),
+                        "d={d} ψ={psi} γ={gamma}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn normal_incidence_diffuse_matches_closed_form() {
+        // ωo = ωi = n, d = 2, kd only: (kd/π)/(2) ∫_{-π/2}^{π/2} cos²γ dγ = kd/4.
+        let pf = PoulinFournier::new(PoulinFournierParams {
+            d: 2.0,
+            n: 1.0,
+            ks: 0.0,
+            kd: 0.8,
+        })
+        .unwrap();
+        let n = Vec3::new(0.0, 0.0, 1.0);
+        assert!((pf.eval(&n, &n) - 0.8 / 4.0).abs() < 1e-12);
     }
 }

@@ -32,16 +32,41 @@ pub(crate) const NAME_SPECULAR: &str = "schlick-specular";
 pub(crate) const NAME_DIFFUSE: &str = "schlick-diffuse";
 
 pub(crate) const PARAMS_SPECULAR: &[ParamInfo] = &[
-    param("c", 0.9, Range::closed(0.0, 1.0), "reflectance at normal incidence (Fresnel C)"),
-    param("r", 0.05, Range::left_open(0.0, 1.0), "roughness (0 mirror, 1 Lambertian)"),
-    param("p", 1.0, Range::left_open(0.0, 1.0), "isotropy (1 isotropic, → 0 anisotropic along x)"),
+    param(
+        "c",
+        0.9,
+        Range::closed(0.0, 1.0),
+        "reflectance at normal incidence (Fresnel C)",
+    ),
+    param(
+        "r",
+        0.05,
+        Range::left_open(0.0, 1.0),
+        "roughness (0 mirror, 1 Lambertian)",
+    ),
+    param(
+        "p",
+        1.0,
+        Range::left_open(0.0, 1.0),
+        "isotropy (1 isotropic, → 0 anisotropic along x)",
+    ),
 ];
 
 pub(crate) const PARAMS_DIFFUSE: &[ParamInfo] = &[
-    param("c", 0.04, Range::closed(0.0, 1.0), "coat reflectance at normal incidence"),
+    param(
+        "c",
+        0.04,
+        Range::closed(0.0, 1.0),
+        "coat reflectance at normal incidence",
+    ),
     param("r", 0.3, Range::left_open(0.0, 1.0), "coat roughness"),
     param("p", 1.0, Range::left_open(0.0, 1.0), "coat isotropy"),
-    param("d", 0.8, Range::closed(0.0, 1.0), "substrate (Lambertian) albedo"),
+    param(
+        "d",
+        0.8,
+        Range::closed(0.0, 1.0),
+        "substrate (Lambertian) albedo",
+    ),
 ];
 
 /// Parameters of [`Schlick`]. `d = None` is the single-layer specular material.
@@ -67,7 +92,12 @@ impl SchlickParams {
     /// Defaults of `schlick-diffuse`.
     pub fn diffuse() -> Self {
         let [c, r, p, d] = defaults(PARAMS_DIFFUSE);
-        Self { c, r, p, d: Some(d) }
+        Self {
+            c,
+            r,
+            p,
+            d: Some(d),
+        }
     }
 }
 
@@ -81,8 +111,16 @@ impl Schlick {
     /// Validate the parameters and build the model.
     pub fn new(params: SchlickParams) -> Result<Self, ParamError> {
         match params.d {
-            None => validate(NAME_SPECULAR, PARAMS_SPECULAR, &[params.c, params.r, params.p])?,
-            Some(d) => validate(NAME_DIFFUSE, PARAMS_DIFFUSE, &[params.c, params.r, params.p, d])?,
+            None => validate(
+                NAME_SPECULAR,
+                PARAMS_SPECULAR,
+                &[params.c, params.r, params.p],
+            )?,
+            Some(d) => validate(
+                NAME_DIFFUSE,
+                PARAMS_DIFFUSE,
+                &[params.c, params.r, params.p, d],
+            )?,
         }
         Ok(Self { params })
     }
@@ -99,7 +137,12 @@ impl Schlick {
 
     pub(crate) fn diffuse_from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [c, r, p, d] = super::take(v);
-        Self::new(SchlickParams { c, r, p, d: Some(d) })
+        Self::new(SchlickParams {
+            c,
+            r,
+            p,
+            d: Some(d),
+        })
     }
 
     #[inline]
@@ -156,6 +199,10 @@ impl Brdf for Schlick {
         true
     }
     fn name(&self) -> &str {
-        if self.params.d.is_some() { NAME_DIFFUSE } else { NAME_SPECULAR }
+        if self.params.d.is_some() {
+            NAME_DIFFUSE
+        } else {
+            NAME_SPECULAR
+        }
     }
 }

@@ -28,7 +28,12 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
     param("s", 0.8, Range::closed(0.0, 0.99), "smoothness"),
     param("m", 0.0, Range::closed(0.0, 1.0), "metalness"),
     param("t", 0.0, Range::closed(0.0, 1.0), "transparency"),
-    param("c", 0.8, Range::closed(0.0, 1.0), "surface colour (grey level)"),
+    param(
+        "c",
+        0.8,
+        Range::closed(0.0, 1.0),
+        "surface colour (grey level)",
+    ),
 ];
 
 const KF: f64 = 1.12;
@@ -84,7 +89,12 @@ impl Strauss {
         let StraussParams { s, m, t, c } = params;
         let rd = (1.0 - s * s * s) * (1.0 - t);
         let d = 1.0 - m * s;
-        Ok(Self { params, diffuse: d * rd * c * FRAC_1_PI, rn: (1.0 - t) - rd, exponent: 3.0 / (1.0 - s) })
+        Ok(Self {
+            params,
+            diffuse: d * rd * c * FRAC_1_PI,
+            rn: (1.0 - t) - rd,
+            exponent: 3.0 / (1.0 - s),
+        })
     }
 
     /// The parameters this model was built with.

@@ -1,6 +1,6 @@
 //! The unit disc `x² + y² ≤ 1` with area measure, binned by a Cartesian grid clipped to the disc.
 
-use super::{Binning, Edge, Grid, Patch, Point2};
+use super::{Axis, Binning, Edge, Grid, Patch, Point2};
 use crate::error::StatsError;
 
 /// Slack on `x² + y² ≤ 1` for points produced by samplers (rounding of `r cos φ`, `r sin φ`).
@@ -51,6 +51,16 @@ impl Binning for DiscBinning {
     fn clip(&self, u: [f64; 2], v: [f64; 2]) -> Vec<Patch> {
         clip_to_disc(u, v)
     }
+
+    /// The chord `[−√(1 − t²), √(1 − t²)]` (the disc is symmetric, so both axes agree).
+    fn section(&self, _axis: Axis, t: f64) -> Vec<[f64; 2]> {
+        if t.abs() < 1.0 {
+            let c = (1.0 - t * t).sqrt();
+            vec![[-c, c]]
+        } else {
+            Vec::new()
+        }
+    }
 }
 
 /// `{x ∈ u, y ∈ v, x² + y² ≤ 1}` as patches whose edges are constants or circle arcs.
@@ -93,7 +103,11 @@ pub(crate) fn clip_to_disc(u: [f64; 2], v: [f64; 2]) -> Vec<Patch> {
             Edge::CircleUpper
         };
         if lo.at(xm) < hi.at(xm) {
-            patches.push(Patch { u: [x0, x1], lo, hi });
+            patches.push(Patch {
+                u: [x0, x1],
+                lo,
+                hi,
+            });
         }
     }
     patches
@@ -126,7 +140,10 @@ mod tests {
                 .flat_map(|i| b.bin_patches(i))
                 .map(|p| patch_area(&p))
                 .sum();
-            assert!((total - std::f64::consts::PI).abs() < 1e-12, "n={n}: {total}");
+            assert!(
+                (total - std::f64::consts::PI).abs() < 1e-12,
+                "n={n}: {total}"
+            );
         }
     }
 

@@ -108,6 +108,10 @@ pub trait Binning: Sync {
     /// (empty when they do not meet).
     fn clip(&self, u: [f64; 2], v: [f64; 2]) -> Vec<Patch>;
 
+    /// The section of the domain on the line `axis = t`: the intervals of the *other*
+    /// parameter covered by the domain (empty outside it). Used for marginal densities.
+    fn section(&self, axis: Axis, t: f64) -> Vec<[f64; 2]>;
+
     /// Number of bins `n_u · n_v` (bins entirely outside the domain included; they have zero mass).
     fn n_bins(&self) -> usize {
         self.grid().n_cells()

@@ -1,6 +1,6 @@
 //! Rectangle (image) domain `[x₀, x₁] × [y₀, y₁]` with area measure.
 
-use super::{Binning, Grid, Patch, Point2};
+use super::{Axis, Binning, Grid, Patch, Point2};
 use crate::error::StatsError;
 
 /// `n_x × n_y` grid over the rectangle `[x₀, x₁] × [y₀, y₁]`; parameters are `(u, v) = (x, y)`,
@@ -52,6 +52,23 @@ impl Binning for RectBinning {
 
     fn clip(&self, u: [f64; 2], v: [f64; 2]) -> Vec<Patch> {
         clip_rect(&self.grid, u, v)
+    }
+
+    fn section(&self, axis: Axis, t: f64) -> Vec<[f64; 2]> {
+        section_rect(&self.grid, axis, t)
+    }
+}
+
+/// The section of the grid's rectangle on the line `axis = t`.
+pub(super) fn section_rect(grid: &Grid, axis: Axis, t: f64) -> Vec<[f64; 2]> {
+    let (along, other) = match axis {
+        Axis::U => (grid.u_range(), grid.v_range()),
+        Axis::V => (grid.v_range(), grid.u_range()),
+    };
+    if t >= along[0] && t <= along[1] {
+        vec![other]
+    } else {
+        Vec::new()
     }
 }
 

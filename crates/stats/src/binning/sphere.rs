@@ -1,6 +1,6 @@
 //! Directions on the sphere or the upper hemisphere, binned in `(cos θ, φ)`.
 
-use super::{Binning, Direction, Grid, Patch};
+use super::{Axis, Binning, Direction, Grid, Patch};
 use crate::error::StatsError;
 use std::f64::consts::TAU;
 
@@ -81,5 +81,9 @@ impl Binning for SphereBinning {
 
     fn clip(&self, u: [f64; 2], v: [f64; 2]) -> Vec<Patch> {
         super::rect::clip_rect(&self.grid, u, v)
+    }
+
+    fn section(&self, axis: Axis, t: f64) -> Vec<[f64; 2]> {
+        super::rect::section_rect(&self.grid, axis, t)
     }
 }

@@ -67,7 +67,11 @@ pub(crate) fn product_points(seed: u64, n: usize) -> Vec<[f64; 2]> {
 // ---------- unit disc ----------
 
 pub(crate) fn uniform_disc_pdf(p: [f64; 2]) -> f64 {
-    if p[0] * p[0] + p[1] * p[1] <= 1.0 { 1.0 / PI } else { 0.0 }
+    if p[0] * p[0] + p[1] * p[1] <= 1.0 {
+        1.0 / PI
+    } else {
+        0.0
+    }
 }
 
 pub(crate) fn disc_points(seed: u64, n: usize, radius_scale: f64) -> Vec<[f64; 2]> {
@@ -143,11 +147,19 @@ pub(crate) struct Lobe {
 }
 
 pub(crate) fn dir(theta: f64, phi: f64) -> [f64; 3] {
-    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+    [
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    ]
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn normalize(a: [f64; 3]) -> [f64; 3] {
@@ -158,7 +170,11 @@ fn normalize(a: [f64; 3]) -> [f64; 3] {
 impl Lobe {
     pub(crate) fn pdf(&self, d: [f64; 3]) -> f64 {
         let c = self.axis[0] * d[0] + self.axis[1] * d[1] + self.axis[2] * d[2];
-        if c <= 0.0 { 0.0 } else { (self.exponent + 1.0) / TAU * c.powf(self.exponent) }
+        if c <= 0.0 {
+            0.0
+        } else {
+            (self.exponent + 1.0) / TAU * c.powf(self.exponent)
+        }
     }
 
     pub(crate) fn sample(&self, rng: &mut Xoshiro256PlusPlus) -> [f64; 3] {
@@ -167,7 +183,11 @@ impl Lobe {
         let s = (1.0 - c * c).max(0.0).sqrt();
         let b = TAU * u2;
         let a = self.axis;
-        let helper = if a[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let helper = if a[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
         let t = normalize(cross(helper, a));
         let bt = cross(a, t);
         let (x, y) = (s * b.cos(), s * b.sin());
@@ -186,12 +206,18 @@ impl Lobe {
 
 /// The lobe used across tests: axis at θ = 30°, φ = 40°, exponent 20.
 pub(crate) fn test_lobe() -> Lobe {
-    Lobe { axis: dir(30f64.to_radians(), 40f64.to_radians()), exponent: 20.0 }
+    Lobe {
+        axis: dir(30f64.to_radians(), 40f64.to_radians()),
+        exponent: 20.0,
+    }
 }
 
 /// The same lobe tilted by `degrees` away from the pole.
 pub(crate) fn tilted_lobe(degrees: f64) -> Lobe {
-    Lobe { axis: dir((30.0 + degrees).to_radians(), 40f64.to_radians()), exponent: 20.0 }
+    Lobe {
+        axis: dir((30.0 + degrees).to_radians(), 40f64.to_radians()),
+        exponent: 20.0,
+    }
 }
 
 pub(crate) fn uniform_sphere_points(seed: u64, n: usize) -> Vec<[f64; 3]> {

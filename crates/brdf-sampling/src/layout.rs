@@ -1,0 +1,159 @@
+//! Where the slices of a set sit, and which slice (or pair of slices) serves an outgoing
+//! direction.
+//!
+//! Slice `(j, k)` has the outgoing direction `ωo_jk = (θ_j, φ_k)` with θ at bin centres
+//! `θ_j = (j + ½) · (π/2) / nθ` and `φ_k = k · 2π / nφ` (`nφ = 1`, `φ_0 = 0` for isotropic
+//! BRDFs). An outgoing direction `ωo = (θo, φo)` is served by the slice with the nearest θ and
+//! the nearest φ (circularly); the sampled direction is rotated about the normal by
+//! `Δ = φo − φ_k`. For isotropic BRDFs this is the papers' "rotate ωo to φ = 0, sample, rotate
+//! back"; for anisotropic ones it keeps the mirror direction of `ωo` exact and errs only in the
+//! orientation of the tangent frame (by at most `π/nφ`). The choice depends only on `ωo`, so the
+//! pdf of a direction is always evaluated with the slice that sampled it.
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+use brdf::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// The slice grid of a set: `theta × phi` outgoing directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SliceLayout {
+    /// θ slices `nθ`.
+    pub theta: usize,
+    /// φ slices `nφ` (1 for isotropic BRDFs).
+    pub phi: usize,
+}
+
+/// One slice chosen for an outgoing direction, with its mixture weight and azimuthal rotation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SliceChoice {
+    /// Slice index `j · nφ + k`.
+    pub index: usize,
+    /// Mixture weight (1 for the nearest-slice rule).
+    pub weight: f64,
+    /// Rotation `Δ = φo − φ_k` (radians) applied to samples of this slice.
+    pub rotation: f64,
+}
+
+impl SliceLayout {
+    /// Number of slices `nθ · nφ`.
+    pub fn len(&self) -> usize {
+        self.theta * self.phi
+    }
+
+    /// `true` when there are no slices.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// `θ_j = (j + ½) · (π/2) / nθ` (radians).
+    pub fn theta_of(&self, j: usize) -> f64 {
+        (j as f64 + 0.5) * FRAC_PI_2 / self.theta as f64
+    }
+
+    /// `φ_k = k · 2π / nφ` (radians).
+    pub fn phi_of(&self, k: usize) -> f64 {
+        k as f64 * TAU / self.phi as f64
+    }
+
+    /// `(θ_j, φ_k)` of slice `index` (radians).
+    pub fn angles_of(&self, index: usize) -> (f64, f64) {
+        (self.theta_of(index / self.phi), self.phi_of(index % self.phi))
+    }
+
+    /// The outgoing direction of slice `index`.
+    pub fn direction_of(&self, index: usize) -> Vec3 {
+        let (t, p) = self.angles_of(index);
+        brdf::direction_from_radians(t, p)
+    }
+
+    /// Polar angle, azimuth and nearest φ slice of `wo`; `None` when `wo` is at or below the
+    /// horizon (or NaN).
+    fn polar(&self, wo: &Vec3) -> Option<(f64, usize, f64)> {
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let theta = wo.z.min(1.0).acos();
+        let phi = wo.y.atan2(wo.x);
+        let step = TAU / self.phi as f64;
+        let k = ((phi.rem_euclid(TAU) / step).round() as usize) % self.phi;
+        Some((theta, k, phi - self.phi_of(k)))
+    }
+
+    /// The nearest slice of `wo` (weight 1), or `None` below the horizon.
+    pub fn nearest(&self, wo: &Vec3) -> Option<SliceChoice> {
+        let (theta, k, rotation) = self.polar(wo)?;
+        let j = ((theta / FRAC_PI_2 * self.theta as f64) as usize).min(self.theta - 1);
+        Some(SliceChoice { index: j * self.phi + k, weight: 1.0, rotation })
+    }
+
+    /// The two θ-neighbouring slices of `wo` with linear weights in θ (`w_a + w_b = 1`); below
+    /// the first and above the last slice centre the end slice gets weight 1 (and the second
+    /// entry repeats it with weight 0). `None` below the horizon.
+    pub fn neighbours(&self, wo: &Vec3) -> Option<[SliceChoice; 2]> {
+        let (theta, k, rotation) = self.polar(wo)?;
+        let t = theta / FRAC_PI_2 * self.theta as f64 - 0.5;
+        let last = self.theta - 1;
+        let (ja, jb, wb) = if !(t > 0.0) {
+            (0, 0, 0.0)
+        } else if t >= last as f64 {
+            (last, last, 0.0)
+        } else {
+            let ja = t.floor() as usize;
+            (ja, ja + 1, t - ja as f64)
+        };
+        Some([
+            SliceChoice { index: ja * self.phi + k, weight: 1.0 - wb, rotation },
+            SliceChoice { index: jb * self.phi + k, weight: wb, rotation },
+        ])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use brdf::direction_from_angles;
+
+    #[test]
+    fn nearest_slice_and_rotation() {
+        let l = SliceLayout { theta: 90, phi: 1 };
+        let c = l.nearest(&direction_from_angles(30.2, 40.0)).unwrap();
+        assert_eq!(c.index, 30);
+        assert_relative_eq!(l.theta_of(30).to_degrees(), 30.5, epsilon = 1e-12);
+        assert_relative_eq!(c.rotation.to_degrees(), 40.0, epsilon = 1e-9);
+        assert_eq!(l.nearest(&Vec3::new(0.0, 0.0, 1.0)).unwrap().index, 0);
+        assert_eq!(l.nearest(&direction_from_angles(89.999, 0.0)).unwrap().index, 89);
+        assert!(l.nearest(&Vec3::new(1.0, 0.0, 0.0)).is_none());
+        assert!(l.nearest(&Vec3::new(f64::NAN, 0.0, 1.0)).is_none());
+    }
+
+    #[test]
+    fn anisotropic_nearest_phi_wraps() {
+        let l = SliceLayout { theta: 4, phi: 8 };
+        // φ = 350° is nearest to φ_0 = 0 with Δ = −10°.
+        let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
+        assert_eq!(c.index, 2 * 8);
+        assert_relative_eq!(c.rotation.to_degrees(), -10.0, epsilon = 1e-9);
+        let c = l.nearest(&direction_from_angles(50.0, 100.0)).unwrap();
+        assert_eq!(c.index % 8, 2);
+        assert_relative_eq!(c.rotation.to_degrees(), 10.0, epsilon = 1e-9);
+        let (t, p) = l.angles_of(c.index);
+        assert_relative_eq!(t.to_degrees(), 56.25, epsilon = 1e-9);
+        assert_relative_eq!(p.to_degrees(), 90.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn neighbour_weights_are_linear_in_theta() {
+        let l = SliceLayout { theta: 9, phi: 1 };
+        // Centres at 5°, 15°, …, 85°.
+        let [a, b] = l.neighbours(&direction_from_angles(12.5, 0.0)).unwrap();
+        assert_eq!((a.index, b.index), (0, 1));
+        assert_relative_eq!(a.weight, 0.25, epsilon = 1e-12);
+        assert_relative_eq!(b.weight, 0.75, epsilon = 1e-12);
+        let [a, b] = l.neighbours(&direction_from_angles(2.0, 0.0)).unwrap();
+        assert_eq!((a.index, a.weight, b.weight), (0, 1.0, 0.0));
+        let [a, b] = l.neighbours(&direction_from_angles(88.0, 0.0)).unwrap();
+        assert_eq!((a.index, a.weight, b.weight), (8, 1.0, 0.0));
+    }
+}

@@ -1,0 +1,177 @@
+//! Build options of a quadtree set, with validation and measured defaults.
+
+use serde::{Deserialize, Serialize};
+
+/// Default number of θ slices for isotropic BRDFs (the papers used 60 and 90).
+pub const DEFAULT_SLICES: usize = 90;
+
+/// Default `[θ, φ]` slice grid for anisotropic BRDFs: 32 × 16 = 512 trees (θ step 2.8°,
+/// φ step 22.5°). See [`SetOptions::anisotropic_slices`].
+pub const DEFAULT_ANISOTROPIC_SLICES: [usize; 2] = [32, 16];
+
+/// Default split threshold `n_max` (the papers' value).
+pub const DEFAULT_N_MAX: f64 = 2.0;
+
+/// Default maximum tree depth (root = 0): leaves no smaller than `2/2⁷` of the disc's square.
+pub const DEFAULT_MAX_DEPTH: u32 = 7;
+
+/// Default resolution (cells per axis) of the sampled image map: `2^(max_depth + 1)`, so the
+/// deepest leaf covers at least 2 × 2 fine cells.
+pub const DEFAULT_GRID: usize = 256;
+
+/// Default safety factor applied to grid maxima to get the leaf bounds `M_i`.
+pub const DEFAULT_SAFETY_FACTOR: f64 = partition_sampler::DEFAULT_SAFETY_FACTOR;
+
+/// Default volume tolerance: cells whose rejection volume is at most this fraction of the total
+/// integral are not split (each such leaf can add at most this many trials per sample).
+pub const DEFAULT_VOLUME_TOLERANCE: f64 = 1e-3;
+
+/// Largest accepted slice count per axis.
+pub const MAX_SLICES: usize = 4096;
+
+/// Largest accepted grid resolution (the image map holds about `21 grid²` bytes per slice
+/// while a slice is being built).
+pub const MAX_GRID: usize = 4096;
+
+/// Options of a [`crate::QuadTreeSet`].
+///
+/// Slices: isotropic BRDFs use `slices` outgoing polar angles at bin centres
+/// `θ_j = (j + ½) · 90° / slices`; anisotropic ones use `anisotropic_slices = [nθ, nφ]`, the
+/// same θ centres times azimuths `φ_k = k · 360° / nφ`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SetOptions {
+    /// θ slices for isotropic BRDFs (default [`DEFAULT_SLICES`]).
+    pub slices: usize,
+    /// `[θ, φ]` slices for anisotropic BRDFs (default [`DEFAULT_ANISOTROPIC_SLICES`]).
+    pub anisotropic_slices: [usize; 2],
+    /// Split threshold: a cell is split while `n_max · I_i / V_i < 1` (default 2).
+    pub n_max: f64,
+    /// Maximum tree depth (default [`DEFAULT_MAX_DEPTH`]); must satisfy
+    /// `2^(max_depth + 1) ≤ grid` (the image map is finer than the deepest leaf).
+    pub max_depth: u32,
+    /// Image-map resolution per axis over `[-1, 1]²`, a power of two (default [`DEFAULT_GRID`]).
+    pub grid: usize,
+    /// Leaf bounds are `safety_factor ×` the sampled maxima (default 1.1; must be ≥ 1).
+    pub safety_factor: f64,
+    /// Cells with rejection volume `V_i ≤ volume_tolerance · I_root` are not split
+    /// (default [`DEFAULT_VOLUME_TOLERANCE`]; 0 = the papers' pure criterion).
+    pub volume_tolerance: f64,
+    /// Sample the mixture of the two θ-neighbouring slices (linear weights in θ) instead of the
+    /// nearest slice (default `false`).
+    pub mixture: bool,
+}
+
+impl Default for SetOptions {
+    fn default() -> Self {
+        Self {
+            slices: DEFAULT_SLICES,
+            anisotropic_slices: DEFAULT_ANISOTROPIC_SLICES,
+            n_max: DEFAULT_N_MAX,
+            max_depth: DEFAULT_MAX_DEPTH,
+            grid: DEFAULT_GRID,
+            safety_factor: DEFAULT_SAFETY_FACTOR,
+            volume_tolerance: DEFAULT_VOLUME_TOLERANCE,
+            mixture: false,
+        }
+    }
+}
+
+/// An invalid [`SetOptions`] field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptionsError {
+    /// A slice count is 0 or above [`MAX_SLICES`].
+    #[error("{what} = {value} must be in 1 ..= {MAX_SLICES}")]
+    InvalidSlices {
+        /// Which count.
+        what: &'static str,
+        /// The value.
+        value: usize,
+    },
+    /// `n_max` must be finite and ≥ 1.
+    #[error("n_max = {0} must be finite and ≥ 1")]
+    InvalidNMax(f64),
+    /// The grid must be a power of two in `4 ..= MAX_GRID`.
+    #[error("grid = {0} must be a power of two in 4 ..= {MAX_GRID}")]
+    InvalidGrid(usize),
+    /// The image map must be finer than the deepest leaf: `2^(max_depth + 1) ≤ grid`.
+    #[error("max_depth = {max_depth} needs grid ≥ 2^(max_depth + 1), got grid = {grid}")]
+    GridTooCoarse {
+        /// The maximum depth.
+        max_depth: u32,
+        /// The grid resolution.
+        grid: usize,
+    },
+    /// The safety factor must be finite and ≥ 1.
+    #[error("safety_factor = {0} must be finite and ≥ 1")]
+    InvalidSafetyFactor(f64),
+    /// The volume tolerance must be finite and ≥ 0.
+    #[error("volume_tolerance = {0} must be finite and ≥ 0")]
+    InvalidVolumeTolerance(f64),
+}
+
+impl SetOptions {
+    /// Checks every field (see [`OptionsError`]).
+    pub fn validate(&self) -> Result<(), OptionsError> {
+        let counts = [
+            ("slices", self.slices),
+            ("anisotropic θ slices", self.anisotropic_slices[0]),
+            ("anisotropic φ slices", self.anisotropic_slices[1]),
+        ];
+        for (what, value) in counts {
+            if value == 0 || value > MAX_SLICES {
+                return Err(OptionsError::InvalidSlices { what, value });
+            }
+        }
+        if !(self.n_max.is_finite() && self.n_max >= 1.0) {
+            return Err(OptionsError::InvalidNMax(self.n_max));
+        }
+        if !(self.grid.is_power_of_two() && (4..=MAX_GRID).contains(&self.grid)) {
+            return Err(OptionsError::InvalidGrid(self.grid));
+        }
+        let finest = 1u64.checked_shl(self.max_depth + 1).unwrap_or(u64::MAX);
+        if self.max_depth > 30 || finest > self.grid as u64 {
+            return Err(OptionsError::GridTooCoarse { max_depth: self.max_depth, grid: self.grid });
+        }
+        if !(self.safety_factor.is_finite() && self.safety_factor >= 1.0) {
+            return Err(OptionsError::InvalidSafetyFactor(self.safety_factor));
+        }
+        if !(self.volume_tolerance.is_finite() && self.volume_tolerance >= 0.0) {
+            return Err(OptionsError::InvalidVolumeTolerance(self.volume_tolerance));
+        }
+        Ok(())
+    }
+
+    /// The options with `max_depth` and the matching grid `2^(max_depth + 1)`.
+    pub fn with_depth(mut self, max_depth: u32) -> Self {
+        self.max_depth = max_depth;
+        self.grid = 1usize.checked_shl(max_depth + 1).unwrap_or(0);
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_errors_are_typed() {
+        assert_eq!(SetOptions::default().validate(), Ok(()));
+        let o = SetOptions::default();
+        let bad = |f: fn(&mut SetOptions)| {
+            let mut x = o;
+            f(&mut x);
+            x.validate().unwrap_err()
+        };
+        assert!(matches!(bad(|o| o.slices = 0), OptionsError::InvalidSlices { .. }));
+        assert!(matches!(bad(|o| o.anisotropic_slices[1] = 0), OptionsError::InvalidSlices { .. }));
+        assert!(matches!(bad(|o| o.n_max = f64::NAN), OptionsError::InvalidNMax(_)));
+        assert!(matches!(bad(|o| o.n_max = 0.5), OptionsError::InvalidNMax(_)));
+        assert!(matches!(bad(|o| o.grid = 100), OptionsError::InvalidGrid(100)));
+        assert!(matches!(bad(|o| o.max_depth = 8), OptionsError::GridTooCoarse { .. }));
+        assert!(matches!(bad(|o| o.max_depth = 99), OptionsError::GridTooCoarse { .. }));
+        assert!(matches!(bad(|o| o.safety_factor = 0.9), OptionsError::InvalidSafetyFactor(_)));
+        assert!(matches!(bad(|o| o.volume_tolerance = -1.0), OptionsError::InvalidVolumeTolerance(_)));
+        assert_eq!(SetOptions::default().with_depth(5).grid, 64);
+        assert_eq!(SetOptions::default().with_depth(5).validate(), Ok(()));
+    }
+}

@@ -1,0 +1,183 @@
+//! Versioned binary persistence of a [`QuadTreeSet`].
+//!
+//! Layout: `b"BRQS"`, [`SET_FORMAT_VERSION`] as little-endian `u32`, then the postcard encoding
+//! of the set: BRDF spec and name, 32 probe values of the BRDF, variant, options, layout, build
+//! evaluation count, and every tree in partition-sampler's own versioned format
+//! ([`partition_sampler::FORMAT_VERSION`]). The BRDF itself is not stored: it is re-attached on
+//! load, which checks that the spec string matches and that the BRDF reproduces the probes
+//! (relative 1e-9).
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+use brdf::{Brdf, direction_from_angles};
+use partition_sampler::{Domain, QuadTree, QuadTreeSampler};
+use serde::{Deserialize, Serialize};
+
+use crate::disc::{DiscBrdf, SliceDensity};
+use crate::error::PersistError;
+use crate::layout::SliceLayout;
+use crate::options::SetOptions;
+use crate::set::{QuadTreeSet, Variant, layout_for, sampler_name};
+
+/// Version of the stored set format; bumped on any incompatible change.
+pub const SET_FORMAT_VERSION: u32 = 1;
+
+const MAGIC: &[u8; 4] = b"BRQS";
+
+/// Relative tolerance of the BRDF probe check on load.
+const PROBE_TOLERANCE: f64 = 1e-9;
+
+#[derive(Serialize, Deserialize)]
+struct Stored {
+    spec: String,
+    brdf_name: String,
+    probes: Vec<f64>,
+    variant: Variant,
+    options: SetOptions,
+    layout: SliceLayout,
+    grid_evaluations: u64,
+    trees: Vec<Vec<u8>>,
+}
+
+/// `f_r` at 32 fixed direction pairs (half of them near the mirror direction).
+fn probes(brdf: &dyn Brdf) -> Vec<f64> {
+    (0..32u32)
+        .map(|k| {
+            let to = 3.0 + f64::from((k * 37) % 84);
+            let po = f64::from((k * 101) % 360);
+            let wo = direction_from_angles(to, po);
+            let wi = if k % 2 == 0 {
+                direction_from_angles(to + 0.7, po + 181.3)
+            } else {
+                direction_from_angles(2.0 + f64::from((k * 53) % 86), f64::from((k * 211) % 360))
+            };
+            brdf.eval(&wo, &wi)
+        })
+        .collect()
+}
+
+fn decode(bytes: &[u8]) -> Result<Stored, PersistError> {
+    let (Some(magic), Some(version)) = (bytes.get(0..4), bytes.get(4..8)) else {
+        return Err(PersistError::Truncated);
+    };
+    if magic != MAGIC {
+        return Err(PersistError::BadMagic);
+    }
+    let found = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
+    if found != SET_FORMAT_VERSION {
+        return Err(PersistError::UnsupportedVersion { found, expected: SET_FORMAT_VERSION });
+    }
+    postcard::from_bytes(&bytes[8..]).map_err(|e| match e {
+        postcard::Error::DeserializeUnexpectedEnd => PersistError::Truncated,
+        other => PersistError::Decode(other.to_string()),
+    })
+}
+
+impl QuadTreeSet {
+    /// Encodes the set: header (magic, version) + postcard payload (see the module docs).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let stored = Stored {
+            spec: self.spec.clone(),
+            brdf_name: self.brdf.name().to_string(),
+            probes: probes(self.brdf.as_ref()),
+            variant: self.variant,
+            options: self.options,
+            layout: self.layout,
+            grid_evaluations: self.grid_evaluations,
+            trees: self.trees.iter().map(|t| t.tree().to_bytes()).collect(),
+        };
+        let mut out = Vec::new();
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&SET_FORMAT_VERSION.to_le_bytes());
+        // Serialising plain data into a Vec cannot fail.
+        if let Ok(payload) = postcard::to_allocvec(&stored) {
+            out.extend_from_slice(&payload);
+        }
+        out
+    }
+
+    /// The BRDF spec recorded in stored bytes (to parse the BRDF before
+    /// [`QuadTreeSet::from_bytes`]).
+    pub fn stored_spec(bytes: &[u8]) -> Result<String, PersistError> {
+        decode(bytes).map(|s| s.spec)
+    }
+
+    /// Decodes a set written by [`QuadTreeSet::to_bytes`] and re-attaches `brdf`.
+    ///
+    /// Errors: [`PersistError::Truncated`], [`PersistError::BadMagic`],
+    /// [`PersistError::UnsupportedVersion`], [`PersistError::Decode`],
+    /// [`PersistError::Corrupt`] (inconsistent layout or options),
+    /// [`PersistError::SpecMismatch`] (`spec` differs from the stored one after trimming),
+    /// [`PersistError::BrdfMismatch`] (the BRDF does not reproduce the stored probe values),
+    /// [`PersistError::Tree`] / [`PersistError::Attach`] for a bad tree.
+    pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
+        let s = decode(bytes)?;
+        if s.spec != spec.trim() {
+            return Err(PersistError::SpecMismatch { stored: s.spec, given: spec.trim().to_string() });
+        }
+        let found = probes(brdf.as_ref());
+        for (probe, (&a, &b)) in s.probes.iter().zip(&found).enumerate() {
+            let ok = a == b || (a - b).abs() <= PROBE_TOLERANCE * a.abs().max(b.abs());
+            if !ok {
+                return Err(PersistError::BrdfMismatch { name: brdf.name().to_string(), probe, stored: a, found: b });
+            }
+        }
+        if s.probes.len() != found.len() {
+            return Err(PersistError::Corrupt(format!("{} probes, expected {}", s.probes.len(), found.len())));
+        }
+        s.options.validate().map_err(|e| PersistError::Corrupt(format!("options: {e}")))?;
+        if layout_for(brdf.as_ref(), &s.options) != s.layout || s.layout.len() != s.trees.len() {
+            return Err(PersistError::Corrupt(format!(
+                "layout {} × {} with {} trees does not fit the options and the BRDF's isotropy",
+                s.layout.theta,
+                s.layout.phi,
+                s.trees.len()
+            )));
+        }
+        let mut trees = Vec::with_capacity(s.trees.len());
+        for (slice, raw) in s.trees.iter().enumerate() {
+            let tree = QuadTree::from_bytes(raw).map_err(|source| PersistError::Tree { slice, source })?;
+            if tree.domain() != Domain::UnitDisc || tree.params().scheme != s.variant_scheme() {
+                return Err(PersistError::Corrupt(format!("slice {slice}: wrong domain or scheme")));
+            }
+            let shape = *tree.shape();
+            let f = DiscBrdf::new(Arc::clone(&brdf), s.layout.direction_of(slice));
+            let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
+                .map_err(|source| PersistError::Attach { slice, source })?;
+            trees.push(sampler);
+        }
+        Ok(QuadTreeSet {
+            brdf,
+            spec: s.spec,
+            variant: s.variant,
+            options: s.options,
+            layout: s.layout,
+            trees,
+            build_time: Duration::ZERO,
+            grid_evaluations: s.grid_evaluations,
+            name: sampler_name(s.variant, s.options.mixture),
+        })
+    }
+
+    /// Writes [`QuadTreeSet::to_bytes`] to `path`.
+    pub fn save(&self, path: &Path) -> Result<(), PersistError> {
+        std::fs::write(path, self.to_bytes()).map_err(|source| PersistError::Io { path: path.to_path_buf(), source })
+    }
+
+    /// Reads a set from `path` and re-attaches `brdf` (see [`QuadTreeSet::from_bytes`]).
+    pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
+        let bytes = std::fs::read(path).map_err(|source| PersistError::Io { path: path.to_path_buf(), source })?;
+        Self::from_bytes(&bytes, brdf, spec)
+    }
+}
+
+impl Stored {
+    fn variant_scheme(&self) -> partition_sampler::Scheme {
+        match self.variant {
+            Variant::Adaptive => partition_sampler::Scheme::Envelope,
+            Variant::Paper => partition_sampler::Scheme::Paper,
+        }
+    }
+}

@@ -1,0 +1,464 @@
+//! [`QuadTreeSet`]: one adaptive quadtree per outgoing-direction slice of a BRDF, sampled
+//! through [`DirectionSampler`].
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use brdf::{Brdf, Vec3, rotate_z};
+use partition_sampler::{
+    AllocationMode, Audit, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sample2, Sampler2D, Scheme, UniformSource,
+};
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::disc::{DiscBrdf, SliceDensity, disc_to_direction, thread_evaluations};
+use crate::error::SetError;
+use crate::image_map::{Counted, EvalCounter, SliceImageMap};
+use crate::layout::{SliceChoice, SliceLayout};
+use crate::options::SetOptions;
+use crate::report::{CostMeasurement, SetReport};
+
+/// Which of the two partition-sampler schemes the trees of a set use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Variant {
+    /// `adaptive` (default): [`Scheme::Envelope`] with [`LeafChoice::Alias`]. Exact: accepted
+    /// points have density `f / ∫ f` whenever the leaf bounds hold, whatever the error of the
+    /// grid integrals; mean trials `Σ V_i / Σ I_i ≤ n_max`.
+    #[default]
+    Adaptive,
+    /// `adaptive-paper`: the papers' variant — leaf chosen ∝ `I_i` by the per-node CDF descent
+    /// (seed 003 Algorithm 1), rejection repeated inside the leaf. Its true density is
+    /// `(I_i / Î) f / ∫_leaf f`, equal to the reported `f / Î` only when the grid integrals
+    /// `I_i` are exact. `sample_batch` uses the papers' batch split (seed 000 §3.6) with the
+    /// randomized remainder.
+    Paper,
+}
+
+impl Variant {
+    /// The sampler name (without the `-mixture` suffix).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Variant::Adaptive => "adaptive",
+            Variant::Paper => "adaptive-paper",
+        }
+    }
+
+    fn scheme(&self) -> Scheme {
+        match self {
+            Variant::Adaptive => Scheme::Envelope,
+            Variant::Paper => Scheme::Paper,
+        }
+    }
+
+    fn leaf_choice(&self) -> LeafChoice {
+        match self {
+            Variant::Adaptive => LeafChoice::Alias,
+            Variant::Paper => LeafChoice::Descent,
+        }
+    }
+}
+
+/// Progress callback: `(slices done, total slices)`, called from the building threads after
+/// each slice.
+pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
+/// A set of adaptive quadtrees over outgoing-direction slices of one BRDF (seed 000 §3.4,
+/// seed 003 §3.1), sampled as a [`DirectionSampler`].
+///
+/// Slice `(θ_j, φ_k)` holds a [`QuadTreeSampler`] of the disc density `x ↦ f_r(ωo_jk, h⁻¹(x))`
+/// (see [`crate::disc`]), built from the image map of [`crate::SetOptions::grid`]² cells plus a
+/// rim band (see the crate docs). For an outgoing direction `ωo`, the nearest slice is sampled
+/// and its sample rotated about the normal by `φo − φ_k` (see [`SliceLayout`]); with
+/// [`SetOptions::mixture`], the two θ-neighbouring slices are mixed with linear weights in θ.
+///
+/// **pdf** (with respect to solid angle): nearest slice `c`,
+/// `p(ωi | ωo) = f_r(ωo_c, R⁻¹ωi) cos θi / Î_c` for `R⁻¹ωi` in a sampleable leaf of tree `c`,
+/// 0 elsewhere and below the horizon; with the mixture `Σ_k w_k p_k(ωi)`. The slice choice
+/// depends only on `ωo`, so `(1/N) Σ f_r(ωo, ωi) L cos θi / p` is unbiased wherever `p > 0`
+/// covers the support of `f_r(ωo, ·)`.
+pub struct QuadTreeSet {
+    pub(crate) brdf: Arc<dyn Brdf>,
+    pub(crate) spec: String,
+    pub(crate) variant: Variant,
+    pub(crate) options: SetOptions,
+    pub(crate) layout: SliceLayout,
+    pub(crate) trees: Vec<QuadTreeSampler<SliceDensity>>,
+    pub(crate) build_time: Duration,
+    pub(crate) grid_evaluations: u64,
+    pub(crate) name: String,
+}
+
+impl std::fmt::Debug for QuadTreeSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("QuadTreeSet")
+            .field("name", &self.name)
+            .field("spec", &self.spec)
+            .field("layout", &self.layout)
+            .field("options", &self.options)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The slice layout a BRDF needs under `options`.
+pub fn layout_for(brdf: &dyn Brdf, options: &SetOptions) -> SliceLayout {
+    if brdf.is_isotropic() {
+        SliceLayout { theta: options.slices, phi: 1 }
+    } else {
+        SliceLayout { theta: options.anisotropic_slices[0], phi: options.anisotropic_slices[1] }
+    }
+}
+
+pub(crate) fn sampler_name(variant: Variant, mixture: bool) -> String {
+    if mixture { format!("{}-mixture", variant.name()) } else { variant.name().to_string() }
+}
+
+/// Builds the tree of slice `index`; returns it with the number of BRDF evaluations spent.
+fn build_slice(
+    brdf: &Arc<dyn Brdf>,
+    layout: SliceLayout,
+    index: usize,
+    options: &SetOptions,
+    variant: Variant,
+) -> Result<(QuadTreeSampler<SliceDensity>, u64), SetError> {
+    let (t, p) = layout.angles_of(index);
+    let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
+    let f = DiscBrdf::new(Arc::clone(brdf), layout.direction_of(index));
+    let counter = EvalCounter::new();
+    let map = SliceImageMap::new(Counted { f: &f, counter: &counter }, options.grid, options.safety_factor)
+        .map_err(|source| SetError::Density { slice: index, theta_deg, phi_deg, source })?;
+    let tree = QuadTreeBuilder::new()
+        .n_max(options.n_max)
+        .max_depth(options.max_depth)
+        .volume_tolerance(options.volume_tolerance)
+        .scheme(variant.scheme())
+        .leaf_choice(variant.leaf_choice())
+        .build_tree(&map)
+        .map_err(|source| SetError::Tree { slice: index, theta_deg, phi_deg, source })?;
+    drop(map);
+    // A clone holds its arrays with exact capacities (the builder grows them amortised).
+    let tree = tree.clone();
+    let shape = *tree.shape();
+    let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
+        .map_err(|source| SetError::Attach { slice: index, source })?;
+    Ok((sampler, counter.total()))
+}
+
+impl QuadTreeSet {
+    /// Builds the set of `brdf` for `variant` (all slices in parallel with rayon; the result
+    /// does not depend on the thread count). The spec recorded for persistence is
+    /// `brdf.name()`; set another with [`QuadTreeSet::with_spec`].
+    pub fn build(brdf: Arc<dyn Brdf>, variant: Variant, options: &SetOptions) -> Result<Self, SetError> {
+        Self::build_with_progress(brdf, variant, options, None)
+    }
+
+    /// [`QuadTreeSet::build`] reporting `(done, total)` after each slice.
+    pub fn build_with_progress(
+        brdf: Arc<dyn Brdf>,
+        variant: Variant,
+        options: &SetOptions,
+        progress: Option<Progress<'_>>,
+    ) -> Result<Self, SetError> {
+        options.validate()?;
+        let start = Instant::now();
+        let layout = layout_for(brdf.as_ref(), options);
+        let total = layout.len();
+        let done = AtomicUsize::new(0);
+        let built: Vec<(QuadTreeSampler<SliceDensity>, u64)> = (0..total)
+            .into_par_iter()
+            .map(|i| {
+                let r = build_slice(&brdf, layout, i, options, variant);
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(p) = progress {
+                    p(d, total);
+                }
+                r
+            })
+            .collect::<Result<_, _>>()?;
+        let grid_evaluations = built.iter().map(|b| b.1).sum();
+        let trees = built.into_iter().map(|b| b.0).collect();
+        let spec = brdf.name().to_string();
+        Ok(Self {
+            brdf,
+            spec,
+            variant,
+            options: *options,
+            layout,
+            trees,
+            build_time: start.elapsed(),
+            grid_evaluations,
+            name: sampler_name(variant, options.mixture),
+        })
+    }
+
+    /// Records the BRDF spec string (checked by [`QuadTreeSet::from_bytes`]).
+    pub fn with_spec(mut self, spec: impl Into<String>) -> Self {
+        self.spec = spec.into().trim().to_string();
+        self
+    }
+
+    /// Switches between the nearest slice and the two-slice mixture (the trees are unchanged).
+    pub fn with_mixture(mut self, mixture: bool) -> Self {
+        self.options.mixture = mixture;
+        self.name = sampler_name(self.variant, mixture);
+        self
+    }
+
+    /// The BRDF.
+    pub fn brdf(&self) -> &Arc<dyn Brdf> {
+        &self.brdf
+    }
+
+    /// The recorded BRDF spec.
+    pub fn spec(&self) -> &str {
+        &self.spec
+    }
+
+    /// The variant.
+    pub fn variant(&self) -> Variant {
+        self.variant
+    }
+
+    /// The options the set was built with (and its current mixture flag).
+    pub fn options(&self) -> &SetOptions {
+        &self.options
+    }
+
+    /// The slice layout.
+    pub fn layout(&self) -> SliceLayout {
+        self.layout
+    }
+
+    /// The tree of slice `index` (area pdf on the disc, see [`QuadTreeSampler`]).
+    pub fn tree(&self, index: usize) -> Option<&QuadTreeSampler<SliceDensity>> {
+        self.trees.get(index)
+    }
+
+    /// Number of trees.
+    pub fn len(&self) -> usize {
+        self.trees.len()
+    }
+
+    /// `true` when the set has no trees (never for a built set).
+    pub fn is_empty(&self) -> bool {
+        self.trees.is_empty()
+    }
+
+    /// Wall-clock build time (zero for a loaded set).
+    pub fn build_time(&self) -> Duration {
+        self.build_time
+    }
+
+    /// BRDF evaluations spent building (image maps and rim bands).
+    pub fn grid_evaluations(&self) -> u64 {
+        self.grid_evaluations
+    }
+
+    /// The slice(s) serving `wo` with their weights; `None` below the horizon.
+    pub fn choices(&self, wo: &Vec3) -> Option<[SliceChoice; 2]> {
+        if self.options.mixture {
+            self.layout.neighbours(wo)
+        } else {
+            self.layout.nearest(wo).map(|c| [c, SliceChoice { weight: 0.0, ..c }])
+        }
+    }
+
+    /// Density of `wi` under slice choice `c` alone, w.r.t. solid angle.
+    #[inline]
+    fn slice_pdf(&self, c: &SliceChoice, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        let Some(tree) = self.trees.get(c.index) else { return 0.0 };
+        let v = rotate_z(wi, -c.rotation);
+        tree.pdf([v.x, v.y]) * wi.z
+    }
+
+    /// Density of `wi` under slice choice `c` alone, w.r.t. area on the disc of that slice
+    /// (the tree's own pdf `f / Î`).
+    pub fn slice_area_pdf(&self, c: &SliceChoice, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        let Some(tree) = self.trees.get(c.index) else { return 0.0 };
+        let v = rotate_z(wi, -c.rotation);
+        tree.pdf([v.x, v.y])
+    }
+
+    /// The mixture pdf `Σ w_k p_k` given the pdf of the component that drew `wi`.
+    #[inline]
+    fn combine(&self, cs: &[SliceChoice; 2], drawn: usize, drawn_pdf: f64, wi: &Vec3) -> f64 {
+        let mut p = 0.0;
+        for (k, c) in cs.iter().enumerate() {
+            if c.weight > 0.0 {
+                let pk = if k == drawn || c.index == cs[drawn].index { drawn_pdf } else { self.slice_pdf(c, wi) };
+                p += c.weight * pk;
+            }
+        }
+        p
+    }
+
+    /// One direction, drawing the disc point with `draw`.
+    #[inline]
+    fn sample_with(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        draw: &mut dyn FnMut(&QuadTreeSampler<SliceDensity>, &mut dyn UniformSource) -> Sample2,
+    ) -> DirSample {
+        let up = DirSample { wi: Vec3::new(0.0, 0.0, 1.0), pdf: 0.0 };
+        let Some(cs) = self.choices(wo) else { return up };
+        let drawn = usize::from(cs[1].weight > 0.0 && u.next_uniform() < cs[1].weight);
+        let c = cs[drawn];
+        let Some(tree) = self.trees.get(c.index) else { return up };
+        let s = draw(tree, u);
+        let v = disc_to_direction(s.point);
+        let wi = rotate_z(&v, c.rotation);
+        let p = s.pdf * v.z;
+        let pdf = if cs[1 - drawn].weight > 0.0 { self.combine(&cs, drawn, p, &wi) } else { p };
+        DirSample { wi, pdf }
+    }
+
+    /// Samples `per_slice` directions for outgoing directions spread over every slice's θ bin
+    /// (φ uniform) on the calling thread, and counts trials, BRDF evaluations (including the
+    /// second component of a mixture), bound violations and exhausted samples. The counts are
+    /// also added to the trees' statistics ([`QuadTreeSet::report`]).
+    pub fn measure_cost(&self, per_slice: usize, seed: u64) -> CostMeasurement {
+        let mut audit = Audit::default();
+        let before = thread_evaluations();
+        let mut samples = 0u64;
+        let dt = std::f64::consts::FRAC_PI_2 / self.layout.theta as f64;
+        let dp = std::f64::consts::TAU / self.layout.phi as f64;
+        for i in 0..self.trees.len() {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, i as u64));
+            let (t, p) = self.layout.angles_of(i);
+            for _ in 0..per_slice {
+                let theta = t + (rng.next_uniform() - 0.5) * dt;
+                let phi = p + (rng.next_uniform() - 0.5) * dp;
+                let wo = brdf::direction_from_radians(theta, phi);
+                let _ = self.sample_with(&wo, &mut rng, &mut |tree, u| {
+                    let mut a = Audit::default();
+                    let s = tree.sample_audited(u, &mut a);
+                    tree.record_audit(&a);
+                    audit.merge(&a);
+                    s
+                });
+                samples += 1;
+            }
+        }
+        CostMeasurement {
+            samples,
+            trials: audit.trials,
+            evaluations: thread_evaluations() - before,
+            violations: audit.violations,
+            exhausted: audit.exhausted,
+        }
+    }
+
+    /// Structure and statistics of the set (counts gathered so far by all sampling calls).
+    pub fn report(&self) -> SetReport {
+        let mut r = SetReport {
+            name: self.name.clone(),
+            brdf: self.brdf.name().to_string(),
+            spec: self.spec.clone(),
+            layout: self.layout,
+            trees: self.trees.len(),
+            build_time: self.build_time,
+            memory_bytes: self.bytes_used(),
+            nodes: 0,
+            leaves: 0,
+            max_depth: 0,
+            expected_mean_trials: 0.0,
+            worst_expected_mean_trials: 0.0,
+            measured_mean_trials: None,
+            samples: 0,
+            bound_violations: 0,
+            exhausted: 0,
+            grid_evaluations: self.grid_evaluations,
+            evaluations_per_sample: None,
+            max_integral_rel_err: None,
+        };
+        let mut trials = 0.0;
+        for t in &self.trees {
+            let s = t.stats();
+            r.nodes += s.nodes;
+            r.leaves += s.active_leaves;
+            r.max_depth = r.max_depth.max(s.depth);
+            r.expected_mean_trials += s.expected_mean_trials;
+            r.worst_expected_mean_trials = r.worst_expected_mean_trials.max(s.expected_mean_trials);
+            r.samples += s.samples;
+            trials += s.measured_mean_trials.unwrap_or(0.0) * s.samples as f64;
+            r.bound_violations += s.bound_violations;
+            r.exhausted += s.exhausted;
+            if let Some(e) = s.integral_rel_err {
+                r.max_integral_rel_err = Some(r.max_integral_rel_err.unwrap_or(0.0).max(e));
+            }
+        }
+        r.expected_mean_trials /= self.trees.len().max(1) as f64;
+        r.measured_mean_trials = (r.samples > 0).then(|| trials / r.samples as f64);
+        r
+    }
+
+    /// [`QuadTreeSet::report`] after a [`QuadTreeSet::measure_cost`] run of `per_slice`
+    /// samples per slice, which fills [`SetReport::evaluations_per_sample`].
+    pub fn report_with_cost(&self, per_slice: usize, seed: u64) -> SetReport {
+        let cost = self.measure_cost(per_slice, seed);
+        let mut r = self.report();
+        r.evaluations_per_sample = cost.evaluations_per_sample();
+        r
+    }
+}
+
+impl DirectionSampler for QuadTreeSet {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
+        self.sample_with(wo, u, &mut |t, u| t.sample(u))
+    }
+
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        let Some(cs) = self.choices(wo) else { return 0.0 };
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        let mut p = 0.0;
+        for c in &cs {
+            if c.weight > 0.0 {
+                p += c.weight * self.slice_pdf(c, wi);
+            }
+        }
+        p
+    }
+
+    fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
+        let nearest = (!self.options.mixture).then(|| self.layout.nearest(wo)).flatten();
+        match (self.variant, nearest) {
+            (Variant::Paper, Some(c)) => {
+                let Some(tree) = self.trees.get(c.index) else { return Vec::new() };
+                let batch = tree.sample_batch(n, AllocationMode::RandomizedRemainder, u);
+                batch
+                    .samples
+                    .iter()
+                    .map(|s| {
+                        let v = disc_to_direction(s.point);
+                        DirSample { wi: rotate_z(&v, c.rotation), pdf: s.pdf * v.z }
+                    })
+                    .collect()
+            }
+            _ => (0..n).map(|_| self.sample(wo, u)).collect(),
+        }
+    }
+
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
+            + (self.trees.capacity() - self.trees.len()) * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
+            + self.spec.capacity()
+            + self.name.capacity()
+    }
+}

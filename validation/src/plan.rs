@@ -1,0 +1,184 @@
+//! Tiers, the user-facing configuration, and the resolved plan of a run.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+use stats::QuadratureOptions;
+
+use crate::domain::Resolution;
+
+/// Suite tier.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Tier {
+    /// CI tier: a handful of BRDFs and angles, sample counts for a few minutes on 2 cores.
+    Quick,
+    /// Full tier: every model (and MERL files when present), angles up to 89°, larger N.
+    Full,
+}
+
+impl Tier {
+    /// `quick` or `full`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Tier::Quick => "quick",
+            Tier::Full => "full",
+        }
+    }
+}
+
+/// BRDF specs of the quick tier.
+pub const QUICK_BRDFS: &[&str] = &["lambert", "phong:n=50", "ward", "ggx:alpha=0.2", "oren-nayar"];
+
+/// Outgoing polar angles (degrees, `φo = 0`) of the quick tier.
+pub const QUICK_THETA_O: &[f64] = &[0.0, 45.0, 80.0];
+
+/// Outgoing polar angles of the full tier.
+pub const FULL_THETA_O: &[f64] = &[0.0, 30.0, 60.0, 75.0, 85.0, 89.0];
+
+/// Samples per case of the quick tier.
+pub const QUICK_SAMPLES: usize = 200_000;
+
+/// Samples per case of the full tier.
+pub const FULL_SAMPLES: usize = 2_000_000;
+
+/// Smallest accepted sample count per case.
+pub const MIN_SAMPLES: usize = 2_000;
+
+/// Where the full tier looks for MERL `.binary` files by default (relative to the working
+/// directory, i.e. the repository root).
+pub const DEFAULT_MERL_DIR: &str = "../shared/data/merl";
+
+/// What to validate: the library form of `brdf-lab validate`.
+///
+/// Empty lists mean "the tier's default". Standalone samplers (environment maps, the synthetic
+/// grid) carry their own targets and ignore `brdfs` and `theta_o`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ValidateConfig {
+    /// BRDF specs (`name` or `name:key=value,...`, `merl:PATH`).
+    pub brdfs: Vec<String>,
+    /// Sampler names (see [`crate::samplers`]).
+    pub samplers: Vec<String>,
+    /// Outgoing polar angles in degrees, each in `[0, 90)`; `φo = 0`.
+    pub theta_o: Vec<f64>,
+    /// Samples per case (one-sample draws; the batch tests draw half as many more).
+    pub samples: Option<usize>,
+    /// Master seed: every case derives its generators from it and its own label.
+    pub seed: u64,
+    /// Quick (CI) tier instead of the full tier.
+    pub quick: bool,
+    /// Also run the mutant samplers and require that every one is caught.
+    pub mutants: bool,
+    /// Family-wise significance level of the whole run (Šidák-corrected per test).
+    pub alpha: f64,
+    /// Directory searched for MERL `.binary` files in the full tier (when `brdfs` is empty).
+    pub merl_dir: Option<PathBuf>,
+}
+
+impl Default for ValidateConfig {
+    /// The full tier with seed 1 and `α = 0.01`.
+    fn default() -> Self {
+        Self {
+            brdfs: Vec::new(),
+            samplers: Vec::new(),
+            theta_o: Vec::new(),
+            samples: None,
+            seed: 1,
+            quick: false,
+            mutants: false,
+            alpha: 0.01,
+            merl_dir: Some(PathBuf::from(DEFAULT_MERL_DIR)),
+        }
+    }
+}
+
+impl ValidateConfig {
+    /// The quick tier with defaults (seed 1, `α = 0.01`).
+    pub fn quick() -> Self {
+        Self {
+            quick: true,
+            ..Self::default()
+        }
+    }
+
+    /// The full tier with defaults.
+    pub fn full() -> Self {
+        Self::default()
+    }
+
+    /// The tier selected by `quick`.
+    pub fn tier(&self) -> Tier {
+        if self.quick { Tier::Quick } else { Tier::Full }
+    }
+}
+
+/// Sample counts, binning and tolerances of a run (resolved from the tier and the config).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// Tier.
+    pub tier: Tier,
+    /// One-sample draws per case.
+    pub samples: usize,
+    /// Samples per batch of the batch tests.
+    pub batch_size: usize,
+    /// Number of batches (`samples / (2 · batch_size)`, at least 50).
+    pub batches: usize,
+    /// Bins per domain.
+    pub resolution: Resolution,
+    /// Quadrature options of the expected counts, KS CDFs, normalisation and support tests.
+    pub quadrature: QuadratureOptions,
+    /// Normalisation: `|∫ pdf − 1| ≤` this.
+    pub normalisation_tolerance: f64,
+    /// Relative tolerance of the pdf-consistency check.
+    pub pdf_rel_tol: f64,
+    /// Sub-cells per bin side of the support-coverage check.
+    pub support_resolution: usize,
+    /// Relative systematic allowance of the unbiasedness z-tests: the standard error is
+    /// combined with `allowance · |reference|` (the pdf normaliser of grid-based samplers is
+    /// itself an estimate, bounded by the normalisation test).
+    pub unbiasedness_allowance: f64,
+}
+
+impl Plan {
+    /// The plan of `tier` with `samples` one-sample draws per case.
+    pub fn new(tier: Tier, samples: usize) -> Self {
+        let batch_size = 256;
+        let (resolution, normalisation_tolerance) = match tier {
+            Tier::Quick => (
+                Resolution {
+                    directions: [16, 32],
+                    disc: 24,
+                    square: [32, 16],
+                },
+                1e-3,
+            ),
+            Tier::Full => (
+                Resolution {
+                    directions: [24, 48],
+                    disc: 32,
+                    square: [64, 32],
+                },
+                1e-3,
+            ),
+        };
+        Self {
+            tier,
+            samples,
+            batch_size,
+            batches: (samples / (2 * batch_size)).max(50),
+            resolution,
+            quadrature: QuadratureOptions::default(),
+            normalisation_tolerance,
+            pdf_rel_tol: 1e-6,
+            support_resolution: 3,
+            unbiasedness_allowance: 1e-4,
+        }
+    }
+
+    /// Default sample count of a tier.
+    pub fn default_samples(tier: Tier) -> usize {
+        match tier {
+            Tier::Quick => QUICK_SAMPLES,
+            Tier::Full => FULL_SAMPLES,
+        }
+    }
+}

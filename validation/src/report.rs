@@ -1,0 +1,254 @@
+//! The report of a run: JSON (design.md §5 schema, plus extra fields) and markdown.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+use stats::TestOutcome;
+
+/// One test of one case.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TestRecord {
+    /// BRDF spec, or the target of a standalone sampler (e.g. `map:procedural-sky-128x64`).
+    pub brdf: String,
+    /// Sampler name.
+    pub sampler: String,
+    /// Outgoing polar angle in degrees (`null` for standalone samplers).
+    pub theta_o: Option<f64>,
+    /// Test name (`chi-square`, `ks-phi`, `unbiasedness`, ...).
+    pub test: String,
+    /// The statistic (`null` in JSON when not finite).
+    pub statistic: f64,
+    /// p-value of statistical tests; `null` for deterministic checks.
+    pub p_value: Option<f64>,
+    /// Whether the test passed (p-values judged at the Šidák per-test level).
+    pub passed: bool,
+    /// Domain the sampler was tested on.
+    pub domain: String,
+    /// Human-readable details.
+    pub detail: String,
+}
+
+impl TestRecord {
+    /// A record from a stats outcome.
+    pub fn new(
+        brdf: &str,
+        sampler: &str,
+        theta_o: Option<f64>,
+        domain: &str,
+        o: &TestOutcome,
+    ) -> Self {
+        Self {
+            brdf: brdf.to_owned(),
+            sampler: sampler.to_owned(),
+            theta_o,
+            test: o.name.clone(),
+            statistic: o.statistic,
+            p_value: o.p_value,
+            passed: o.passed,
+            domain: domain.to_owned(),
+            detail: o.detail.clone(),
+        }
+    }
+
+    /// Re-judges a p-valued record at `level` (deterministic ones keep their verdict).
+    pub(crate) fn judge(&mut self, level: f64) {
+        if let Some(p) = self.p_value {
+            self.passed = p >= level;
+        }
+    }
+}
+
+/// The outcome of one mutant and its control.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MutantRecord {
+    /// Mutant name.
+    pub name: String,
+    /// Whether at least one test rejected the mutant.
+    pub detected: bool,
+    /// The tests that rejected it.
+    pub caught_by: Vec<String>,
+    /// Smallest p-value among its tests (`null` if none).
+    pub min_p_value: Option<f64>,
+    /// Whether the unbroken base passed every test in the same setting.
+    pub control_passed: bool,
+    /// The bug.
+    pub description: String,
+    /// BRDF of the setting.
+    pub brdf: String,
+    /// Outgoing angle of the setting.
+    pub theta_o: f64,
+    /// The mutant's tests.
+    pub tests: Vec<TestRecord>,
+    /// The control's tests.
+    pub control_tests: Vec<TestRecord>,
+}
+
+/// The report of a validation run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ValidationReport {
+    /// Family-wise significance level.
+    pub alpha: f64,
+    /// Every test passed (and, with mutants, every mutant was caught and every control passed).
+    pub passed: bool,
+    /// Every test of every case, in a fixed order.
+    pub tests: Vec<TestRecord>,
+    /// Mutants (empty unless requested).
+    pub mutants: Vec<MutantRecord>,
+    /// `quick` or `full`.
+    pub tier: String,
+    /// Master seed.
+    pub seed: u64,
+    /// One-sample draws per case.
+    pub samples: usize,
+    /// Batches per case and their size.
+    pub batches: [usize; 2],
+    /// Number of p-valued tests in the family (cases and mutant controls).
+    pub m: usize,
+    /// Šidák per-test level `1 − (1 − α)^{1/m}`.
+    pub per_test_level: f64,
+}
+
+fn fmt_num(x: f64) -> String {
+    if x.is_nan() {
+        "—".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "∞".into() } else { "−∞".into() }
+    } else if x == 0.0 {
+        "0".into()
+    } else if x.abs() >= 1e-3 && x.abs() < 1e5 {
+        format!("{x:.4}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+fn fmt_p(p: Option<f64>) -> String {
+    match p {
+        None => "—".into(),
+        Some(p) if p == 0.0 => "0".into(),
+        Some(p) if p >= 1e-3 => format!("{p:.4}"),
+        Some(p) => format!("{p:.2e}"),
+    }
+}
+
+fn fmt_theta(t: Option<f64>) -> String {
+    t.map_or_else(|| "—".into(), |t| format!("{t}°"))
+}
+
+impl ValidationReport {
+    /// Whether the run passed: every test, and with mutants every detection and control.
+    pub fn passed(&self) -> bool {
+        self.passed
+    }
+
+    /// The failed tests of the correct samplers.
+    pub fn failures(&self) -> impl Iterator<Item = &TestRecord> {
+        self.tests.iter().filter(|t| !t.passed)
+    }
+
+    /// JSON with the schema of design.md §5
+    /// (`{"alpha", "passed", "tests": [{"brdf", "sampler", "theta_o", "test", "statistic",
+    /// "p_value", "passed"}], "mutants": [{"name", "detected"}]}`) plus extra fields
+    /// (`domain`, `detail`, `caught_by`, `control_passed`, the tier and sample counts).
+    /// Non-finite statistics are written as `null`.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self)
+            .unwrap_or_else(|e| format!("{{\"error\": \"serialisation failed: {e}\"}}"))
+    }
+
+    /// A readable markdown report: a summary, a table of every test with its statistic and
+    /// p-value, the mutant table, and the details of every failure.
+    pub fn to_markdown(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "# brdf-lab validate — {} tier\n", self.tier);
+        let failed = self.tests.iter().filter(|t| !t.passed).count();
+        let _ = writeln!(
+            s,
+            "**Result: {}** — {} tests, {} failed; family-wise α = {}, Šidák per-test level {:.3e} over m = {} p-valued tests; seed {}, {} one-sample draws per case plus {} batches of {}.\n",
+            if self.passed { "PASSED" } else { "FAILED" },
+            self.tests.len(),
+            failed,
+            self.alpha,
+            self.per_test_level,
+            self.m,
+            self.seed,
+            self.samples,
+            self.batches[0],
+            self.batches[1]
+        );
+        let _ = writeln!(s, "## Tests\n");
+        table(&mut s, &self.tests);
+        if !self.mutants.is_empty() {
+            let _ = writeln!(s, "\n## Mutants\n");
+            let _ = writeln!(
+                s,
+                "| mutant | setting | bug | detected | caught by | min p | control passes |"
+            );
+            let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+            for m in &self.mutants {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} at {}° | {} | {} | {} | {} | {} |",
+                    m.name,
+                    m.brdf,
+                    m.theta_o,
+                    m.description,
+                    if m.detected { "yes" } else { "**NO**" },
+                    if m.caught_by.is_empty() {
+                        "—".to_owned()
+                    } else {
+                        m.caught_by.join(", ")
+                    },
+                    fmt_p(m.min_p_value),
+                    if m.control_passed { "yes" } else { "**NO**" }
+                );
+            }
+            for m in &self.mutants {
+                let _ = writeln!(s, "\n### Mutant `{}` ({} at {}°)\n", m.name, m.brdf, m.theta_o);
+                table(&mut s, &m.tests);
+            }
+        }
+        let fails: Vec<&TestRecord> = self
+            .tests
+            .iter()
+            .chain(self.mutants.iter().flat_map(|m| m.control_tests.iter()))
+            .filter(|t| !t.passed)
+            .collect();
+        if !fails.is_empty() {
+            let _ = writeln!(s, "\n## Failures\n");
+            for t in fails {
+                let _ = writeln!(
+                    s,
+                    "- **{}** / {} / {}: `{}` — {}",
+                    t.sampler,
+                    t.brdf,
+                    fmt_theta(t.theta_o),
+                    t.test,
+                    t.detail
+                );
+            }
+        }
+        s
+    }
+}
+
+fn table(s: &mut String, rows: &[TestRecord]) {
+    let _ = writeln!(
+        s,
+        "| sampler | target | θo | test | statistic | p-value | result |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for t in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            t.sampler,
+            t.brdf,
+            fmt_theta(t.theta_o),
+            t.test,
+            fmt_num(t.statistic),
+            fmt_p(t.p_value),
+            if t.passed { "pass" } else { "**FAIL**" }
+        );
+    }
+}

@@ -1,0 +1,470 @@
+//! A validation run: resolve the configuration, build the cases, run them in parallel, judge
+//! every p-value at the Šidák level, and collect the report.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use brdf::{Brdf, Vec3, direction_from_angles};
+use rayon::prelude::*;
+use stats::{TestOutcome, sidak_level};
+
+use crate::error::ValidationError;
+use crate::mutants::mutants;
+use crate::plan::{FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig};
+use crate::references::{albedo_reference, lit_reference};
+use crate::registry::{SamplerBuild, SamplerEntry, StandaloneCase, find_sampler, samplers};
+use crate::report::{MutantRecord, TestRecord, ValidationReport};
+use crate::runner::{error_outcome, names, run_any};
+use crate::seeding::case_seed;
+use crate::subject::AnySubject;
+use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
+
+/// Progress of a run, reported once at the start and once per finished case.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProgressEvent {
+    /// The run starts `total` cases (a mutant with its control counts as one).
+    Started {
+        /// Number of cases.
+        total: usize,
+    },
+    /// A case finished (events may arrive in any order; the report's order is fixed).
+    Finished {
+        /// Cases finished so far.
+        done: usize,
+        /// Number of cases.
+        total: usize,
+        /// `sampler | target | θo` (or `mutant:name`).
+        label: String,
+        /// Whether all its tests passed at the placeholder level (for mutants: whether caught).
+        passed: bool,
+    },
+}
+
+/// The cases of one run, resolved from a [`ValidateConfig`].
+struct Resolved {
+    plan: Plan,
+    brdfs: Vec<(String, Arc<dyn Brdf>)>,
+    angles: Vec<f64>,
+    samplers: Vec<&'static SamplerEntry>,
+}
+
+fn merl_specs(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<String> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "binary"))
+        .map(|p| format!("merl:{}", p.display()))
+        .collect();
+    files.sort();
+    files
+}
+
+fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
+    if !(config.alpha > 0.0 && config.alpha < 1.0) {
+        return Err(ValidationError::BadAlpha(config.alpha));
+    }
+    let tier = config.tier();
+    let samples = config.samples.unwrap_or(Plan::default_samples(tier));
+    if samples < MIN_SAMPLES {
+        return Err(ValidationError::TooFewSamples {
+            got: samples,
+            min: MIN_SAMPLES,
+        });
+    }
+    let angles: Vec<f64> = if config.theta_o.is_empty() {
+        match tier {
+            Tier::Quick => QUICK_THETA_O.to_vec(),
+            Tier::Full => FULL_THETA_O.to_vec(),
+        }
+    } else {
+        config.theta_o.clone()
+    };
+    if let Some(&bad) = angles.iter().find(|a| !(a.is_finite() && **a >= 0.0 && **a < 90.0)) {
+        return Err(ValidationError::BadAngle(bad));
+    }
+    let mut entries: Vec<&'static SamplerEntry> = Vec::new();
+    if config.samplers.is_empty() {
+        entries.extend(samplers().iter());
+    } else {
+        for name in &config.samplers {
+            let e = find_sampler(name).ok_or_else(|| ValidationError::UnknownSampler {
+                name: name.clone(),
+                known: samplers().iter().map(|e| e.name).collect::<Vec<_>>().join(", "),
+            })?;
+            if !entries.iter().any(|x| x.name == e.name) {
+                entries.push(e);
+            }
+        }
+    }
+    let specs: Vec<String> = if config.brdfs.is_empty() {
+        match tier {
+            Tier::Quick => QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect(),
+            Tier::Full => {
+                let mut v: Vec<String> = brdf::models()
+                    .iter()
+                    .filter(|m| m.name != "merl")
+                    .map(|m| m.name.to_owned())
+                    .collect();
+                if let Some(dir) = &config.merl_dir {
+                    v.extend(merl_specs(dir));
+                }
+                v
+            }
+        }
+    } else {
+        config.brdfs.clone()
+    };
+    let mut brdfs = Vec::with_capacity(specs.len());
+    for spec in specs {
+        match brdf::parse_spec(&spec) {
+            Ok(b) => brdfs.push((spec, Arc::from(b))),
+            Err(source) => return Err(ValidationError::Brdf { spec, source }),
+        }
+    }
+    if entries.is_empty() {
+        return Err(ValidationError::Empty("no sampler selected".into()));
+    }
+    if entries.iter().any(|e| e.uses_brdf()) && (brdfs.is_empty() || angles.is_empty()) {
+        return Err(ValidationError::Empty(
+            "BRDF samplers need at least one BRDF and one angle".into(),
+        ));
+    }
+    Ok(Resolved {
+        plan: Plan::new(tier, samples),
+        brdfs,
+        angles,
+        samplers: entries,
+    })
+}
+
+/// The outcomes of one case.
+struct CaseResult {
+    sampler: String,
+    target: String,
+    theta_o: Option<f64>,
+    domain: String,
+    outcomes: Vec<TestOutcome>,
+}
+
+impl CaseResult {
+    fn label(&self) -> String {
+        match self.theta_o {
+            Some(t) => format!("{} | {} | {t}°", self.sampler, self.target),
+            None => format!("{} | {}", self.sampler, self.target),
+        }
+    }
+}
+
+/// A unit of parallel work: one sampler with one BRDF (all angles, sharing one build), or one
+/// standalone case.
+enum Job<'a> {
+    Brdf {
+        entry: &'static SamplerEntry,
+        brdf: usize,
+    },
+    Standalone {
+        entry: &'static SamplerEntry,
+        case: &'a StandaloneCase,
+    },
+}
+
+fn references_for(brdf: &dyn Brdf, wo: &Vec3) -> Result<BrdfReferences, String> {
+    Ok(BrdfReferences {
+        albedo: albedo_reference(brdf, wo).map_err(|e| e.to_string())?,
+        lit: lit_reference(brdf, wo).map_err(|e| e.to_string())?,
+    })
+}
+
+fn case_label(sampler: &str, target: &str, theta: Option<f64>) -> String {
+    format!("{sampler}|{target}|{theta:?}")
+}
+
+fn run_brdf_job(
+    entry: &SamplerEntry,
+    r: &Resolved,
+    bi: usize,
+    refs: &[Result<BrdfReferences, String>],
+    seed: u64,
+    on_done: &(dyn Fn(&CaseResult) + Sync),
+) -> Vec<CaseResult> {
+    let (spec, brdf) = &r.brdfs[bi];
+    // Direction samplers are built once per BRDF; disc samplers per angle.
+    let built = match entry.kind {
+        SamplerBuild::Direction { build, .. } => Some(build(brdf)),
+        _ => None,
+    };
+    let mut out = Vec::with_capacity(r.angles.len());
+    for (ai, &theta) in r.angles.iter().enumerate() {
+        let wo = direction_from_angles(theta, 0.0);
+        let subject: Result<AnySubject, String> = refs
+            .get(ai)
+            .cloned()
+            .unwrap_or_else(|| Err("missing reference".into()))
+            .and_then(|refs| match (&entry.kind, &built) {
+                (SamplerBuild::Direction { domain, .. }, Some(b)) => {
+                    let b = b.as_ref().map_err(Clone::clone)?;
+                    Ok(AnySubject::Direction(brdf_direction_subject(
+                        Arc::new(b.at(wo)),
+                        *domain,
+                        Arc::clone(brdf),
+                        wo,
+                        &refs,
+                    )))
+                }
+                (SamplerBuild::BrdfDisc(build), _) => Ok(AnySubject::Planar(brdf_disc_subject(
+                    build(brdf, &wo)?,
+                    Arc::clone(brdf),
+                    wo,
+                    &refs,
+                ))),
+                _ => Err("not a BRDF sampler".into()),
+            });
+        let (domain, outcomes) = match &subject {
+            Ok(s) => (
+                s.domain().name().to_owned(),
+                run_any(
+                    s,
+                    &r.plan,
+                    case_seed(seed, &case_label(entry.name, spec, Some(theta))),
+                ),
+            ),
+            Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
+        };
+        let c = CaseResult {
+            sampler: entry.name.to_owned(),
+            target: spec.clone(),
+            theta_o: Some(theta),
+            domain,
+            outcomes,
+        };
+        on_done(&c);
+        out.push(c);
+    }
+    out
+}
+
+/// Runs a validation: every selected sampler × BRDF × angle (and the standalone samplers'
+/// targets), then the mutants when asked.
+///
+/// `progress` is called from worker threads (hence `Sync`) with a [`ProgressEvent::Started`]
+/// and one [`ProgressEvent::Finished`] per case. The report depends only on the configuration
+/// (seed included), never on the number of threads: cases are seeded from the master seed and
+/// their own labels, samples are drawn in fixed chunks with one generator each, and results
+/// are collected in a fixed order.
+///
+/// # Errors
+/// [`ValidationError`] for bad input (unknown sampler, bad BRDF spec, bad angle, too few
+/// samples, bad `alpha`, empty selection). Failing samplers are reported, not errors.
+pub fn run(
+    config: &ValidateConfig,
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
+    let r = resolve(config)?;
+    let seed = config.seed;
+
+    // Standalone samplers' cases are built up front (cheap), so the total is known.
+    let standalone: Vec<(&'static SamplerEntry, Result<Vec<StandaloneCase>, String>)> = r
+        .samplers
+        .iter()
+        .filter_map(|e| match e.kind {
+            SamplerBuild::Standalone(build) => Some((*e, build())),
+            _ => None,
+        })
+        .collect();
+    let brdf_entries: Vec<&'static SamplerEntry> =
+        r.samplers.iter().copied().filter(|e| e.uses_brdf()).collect();
+    let mut jobs: Vec<Job<'_>> = Vec::new();
+    for &entry in &brdf_entries {
+        for bi in 0..r.brdfs.len() {
+            jobs.push(Job::Brdf { entry, brdf: bi });
+        }
+    }
+    let mut failed_builds: Vec<CaseResult> = Vec::new();
+    for (entry, cases) in &standalone {
+        match cases {
+            Ok(cases) => jobs.extend(cases.iter().map(|case| Job::Standalone { entry, case })),
+            Err(e) => failed_builds.push(CaseResult {
+                sampler: entry.name.to_owned(),
+                target: "—".into(),
+                theta_o: None,
+                domain: "—".into(),
+                outcomes: vec![error_outcome(names::BUILD, e)],
+            }),
+        }
+    }
+    let mutant_list = if config.mutants { mutants() } else { &[] };
+    let total = brdf_entries.len() * r.brdfs.len() * r.angles.len()
+        + jobs
+            .iter()
+            .filter(|j| matches!(j, Job::Standalone { .. }))
+            .count()
+        + mutant_list.len();
+    progress(ProgressEvent::Started { total });
+    let done = AtomicUsize::new(0);
+    let notify = |label: String, passed: bool| {
+        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+        progress(ProgressEvent::Finished {
+            done: d,
+            total,
+            label,
+            passed,
+        });
+    };
+    let on_done = |c: &CaseResult| notify(c.label(), c.outcomes.iter().all(|o| o.passed));
+
+    // References of every (BRDF, angle), shared by the samplers.
+    let refs: Vec<Vec<Result<BrdfReferences, String>>> = if brdf_entries.is_empty() {
+        Vec::new()
+    } else {
+        r.brdfs
+            .par_iter()
+            .map(|(_, b)| {
+                r.angles
+                    .par_iter()
+                    .map(|&t| references_for(b.as_ref(), &direction_from_angles(t, 0.0)))
+                    .collect()
+            })
+            .collect()
+    };
+
+    let results: Vec<Vec<CaseResult>> = jobs
+        .par_iter()
+        .map(|job| match job {
+            Job::Brdf { entry, brdf } => {
+                run_brdf_job(entry, &r, *brdf, &refs[*brdf], seed, &on_done)
+            }
+            Job::Standalone { entry, case } => {
+                let c = CaseResult {
+                    sampler: entry.name.to_owned(),
+                    target: case.target.clone(),
+                    theta_o: None,
+                    domain: case.subject.domain.name().to_owned(),
+                    outcomes: run_any(
+                        &AnySubject::Planar(case.subject.clone()),
+                        &r.plan,
+                        case_seed(seed, &case_label(entry.name, &case.target, None)),
+                    ),
+                };
+                on_done(&c);
+                vec![c]
+            }
+        })
+        .collect();
+
+    let mutant_results: Vec<(CaseResult, CaseResult)> = mutant_list
+        .par_iter()
+        .map(|m| {
+            let label = |kind: &str| format!("{kind}:{}", m.name);
+            let wo = direction_from_angles(m.theta_o, 0.0);
+            let built = brdf::parse_spec(m.brdf)
+                .map_err(|e| e.to_string())
+                .and_then(|b| {
+                    let b: Arc<dyn Brdf> = Arc::from(b);
+                    let refs = references_for(b.as_ref(), &wo)?;
+                    m.build(&b, &wo, &refs)
+                });
+            let run_one = |s: Result<&AnySubject, &String>, kind: &str| {
+                let (domain, outcomes) = match s {
+                    Ok(s) => (
+                        s.domain().name().to_owned(),
+                        run_any(s, &r.plan, case_seed(seed, &label(kind))),
+                    ),
+                    Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
+                };
+                CaseResult {
+                    sampler: label(kind),
+                    target: m.brdf.to_owned(),
+                    theta_o: Some(m.theta_o),
+                    domain,
+                    outcomes,
+                }
+            };
+            let (mc, cc) = match &built {
+                Ok(case) => (run_one(Ok(&case.mutant), "mutant"), run_one(Ok(&case.control), "control")),
+                Err(e) => (run_one(Err(e), "mutant"), run_one(Err(e), "control")),
+            };
+            notify(label("mutant"), mc.outcomes.iter().any(|o| !o.passed));
+            (mc, cc)
+        })
+        .collect();
+
+    Ok(assemble(
+        config,
+        &r.plan,
+        failed_builds.into_iter().chain(results.into_iter().flatten()).collect(),
+        mutant_results,
+    ))
+}
+
+fn records(c: &CaseResult) -> Vec<TestRecord> {
+    c.outcomes
+        .iter()
+        .map(|o| TestRecord::new(&c.target, &c.sampler, c.theta_o, &c.domain, o))
+        .collect()
+}
+
+fn assemble(
+    config: &ValidateConfig,
+    plan: &Plan,
+    cases: Vec<CaseResult>,
+    mutant_results: Vec<(CaseResult, CaseResult)>,
+) -> ValidationReport {
+    let mut tests: Vec<TestRecord> = cases.iter().flat_map(records).collect();
+    let mut controls: Vec<Vec<TestRecord>> =
+        mutant_results.iter().map(|(_, c)| records(c)).collect();
+    let m = tests
+        .iter()
+        .chain(controls.iter().flatten())
+        .filter(|t| t.p_value.is_some())
+        .count();
+    let level = sidak_level(config.alpha, m);
+    tests.iter_mut().for_each(|t| t.judge(level));
+    controls.iter_mut().flatten().for_each(|t| t.judge(level));
+    let mutants: Vec<MutantRecord> = mutant_results
+        .iter()
+        .zip(controls)
+        .zip(mutants())
+        .map(|(((mc, _), control_tests), m)| {
+            let mut mtests = records(mc);
+            mtests.iter_mut().for_each(|t| t.judge(level));
+            let caught_by: Vec<String> = mtests
+                .iter()
+                .filter(|t| !t.passed && t.test != names::BUILD)
+                .map(|t| t.test.clone())
+                .collect();
+            MutantRecord {
+                name: m.name.to_owned(),
+                detected: !caught_by.is_empty(),
+                caught_by,
+                min_p_value: mtests
+                    .iter()
+                    .filter_map(|t| t.p_value)
+                    .min_by(f64::total_cmp),
+                control_passed: control_tests.iter().all(|t| t.passed),
+                description: m.description.to_owned(),
+                brdf: m.brdf.to_owned(),
+                theta_o: m.theta_o,
+                tests: mtests,
+                control_tests,
+            }
+        })
+        .collect();
+    let passed = tests.iter().all(|t| t.passed)
+        && mutants.iter().all(|m| m.detected && m.control_passed);
+    ValidationReport {
+        alpha: config.alpha,
+        passed,
+        tests,
+        mutants,
+        tier: plan.tier.name().to_owned(),
+        seed: config.seed,
+        samples: plan.samples,
+        batches: [plan.batches, plan.batch_size],
+        m,
+        per_test_level: level,
+    }
+}

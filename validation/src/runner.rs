@@ -1,0 +1,349 @@
+//! Runs every test of the suite on one subject.
+
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use stats::{
+    Axis, Binning, DEFAULT_MIN_EXPECTED, TestOutcome, chi_square_gof, expected_masses_with,
+    histogram, ks_projection_test, normalisation, pdf_consistency, support_coverage,
+};
+
+use crate::plan::Plan;
+use crate::seeding::{chunk_seed, stream_seed};
+use crate::subject::{AnySubject, Reference, SamplerUnderTest, Subject};
+
+/// One-sample draws per generator chunk (each chunk has its own generator).
+pub const DRAW_CHUNK: usize = 4096;
+
+/// The unbiasedness tests allow a systematic relative error of this many times the sampler's
+/// declared normaliser error ([`SamplerUnderTest::normaliser_rel_err`], e.g. a Richardson
+/// estimate, which is an estimate, not a bound).
+pub const DECLARED_ERROR_FACTOR: f64 = 3.0;
+
+/// Test names, in report order.
+pub mod names {
+    /// Pearson chi-square of the one-sample draws against the reported pdf.
+    pub const CHI_SQUARE: &str = "chi-square";
+    /// Chi-square of the pooled batch draws.
+    pub const BATCH_CHI_SQUARE: &str = "batch-chi-square";
+    /// pdf returned with samples equals `pdf(x)` and is positive.
+    pub const PDF_CONSISTENCY: &str = "pdf-consistency";
+    /// `∫ pdf = 1` within the plan's tolerance.
+    pub const NORMALISATION: &str = "normalisation";
+    /// No region where the target is positive and the pdf is not.
+    pub const SUPPORT: &str = "support-coverage";
+    /// One-sample estimator z-test against the reference.
+    pub const UNBIASEDNESS: &str = "unbiasedness";
+    /// Every batch returned the number of samples asked for.
+    pub const BATCH_SIZE: &str = "batch-size";
+    /// z-test of the per-batch estimates against the reference.
+    pub const BATCH_UNBIASEDNESS: &str = "batch-unbiasedness";
+    /// Zero bound violations during the run.
+    pub const BOUND_AUDIT: &str = "bound-audit";
+    /// The sampler could be built.
+    pub const BUILD: &str = "build";
+}
+
+/// A failed deterministic outcome describing an error that prevented a test.
+pub(crate) fn error_outcome(name: &str, error: impl std::fmt::Display) -> TestOutcome {
+    TestOutcome::deterministic(name, f64::NAN, false, format!("error: {error}"))
+}
+
+fn renamed(mut o: TestOutcome, name: &str) -> TestOutcome {
+    o.name = name.to_owned();
+    o
+}
+
+/// Runs the suite on a subject; `seed` is the case seed.
+pub(crate) fn run_any(subject: &AnySubject, plan: &Plan, seed: u64) -> Vec<TestOutcome> {
+    match subject {
+        AnySubject::Direction(s) => match plan.resolution.sphere_binning(s.domain) {
+            Ok(Some(b)) => run_subject(s, &b, plan, seed),
+            Ok(None) => vec![error_outcome(names::BUILD, "direction subject on a planar domain")],
+            Err(e) => vec![error_outcome(names::BUILD, e)],
+        },
+        AnySubject::Planar(s) => match plan.resolution.planar_binning(s.domain) {
+            Ok(Some(b)) => run_subject(s, b.as_ref(), plan, seed),
+            Ok(None) => vec![error_outcome(names::BUILD, "planar subject on a direction domain")],
+            Err(e) => vec![error_outcome(names::BUILD, e)],
+        },
+    }
+}
+
+/// `n` one-sample draws in fixed chunks of [`DRAW_CHUNK`], chunk `c` with its own generator
+/// seeded from `(seed, c)`: the result depends only on `(n, seed)`, not on the thread count.
+pub fn draw<P: Copy + Send>(
+    sampler: &dyn SamplerUnderTest<P>,
+    n: usize,
+    seed: u64,
+) -> Vec<(P, f64)> {
+    let chunks: Vec<Vec<(P, f64)>> = (0..n.div_ceil(DRAW_CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
+            let len = DRAW_CHUNK.min(n - c * DRAW_CHUNK);
+            (0..len).map(|_| sampler.sample(&mut rng)).collect()
+        })
+        .collect();
+    chunks.concat()
+}
+
+/// `k` batches of `size` draws, batch `b` with its own generator seeded from `(seed, b)`.
+pub fn draw_batches<P: Copy + Send>(
+    sampler: &dyn SamplerUnderTest<P>,
+    size: usize,
+    k: usize,
+    seed: u64,
+) -> Vec<Vec<(P, f64)>> {
+    (0..k)
+        .into_par_iter()
+        .map(|b| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, b as u64));
+            sampler.sample_batch(size, &mut rng)
+        })
+        .collect()
+}
+
+/// `g(x) / pdf(x)`: 0 where `g = 0` (whatever the pdf), `+∞` where `g > 0` but the pdf is not.
+fn estimate(g: f64, pdf: f64) -> f64 {
+    if g == 0.0 {
+        0.0
+    } else if pdf > 0.0 {
+        g / pdf
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Two-sided z-test of `mean(values)` against `reference`, the standard error combined with a
+/// systematic term `√((allowance · |ref|)² + ref.abs_error²)`; judged at `alpha`.
+pub fn z_test(
+    name: &str,
+    values: &[f64],
+    reference: &Reference,
+    allowance: f64,
+    alpha: f64,
+) -> TestOutcome {
+    if values.len() < 2 {
+        return error_outcome(name, format!("need at least 2 values, got {}", values.len()));
+    }
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return TestOutcome::with_p_value(
+            name,
+            f64::INFINITY,
+            0.0,
+            alpha,
+            format!("estimator value {i} is not finite ({}): a sample landed where the integrand is positive but the pdf is not", values[i]),
+        );
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
+    let se = (var / n).sqrt();
+    let sys = ((allowance * reference.value).powi(2) + reference.abs_error.powi(2)).sqrt();
+    let total = (se * se + sys * sys)
+        .sqrt()
+        .max(1e-12 * mean.abs().max(reference.value.abs()));
+    let z = if total > 0.0 {
+        (mean - reference.value) / total
+    } else if mean == reference.value {
+        0.0
+    } else {
+        f64::INFINITY
+    };
+    let p = statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2);
+    let detail = format!(
+        "mean {mean:.8e} vs reference {:.8e} (rel. dev. {:.2e}); standard error {se:.3e}, systematic allowance {sys:.3e}; z = {z:.3}, n = {}",
+        reference.value,
+        (mean - reference.value) / reference.value.abs().max(f64::MIN_POSITIVE),
+        values.len()
+    );
+    TestOutcome::with_p_value(name, z, p, alpha, detail)
+}
+
+fn chi_square<P: Copy + Send + Sync>(
+    name: &str,
+    binning: &dyn Binning<Point = P>,
+    masses: &[f64],
+    points: &[P],
+    alpha: f64,
+) -> TestOutcome {
+    if points.is_empty() {
+        return error_outcome(name, "no samples");
+    }
+    let hist = histogram(binning, points);
+    let n = points.len() as f64;
+    let mut observed = hist.counts;
+    let mut expected: Vec<f64> = masses.iter().map(|m| m * n).collect();
+    observed.push(hist.outside);
+    expected.push(0.0);
+    match chi_square_gof(&observed, &expected, DEFAULT_MIN_EXPECTED) {
+        Ok(r) => r.outcome(name, alpha),
+        Err(e) => error_outcome(name, e),
+    }
+}
+
+/// Every test of the suite on `s` (binned by `binning`), in report order. p-values are judged
+/// at a placeholder level here; the run re-judges them with the Šidák level.
+pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
+    s: &Subject<P>,
+    binning: &dyn Binning<Point = P>,
+    plan: &Plan,
+    seed: u64,
+) -> Vec<TestOutcome> {
+    let alpha = 0.01;
+    let t0 = std::time::Instant::now();
+    let tm = |what: &str| if std::env::var_os("VT").is_some() { eprintln!("  TIMING {what}: {:.2}s", t0.elapsed().as_secs_f64()); };
+    let sampler = s.sampler.as_ref();
+    let violations_before = sampler.bound_violations();
+    let singles = draw(sampler, plan.samples, stream_seed(seed, 1));
+    let batches = draw_batches(
+        sampler,
+        plan.batch_size,
+        plan.batches,
+        stream_seed(seed, 2),
+    );
+    let violations_after = sampler.bound_violations();
+    tm("draw");
+
+    let pdf = |p: P| sampler.pdf(p);
+    let points: Vec<P> = singles.iter().map(|s| s.0).collect();
+    let batch_points: Vec<P> = batches.iter().flatten().map(|s| s.0).collect();
+    let opts = &plan.quadrature;
+    let mut out = Vec::with_capacity(11);
+
+    let n_max = points.len().max(batch_points.len()) as u64;
+    match expected_masses_with(&pdf, binning, n_max, opts) {
+        Ok(table) => {
+            out.push(chi_square(
+                names::CHI_SQUARE,
+                binning,
+                &table.masses,
+                &points,
+                alpha,
+            ));
+            out.push(chi_square(
+                names::BATCH_CHI_SQUARE,
+                binning,
+                &table.masses,
+                &batch_points,
+                alpha,
+            ));
+        }
+        Err(e) => {
+            out.push(error_outcome(names::CHI_SQUARE, &e));
+            out.push(error_outcome(names::BATCH_CHI_SQUARE, &e));
+        }
+    }
+    tm("chi2");
+    let axis_names = s.domain.axis_names();
+    for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
+        out.push(
+            match ks_projection_test(binning, &pdf, &points, axis, alpha, opts) {
+                Ok(o) => renamed(o, name),
+                Err(e) => error_outcome(name, e),
+            },
+        );
+    }
+    tm("ks");
+    let all: Vec<(P, f64)> = singles.iter().chain(batches.iter().flatten()).copied().collect();
+    out.push(match pdf_consistency(&all, &pdf, plan.pdf_rel_tol) {
+        Ok(o) => renamed(o, names::PDF_CONSISTENCY),
+        Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
+    });
+    out.push(
+        match normalisation(binning, &pdf, 1.0, plan.normalisation_tolerance, opts) {
+            Ok(o) => renamed(o, names::NORMALISATION),
+            Err(e) => error_outcome(names::NORMALISATION, e),
+        },
+    );
+    tm("pdf+norm");
+    let target = s.target.as_ref();
+    out.push(
+        match support_coverage(binning, target, &pdf, plan.support_resolution, opts) {
+            Ok(o) => renamed(o, names::SUPPORT),
+            Err(e) => error_outcome(names::SUPPORT, e),
+        },
+    );
+
+    tm("support");
+    // The estimator's bias may reach the normaliser's error: allow the larger of the plan's
+    // allowance and DECLARED_ERROR_FACTOR times the sampler's own estimate.
+    let declared = sampler.normaliser_rel_err();
+    let allowance = declared.map_or(plan.unbiasedness_allowance, |d| {
+        plan.unbiasedness_allowance.max(DECLARED_ERROR_FACTOR * d)
+    });
+    let g = s.single.integrand.as_ref();
+    let values: Vec<f64> = singles.iter().map(|&(p, q)| estimate(g(p), q)).collect();
+    let mut o = z_test(
+        names::UNBIASEDNESS,
+        &values,
+        &s.single.reference,
+        allowance,
+        alpha,
+    );
+    o.detail = format!("estimand {}: {}", s.single.label, o.detail);
+    out.push(o);
+
+    let short: Vec<(usize, usize)> = batches
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.len() != plan.batch_size)
+        .map(|(i, b)| (i, b.len()))
+        .collect();
+    out.push(TestOutcome::deterministic(
+        names::BATCH_SIZE,
+        short.len() as f64,
+        short.is_empty(),
+        match short.first() {
+            None => format!(
+                "all {} batches returned {} samples",
+                batches.len(),
+                plan.batch_size
+            ),
+            Some(&(i, len)) => format!(
+                "{} of {} batches returned a number of samples other than {} (first: batch {i} with {len})",
+                short.len(),
+                batches.len(),
+                plan.batch_size
+            ),
+        },
+    ));
+
+    let g = s.batch.integrand.as_ref();
+    let b = plan.batch_size as f64;
+    let means: Vec<f64> = batches
+        .iter()
+        .map(|batch| batch.iter().map(|&(p, q)| estimate(g(p), q)).sum::<f64>() / b)
+        .collect();
+    let mut o = z_test(
+        names::BATCH_UNBIASEDNESS,
+        &means,
+        &s.batch.reference,
+        allowance,
+        alpha,
+    );
+    o.detail = format!(
+        "estimand {}, {} batches of {}: {}",
+        s.batch.label,
+        batches.len(),
+        plan.batch_size,
+        o.detail
+    );
+    out.push(o);
+
+    if let (Some(before), Some(after)) = (violations_before, violations_after) {
+        let v = after.saturating_sub(before);
+        out.push(TestOutcome::deterministic(
+            names::BOUND_AUDIT,
+            v as f64,
+            v == 0,
+            format!(
+                "{v} rejection trials with f > M_i while drawing {} + {} samples",
+                points.len(),
+                batch_points.len()
+            ),
+        ));
+    }
+    out
+}
