@@ -61,8 +61,9 @@ pub use plan::{
     QUICK_THETA_O, Tier, ValidateConfig,
 };
 pub use registry::{
-    BuiltDirection, DISC_GRID, DirectionBuild, DiscBuild, SAMPLERS, SamplerBuild, SamplerEntry,
-    StandaloneBuild, StandaloneCase, find_sampler, quadtree_disc_sampler, samplers, test_maps,
+    BuiltDirection, DISC_GRID, DISC_SAFETY, DirectionBuild, DiscBuild, SAMPLERS, SamplerBuild, SamplerEntry,
+    StandaloneBuild, StandaloneCase, find_sampler, quadtree_disc_density, quadtree_disc_sampler,
+    samplers, test_maps,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
 pub use run::{ProgressEvent, run};

@@ -192,8 +192,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     seed: u64,
 ) -> Vec<TestOutcome> {
     let alpha = 0.01;
-    let t0 = std::time::Instant::now();
-    let tm = |what: &str| if std::env::var_os("VT").is_some() { eprintln!("  TIMING {what}: {:.2}s", t0.elapsed().as_secs_f64()); };
     let sampler = s.sampler.as_ref();
     let violations_before = sampler.bound_violations();
     let singles = draw(sampler, plan.samples, stream_seed(seed, 1));
@@ -204,7 +202,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         stream_seed(seed, 2),
     );
     let violations_after = sampler.bound_violations();
-    tm("draw");
 
     let pdf = |p: P| sampler.pdf(p);
     let points: Vec<P> = singles.iter().map(|s| s.0).collect();
@@ -235,7 +232,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
             out.push(error_outcome(names::BATCH_CHI_SQUARE, &e));
         }
     }
-    tm("chi2");
     let axis_names = s.domain.axis_names();
     for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
         out.push(
@@ -245,7 +241,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
             },
         );
     }
-    tm("ks");
     let all: Vec<(P, f64)> = singles.iter().chain(batches.iter().flatten()).copied().collect();
     out.push(match pdf_consistency(&all, &pdf, plan.pdf_rel_tol) {
         Ok(o) => renamed(o, names::PDF_CONSISTENCY),
@@ -257,7 +252,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
             Err(e) => error_outcome(names::NORMALISATION, e),
         },
     );
-    tm("pdf+norm");
     let target = s.target.as_ref();
     out.push(
         match support_coverage(binning, target, &pdf, plan.support_resolution, opts) {
@@ -266,7 +260,6 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         },
     );
 
-    tm("support");
     // The estimator's bias may reach the normaliser's error: allow the larger of the plan's
     // allowance and DECLARED_ERROR_FACTOR times the sampler's own estimate.
     let declared = sampler.normaliser_rel_err();

@@ -1,6 +1,9 @@
 //! Baseline samplers that brdf-lab's adaptive-partition sampler is compared with.
 //!
-//! Today: the classic marginal/conditional piecewise-constant CDF sampler
+//! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
+//! [`UniformHemisphere`] and [`CosineHemisphere`].
+//!
+//! Planar samplers: the classic marginal/conditional piecewise-constant CDF sampler
 //! ([`PiecewiseConstant2D`], with its 1D building block [`PiecewiseConstant1D`]), as used by
 //! pbrt for environment maps. It implements the shared [`partition_sampler::Sampler2D`] and
 //! [`partition_sampler::InvertibleSampler2D`] contract: pdfs are **with respect to area on the
@@ -28,9 +31,13 @@
 // Validation is written `if !(x >= 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod hemisphere;
 pub mod parallel;
 pub mod piecewise_constant;
+pub mod registry;
 
+pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use parallel::sample_par;
 pub use partition_sampler::Rect;
+pub use registry::{DIRECTION_SAMPLERS, build_direction_sampler};
 pub use piecewise_constant::{PiecewiseConstant1D, PiecewiseConstant2D, Sample1, TabulatedError};

@@ -171,14 +171,17 @@ pub(crate) struct SliceImageMap<'a> {
     grid: SampledGridDensity<Counted<'a>>,
     band: RimBand,
     safety: f64,
+    /// Bounds are taken over the cell grown by this many fine cells on every side.
+    dilation: f64,
 }
 
 impl<'a> SliceImageMap<'a> {
     /// Evaluates the image map (`grid²` cells) and the rim band of `f`.
-    pub(crate) fn new(f: Counted<'a>, grid: usize, safety: f64) -> Result<Self, DensityError> {
+    pub(crate) fn new(f: Counted<'a>, grid: usize, safety: f64, dilation: u32) -> Result<Self, DensityError> {
         let band = RimBand::new(&f, grid)?;
+        let h = 2.0 / grid as f64;
         let grid = SampledGridDensity::new(f, Domain::UnitDisc, grid)?.with_safety_factor(safety)?;
-        Ok(Self { grid, band, safety })
+        Ok(Self { grid, band, safety, dilation: f64::from(dilation) * h })
     }
 }
 
@@ -196,6 +199,11 @@ impl RegionStats for SliceImageMap<'_> {
 
     fn region(&self, cell: &Rect) -> RegionEstimate {
         let mut est = self.grid.region(cell);
+        if self.dilation > 0.0 {
+            let d = self.dilation;
+            let grown = Rect::new((cell.x0 - d).max(-1.0), (cell.y0 - d).max(-1.0), (cell.x1 + d).min(1.0), (cell.y1 + d).min(1.0));
+            est.max_bound = est.max_bound.max(self.grid.region(&grown).max_bound);
+        }
         if let Some(m) = self.band.max_in(cell) {
             est.max_bound = est.max_bound.max(self.safety * m);
         }
@@ -234,7 +242,7 @@ mod tests {
         let b: Arc<dyn brdf::Brdf> = Arc::new(RimPeak);
         let d = DiscBrdf::new(b, brdf::direction_from_angles(10.0, 0.0));
         let counter = EvalCounter::new();
-        let map = SliceImageMap::new(Counted { f: &d, counter: &counter }, 64, 1.1).unwrap();
+        let map = SliceImageMap::new(Counted { f: &d, counter: &counter }, 64, 1.1, 0).unwrap();
         let cell = Rect::new(0.5, -0.25, 1.0, 0.25);
         let plain = map.grid.region(&cell).max_bound;
         let guarded = map.region(&cell).max_bound;

@@ -56,6 +56,10 @@ pub struct SetOptions {
     /// Cells with rejection volume `V_i ≤ volume_tolerance · I_root` are not split
     /// (default [`DEFAULT_VOLUME_TOLERANCE`]; 0 = the papers' pure criterion).
     pub volume_tolerance: f64,
+    /// Leaf bounds are the image-map maxima over the leaf grown by this many fine cells on
+    /// every side (default 0). Piecewise-constant data such as MERL tables need 1: a fine cell
+    /// can straddle a bin that none of its sample points hits.
+    pub bound_dilation: u32,
     /// Sample the mixture of the two θ-neighbouring slices (linear weights in θ) instead of the
     /// nearest slice (default `false`).
     pub mixture: bool,
@@ -71,6 +75,7 @@ impl Default for SetOptions {
             grid: DEFAULT_GRID,
             safety_factor: DEFAULT_SAFETY_FACTOR,
             volume_tolerance: DEFAULT_VOLUME_TOLERANCE,
+            bound_dilation: 0,
             mixture: false,
         }
     }

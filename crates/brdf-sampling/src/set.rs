@@ -128,7 +128,7 @@ fn build_slice(
     let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
     let f = DiscBrdf::new(Arc::clone(brdf), layout.direction_of(index));
     let counter = EvalCounter::new();
-    let map = SliceImageMap::new(Counted { f: &f, counter: &counter }, options.grid, options.safety_factor)
+    let map = SliceImageMap::new(Counted { f: &f, counter: &counter }, options.grid, options.safety_factor, options.bound_dilation)
         .map_err(|source| SetError::Density { slice: index, theta_deg, phi_deg, source })?;
     let tree = QuadTreeBuilder::new()
         .n_max(options.n_max)

@@ -2,12 +2,6 @@
 
 use crate::error::CliResult;
 
-/// Samplers the `sample`, `eval` and `validate` commands accept, with one line each.
-pub(crate) const SAMPLERS: &[(&str, &str)] = &[
-    ("adaptive", "adaptive partition (quadtree + rejection), envelope scheme: exact, default"),
-    ("adaptive-paper", "adaptive partition as in the papers: leaf ∝ I_i, CDF descent, image-map bounds"),
-];
-
 /// Runs `brdf-lab list`.
 pub(crate) fn run() -> CliResult<()> {
     println!("BRDF models (SPEC = name or name:key=value,...; also merl:PATH for MERL files)");
@@ -25,7 +19,7 @@ pub(crate) fn run() -> CliResult<()> {
         }
     }
     println!("\nSamplers (--sampler NAME)");
-    for (name, doc) in SAMPLERS {
+    for (name, doc) in baselines::DIRECTION_SAMPLERS {
         println!("  {name:<16} {doc}");
     }
     Ok(())

@@ -2,11 +2,15 @@
 //!
 //! Exit codes: 0 success (all tests passed), 1 a statistical test failed, 2 bad usage or input.
 
+mod brdf_args;
+mod build_cmd;
 mod envmap_cmd;
+mod eval_cmd;
 mod error;
 mod list_cmd;
 mod output;
 mod progress;
+mod sample_cmd;
 
 use clap::{Parser, Subcommand};
 use error::CliError;
@@ -23,6 +27,12 @@ struct Cli {
 enum Command {
     /// List the BRDF models with their parameters, and the samplers.
     List,
+    /// Draw incident directions for a BRDF and outgoing direction (CSV x,y,z,pdf).
+    Sample(sample_cmd::SampleArgs),
+    /// Evaluate the BRDF (and a sampler's pdf) at directions read from a CSV file.
+    Eval(eval_cmd::EvalArgs),
+    /// Build (and save) a BRDF's set of adaptive quadtrees, with its report.
+    Build(build_cmd::BuildArgs),
     /// Sample an environment map (directions ∝ luminance per solid angle) and print a summary.
     Envmap(envmap_cmd::EnvmapArgs),
 }
@@ -49,6 +59,9 @@ fn main() {
     };
     let result = match cli.command {
         Command::List => list_cmd::run(),
+        Command::Sample(args) => sample_cmd::run(&args),
+        Command::Eval(args) => eval_cmd::run(&args),
+        Command::Build(args) => build_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
     };
     if let Err(e) = result {

@@ -21,8 +21,7 @@ use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::DirectionSampler;
-use brdf_sampling::disc::DiscBrdf;
-use partition_sampler::{Domain as PsDomain, QuadTreeBuilder, SampledGridDensity};
+use partition_sampler::QuadTreeBuilder;
 
 pub use bases::{CosineHemisphere, LobeMixture, cosine_direction, cosine_pdf};
 pub use direction::{CosineReportedUniform, RegionScaledPdf, TruncatedCosine};
@@ -30,7 +29,7 @@ pub use planar::{FloorSplit, Remainder, ScaledBounds};
 
 use crate::adapters::{DirectionAtWo, QuadTreePlanar};
 use crate::domain::Domain;
-use crate::registry::{DISC_GRID, quadtree_disc_sampler};
+use crate::registry::{quadtree_disc_density, quadtree_disc_sampler};
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
 
@@ -189,16 +188,11 @@ pub static MUTANTS: &[Mutant] = &[
     },
     Mutant {
         name: "leaf-bound-too-low",
-        description: "disc quadtree whose leaf bounds are 0.7 x the sampled density's (effective safety factor 0.77 < 1)",
+        description: "disc quadtree whose leaf bounds are 0.7 x the honest ones (effective safety factor 0.875 < 1)",
         brdf: "phong:n=50",
         theta_o: 45.0,
         build: |b, wo, r| {
-            let density = SampledGridDensity::new(
-                DiscBrdf::new(Arc::clone(b), *wo),
-                PsDomain::UnitDisc,
-                DISC_GRID,
-            )
-            .map_err(|e| e.to_string())?;
+            let density = quadtree_disc_density(b, wo)?;
             let broken = QuadTreeBuilder::new()
                 .build(ScaledBounds {
                     inner: density,

@@ -1,0 +1,116 @@
+//! Arguments shared by the BRDF commands (`sample`, `eval`, `build`) and building samplers.
+
+use std::sync::Arc;
+
+use brdf::{Brdf, Vec3};
+use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions};
+use clap::Args;
+
+use crate::error::{CliError, CliResult};
+use crate::progress;
+
+/// The BRDF and the outgoing direction.
+#[derive(Debug, Args)]
+pub(crate) struct BrdfArgs {
+    /// BRDF: `name` or `name:key=value,...` (e.g. `phong:n=50,ks=0.7,kd=0.3`) or `merl:PATH`.
+    #[arg(long = "brdf")]
+    pub(crate) spec: String,
+    /// Outgoing polar angle θo in degrees, in [0, 90).
+    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    pub(crate) theta_o: f64,
+    /// Outgoing azimuth φo in degrees.
+    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    pub(crate) phi_o: f64,
+}
+
+/// Options of the adaptive quadtree sets.
+#[derive(Debug, Args, Clone)]
+pub(crate) struct SetArgs {
+    /// Outgoing-angle slices of an isotropic BRDF's set.
+    #[arg(long, default_value_t = brdf_sampling::DEFAULT_SLICES)]
+    pub(crate) slices: usize,
+    /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
+    #[arg(long, default_value_t = brdf_sampling::DEFAULT_N_MAX)]
+    pub(crate) n_max: f64,
+    /// Maximum quadtree depth.
+    #[arg(long, default_value_t = brdf_sampling::DEFAULT_MAX_DEPTH)]
+    pub(crate) max_depth: u32,
+}
+
+impl SetArgs {
+    pub(crate) fn options(&self) -> SetOptions {
+        SetOptions { slices: self.slices, n_max: self.n_max, max_depth: self.max_depth, ..SetOptions::default() }
+    }
+}
+
+/// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure).
+pub(crate) fn parse_brdf(spec: &str) -> CliResult<Arc<dyn Brdf>> {
+    brdf::parse_spec(spec).map(Arc::from).map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))
+}
+
+/// The outgoing direction of `--theta-o/--phi-o`, validated.
+pub(crate) fn outgoing(args: &BrdfArgs) -> CliResult<Vec3> {
+    if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
+        return Err(CliError::input(format!("--theta-o must be in [0, 90) degrees, got {}", args.theta_o)));
+    }
+    if !args.phi_o.is_finite() {
+        return Err(CliError::input(format!("--phi-o must be finite, got {}", args.phi_o)));
+    }
+    Ok(brdf::direction_from_angles(args.theta_o, args.phi_o))
+}
+
+/// A built direction sampler; adaptive sets are kept concrete for their reports.
+pub(crate) enum Built {
+    /// An adaptive quadtree set.
+    Set(Box<QuadTreeSet>),
+    /// Any other sampler.
+    Other(Box<dyn DirectionSampler>),
+}
+
+impl Built {
+    pub(crate) fn sampler(&self) -> &dyn DirectionSampler {
+        match self {
+            Built::Set(s) => s.as_ref(),
+            Built::Other(s) => s.as_ref(),
+        }
+    }
+}
+
+/// Builds sampler `name` for `brdf` (spec recorded), with a progress bar over the slices.
+pub(crate) fn build(name: &str, spec: &str, brdf: Arc<dyn Brdf>, options: &SetOptions) -> CliResult<Built> {
+    let pb = progress::bar(0, "building");
+    let tick = |done: usize, total: usize| {
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    };
+    let built = if brdf_sampling::parse_sampler_name(name).is_some() {
+        brdf_sampling::build_set(name, brdf, options, Some(&tick))
+            .map(|s| Built::Set(Box::new(s.with_spec(spec))))
+            .map_err(CliError::input)
+    } else {
+        baselines::build_direction_sampler(name, brdf, options, Some(&tick)).map(Built::Other).map_err(CliError::input)
+    };
+    pb.finish_and_clear();
+    built
+}
+
+/// Prints the build report of an adaptive set (nothing for other samplers).
+pub(crate) fn print_set_report(built: &Built) {
+    let Built::Set(set) = built else { return };
+    let r = set.report();
+    println!(
+        "set        {} slices ({:?}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
+        r.trees,
+        r.layout,
+        r.build_time.as_secs_f64(),
+        r.memory_bytes as f64 / 1024.0,
+        r.nodes,
+        r.leaves,
+        r.max_depth
+    );
+    let measured = r.measured_mean_trials.map_or("n/a".into(), |t| format!("{t:.4}"));
+    println!(
+        "trials     expected {:.4} (worst slice {:.4}), measured {measured}; bound violations {}; grid evaluations {}",
+        r.expected_mean_trials, r.worst_expected_mean_trials, r.bound_violations, r.grid_evaluations
+    );
+}

@@ -1,0 +1,45 @@
+//! `brdf-lab build`: build (and optionally save) a BRDF's set of adaptive quadtrees.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::brdf_args::{self, Built, SetArgs};
+use crate::error::{CliError, CliResult};
+
+/// Arguments of `brdf-lab build`.
+#[derive(Debug, Args)]
+pub(crate) struct BuildArgs {
+    /// BRDF: `name` or `name:key=value,...` or `merl:PATH`.
+    #[arg(long = "brdf")]
+    spec: String,
+    /// `adaptive` (default) or `adaptive-paper`.
+    #[arg(long, default_value = "adaptive")]
+    sampler: String,
+    /// Save the set here (postcard with a format-version header; written atomically).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    set: SetArgs,
+}
+
+/// Runs `brdf-lab build`.
+pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
+    if brdf_sampling::parse_sampler_name(&args.sampler).is_none() {
+        return Err(CliError::input(format!(
+            "--sampler {}: `build` makes adaptive quadtree sets; use one of {}",
+            args.sampler,
+            brdf_sampling::SAMPLER_NAMES.join(", ")
+        )));
+    }
+    let brdf = brdf_args::parse_brdf(&args.spec)?;
+    let built = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set.options())?;
+    println!("brdf       {}", args.spec);
+    brdf_args::print_set_report(&built);
+    if let (Some(path), Built::Set(set)) = (&args.out, &built) {
+        let bytes = set.to_bytes();
+        crate::output::write_atomically(path, |w| w.write_all(&bytes))?;
+        println!("wrote      {} ({} bytes)", path.display(), bytes.len());
+    }
+    Ok(())
+}

@@ -1,0 +1,113 @@
+//! `brdf-lab eval`: BRDF values (and a sampler's pdf) at given incident directions.
+
+use std::path::{Path, PathBuf};
+
+use brdf::Vec3;
+use clap::Args;
+
+use crate::brdf_args::{self, BrdfArgs, SetArgs};
+use crate::error::{CliError, CliResult};
+use crate::output::{num, write_atomically};
+
+/// Arguments of `brdf-lab eval`.
+#[derive(Debug, Args)]
+pub(crate) struct EvalArgs {
+    #[command(flatten)]
+    brdf: BrdfArgs,
+    /// Also report this sampler's pdf (w.r.t. solid angle), the same value `sample` reports.
+    #[arg(long)]
+    sampler: Option<String>,
+    /// CSV of incident directions `x,y,z` (one per row; a header row is allowed; more columns
+    /// are ignored, so `sample --out` files work as they are).
+    #[arg(long)]
+    dirs: PathBuf,
+    /// Write `x,y,z,f[,pdf]` here (atomically) instead of standard output.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    set: SetArgs,
+}
+
+/// Reads the directions of a CSV file (exit 2 naming the bad line).
+fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let mut dirs = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let parsed: Option<Vec<f64>> = fields.iter().take(3).map(|f| f.parse::<f64>().ok()).collect();
+        match parsed {
+            Some(v) if v.len() == 3 => {
+                let d = Vec3::new(v[0], v[1], v[2]);
+                if !(d.iter().all(|c| c.is_finite()) && d.norm() > 0.0) {
+                    return Err(CliError::input(format!(
+                        "{}:{}: direction must be finite and non-zero",
+                        path.display(),
+                        i + 1
+                    )));
+                }
+                dirs.push(d);
+            }
+            // A header row (first non-empty line that is not numeric) is skipped.
+            _ if dirs.is_empty() && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) && i < 1 => {}
+            _ => {
+                return Err(CliError::input(format!(
+                    "{}:{}: expected three numbers `x,y,z`, got `{line}`",
+                    path.display(),
+                    i + 1
+                )));
+            }
+        }
+    }
+    if dirs.is_empty() {
+        return Err(CliError::input(format!("{}: no directions", path.display())));
+    }
+    Ok(dirs)
+}
+
+/// Runs `brdf-lab eval`.
+pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
+    let wo = brdf_args::outgoing(&args.brdf)?;
+    let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
+    let dirs = read_directions(&args.dirs)?;
+    let built = match &args.sampler {
+        Some(name) => Some(brdf_args::build(name, &args.brdf.spec, brdf.clone(), &args.set.options())?),
+        None => None,
+    };
+    let rows: Vec<(Vec3, f64, Option<f64>)> = dirs
+        .iter()
+        .map(|d| {
+            let wi = d.normalize();
+            let f = brdf.eval(&wo, &wi);
+            // The pdf at the direction exactly as given (unit rows from `sample` are unchanged).
+            let pdf = built.as_ref().map(|b| b.sampler().pdf(&wo, d));
+            (*d, f, pdf)
+        })
+        .collect();
+    let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
+        writeln!(w, "{}", if built.is_some() { "x,y,z,f,pdf" } else { "x,y,z,f" })?;
+        for (d, f, pdf) in &rows {
+            write!(w, "{},{},{},{}", num(d.x), num(d.y), num(d.z), num(*f))?;
+            if let Some(p) = pdf {
+                write!(w, ",{}", num(*p))?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    };
+    match &args.out {
+        Some(path) => {
+            write_atomically(path, write)?;
+            eprintln!("wrote {} ({} rows)", path.display(), rows.len());
+        }
+        None => {
+            let stdout = std::io::stdout();
+            let mut lock = stdout.lock();
+            write(&mut lock).map_err(CliError::input)?;
+        }
+    }
+    Ok(())
+}

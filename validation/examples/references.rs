@@ -1,0 +1,49 @@
+//! Regenerates `validation/references/albedo.json`: the directional albedo and the radiance
+//! reflected from the analytic environment for every quick-tier (BRDF, θo) and every mutant
+//! setting, by the reference quadrature rule.
+//!
+//! ```sh
+//! cargo run --release -p validation --example references > validation/references/albedo.json
+//! ```
+
+use validation::references::{
+    ENVIRONMENT_FORMULA, REFERENCE_RULE, StoredReferences, compute_stored,
+};
+use validation::{QUICK_BRDFS, QUICK_THETA_O, mutants};
+
+fn main() {
+    let mut settings: Vec<(String, f64)> = Vec::new();
+    for spec in QUICK_BRDFS {
+        for &t in QUICK_THETA_O {
+            settings.push(((*spec).to_owned(), t));
+        }
+    }
+    for m in mutants() {
+        if !settings.iter().any(|(s, t)| s == m.brdf && *t == m.theta_o) {
+            settings.push((m.brdf.to_owned(), m.theta_o));
+        }
+    }
+    let mut entries = Vec::new();
+    for (spec, t) in settings {
+        match compute_stored(&spec, t) {
+            Ok(e) => entries.push(e),
+            Err(e) => {
+                eprintln!("{spec} at {t}: {e}");
+                std::process::exit(1);
+            }
+        }
+    }
+    let table = StoredReferences {
+        rule: REFERENCE_RULE.to_owned(),
+        environment: ENVIRONMENT_FORMULA.to_owned(),
+        generated_by: "cargo run --release -p validation --example references > validation/references/albedo.json".to_owned(),
+        entries,
+    };
+    match serde_json::to_string_pretty(&table) {
+        Ok(s) => println!("{s}"),
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(1);
+        }
+    }
+}
