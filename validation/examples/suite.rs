@@ -34,7 +34,13 @@ fn main() {
     }
     let start = Instant::now();
     let progress = |e: ProgressEvent| {
-        if let ProgressEvent::Finished { done, total, label, passed } = e {
+        if let ProgressEvent::Finished {
+            done,
+            total,
+            label,
+            passed,
+        } = e
+        {
             eprintln!(
                 "[{done:>3}/{total}] {:>7.1}s {} {label}",
                 start.elapsed().as_secs_f64(),
@@ -55,7 +61,9 @@ fn main() {
     }
     let md = r.to_markdown();
     match report {
-        Some(path) => std::fs::write(path, md).unwrap_or_else(|e| eprintln!("cannot write report: {e}")),
+        Some(path) => {
+            std::fs::write(path, md).unwrap_or_else(|e| eprintln!("cannot write report: {e}"))
+        }
         None => println!("{md}"),
     }
     std::process::exit(if r.passed() { 0 } else { 1 });

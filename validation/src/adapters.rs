@@ -109,7 +109,9 @@ impl<D: RegionStats + Send> SamplerUnderTest<Point2> for QuadTreePlanar<D> {
     }
 
     fn sample_batch(&self, n: usize, u: &mut dyn UniformSource) -> Vec<(Point2, f64)> {
-        let b = self.0.sample_batch(n, AllocationMode::RandomizedRemainder, u);
+        let b = self
+            .0
+            .sample_batch(n, AllocationMode::RandomizedRemainder, u);
         b.samples.iter().map(|s| (s.point, s.pdf)).collect()
     }
 

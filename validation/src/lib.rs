@@ -7,7 +7,7 @@
 //!   `sample_batch`. Adapters cover any `DirectionSampler` at a fixed `ωo` (directions, pdf
 //!   w.r.t. solid angle, on the [`Domain::Hemisphere`] or [`Domain::Sphere`]) and any planar
 //!   `Sampler2D` (pdf w.r.t. area on the [`Domain::Disc`] or [`Domain::UnitSquare`]).
-//! * [`samplers`] is the registry (one entry per sampler); [`mutants`] the broken ones.
+//! * [`samplers`] is the registry (one entry per sampler); [`mutants()`] the broken ones.
 //! * [`run`] executes a [`ValidateConfig`] (quick or full tier) and returns a
 //!   [`ValidationReport`] ([`ValidationReport::to_json`], [`ValidationReport::to_markdown`]).
 //!
@@ -61,13 +61,13 @@ pub use plan::{
     QUICK_THETA_O, Tier, ValidateConfig,
 };
 pub use registry::{
-    BuiltDirection, DISC_GRID, DISC_SAFETY, DirectionBuild, DiscBuild, SAMPLERS, SamplerBuild, SamplerEntry,
-    StandaloneBuild, StandaloneCase, find_sampler, quadtree_disc_density, quadtree_disc_sampler,
-    samplers, test_maps,
+    BuiltDirection, DISC_GRID, DISC_SAFETY, DirectionBuild, DiscBuild, SAMPLERS, SamplerBuild,
+    SamplerEntry, StandaloneBuild, StandaloneCase, find_sampler, quadtree_disc_density,
+    quadtree_disc_sampler, samplers, test_maps,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
 pub use run::{ProgressEvent, run};
-pub use runner::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, z_test};
+pub use runner::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };

@@ -27,7 +27,13 @@ impl Tier {
 }
 
 /// BRDF specs of the quick tier.
-pub const QUICK_BRDFS: &[&str] = &["lambert", "phong:n=50", "ward", "ggx:alpha=0.2", "oren-nayar"];
+pub const QUICK_BRDFS: &[&str] = &[
+    "lambert",
+    "phong:n=50",
+    "ward",
+    "ggx:alpha=0.2",
+    "oren-nayar",
+];
 
 /// Outgoing polar angles (degrees, `φo = 0`) of the quick tier.
 pub const QUICK_THETA_O: &[f64] = &[0.0, 45.0, 80.0];
@@ -170,7 +176,7 @@ impl Plan {
             normalisation_tolerance,
             pdf_rel_tol: 1e-6,
             support_resolution: 3,
-            unbiasedness_allowance: 1e-4,
+            unbiasedness_allowance: 0.0,
         }
     }
 

@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirectionSampler, SetOptions};
 use brdf_sampling::disc::DiscBrdf;
+use brdf_sampling::{DirectionSampler, SetOptions};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, SamplerKind, Scheme};
 use partition_sampler::{Domain as PsDomain, QuadTreeBuilder, Rect, SampledGridDensity};
 
@@ -144,7 +144,9 @@ pub static SAMPLERS: &[SamplerEntry] = &[
     SamplerEntry {
         name: "envmap-adaptive",
         summary: "environment-map adaptive sampler (envelope scheme) on the procedural sky and a synthetic map",
-        kind: SamplerBuild::Standalone(|| envmap_cases(SamplerKind::Adaptive(AdaptiveOptions::default()))),
+        kind: SamplerBuild::Standalone(|| {
+            envmap_cases(SamplerKind::Adaptive(AdaptiveOptions::default()))
+        }),
     },
     SamplerEntry {
         name: "envmap-adaptive-paper",

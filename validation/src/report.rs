@@ -112,7 +112,11 @@ fn fmt_num(x: f64) -> String {
     if x.is_nan() {
         "—".into()
     } else if x.is_infinite() {
-        if x > 0.0 { "∞".into() } else { "−∞".into() }
+        if x > 0.0 {
+            "∞".into()
+        } else {
+            "−∞".into()
+        }
     } else if x == 0.0 {
         "0".into()
     } else if x.abs() >= 1e-3 && x.abs() < 1e5 {
@@ -125,7 +129,7 @@ fn fmt_num(x: f64) -> String {
 fn fmt_p(p: Option<f64>) -> String {
     match p {
         None => "—".into(),
-        Some(p) if p == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(p) if p >= 1e-3 => format!("{p:.4}"),
         Some(p) => format!("{p:.2e}"),
     }
@@ -204,7 +208,11 @@ impl ValidationReport {
                 );
             }
             for m in &self.mutants {
-                let _ = writeln!(s, "\n### Mutant `{}` ({} at {}°)\n", m.name, m.brdf, m.theta_o);
+                let _ = writeln!(
+                    s,
+                    "\n### Mutant `{}` ({} at {}°)\n",
+                    m.name, m.brdf, m.theta_o
+                );
                 table(&mut s, &m.tests);
             }
         }
@@ -250,5 +258,32 @@ fn table(s: &mut String, rows: &[TestRecord]) {
             fmt_p(t.p_value),
             if t.passed { "pass" } else { "**FAIL**" }
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_formatted_for_tables() {
+        assert_eq!(fmt_num(f64::INFINITY), "∞");
+        assert_eq!(fmt_num(f64::NAN), "—");
+        assert_eq!(fmt_num(0.5), "0.5000");
+        assert_eq!(fmt_num(1.5e-7), "1.500e-7");
+        assert_eq!(fmt_p(None), "—");
+        assert_eq!(fmt_p(Some(0.25)), "0.2500");
+        assert_eq!(fmt_p(Some(2e-9)), "2.00e-9");
+        assert_eq!(fmt_theta(Some(45.0)), "45°");
+    }
+
+    #[test]
+    fn non_finite_statistics_serialise_as_null() {
+        let o = TestOutcome::with_p_value("chi-square", f64::INFINITY, 0.0, 0.01, "x".into());
+        let r = TestRecord::new("lambert", "s", None, "disc", &o);
+        let v: serde_json::Value =
+            serde_json::from_str(&serde_json::to_string(&r).unwrap()).unwrap();
+        assert!(v["statistic"].is_null() && v["theta_o"].is_null());
+        assert_eq!(v["p_value"], 0.0);
     }
 }

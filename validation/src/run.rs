@@ -11,11 +11,13 @@ use stats::{TestOutcome, sidak_level};
 
 use crate::error::ValidationError;
 use crate::mutants::mutants;
-use crate::plan::{FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig};
+use crate::plan::{
+    FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
+};
 use crate::references::{albedo_reference, lit_reference};
 use crate::registry::{SamplerBuild, SamplerEntry, StandaloneCase, find_sampler, samplers};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
-use crate::runner::{error_outcome, names, run_any};
+use crate::runner::{error_outcome, names, run_case};
 use crate::seeding::case_seed;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
@@ -83,7 +85,10 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
     } else {
         config.theta_o.clone()
     };
-    if let Some(&bad) = angles.iter().find(|a| !(a.is_finite() && **a >= 0.0 && **a < 90.0)) {
+    if let Some(&bad) = angles
+        .iter()
+        .find(|a| !(a.is_finite() && **a >= 0.0 && **a < 90.0))
+    {
         return Err(ValidationError::BadAngle(bad));
     }
     let mut entries: Vec<&'static SamplerEntry> = Vec::new();
@@ -93,7 +98,11 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         for name in &config.samplers {
             let e = find_sampler(name).ok_or_else(|| ValidationError::UnknownSampler {
                 name: name.clone(),
-                known: samplers().iter().map(|e| e.name).collect::<Vec<_>>().join(", "),
+                known: samplers()
+                    .iter()
+                    .map(|e| e.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             })?;
             if !entries.iter().any(|x| x.name == e.name) {
                 entries.push(e);
@@ -200,33 +209,30 @@ fn run_brdf_job(
     let mut out = Vec::with_capacity(r.angles.len());
     for (ai, &theta) in r.angles.iter().enumerate() {
         let wo = direction_from_angles(theta, 0.0);
-        let subject: Result<AnySubject, String> = refs
-            .get(ai)
-            .cloned()
-            .unwrap_or_else(|| Err("missing reference".into()))
-            .and_then(|refs| match (&entry.kind, &built) {
-                (SamplerBuild::Direction { domain, .. }, Some(b)) => {
-                    let b = b.as_ref().map_err(Clone::clone)?;
-                    Ok(AnySubject::Direction(brdf_direction_subject(
-                        Arc::new(b.at(wo)),
-                        *domain,
-                        Arc::clone(brdf),
-                        wo,
-                        &refs,
-                    )))
-                }
-                (SamplerBuild::BrdfDisc(build), _) => Ok(AnySubject::Planar(brdf_disc_subject(
-                    build(brdf, &wo)?,
-                    Arc::clone(brdf),
-                    wo,
-                    &refs,
-                ))),
-                _ => Err("not a BRDF sampler".into()),
-            });
+        let subject: Result<AnySubject, String> =
+            refs.get(ai)
+                .cloned()
+                .unwrap_or_else(|| Err("missing reference".into()))
+                .and_then(|refs| match (&entry.kind, &built) {
+                    (SamplerBuild::Direction { domain, .. }, Some(b)) => {
+                        let b = b.as_ref().map_err(Clone::clone)?;
+                        Ok(AnySubject::Direction(brdf_direction_subject(
+                            Arc::new(b.at(wo)),
+                            *domain,
+                            Arc::clone(brdf),
+                            wo,
+                            &refs,
+                        )))
+                    }
+                    (SamplerBuild::BrdfDisc(build), _) => Ok(AnySubject::Planar(
+                        brdf_disc_subject(build(brdf, &wo)?, Arc::clone(brdf), wo, &refs),
+                    )),
+                    _ => Err("not a BRDF sampler".into()),
+                });
         let (domain, outcomes) = match &subject {
             Ok(s) => (
                 s.domain().name().to_owned(),
-                run_any(
+                run_case(
                     s,
                     &r.plan,
                     case_seed(seed, &case_label(entry.name, spec, Some(theta))),
@@ -275,8 +281,12 @@ pub fn run(
             _ => None,
         })
         .collect();
-    let brdf_entries: Vec<&'static SamplerEntry> =
-        r.samplers.iter().copied().filter(|e| e.uses_brdf()).collect();
+    let brdf_entries: Vec<&'static SamplerEntry> = r
+        .samplers
+        .iter()
+        .copied()
+        .filter(|e| e.uses_brdf())
+        .collect();
     let mut jobs: Vec<Job<'_>> = Vec::new();
     for &entry in &brdf_entries {
         for bi in 0..r.brdfs.len() {
@@ -343,7 +353,7 @@ pub fn run(
                     target: case.target.clone(),
                     theta_o: None,
                     domain: case.subject.domain.name().to_owned(),
-                    outcomes: run_any(
+                    outcomes: run_case(
                         &AnySubject::Planar(case.subject.clone()),
                         &r.plan,
                         case_seed(seed, &case_label(entry.name, &case.target, None)),
@@ -371,7 +381,7 @@ pub fn run(
                 let (domain, outcomes) = match s {
                     Ok(s) => (
                         s.domain().name().to_owned(),
-                        run_any(s, &r.plan, case_seed(seed, &label(kind))),
+                        run_case(s, &r.plan, case_seed(seed, &label(kind))),
                     ),
                     Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
                 };
@@ -384,7 +394,10 @@ pub fn run(
                 }
             };
             let (mc, cc) = match &built {
-                Ok(case) => (run_one(Ok(&case.mutant), "mutant"), run_one(Ok(&case.control), "control")),
+                Ok(case) => (
+                    run_one(Ok(&case.mutant), "mutant"),
+                    run_one(Ok(&case.control), "control"),
+                ),
                 Err(e) => (run_one(Err(e), "mutant"), run_one(Err(e), "control")),
             };
             notify(label("mutant"), mc.outcomes.iter().any(|o| !o.passed));
@@ -395,7 +408,10 @@ pub fn run(
     Ok(assemble(
         config,
         &r.plan,
-        failed_builds.into_iter().chain(results.into_iter().flatten()).collect(),
+        failed_builds
+            .into_iter()
+            .chain(results.into_iter().flatten())
+            .collect(),
         mutant_results,
     ))
 }
@@ -453,8 +469,8 @@ fn assemble(
             }
         })
         .collect();
-    let passed = tests.iter().all(|t| t.passed)
-        && mutants.iter().all(|m| m.detected && m.control_passed);
+    let passed =
+        tests.iter().all(|t| t.passed) && mutants.iter().all(|m| m.detected && m.control_passed);
     ValidationReport {
         alpha: config.alpha,
         passed,
@@ -466,5 +482,79 @@ fn assemble(
         batches: [plan.batches, plan.batch_size],
         m,
         per_test_level: level,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(sampler: &str, outcomes: Vec<TestOutcome>) -> CaseResult {
+        CaseResult {
+            sampler: sampler.into(),
+            target: "lambert".into(),
+            theta_o: Some(0.0),
+            domain: "hemisphere".into(),
+            outcomes,
+        }
+    }
+
+    fn p(name: &str, p: f64) -> TestOutcome {
+        TestOutcome::with_p_value(name, 1.0, p, 0.01, String::new())
+    }
+
+    fn det(name: &str, ok: bool) -> TestOutcome {
+        TestOutcome::deterministic(name, 0.0, ok, String::new())
+    }
+
+    fn assembled(
+        cases: Vec<CaseResult>,
+        mutants: Vec<(CaseResult, CaseResult)>,
+    ) -> ValidationReport {
+        let config = ValidateConfig::quick();
+        assemble(&config, &Plan::new(Tier::Quick, 1000), cases, mutants)
+    }
+
+    #[test]
+    fn p_values_are_judged_at_the_sidak_level() {
+        // m = 4 p-valued tests at α = 0.01: the per-test level is ≈ 0.0025.
+        let cases = vec![
+            case("a", vec![p("x", 0.004), p("y", 0.5), det("z", true)]),
+            case("b", vec![p("x", 0.3), p("y", 0.9)]),
+        ];
+        let r = assembled(cases, Vec::new());
+        assert_eq!(r.m, 4);
+        assert!((r.per_test_level - sidak_level(0.01, 4)).abs() < 1e-15);
+        assert!(
+            r.tests.iter().all(|t| t.passed),
+            "0.004 passes at the Šidák level"
+        );
+        assert!(r.passed());
+        let r = assembled(
+            vec![case("a", vec![p("x", 0.001), p("y", 0.5)])],
+            Vec::new(),
+        );
+        assert!(!r.passed() && !r.tests[0].passed && r.tests[1].passed);
+        let r = assembled(vec![case("a", vec![det("x", false)])], Vec::new());
+        assert!(!r.passed());
+    }
+
+    #[test]
+    fn a_missed_mutant_or_a_failed_control_fails_the_run() {
+        let good = || case("control:m", vec![p("x", 0.5)]);
+        let caught = || case("mutant:m", vec![p("x", 1e-30), p("y", 0.4)]);
+        let missed = || case("mutant:m", vec![p("x", 0.2)]);
+        let r = assembled(vec![case("a", vec![p("x", 0.5)])], vec![(caught(), good())]);
+        assert!(r.passed());
+        assert_eq!(r.mutants[0].caught_by, vec!["x".to_owned()]);
+        assert_eq!(r.mutants[0].min_p_value, Some(1e-30));
+        let r = assembled(vec![case("a", vec![p("x", 0.5)])], vec![(missed(), good())]);
+        assert!(!r.passed() && !r.mutants[0].detected);
+        let bad_control = case("control:m", vec![p("x", 1e-9)]);
+        let r = assembled(
+            vec![case("a", vec![p("x", 0.5)])],
+            vec![(caught(), bad_control)],
+        );
+        assert!(!r.passed() && !r.mutants[0].control_passed);
     }
 }

@@ -54,17 +54,26 @@ fn renamed(mut o: TestOutcome, name: &str) -> TestOutcome {
     o
 }
 
-/// Runs the suite on a subject; `seed` is the case seed.
-pub(crate) fn run_any(subject: &AnySubject, plan: &Plan, seed: u64) -> Vec<TestOutcome> {
+/// Runs every test of the suite on one subject with case seed `seed` (see
+/// [`crate::seeding::case_seed`]) and returns the outcomes in report order. p-values are raw:
+/// each outcome's `passed` uses a placeholder level of 0.01; [`crate::run`] re-judges them
+/// with the Šidák level of the whole run.
+pub fn run_case(subject: &AnySubject, plan: &Plan, seed: u64) -> Vec<TestOutcome> {
     match subject {
         AnySubject::Direction(s) => match plan.resolution.sphere_binning(s.domain) {
             Ok(Some(b)) => run_subject(s, &b, plan, seed),
-            Ok(None) => vec![error_outcome(names::BUILD, "direction subject on a planar domain")],
+            Ok(None) => vec![error_outcome(
+                names::BUILD,
+                "direction subject on a planar domain",
+            )],
             Err(e) => vec![error_outcome(names::BUILD, e)],
         },
         AnySubject::Planar(s) => match plan.resolution.planar_binning(s.domain) {
             Ok(Some(b)) => run_subject(s, b.as_ref(), plan, seed),
-            Ok(None) => vec![error_outcome(names::BUILD, "planar subject on a direction domain")],
+            Ok(None) => vec![error_outcome(
+                names::BUILD,
+                "planar subject on a direction domain",
+            )],
             Err(e) => vec![error_outcome(names::BUILD, e)],
         },
     }
@@ -125,7 +134,10 @@ pub fn z_test(
     alpha: f64,
 ) -> TestOutcome {
     if values.len() < 2 {
-        return error_outcome(name, format!("need at least 2 values, got {}", values.len()));
+        return error_outcome(
+            name,
+            format!("need at least 2 values, got {}", values.len()),
+        );
     }
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return TestOutcome::with_p_value(
@@ -133,7 +145,10 @@ pub fn z_test(
             f64::INFINITY,
             0.0,
             alpha,
-            format!("estimator value {i} is not finite ({}): a sample landed where the integrand is positive but the pdf is not", values[i]),
+            format!(
+                "estimator value {i} is not finite ({}): a sample landed where the integrand is positive but the pdf is not",
+                values[i]
+            ),
         );
     }
     let n = values.len() as f64;
@@ -195,12 +210,7 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     let sampler = s.sampler.as_ref();
     let violations_before = sampler.bound_violations();
     let singles = draw(sampler, plan.samples, stream_seed(seed, 1));
-    let batches = draw_batches(
-        sampler,
-        plan.batch_size,
-        plan.batches,
-        stream_seed(seed, 2),
-    );
+    let batches = draw_batches(sampler, plan.batch_size, plan.batches, stream_seed(seed, 2));
     let violations_after = sampler.bound_violations();
 
     let pdf = |p: P| sampler.pdf(p);
@@ -241,7 +251,11 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
             },
         );
     }
-    let all: Vec<(P, f64)> = singles.iter().chain(batches.iter().flatten()).copied().collect();
+    let all: Vec<(P, f64)> = singles
+        .iter()
+        .chain(batches.iter().flatten())
+        .copied()
+        .collect();
     out.push(match pdf_consistency(&all, &pdf, plan.pdf_rel_tol) {
         Ok(o) => renamed(o, names::PDF_CONSISTENCY),
         Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
@@ -339,4 +353,63 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::adapters::DirectionAtWo;
+    use crate::mutants::CosineHemisphere;
+    use std::sync::Arc;
+
+    fn reference(value: f64) -> Reference {
+        Reference {
+            value,
+            abs_error: 0.0,
+            rule: "test".into(),
+        }
+    }
+
+    #[test]
+    fn z_test_accepts_the_truth_and_rejects_a_shift() {
+        let values: Vec<f64> = (0..1000)
+            .map(|i| 1.0 + ((i % 7) as f64 - 3.0) * 0.1)
+            .collect();
+        let ok = z_test("u", &values, &reference(1.0), 0.0, 0.01);
+        assert!(ok.passed && ok.p_value.is_some_and(|p| p > 0.9));
+        // Standard error ≈ 0.2/√1000 ≈ 0.0063: a shift of 0.1 is 15 standard errors.
+        let bad = z_test("u", &values, &reference(1.1), 0.0, 0.01);
+        assert!(!bad.passed && bad.p_value.is_some_and(|p| p < 1e-20));
+        let inf = z_test("u", &[1.0, f64::INFINITY], &reference(1.0), 0.0, 0.01);
+        assert_eq!(inf.p_value, Some(0.0));
+        assert!(!z_test("u", &[1.0], &reference(1.0), 0.0, 0.01).passed);
+    }
+
+    #[test]
+    fn z_test_allowance_covers_a_declared_systematic_error() {
+        // A zero-variance estimator 1e-5 (relative) off its reference.
+        let values = vec![1.0 + 1e-5; 100];
+        assert!(!z_test("u", &values, &reference(1.0), 0.0, 0.01).passed);
+        assert!(z_test("u", &values, &reference(1.0), 1e-4, 0.01).passed);
+    }
+
+    #[test]
+    fn estimates_treat_zero_integrands_and_missing_pdfs() {
+        assert_eq!(estimate(0.0, 0.0), 0.0);
+        assert_eq!(estimate(2.0, 4.0), 0.5);
+        assert!(estimate(1.0, 0.0).is_infinite());
+    }
+
+    #[test]
+    fn draws_depend_only_on_seed_and_extend_as_prefixes() {
+        let s = DirectionAtWo::new(Arc::new(CosineHemisphere), brdf::Vec3::new(0.0, 0.0, 1.0));
+        let a = draw(&s, 5000, 9);
+        let b = draw(&s, 9000, 9);
+        assert_eq!(a.as_slice(), &b[..5000]);
+        assert_ne!(a, draw(&s, 5000, 10));
+        let k = draw_batches(&s, 16, 4, 3);
+        assert_eq!(k.len(), 4);
+        assert!(k.iter().all(|b| b.len() == 16));
+        assert_eq!(k, draw_batches(&s, 16, 4, 3));
+    }
 }

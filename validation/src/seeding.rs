@@ -22,3 +22,17 @@ pub fn case_seed(seed: u64, label: &str) -> u64 {
 pub fn stream_seed(case_seed: u64, stream: u64) -> u64 {
     chunk_seed(case_seed, stream.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hashes_are_fnv1a_and_seeds_separate_labels() {
+        assert_eq!(label_hash(""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(label_hash("a"), 0xaf63_dc4c_8601_ec8c);
+        assert_ne!(case_seed(1, "a|b"), case_seed(1, "a|c"));
+        assert_ne!(case_seed(1, "a"), case_seed(2, "a"));
+        assert_ne!(stream_seed(5, 1), stream_seed(5, 2));
+    }
+}

@@ -269,3 +269,52 @@ pub fn disc_integral(g: &(dyn Fn(Point2) -> f64 + Sync)) -> Result<Reference, St
             .into(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::adapters::PlainPlanar;
+    use approx::assert_relative_eq;
+    use partition_sampler::Rect;
+    use stats::RectBinning;
+
+    fn integrate_square(g: &(dyn Fn(Point2) -> f64 + Sync), nx: usize, ny: usize) -> f64 {
+        let bins = RectBinning::unit_square(nx, ny).unwrap();
+        let opts = QuadratureOptions {
+            order: 8,
+            ..QuadratureOptions::default()
+        };
+        integrate(g, &bins, 1e-11, &opts).unwrap().value
+    }
+
+    #[test]
+    fn cos_sin_rows_sum_to_the_upper_hemisphere() {
+        let total: f64 = (0..10)
+            .map(|j| cos_sin_integral(j as f64 / 10.0, (j + 1) as f64 / 10.0))
+            .sum();
+        assert_relative_eq!(total, 1.0 / (2.0 * PI), epsilon = 1e-15);
+    }
+
+    #[test]
+    fn closed_form_references_match_quadrature() {
+        let map = synthetic_map().unwrap();
+        let table = baselines::PiecewiseConstant2D::new(4, 2, vec![1.0; 8], Rect::UNIT).unwrap();
+        let sampler: Arc<dyn SamplerUnderTest<Point2>> = Arc::new(PlainPlanar(table));
+        let env = envmap_subject(Arc::clone(&sampler), &map);
+        let q = integrate_square(env.single.integrand.as_ref(), 16, 8);
+        assert_relative_eq!(env.single.reference.value, q, max_relative = 1e-9);
+
+        let values = synthetic_values(16, 8, 2);
+        let grid = grid_subject(sampler, 16, 8, values);
+        let q = integrate_square(grid.single.integrand.as_ref(), 16, 8);
+        assert_relative_eq!(grid.single.reference.value, q, max_relative = 1e-10);
+    }
+
+    #[test]
+    fn synthetic_values_have_holes_and_a_peak() {
+        let v = synthetic_values(16, 8, 5);
+        assert!(v.contains(&0.0));
+        assert!(v.iter().all(|&x| x >= 0.0 && x.is_finite()));
+        assert_eq!(v.iter().copied().fold(0.0, f64::max), 40.0);
+    }
+}

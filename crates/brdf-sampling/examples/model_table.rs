@@ -3,7 +3,13 @@
 //! trials, BRDF evaluations per accepted sample, bound violations and the sampling rate.
 //!
 //! Run: `cargo run --release -p brdf-sampling --example model_table [-- OPTIONS]`
-//! Options: `--runs R` (default 3), `--grid N`, `--depth D`, `--tol T`, `--slices K`,
+//! Columns: median wall-clock build time on the default rayon pool (`build s`), one build on a
+//! the CPU seconds of one more build (`CPU s`; ≈ 2 × the wall time on 2 idle cores), memory, leaves per tree, expected and measured
+//! trials per sample, BRDF evaluations per accepted sample, bound violations, samples per
+//! second on one thread at random outgoing directions.
+//!
+//! Options: `--runs R` (default 3), `--grid N`, `--depth D`, `--tol T`, `--slices K`, `--nmax X`,
+//! `--safety S`,
 //! `--variant adaptive|adaptive-paper`, `--only name,name`, `--per-slice S` (default 2000).
 
 use std::sync::Arc;
@@ -18,6 +24,7 @@ struct Row {
     name: String,
     trees: usize,
     build_s: f64,
+    single_s: f64,
     kib: f64,
     leaves: f64,
     expected: f64,
@@ -27,11 +34,37 @@ struct Row {
     msps: f64,
 }
 
-fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
-    args.iter().position(|a| a == key).and_then(|i| args.get(i + 1)).and_then(|v| v.parse().ok())
+/// User + system CPU seconds of this process (Linux `/proc/self/stat`, 100 ticks/s); NaN elsewhere.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    let after = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| {
+        f.get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    // Fields 14 and 15 of stat (utime, stime) are at 11 and 12 after the command name.
+    (ticks(11) + ticks(12)) / 100.0
 }
 
-fn measure(name: &str, brdf: Arc<dyn Brdf>, variant: Variant, opts: &SetOptions, runs: usize, per_slice: usize) -> Row {
+fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
+    args.iter()
+        .position(|a| a == key)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+}
+
+fn measure(
+    name: &str,
+    brdf: Arc<dyn Brdf>,
+    variant: Variant,
+    opts: &SetOptions,
+    runs: usize,
+    per_slice: usize,
+) -> Row {
     let mut times = Vec::new();
     let mut set = None;
     for _ in 0..runs.max(1) {
@@ -39,15 +72,24 @@ fn measure(name: &str, brdf: Arc<dyn Brdf>, variant: Variant, opts: &SetOptions,
         let s = QuadTreeSet::build(Arc::clone(&brdf), variant, opts).expect("build");
         times.push(t.elapsed().as_secs_f64());
         set = Some(s);
+        if times[0] > 20.0 {
+            break;
+        }
     }
     times.sort_by(f64::total_cmp);
+    // CPU seconds of one more build (process user + system time, robust to other load).
+    let c0 = cpu_seconds();
+    let _ = QuadTreeSet::build(Arc::clone(&brdf), variant, opts).expect("build");
+    let single_s = cpu_seconds() - c0;
     let set = set.expect("at least one run");
     let rep = set.report_with_cost(per_slice, 7);
     // Sampling rate on one thread at random outgoing directions.
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
     let n = 200_000;
     let wos: Vec<_> = (0..1024)
-        .map(|_| brdf::direction_from_angles(rng.random::<f64>() * 89.9, rng.random::<f64>() * 360.0))
+        .map(|_| {
+            brdf::direction_from_angles(rng.random::<f64>() * 89.9, rng.random::<f64>() * 360.0)
+        })
         .collect();
     let t = Instant::now();
     let mut acc = 0.0;
@@ -61,6 +103,7 @@ fn measure(name: &str, brdf: Arc<dyn Brdf>, variant: Variant, opts: &SetOptions,
         name: name.to_string(),
         trees: rep.trees,
         build_s: times[times.len() / 2],
+        single_s,
         kib: rep.memory_bytes as f64 / 1024.0,
         leaves: rep.leaves as f64 / rep.trees as f64,
         expected: rep.expected_mean_trials,
@@ -86,6 +129,9 @@ fn main() {
     if let Some(k) = arg(&args, "--slices") {
         opts.slices = k;
     }
+    if let Some(n) = arg(&args, "--nmax") {
+        opts.n_max = n;
+    }
     if let Some(s) = arg(&args, "--safety") {
         opts.safety_factor = s;
     }
@@ -95,7 +141,8 @@ fn main() {
     };
     let runs = arg(&args, "--runs").unwrap_or(3);
     let per_slice = arg(&args, "--per-slice").unwrap_or(2000);
-    let only: Option<Vec<String>> = arg::<String>(&args, "--only").map(|s| s.split(',').map(str::to_string).collect());
+    let only: Option<Vec<String>> =
+        arg::<String>(&args, "--only").map(|s| s.split(',').map(str::to_string).collect());
     let wanted = |n: &str| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n));
 
     println!(
@@ -111,36 +158,70 @@ fn main() {
         rayon::current_num_threads()
     );
     println!(
-        "| {:<22} | {:>5} | {:>8} | {:>9} | {:>7} | {:>8} | {:>8} | {:>10} | {:>6} | {:>9} |",
-        "model", "trees", "build s", "KiB", "leaves", "E[trials]", "trials", "evals/smp", "viol.", "Msample/s"
+        "| {:<22} | {:>5} | {:>8} | {:>8} | {:>9} | {:>7} | {:>8} | {:>8} | {:>10} | {:>6} | {:>9} |",
+        "model",
+        "trees",
+        "build s",
+        "CPU s",
+        "KiB",
+        "leaves",
+        "E[trials]",
+        "trials",
+        "evals/smp",
+        "viol.",
+        "Msample/s"
     );
-    println!("|{:-<24}|{:->7}|{:->10}|{:->11}|{:->9}|{:->10}|{:->10}|{:->12}|{:->8}|{:->11}|", "", "", "", "", "", "", "", "", "", "");
+    println!(
+        "|{:-<24}|{:->7}|{:->10}|{:->10}|{:->11}|{:->9}|{:->10}|{:->10}|{:->12}|{:->8}|{:->11}|",
+        "", "", "", "", "", "", "", "", "", "", ""
+    );
     let mut rows = Vec::new();
-    let mut specs: Vec<String> = models().iter().filter(|m| m.name != "merl").map(|m| m.name.to_string()).collect();
+    let mut specs: Vec<String> = models()
+        .iter()
+        .filter(|m| m.name != "merl")
+        .map(|m| m.name.to_string())
+        .collect();
     specs.push("merl(phong:n=50)".to_string());
     for spec in specs.iter().filter(|s| wanted(s)) {
-        let brdf: Arc<dyn Brdf> = if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
-            let analytic = parse_spec(inner).expect("spec");
-            let dir = tempfile::tempdir().expect("tempdir");
-            let path = dir.path().join("synthetic.binary");
-            brdf::write_merl(&path, &|th, td, pd| {
-                let (wo, wi) = brdf::merl::half_diff_to_directions(th, td, pd);
-                if wo.z > 0.0 && wi.z > 0.0 { analytic.eval_rgb(&wo, &wi) } else { [-1.0; 3] }
-            })
-            .expect("write_merl");
-            Arc::new(MerlBrdf::load(&path).expect("load merl"))
-        } else {
-            Arc::from(parse_spec(spec).expect("spec"))
-        };
+        let brdf: Arc<dyn Brdf> =
+            if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
+                let analytic = parse_spec(inner).expect("spec");
+                let dir = tempfile::tempdir().expect("tempdir");
+                let path = dir.path().join("synthetic.binary");
+                brdf::write_merl(&path, &|th, td, pd| {
+                    let (wo, wi) = brdf::merl::half_diff_to_directions(th, td, pd);
+                    if wo.z > 0.0 && wi.z > 0.0 {
+                        analytic.eval_rgb(&wo, &wi)
+                    } else {
+                        [-1.0; 3]
+                    }
+                })
+                .expect("write_merl");
+                Arc::new(MerlBrdf::load(&path).expect("load merl"))
+            } else {
+                Arc::from(parse_spec(spec).expect("spec"))
+            };
         let r = measure(spec, brdf, variant, &opts, runs, per_slice);
         println!(
-            "| {:<22} | {:>5} | {:>8.3} | {:>9.1} | {:>7.1} | {:>8.3} | {:>8.3} | {:>10.3} | {:>6} | {:>9.2} |",
-            r.name, r.trees, r.build_s, r.kib, r.leaves, r.expected, r.measured, r.evals, r.violations, r.msps
+            "| {:<22} | {:>5} | {:>8.3} | {:>8.3} | {:>9.1} | {:>7.1} | {:>8.3} | {:>8.3} | {:>10.3} | {:>6} | {:>9.2} |",
+            r.name,
+            r.trees,
+            r.build_s,
+            r.single_s,
+            r.kib,
+            r.leaves,
+            r.expected,
+            r.measured,
+            r.evals,
+            r.violations,
+            r.msps
         );
         rows.push(r);
     }
     let iso: Vec<&Row> = rows.iter().filter(|r| r.trees == opts.slices).collect();
-    let mean = |f: &dyn Fn(&Row) -> f64, rs: &[&Row]| rs.iter().map(|r| f(r)).sum::<f64>() / rs.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&Row) -> f64, rs: &[&Row]| {
+        rs.iter().map(|r| f(r)).sum::<f64>() / rs.len().max(1) as f64
+    };
     let all: Vec<&Row> = rows.iter().collect();
     println!(
         "mean over {} models: memory {:.1} KiB ({:.1} KiB over the {} isotropic-layout sets), E[trials] {:.3}, trials {:.3}, evals/sample {:.3}; max build {:.3} s",

@@ -9,7 +9,9 @@ use std::cell::Cell;
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
-use partition_sampler::{Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats};
+use partition_sampler::{
+    Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats,
+};
 
 /// `h(v) = (v.x, v.y)`: the disc point of a direction (meaningful for `v.z ≥ 0`).
 #[inline]
@@ -62,7 +64,10 @@ pub struct DiscBrdf {
 
 impl std::fmt::Debug for DiscBrdf {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("DiscBrdf").field("brdf", &self.brdf.name()).field("wo", &self.wo).finish()
+        f.debug_struct("DiscBrdf")
+            .field("brdf", &self.brdf.name())
+            .field("wo", &self.wo)
+            .finish()
     }
 }
 
@@ -124,7 +129,11 @@ impl RegionStats for SliceDensity {
         Domain::UnitDisc
     }
     fn region(&self, _cell: &Rect) -> RegionEstimate {
-        RegionEstimate { max_bound: f64::INFINITY, integral: 0.0, integral_rel_err: None }
+        RegionEstimate {
+            max_bound: f64::INFINITY,
+            integral: 0.0,
+            integral_rel_err: None,
+        }
     }
     fn integral_source(&self) -> IntegralSource {
         IntegralSource::GridEstimate
@@ -148,7 +157,10 @@ mod tests {
         let p = direction_to_disc(&v);
         assert_relative_eq!(disc_to_direction(p), v, epsilon = 1e-15);
         assert_relative_eq!(area_pdf_to_solid_angle(2.0, &v), 2.0 * v.z);
-        assert_relative_eq!(solid_angle_pdf_to_area(area_pdf_to_solid_angle(2.0, &v), &v), 2.0);
+        assert_relative_eq!(
+            solid_angle_pdf_to_area(area_pdf_to_solid_angle(2.0, &v), &v),
+            2.0
+        );
         assert_eq!(area_pdf_to_solid_angle(2.0, &Vec3::new(1.0, 0.0, 0.0)), 0.0);
         assert_eq!(disc_to_direction([1.0, 1.0]).z, 0.0);
     }
@@ -160,7 +172,11 @@ mod tests {
         let d = DiscBrdf::new(b.clone(), wo);
         let wi = brdf::direction_from_angles(25.0, 170.0);
         let before = thread_evaluations();
-        assert_relative_eq!(d.eval(direction_to_disc(&wi)), b.eval(&wo, &wi), max_relative = 1e-12);
+        assert_relative_eq!(
+            d.eval(direction_to_disc(&wi)),
+            b.eval(&wo, &wi),
+            max_relative = 1e-12
+        );
         assert_eq!(thread_evaluations(), before + 1);
         assert_eq!(d.eval([0.8, 0.8]), 0.0);
         assert_eq!(d.eval([f64::NAN, 0.0]), 0.0);

@@ -10,7 +10,12 @@ use crate::options::SetOptions;
 use crate::set::{Progress, QuadTreeSet, Variant};
 
 /// Sampler names this crate builds: the two variants, each with the optional two-slice mixture.
-pub const SAMPLER_NAMES: &[&str] = &["adaptive", "adaptive-paper", "adaptive-mixture", "adaptive-paper-mixture"];
+pub const SAMPLER_NAMES: &[&str] = &[
+    "adaptive",
+    "adaptive-paper",
+    "adaptive-mixture",
+    "adaptive-paper-mixture",
+];
 
 /// The variant and mixture flag of a sampler name, if this crate knows it.
 pub fn parse_sampler_name(name: &str) -> Option<(Variant, bool)> {
@@ -63,5 +68,7 @@ pub fn build_set(
     };
     let mut opts = *options;
     opts.mixture |= mixture;
-    Ok(QuadTreeSet::build_with_progress(brdf, variant, &opts, progress)?)
+    Ok(QuadTreeSet::build_with_progress(
+        brdf, variant, &opts, progress,
+    )?)
 }

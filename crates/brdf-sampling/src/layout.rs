@@ -58,7 +58,10 @@ impl SliceLayout {
 
     /// `(θ_j, φ_k)` of slice `index` (radians).
     pub fn angles_of(&self, index: usize) -> (f64, f64) {
-        (self.theta_of(index / self.phi), self.phi_of(index % self.phi))
+        (
+            self.theta_of(index / self.phi),
+            self.phi_of(index % self.phi),
+        )
     }
 
     /// The outgoing direction of slice `index`.
@@ -67,10 +70,10 @@ impl SliceLayout {
         brdf::direction_from_radians(t, p)
     }
 
-    /// Polar angle, azimuth and nearest φ slice of `wo`; `None` when `wo` is at or below the
-    /// horizon (or NaN).
+    /// Polar angle, nearest φ slice and rotation of `wo`; `None` when `wo` is at or below the
+    /// horizon or not finite.
     fn polar(&self, wo: &Vec3) -> Option<(f64, usize, f64)> {
-        if !(wo.z > 0.0) {
+        if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
             return None;
         }
         let theta = wo.z.min(1.0).acos();
@@ -84,7 +87,11 @@ impl SliceLayout {
     pub fn nearest(&self, wo: &Vec3) -> Option<SliceChoice> {
         let (theta, k, rotation) = self.polar(wo)?;
         let j = ((theta / FRAC_PI_2 * self.theta as f64) as usize).min(self.theta - 1);
-        Some(SliceChoice { index: j * self.phi + k, weight: 1.0, rotation })
+        Some(SliceChoice {
+            index: j * self.phi + k,
+            weight: 1.0,
+            rotation,
+        })
     }
 
     /// The two θ-neighbouring slices of `wo` with linear weights in θ (`w_a + w_b = 1`); below
@@ -103,8 +110,16 @@ impl SliceLayout {
             (ja, ja + 1, t - ja as f64)
         };
         Some([
-            SliceChoice { index: ja * self.phi + k, weight: 1.0 - wb, rotation },
-            SliceChoice { index: jb * self.phi + k, weight: wb, rotation },
+            SliceChoice {
+                index: ja * self.phi + k,
+                weight: 1.0 - wb,
+                rotation,
+            },
+            SliceChoice {
+                index: jb * self.phi + k,
+                weight: wb,
+                rotation,
+            },
         ])
     }
 }
@@ -123,7 +138,12 @@ mod tests {
         assert_relative_eq!(l.theta_of(30).to_degrees(), 30.5, epsilon = 1e-12);
         assert_relative_eq!(c.rotation.to_degrees(), 40.0, epsilon = 1e-9);
         assert_eq!(l.nearest(&Vec3::new(0.0, 0.0, 1.0)).unwrap().index, 0);
-        assert_eq!(l.nearest(&direction_from_angles(89.999, 0.0)).unwrap().index, 89);
+        assert_eq!(
+            l.nearest(&direction_from_angles(89.999, 0.0))
+                .unwrap()
+                .index,
+            89
+        );
         assert!(l.nearest(&Vec3::new(1.0, 0.0, 0.0)).is_none());
         assert!(l.nearest(&Vec3::new(f64::NAN, 0.0, 1.0)).is_none());
     }

@@ -1,7 +1,72 @@
 //! BRDF importance sampling with sets of adaptive quadtrees on the projected disc
-//! (Montes, Ureña et al., GRAPP 2008 §3 / CEIG 2008 §3).
+//! (Montes, Ureña, García & Lastra, GRAPP 2008 §3; CEIG 2008 §3).
 //!
-//! TODO crate docs.
+//! # Math
+//! * **Disc adapter** ([`disc`]): a direction `v` maps to the unit disc by `h(v) = (v.x, v.y)`,
+//!   `h⁻¹(x, y) = (x, y, √(1 − x² − y²))`. Area on the disc is projected solid angle
+//!   (`dA = cos θ dσ`), so the disc density `x ↦ f_r(ωo, h⁻¹(x))` ([`DiscBrdf`]) is
+//!   proportional to `f_r cos θi` with respect to solid angle and the sampler never evaluates
+//!   the cosine. Public pdfs are with respect to **solid angle**:
+//!   `p_σ(ωi) = p_A(h(ωi)) · cos θi` ([`area_pdf_to_solid_angle`]); 0 below the horizon.
+//! * **Slices** ([`SliceLayout`]): one quadtree per outgoing direction `ωo_j` with
+//!   `θ_j = (j + ½) · 90° / slices` (bin centres; default 90 slices). Isotropic BRDFs: `ωo` is
+//!   rotated to `φ = 0`, the slice with the nearest θ is sampled and the sample rotated back;
+//!   the pdf is evaluated with the same slice (the choice depends only on `ωo`), so
+//!   `f_r L cos / p` stays an unbiased estimator wherever `p > 0` covers `f_r(ωo, ·)`.
+//!   Anisotropic BRDFs use a `(θ, φ)` grid (default 32 × 16; samples are rotated by
+//!   `φo − φ_k`, which keeps the mirror direction exact). Optional **mixture** of the two
+//!   θ-neighbouring slices with linear weights in θ and the exact pdf `Σ w_k p_k`.
+//! * **Trees** (partition-sampler): each slice's tree is built from the papers' image map
+//!   ([`partition_sampler::SampledGridDensity`], `grid²` cells over `[-1, 1]²`, finer than the
+//!   deepest leaf: `2^(max_depth+1) ≤ grid`) with the rectangle adjustment of seed 000 §3.8
+//!   (rejection rectangles shrunk to the bounding box of cell ∩ disc), plus a **rim band**
+//!   that samples `f` densely in `cos θi ∈ (10⁻⁶, 2/√grid]` so that bounds near the horizon
+//!   hold (see `image_map.rs`; without it every tested glossy model violated its bounds at
+//!   θo ≥ 85°). Slices whose expected trials exceed [`SetOptions::refine_threshold`] are
+//!   rebuilt up to [`SetOptions::refine_levels`] levels deeper (grid doubled each time).
+//!
+//! # Samplers ([`build_sampler`], [`SAMPLER_NAMES`])
+//! * `adaptive` — [`Variant::Adaptive`]: envelope scheme (leaf ∝ `V_i`, restart on
+//!   rejection), alias leaf choice. Exact: samples have density `f / ∫ f` whenever the bounds
+//!   hold; the reported pdf is `f / Î` (`Î` = grid integral, relative error reported).
+//! * `adaptive-paper` — [`Variant::Paper`]: leaf ∝ `I_i` by the per-node CDF descent, rejection
+//!   inside the leaf, image-map bounds and rectangle adjustment; exact only when the `I_i` are.
+//! * `adaptive-mixture`, `adaptive-paper-mixture` — the same with the two-slice mixture.
+//!
+//! Every trial with `f > M_i` is counted ([`SetReport::bound_violations`]); BRDFs whose `f_r`
+//! is unbounded at the horizon (terms in `1/cos θi`, e.g. Strauss, Beard–Maxwell) cannot be
+//! bounded on the disc: their grazing slices need many trials and may report violations.
+//!
+//! # Example
+//! ```
+//! use std::sync::Arc;
+//! use brdf::{Brdf, direction_from_angles, parse_spec};
+//! use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, build_sampler};
+//! use rand::{SeedableRng, rngs::Xoshiro256PlusPlus};
+//!
+//! let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50")?);
+//! let opts = SetOptions { slices: 9, ..SetOptions::default() };
+//! let sampler = build_sampler("adaptive", brdf.clone(), &opts)?;
+//!
+//! let wo = direction_from_angles(30.0, 45.0);
+//! let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+//! let s = sampler.sample(&wo, &mut rng);
+//! assert!(s.wi.z > 0.0 && s.pdf > 0.0);
+//! // The pdf (w.r.t. solid angle) is the one `sample` reported.
+//! assert!((sampler.pdf(&wo, &s.wi) - s.pdf).abs() <= 1e-9 * s.pdf);
+//! // One-sample estimate of the directional albedo ∫ f cos dσ.
+//! let _estimate = brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf;
+//!
+//! // Sets can be saved and re-attached to the same BRDF spec.
+//! let set = QuadTreeSet::build(brdf.clone(), Default::default(), &opts)?.with_spec("phong:n=50");
+//! let back = QuadTreeSet::from_bytes(&set.to_bytes(), brdf, "phong:n=50")?;
+//! assert_eq!(back.report().trees, 9);
+//! assert_eq!(set.report().bound_violations, 0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+// `!(x > 0.0)`-style checks are deliberate: they reject NaN along with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod direction_sampler;
 pub mod disc;
@@ -15,11 +80,20 @@ mod report;
 mod set;
 
 pub use direction_sampler::{DirSample, DirectionSampler};
-pub use disc::{DiscBrdf, SliceDensity, area_pdf_to_solid_angle, disc_to_direction, direction_to_disc, solid_angle_pdf_to_area};
+pub use disc::{
+    DiscBrdf, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
+    solid_angle_pdf_to_area,
+};
 pub use error::{PersistError, SamplerError, SetError};
-pub use factory::{SAMPLER_NAMES, build_sampler, build_sampler_with_progress, build_set, parse_sampler_name};
+pub use factory::{
+    SAMPLER_NAMES, build_sampler, build_sampler_with_progress, build_set, parse_sampler_name,
+};
 pub use layout::{SliceChoice, SliceLayout};
-pub use options::*;
+pub use options::{
+    DEFAULT_ANISOTROPIC_SLICES, DEFAULT_GRID, DEFAULT_MAX_DEPTH, DEFAULT_N_MAX,
+    DEFAULT_REFINE_LEVELS, DEFAULT_REFINE_THRESHOLD, DEFAULT_SAFETY_FACTOR, DEFAULT_SLICES,
+    DEFAULT_VOLUME_TOLERANCE, MAX_GRID, MAX_SLICES, OptionsError, SetOptions,
+};
 pub use persist::SET_FORMAT_VERSION;
 pub use report::{CostMeasurement, SetReport};
 pub use set::{Progress, QuadTreeSet, Variant, layout_for};

@@ -67,7 +67,10 @@ fn decode(bytes: &[u8]) -> Result<Stored, PersistError> {
     }
     let found = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
     if found != SET_FORMAT_VERSION {
-        return Err(PersistError::UnsupportedVersion { found, expected: SET_FORMAT_VERSION });
+        return Err(PersistError::UnsupportedVersion {
+            found,
+            expected: SET_FORMAT_VERSION,
+        });
     }
     postcard::from_bytes(&bytes[8..]).map_err(|e| match e {
         postcard::Error::DeserializeUnexpectedEnd => PersistError::Truncated,
@@ -115,19 +118,33 @@ impl QuadTreeSet {
     pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
         let s = decode(bytes)?;
         if s.spec != spec.trim() {
-            return Err(PersistError::SpecMismatch { stored: s.spec, given: spec.trim().to_string() });
+            return Err(PersistError::SpecMismatch {
+                stored: s.spec,
+                given: spec.trim().to_string(),
+            });
         }
         let found = probes(brdf.as_ref());
         for (probe, (&a, &b)) in s.probes.iter().zip(&found).enumerate() {
             let ok = a == b || (a - b).abs() <= PROBE_TOLERANCE * a.abs().max(b.abs());
             if !ok {
-                return Err(PersistError::BrdfMismatch { name: brdf.name().to_string(), probe, stored: a, found: b });
+                return Err(PersistError::BrdfMismatch {
+                    name: brdf.name().to_string(),
+                    probe,
+                    stored: a,
+                    found: b,
+                });
             }
         }
         if s.probes.len() != found.len() {
-            return Err(PersistError::Corrupt(format!("{} probes, expected {}", s.probes.len(), found.len())));
+            return Err(PersistError::Corrupt(format!(
+                "{} probes, expected {}",
+                s.probes.len(),
+                found.len()
+            )));
         }
-        s.options.validate().map_err(|e| PersistError::Corrupt(format!("options: {e}")))?;
+        s.options
+            .validate()
+            .map_err(|e| PersistError::Corrupt(format!("options: {e}")))?;
         if layout_for(brdf.as_ref(), &s.options) != s.layout || s.layout.len() != s.trees.len() {
             return Err(PersistError::Corrupt(format!(
                 "layout {} × {} with {} trees does not fit the options and the BRDF's isotropy",
@@ -138,9 +155,12 @@ impl QuadTreeSet {
         }
         let mut trees = Vec::with_capacity(s.trees.len());
         for (slice, raw) in s.trees.iter().enumerate() {
-            let tree = QuadTree::from_bytes(raw).map_err(|source| PersistError::Tree { slice, source })?;
+            let tree =
+                QuadTree::from_bytes(raw).map_err(|source| PersistError::Tree { slice, source })?;
             if tree.domain() != Domain::UnitDisc || tree.params().scheme != s.variant_scheme() {
-                return Err(PersistError::Corrupt(format!("slice {slice}: wrong domain or scheme")));
+                return Err(PersistError::Corrupt(format!(
+                    "slice {slice}: wrong domain or scheme"
+                )));
             }
             let shape = *tree.shape();
             let f = DiscBrdf::new(Arc::clone(&brdf), s.layout.direction_of(slice));
@@ -163,12 +183,18 @@ impl QuadTreeSet {
 
     /// Writes [`QuadTreeSet::to_bytes`] to `path`.
     pub fn save(&self, path: &Path) -> Result<(), PersistError> {
-        std::fs::write(path, self.to_bytes()).map_err(|source| PersistError::Io { path: path.to_path_buf(), source })
+        std::fs::write(path, self.to_bytes()).map_err(|source| PersistError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
     }
 
     /// Reads a set from `path` and re-attaches `brdf` (see [`QuadTreeSet::from_bytes`]).
     pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
-        let bytes = std::fs::read(path).map_err(|source| PersistError::Io { path: path.to_path_buf(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| PersistError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_bytes(&bytes, brdf, spec)
     }
 }

@@ -79,10 +79,26 @@ impl std::fmt::Display for SetReport {
         let opt = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
         writeln!(f, "sampler            {}", self.name)?;
         writeln!(f, "brdf               {} (spec `{}`)", self.brdf, self.spec)?;
-        writeln!(f, "slices             {} θ × {} φ = {} trees", self.layout.theta, self.layout.phi, self.trees)?;
-        writeln!(f, "build time         {:.3} s", self.build_time.as_secs_f64())?;
-        writeln!(f, "memory             {:.1} KiB", self.memory_bytes as f64 / 1024.0)?;
-        writeln!(f, "nodes / leaves     {} / {} (max depth {})", self.nodes, self.leaves, self.max_depth)?;
+        writeln!(
+            f,
+            "slices             {} θ × {} φ = {} trees",
+            self.layout.theta, self.layout.phi, self.trees
+        )?;
+        writeln!(
+            f,
+            "build time         {:.3} s",
+            self.build_time.as_secs_f64()
+        )?;
+        writeln!(
+            f,
+            "memory             {:.1} KiB",
+            self.memory_bytes as f64 / 1024.0
+        )?;
+        writeln!(
+            f,
+            "nodes / leaves     {} / {} (max depth {})",
+            self.nodes, self.leaves, self.max_depth
+        )?;
         writeln!(
             f,
             "trials / sample    expected {:.3} (worst slice {:.3}), measured {}",
@@ -97,6 +113,11 @@ impl std::fmt::Display for SetReport {
             "samples            {} (bound violations {}, exhausted {})",
             self.samples, self.bound_violations, self.exhausted
         )?;
-        write!(f, "integral rel. err. {}", self.max_integral_rel_err.map_or_else(|| "-".to_string(), |v| format!("{v:.2e}")))
+        write!(
+            f,
+            "integral rel. err. {}",
+            self.max_integral_rel_err
+                .map_or_else(|| "-".to_string(), |v| format!("{v:.2e}"))
+        )
     }
 }

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3, rotate_z};
 use partition_sampler::{
-    AllocationMode, Audit, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sample2, Sampler2D, Scheme, UniformSource,
+    AllocationMode, Audit, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sample2, Sampler2D,
+    Scheme, UniformSource,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -62,8 +63,9 @@ impl Variant {
     }
 }
 
-/// Progress callback: `(slices done, total slices)`, called from the building threads after
-/// each slice.
+/// Progress callback: `(slices done, total)`, called from the building threads after each
+/// slice is built. `total` starts at the number of slices and grows by the number of slices
+/// chosen for refinement at each refinement level ([`SetOptions::refine_levels`]).
 pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
 
 /// A set of adaptive quadtrees over outgoing-direction slices of one BRDF (seed 000 §3.4,
@@ -106,14 +108,24 @@ impl std::fmt::Debug for QuadTreeSet {
 /// The slice layout a BRDF needs under `options`.
 pub fn layout_for(brdf: &dyn Brdf, options: &SetOptions) -> SliceLayout {
     if brdf.is_isotropic() {
-        SliceLayout { theta: options.slices, phi: 1 }
+        SliceLayout {
+            theta: options.slices,
+            phi: 1,
+        }
     } else {
-        SliceLayout { theta: options.anisotropic_slices[0], phi: options.anisotropic_slices[1] }
+        SliceLayout {
+            theta: options.anisotropic_slices[0],
+            phi: options.anisotropic_slices[1],
+        }
     }
 }
 
 pub(crate) fn sampler_name(variant: Variant, mixture: bool) -> String {
-    if mixture { format!("{}-mixture", variant.name()) } else { variant.name().to_string() }
+    if mixture {
+        format!("{}-mixture", variant.name())
+    } else {
+        variant.name().to_string()
+    }
 }
 
 /// Builds the tree of slice `index`; returns it with the number of BRDF evaluations spent.
@@ -128,8 +140,21 @@ fn build_slice(
     let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
     let f = DiscBrdf::new(Arc::clone(brdf), layout.direction_of(index));
     let counter = EvalCounter::new();
-    let map = SliceImageMap::new(Counted { f: &f, counter: &counter }, options.grid, options.safety_factor, options.bound_dilation)
-        .map_err(|source| SetError::Density { slice: index, theta_deg, phi_deg, source })?;
+    let map = SliceImageMap::new(
+        Counted {
+            f: &f,
+            counter: &counter,
+        },
+        options.grid,
+        options.safety_factor,
+        options.dilation_for(brdf.as_ref()),
+    )
+    .map_err(|source| SetError::Density {
+        slice: index,
+        theta_deg,
+        phi_deg,
+        source,
+    })?;
     let tree = QuadTreeBuilder::new()
         .n_max(options.n_max)
         .max_depth(options.max_depth)
@@ -137,13 +162,23 @@ fn build_slice(
         .scheme(variant.scheme())
         .leaf_choice(variant.leaf_choice())
         .build_tree(&map)
-        .map_err(|source| SetError::Tree { slice: index, theta_deg, phi_deg, source })?;
+        .map_err(|source| SetError::Tree {
+            slice: index,
+            theta_deg,
+            phi_deg,
+            source,
+        })?;
     drop(map);
     // A clone holds its arrays with exact capacities (the builder grows them amortised).
     let tree = tree.clone();
     let shape = *tree.shape();
-    let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
-        .map_err(|source| SetError::Attach { slice: index, source })?;
+    let sampler =
+        QuadTreeSampler::from_parts(tree, SliceDensity { f, shape }).map_err(|source| {
+            SetError::Attach {
+                slice: index,
+                source,
+            }
+        })?;
     Ok((sampler, counter.total()))
 }
 
@@ -151,7 +186,11 @@ impl QuadTreeSet {
     /// Builds the set of `brdf` for `variant` (all slices in parallel with rayon; the result
     /// does not depend on the thread count). The spec recorded for persistence is
     /// `brdf.name()`; set another with [`QuadTreeSet::with_spec`].
-    pub fn build(brdf: Arc<dyn Brdf>, variant: Variant, options: &SetOptions) -> Result<Self, SetError> {
+    pub fn build(
+        brdf: Arc<dyn Brdf>,
+        variant: Variant,
+        options: &SetOptions,
+    ) -> Result<Self, SetError> {
         Self::build_with_progress(brdf, variant, options, None)
     }
 
@@ -165,19 +204,58 @@ impl QuadTreeSet {
         options.validate()?;
         let start = Instant::now();
         let layout = layout_for(brdf.as_ref(), options);
-        let total = layout.len();
+        let total = AtomicUsize::new(layout.len());
         let done = AtomicUsize::new(0);
-        let built: Vec<(QuadTreeSampler<SliceDensity>, u64)> = (0..total)
+        let tick = || {
+            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(p) = progress {
+                p(d, total.load(Ordering::Relaxed));
+            }
+        };
+        let mut built: Vec<(QuadTreeSampler<SliceDensity>, u64)> = (0..layout.len())
             .into_par_iter()
             .map(|i| {
                 let r = build_slice(&brdf, layout, i, options, variant);
-                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                if let Some(p) = progress {
-                    p(d, total);
-                }
+                tick();
                 r
             })
             .collect::<Result<_, _>>()?;
+        // Refinement of the worst slices (grazing lobes squeezed against the rim).
+        let cap = layout.len().div_ceil(10);
+        let mut level_opts = *options;
+        for _ in 0..options.refine_levels {
+            let mut worst: Vec<(f64, usize)> = built
+                .iter()
+                .enumerate()
+                .map(|(i, (t, _))| (t.tree().expected_mean_trials(), i))
+                .filter(|&(e, _)| e > options.refine_threshold)
+                .collect();
+            if worst.is_empty() {
+                break;
+            }
+            worst.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            worst.truncate(cap);
+            level_opts = level_opts.with_depth(level_opts.max_depth + 1);
+            let opts = level_opts;
+            total.fetch_add(worst.len(), Ordering::Relaxed);
+            let redone: Vec<(usize, (QuadTreeSampler<SliceDensity>, u64))> = worst
+                .par_iter()
+                .map(|&(_, i)| {
+                    let r = build_slice(&brdf, layout, i, &opts, variant).map(|b| (i, b));
+                    tick();
+                    r
+                })
+                .collect::<Result<_, _>>()?;
+            for (i, (tree, evals)) in redone {
+                let old = &mut built[i];
+                let better =
+                    tree.tree().expected_mean_trials() < old.0.tree().expected_mean_trials();
+                old.1 += evals;
+                if better {
+                    old.0 = tree;
+                }
+            }
+        }
         let grid_evaluations = built.iter().map(|b| b.1).sum();
         let trees = built.into_iter().map(|b| b.0).collect();
         let spec = brdf.name().to_string();
@@ -262,7 +340,9 @@ impl QuadTreeSet {
         if self.options.mixture {
             self.layout.neighbours(wo)
         } else {
-            self.layout.nearest(wo).map(|c| [c, SliceChoice { weight: 0.0, ..c }])
+            self.layout
+                .nearest(wo)
+                .map(|c| [c, SliceChoice { weight: 0.0, ..c }])
         }
     }
 
@@ -272,7 +352,9 @@ impl QuadTreeSet {
         if !(wi.z > 0.0) {
             return 0.0;
         }
-        let Some(tree) = self.trees.get(c.index) else { return 0.0 };
+        let Some(tree) = self.trees.get(c.index) else {
+            return 0.0;
+        };
         let v = rotate_z(wi, -c.rotation);
         tree.pdf([v.x, v.y]) * wi.z
     }
@@ -283,7 +365,9 @@ impl QuadTreeSet {
         if !(wi.z > 0.0) {
             return 0.0;
         }
-        let Some(tree) = self.trees.get(c.index) else { return 0.0 };
+        let Some(tree) = self.trees.get(c.index) else {
+            return 0.0;
+        };
         let v = rotate_z(wi, -c.rotation);
         tree.pdf([v.x, v.y])
     }
@@ -294,7 +378,11 @@ impl QuadTreeSet {
         let mut p = 0.0;
         for (k, c) in cs.iter().enumerate() {
             if c.weight > 0.0 {
-                let pk = if k == drawn || c.index == cs[drawn].index { drawn_pdf } else { self.slice_pdf(c, wi) };
+                let pk = if k == drawn || c.index == cs[drawn].index {
+                    drawn_pdf
+                } else {
+                    self.slice_pdf(c, wi)
+                };
                 p += c.weight * pk;
             }
         }
@@ -309,16 +397,27 @@ impl QuadTreeSet {
         u: &mut dyn UniformSource,
         draw: &mut dyn FnMut(&QuadTreeSampler<SliceDensity>, &mut dyn UniformSource) -> Sample2,
     ) -> DirSample {
-        let up = DirSample { wi: Vec3::new(0.0, 0.0, 1.0), pdf: 0.0 };
-        let Some(cs) = self.choices(wo) else { return up };
+        let up = DirSample {
+            wi: Vec3::new(0.0, 0.0, 1.0),
+            pdf: 0.0,
+        };
+        let Some(cs) = self.choices(wo) else {
+            return up;
+        };
         let drawn = usize::from(cs[1].weight > 0.0 && u.next_uniform() < cs[1].weight);
         let c = cs[drawn];
-        let Some(tree) = self.trees.get(c.index) else { return up };
+        let Some(tree) = self.trees.get(c.index) else {
+            return up;
+        };
         let s = draw(tree, u);
         let v = disc_to_direction(s.point);
         let wi = rotate_z(&v, c.rotation);
         let p = s.pdf * v.z;
-        let pdf = if cs[1 - drawn].weight > 0.0 { self.combine(&cs, drawn, p, &wi) } else { p };
+        let pdf = if cs[1 - drawn].weight > 0.0 {
+            self.combine(&cs, drawn, p, &wi)
+        } else {
+            p
+        };
         DirSample { wi, pdf }
     }
 
@@ -333,7 +432,8 @@ impl QuadTreeSet {
         let dt = std::f64::consts::FRAC_PI_2 / self.layout.theta as f64;
         let dp = std::f64::consts::TAU / self.layout.phi as f64;
         for i in 0..self.trees.len() {
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, i as u64));
+            let mut rng =
+                Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, i as u64));
             let (t, p) = self.layout.angles_of(i);
             for _ in 0..per_slice {
                 let theta = t + (rng.next_uniform() - 0.5) * dt;
@@ -422,7 +522,9 @@ impl DirectionSampler for QuadTreeSet {
     }
 
     fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        let Some(cs) = self.choices(wo) else { return 0.0 };
+        let Some(cs) = self.choices(wo) else {
+            return 0.0;
+        };
         if !(wi.z > 0.0) {
             return 0.0;
         }
@@ -436,17 +538,24 @@ impl DirectionSampler for QuadTreeSet {
     }
 
     fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
-        let nearest = (!self.options.mixture).then(|| self.layout.nearest(wo)).flatten();
+        let nearest = (!self.options.mixture)
+            .then(|| self.layout.nearest(wo))
+            .flatten();
         match (self.variant, nearest) {
             (Variant::Paper, Some(c)) => {
-                let Some(tree) = self.trees.get(c.index) else { return Vec::new() };
+                let Some(tree) = self.trees.get(c.index) else {
+                    return Vec::new();
+                };
                 let batch = tree.sample_batch(n, AllocationMode::RandomizedRemainder, u);
                 batch
                     .samples
                     .iter()
                     .map(|s| {
                         let v = disc_to_direction(s.point);
-                        DirSample { wi: rotate_z(&v, c.rotation), pdf: s.pdf * v.z }
+                        DirSample {
+                            wi: rotate_z(&v, c.rotation),
+                            pdf: s.pdf * v.z,
+                        }
                     })
                     .collect()
             }
@@ -457,7 +566,8 @@ impl DirectionSampler for QuadTreeSet {
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
-            + (self.trees.capacity() - self.trees.len()) * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
+            + (self.trees.capacity() - self.trees.len())
+                * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
             + self.spec.capacity()
             + self.name.capacity()
     }

@@ -16,15 +16,37 @@ fn check_set(spec: &str, set: &QuadTreeSet, seed: u64) {
         let wo = wo_at(theta);
         let samples = draw(set, &wo, N, seed + k as u64);
         for s in &samples {
-            assert!(s.pdf > 0.0, "{spec} {} θo={theta}: sample with pdf {}", set.name(), s.pdf);
-            assert!(s.wi.z > 0.0 && (s.wi.norm() - 1.0).abs() < 1e-12, "{spec}: {:?}", s.wi);
+            assert!(
+                s.pdf > 0.0,
+                "{spec} {} θo={theta}: sample with pdf {}",
+                set.name(),
+                s.pdf
+            );
+            assert!(
+                s.wi.z > 0.0 && (s.wi.norm() - 1.0).abs() < 1e-12,
+                "{spec}: {:?}",
+                s.wi
+            );
         }
         let mismatch = worst_pdf_mismatch(set, &wo, &samples);
-        assert!(mismatch <= 1e-9, "{spec} {} θo={theta}: pdf mismatch {mismatch:e}", set.name());
+        assert!(
+            mismatch <= 1e-9,
+            "{spec} {} θo={theta}: pdf mismatch {mismatch:e}",
+            set.name()
+        );
         let r = chi_square(&samples, &|w| set.pdf(&wo, w));
-        assert!(r.p_value >= ALPHA, "{spec} {} θo={theta}: {}", set.name(), r.summary());
+        assert!(
+            r.p_value >= ALPHA,
+            "{spec} {} θo={theta}: {}",
+            set.name(),
+            r.summary()
+        );
         let l1 = l1_to_target(set, b.as_ref(), &wo);
-        println!("{spec:<28} {:<16} θo={theta:>4}°  {}  L1(pdf, f cos) = {l1:.4}", set.name(), r.summary());
+        println!(
+            "{spec:<28} {:<16} θo={theta:>4}°  {}  L1(pdf, f cos) = {l1:.4}",
+            set.name(),
+            r.summary()
+        );
     }
     let rep = set.report();
     assert_eq!(rep.bound_violations, 0, "{spec} {}: {rep}", set.name());
@@ -33,7 +55,11 @@ fn check_set(spec: &str, set: &QuadTreeSet, seed: u64) {
     let wo = wo_at(30.0);
     let total = integral(&|w| set.pdf(&wo, w));
     let tol = 2e-3_f64.max(5.0 * rep.max_integral_rel_err.unwrap_or(0.0));
-    assert!((total - 1.0).abs() <= tol, "{spec} {}: ∫pdf = {total}, tolerance {tol:e}", set.name());
+    assert!(
+        (total - 1.0).abs() <= tol,
+        "{spec} {}: ∫pdf = {total}, tolerance {tol:e}",
+        set.name()
+    );
 }
 
 fn check_model(spec: &str, seed: u64, mixture: bool) {
@@ -64,7 +90,11 @@ fn phong_1000_sharp() {
 
 #[test]
 fn ward_anisotropic() {
-    let set = build("ward:alpha_x=0.08,alpha_y=0.3", Variant::Adaptive, &test_options());
+    let set = build(
+        "ward:alpha_x=0.08,alpha_y=0.3",
+        Variant::Adaptive,
+        &test_options(),
+    );
     assert_eq!(set.layout().phi, 8, "anisotropic BRDFs use a (θ, φ) grid");
     check_model("ward:alpha_x=0.08,alpha_y=0.3", 40, true);
 }

@@ -5,26 +5,40 @@ mod common;
 use std::sync::Mutex;
 
 use brdf_sampling::{
-    OptionsError, SAMPLER_NAMES, SamplerError, SetError, SetOptions, build_sampler, build_sampler_with_progress, build_set,
+    OptionsError, SAMPLER_NAMES, SamplerError, SetError, SetOptions, build_sampler,
+    build_sampler_with_progress, build_set,
 };
 use common::*;
 
 #[test]
 fn known_names_build_and_report_their_name() {
-    let opts = SetOptions { slices: 3, ..test_options() };
+    let opts = SetOptions {
+        slices: 3,
+        ..test_options()
+    };
     for name in SAMPLER_NAMES {
         let s = build_sampler(name, brdf("lambert"), &opts).unwrap();
         assert_eq!(s.name(), *name);
         assert!(s.bytes_used() > 0);
     }
     // `options.mixture` turns the mixture on for the plain name too.
-    let s = build_sampler("adaptive", brdf("lambert"), &SetOptions { mixture: true, ..opts }).unwrap();
+    let s = build_sampler(
+        "adaptive",
+        brdf("lambert"),
+        &SetOptions {
+            mixture: true,
+            ..opts
+        },
+    )
+    .unwrap();
     assert_eq!(s.name(), "adaptive-mixture");
 }
 
 #[test]
 fn unknown_names_and_bad_options_are_typed_errors() {
-    let err = build_sampler("cosine", brdf("lambert"), &test_options()).err().unwrap();
+    let err = build_sampler("cosine", brdf("lambert"), &test_options())
+        .err()
+        .unwrap();
     match &err {
         SamplerError::UnknownSampler { name, known } => {
             assert_eq!(name, "cosine");
@@ -34,9 +48,14 @@ fn unknown_names_and_bad_options_are_typed_errors() {
         other => panic!("{other:?}"),
     }
     assert!(err.to_string().contains("adaptive-paper"));
-    let bad = SetOptions { n_max: 0.5, ..test_options() };
+    let bad = SetOptions {
+        n_max: 0.5,
+        ..test_options()
+    };
     assert!(matches!(
-        build_sampler("adaptive", brdf("lambert"), &bad).err().unwrap(),
+        build_sampler("adaptive", brdf("lambert"), &bad)
+            .err()
+            .unwrap(),
         SamplerError::Build(SetError::Options(OptionsError::InvalidNMax(_)))
     ));
 }
@@ -45,8 +64,12 @@ fn unknown_names_and_bad_options_are_typed_errors() {
 fn progress_reports_every_slice() {
     let seen = Mutex::new(Vec::new());
     let cb = |done: usize, total: usize| seen.lock().unwrap().push((done, total));
-    let opts = SetOptions { slices: 7, ..test_options() };
-    let s = build_sampler_with_progress("adaptive-paper", brdf("phong:n=20"), &opts, Some(&cb)).unwrap();
+    let opts = SetOptions {
+        slices: 7,
+        ..test_options()
+    };
+    let s = build_sampler_with_progress("adaptive-paper", brdf("phong:n=20"), &opts, Some(&cb))
+        .unwrap();
     assert_eq!(s.name(), "adaptive-paper");
     let mut v = seen.into_inner().unwrap();
     v.sort_unstable();
@@ -55,20 +78,38 @@ fn progress_reports_every_slice() {
 
 #[test]
 fn build_is_deterministic_across_thread_counts() {
-    let opts = SetOptions { slices: 5, ..test_options() };
-    let a = build_set("adaptive", brdf("ggx:alpha=0.1"), &opts, None).unwrap().to_bytes();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    let b = pool.install(|| build_set("adaptive", brdf("ggx:alpha=0.1"), &opts, None).unwrap().to_bytes());
+    let opts = SetOptions {
+        slices: 5,
+        ..test_options()
+    };
+    let a = build_set("adaptive", brdf("ggx:alpha=0.1"), &opts, None)
+        .unwrap()
+        .to_bytes();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let b = pool.install(|| {
+        build_set("adaptive", brdf("ggx:alpha=0.1"), &opts, None)
+            .unwrap()
+            .to_bytes()
+    });
     assert_eq!(a, b);
 }
 
 #[test]
 fn report_counts_structure_and_evaluations() {
-    let set = build("phong:n=50", brdf_sampling::Variant::Adaptive, &test_options());
+    let set = build(
+        "phong:n=50",
+        brdf_sampling::Variant::Adaptive,
+        &test_options(),
+    );
     let r = set.report();
     assert_eq!(r.trees, 9);
     assert!(r.leaves >= 9 && r.nodes >= r.leaves && r.max_depth <= test_options().max_depth);
-    assert!(r.expected_mean_trials >= 1.0 && r.expected_mean_trials <= r.worst_expected_mean_trials);
+    assert!(
+        r.expected_mean_trials >= 1.0 && r.expected_mean_trials <= r.worst_expected_mean_trials
+    );
     assert!(r.grid_evaluations as usize > 9 * 256 * 256);
     assert!(r.memory_bytes > 0 && r.measured_mean_trials.is_none());
     let cost = set.measure_cost(2000, 1);
@@ -79,4 +120,32 @@ fn report_counts_structure_and_evaluations() {
     assert_eq!(r.samples, 9 * 2100);
     assert!(r.evaluations_per_sample.unwrap() >= 1.0);
     assert!(format!("{r}").contains("phong"));
+}
+
+#[test]
+fn grazing_slices_are_refined() {
+    let base = SetOptions {
+        slices: 18,
+        refine_levels: 0,
+        ..SetOptions::default()
+    };
+    let plain = build("ashikhmin-shirley", brdf_sampling::Variant::Adaptive, &base).report();
+    let refined = build(
+        "ashikhmin-shirley",
+        brdf_sampling::Variant::Adaptive,
+        &SetOptions {
+            refine_levels: 2,
+            ..base
+        },
+    )
+    .report();
+    assert_eq!(plain.max_depth, base.max_depth);
+    assert!(refined.max_depth > base.max_depth, "{refined}");
+    assert!(
+        refined.worst_expected_mean_trials < 0.5 * plain.worst_expected_mean_trials,
+        "{} vs {}",
+        refined.worst_expected_mean_trials,
+        plain.worst_expected_mean_trials
+    );
+    assert!(refined.grid_evaluations > plain.grid_evaluations);
 }

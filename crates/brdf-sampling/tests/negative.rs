@@ -29,17 +29,29 @@ impl DirectionSampler for Broken<'_> {
     }
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let s = self.set.sample(wo, u);
-        DirSample { wi: s.wi, pdf: self.pdf(wo, &s.wi) }
+        DirSample {
+            wi: s.wi,
+            pdf: self.pdf(wo, &s.wi),
+        }
     }
     fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        let Some(c) = self.set.layout().nearest(wo) else { return 0.0 };
+        let Some(c) = self.set.layout().nearest(wo) else {
+            return 0.0;
+        };
         match self.bug {
             Bug::NeighbourSlice => {
-                let n = SliceChoice { index: c.index + 1, ..c };
+                let n = SliceChoice {
+                    index: c.index + 1,
+                    ..c
+                };
                 self.set.slice_area_pdf(&n, wi) * wi.z
             }
             Bug::NoCosine => self.set.slice_area_pdf(&c, wi),
-            Bug::NoRotation => self.set.slice_area_pdf(&SliceChoice { rotation: 0.0, ..c }, wi) * wi.z,
+            Bug::NoRotation => {
+                self.set
+                    .slice_area_pdf(&SliceChoice { rotation: 0.0, ..c }, wi)
+                    * wi.z
+            }
         }
     }
     fn bytes_used(&self) -> usize {
@@ -54,8 +66,16 @@ fn broken_pdfs_are_rejected_and_the_honest_one_passes() {
     let wo = wo_at(33.0);
     let honest = draw(&set, &wo, 20_000, 5);
     let r = chi_square(&honest, &|w| set.pdf(&wo, w));
-    assert!(r.p_value >= ALPHA, "honest sampler rejected: {}", r.summary());
-    for (bug, name) in [(Bug::NeighbourSlice, "neighbour slice"), (Bug::NoCosine, "no cosine"), (Bug::NoRotation, "no rotation")] {
+    assert!(
+        r.p_value >= ALPHA,
+        "honest sampler rejected: {}",
+        r.summary()
+    );
+    for (bug, name) in [
+        (Bug::NeighbourSlice, "neighbour slice"),
+        (Bug::NoCosine, "no cosine"),
+        (Bug::NoRotation, "no rotation"),
+    ] {
         let b = Broken { set: &set, bug };
         let samples = draw(&b, &wo, 20_000, 5);
         let r = chi_square(&samples, &|w| b.pdf(&wo, w));
@@ -68,14 +88,24 @@ fn broken_pdfs_are_rejected_and_the_honest_one_passes() {
 fn bounds_too_low_are_audited_and_rejected() {
     // A 8 × 8 image map without safety factor cannot see a Phong lobe of exponent 1000: the
     // leaf bounds are too low, the audit counts violations and the samples follow min(f, M).
-    let opts = SetOptions { slices: 9, grid: 8, max_depth: 2, safety_factor: 1.0, ..SetOptions::default() };
+    let opts = SetOptions {
+        slices: 9,
+        grid: 8,
+        max_depth: 2,
+        safety_factor: 1.0,
+        ..SetOptions::default()
+    };
     let set = build("phong:n=1000,kd=0", Variant::Adaptive, &opts);
     let wo = wo_at(35.0);
     let samples = draw(&set, &wo, 20_000, 9);
     let rep = set.report();
     assert!(rep.bound_violations > 0, "{rep}");
     let r = chi_square(&samples, &|w| set.pdf(&wo, w));
-    assert!(r.p_value < ALPHA, "too-low bounds not detected: {}", r.summary());
+    assert!(
+        r.p_value < ALPHA,
+        "too-low bounds not detected: {}",
+        r.summary()
+    );
     // The defaults on the same BRDF and direction: no violation, test passes.
     let good = build("phong:n=1000,kd=0", Variant::Adaptive, &test_options());
     let samples = draw(&good, &wo, 20_000, 9);

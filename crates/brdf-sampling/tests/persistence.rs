@@ -51,7 +51,10 @@ fn typed_errors() {
     let bytes = set.to_bytes();
     let load = |b: &[u8]| QuadTreeSet::from_bytes(b, brdf("phong:n=50"), "phong:n=50");
     for cut in [0, 3, 7, 8, 9, bytes.len() / 2, bytes.len() - 1] {
-        assert!(matches!(load(&bytes[..cut]), Err(PersistError::Truncated)), "cut at {cut}");
+        assert!(
+            matches!(load(&bytes[..cut]), Err(PersistError::Truncated)),
+            "cut at {cut}"
+        );
     }
     let mut v = bytes.clone();
     v[4..8].copy_from_slice(&(SET_FORMAT_VERSION + 1).to_le_bytes());
@@ -77,7 +80,9 @@ fn corrupted_bytes_never_panic() {
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
     let mut errors = 0;
     for _ in 0..300 {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let mut v = bytes.clone();
         let at = 8 + (state >> 33) as usize % (v.len() - 8);
         v[at] ^= 1 << ((state >> 20) % 8);

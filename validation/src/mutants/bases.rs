@@ -88,7 +88,9 @@ impl LobeMixture {
         let theta = wo.z.clamp(-1.0, 1.0).acos().to_degrees();
         let phi = wo.y.atan2(wo.x).to_degrees();
         let theta_slice = match self.slice_step {
-            Some(step) => (((theta / step).round() as i64 + i64::from(offset)) as f64 * step).clamp(0.0, 89.9),
+            Some(step) => {
+                (((theta / step).round() as i64 + i64::from(offset)) as f64 * step).clamp(0.0, 89.9)
+            }
             None => theta,
         };
         // Mirror of (θ, φ) is (θ, φ + 180°).

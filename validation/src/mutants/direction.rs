@@ -91,7 +91,11 @@ pub struct RegionScaledPdf {
 
 impl RegionScaledPdf {
     fn scale(&self, wi: &Vec3) -> f64 {
-        if wi.y > 0.0 { self.factor } else { 2.0 - self.factor }
+        if wi.y > 0.0 {
+            self.factor
+        } else {
+            2.0 - self.factor
+        }
     }
 }
 

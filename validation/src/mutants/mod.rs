@@ -110,7 +110,11 @@ fn phong_mixture() -> LobeMixture {
     LobeMixture::correct(0.3, 50.0)
 }
 
-fn control_disc(brdf: &Arc<dyn Brdf>, wo: &Vec3, refs: &BrdfReferences) -> Result<AnySubject, String> {
+fn control_disc(
+    brdf: &Arc<dyn Brdf>,
+    wo: &Vec3,
+    refs: &BrdfReferences,
+) -> Result<AnySubject, String> {
     Ok(AnySubject::Planar(brdf_disc_subject(
         Arc::new(QuadTreePlanar(quadtree_disc_sampler(brdf, wo)?)),
         Arc::clone(brdf),
@@ -278,4 +282,90 @@ pub static MUTANTS: &[Mutant] = &[
 /// Every mutant.
 pub fn mutants() -> &'static [Mutant] {
     MUTANTS
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use brdf::direction_from_angles;
+    use stats::{QuadratureOptions, SphereBinning, integrate};
+
+    /// `∫ pdf(ωo, ·) dω` over the sphere (or hemisphere).
+    fn mass(s: &dyn DirectionSampler, wo: &Vec3, sphere: bool) -> f64 {
+        let bins = if sphere {
+            SphereBinning::sphere(32, 32).unwrap()
+        } else {
+            SphereBinning::hemisphere(16, 32).unwrap()
+        };
+        let f = |d: [f64; 3]| s.pdf(wo, &Vec3::new(d[0], d[1], d[2]));
+        integrate(&f, &bins, 1e-8, &QuadratureOptions::default())
+            .unwrap()
+            .value
+    }
+
+    #[test]
+    fn bases_and_pdf_preserving_mutants_are_normalised() {
+        let wo = direction_from_angles(45.0, 0.0);
+        let base = phong_mixture();
+        assert_relative_eq!(mass(&base, &wo, true), 1.0, epsilon = 1e-6);
+        assert_relative_eq!(mass(&CosineHemisphere, &wo, false), 1.0, epsilon = 1e-8);
+        // These mutants keep ∫ pdf = 1: only the tests that look at the samples catch them.
+        let region = RegionScaledPdf { base, factor: 1.03 };
+        assert_relative_eq!(mass(&region, &wo, true), 1.0, epsilon = 1e-6);
+        assert_relative_eq!(
+            mass(&CosineReportedUniform, &wo, false),
+            1.0,
+            epsilon = 1e-8
+        );
+        let hole = TruncatedCosine {
+            theta_max_deg: 80.0,
+        };
+        assert_relative_eq!(mass(&hole, &wo, false), 1.0, epsilon = 1e-6);
+        // ... while the unnormalised mixture integrates to 1.2.
+        let broken = LobeMixture {
+            pdf_weights: [0.35, 0.85],
+            ..LobeMixture::correct(0.35 / 1.2, 50.0)
+        };
+        assert_relative_eq!(mass(&broken, &wo, true), 1.2, epsilon = 1e-6);
+    }
+
+    #[test]
+    fn samples_report_their_pdf() {
+        let wo = direction_from_angles(30.0, 20.0);
+        let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(4);
+        let samplers: [&dyn DirectionSampler; 3] = [
+            &phong_mixture(),
+            &CosineHemisphere,
+            &TruncatedCosine {
+                theta_max_deg: 80.0,
+            },
+        ];
+        for s in samplers {
+            for _ in 0..200 {
+                let x = s.sample(&wo, &mut rng);
+                assert!((x.wi.norm() - 1.0).abs() < 1e-12);
+                assert_relative_eq!(x.pdf, s.pdf(&wo, &x.wi), max_relative = 1e-12);
+                assert!(x.pdf > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn every_mutant_builds() {
+        for m in mutants() {
+            let b: Arc<dyn Brdf> = Arc::from(brdf::parse_spec(m.brdf).unwrap());
+            let wo = direction_from_angles(m.theta_o, 0.0);
+            let r = crate::subject::Reference {
+                value: 1.0,
+                abs_error: 0.0,
+                rule: String::new(),
+            };
+            let refs = BrdfReferences {
+                albedo: r.clone(),
+                lit: r,
+            };
+            assert!(m.build(&b, &wo, &refs).is_ok(), "{}", m.name);
+        }
+    }
 }
