@@ -38,6 +38,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         stats.measured_mean_trials.unwrap_or(f64::NAN),
         stats.bound_violations
     );
-    println!("fraction of samples within 0.1 of the spot: {:.4}", inside_spot as f64 / n as f64);
+    println!(
+        "fraction of samples within 0.1 of the spot: {:.4}",
+        inside_spot as f64 / n as f64
+    );
     Ok(())
 }

@@ -26,7 +26,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sampler.bytes_used()
     );
     if let Some(s) = sampler.stats() {
-        println!("mean trials {:.4}, bound violations {}", s.measured_mean_trials.unwrap_or(f64::NAN), s.bound_violations);
+        println!(
+            "mean trials {:.4}, bound violations {}",
+            s.measured_mean_trials.unwrap_or(f64::NAN),
+            s.bound_violations
+        );
     }
     Ok(())
 }

@@ -5,7 +5,7 @@
 //! test is weaker than it claims.
 //!
 //! ```sh
-//! cargo run --release -p validation --example calibrate -- [--seeds 200] [--samples 200000]
+//! cargo run --release -p validation --example calibrate -- [--seeds 200] [--samples 200000] [--only adaptive]
 //! ```
 
 use std::collections::BTreeMap;
@@ -35,7 +35,7 @@ fn adaptive_phong() -> Result<(String, AnySubject), String> {
     };
     let built = build(&brdf)?;
     Ok((
-        "adaptive | phong:n=50 | 45°".into(),
+        "adaptive, phong:n=50, 45°".into(),
         AnySubject::Direction(brdf_direction_subject(
             Arc::new(built.at(wo)),
             domain,
@@ -62,15 +62,16 @@ fn standalone(name: &str, target: &str) -> Result<(String, AnySubject), String> 
 }
 
 fn main() {
-    let (mut seeds, mut samples) = (200u64, QUICK_SAMPLES);
+    let (mut seeds, mut samples, mut only) = (200u64, QUICK_SAMPLES, None::<String>);
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
-        let v = args.next().and_then(|v| v.parse::<u64>().ok());
-        match (a.as_str(), v) {
+        let v = args.next().unwrap_or_default();
+        match (a.as_str(), v.parse::<u64>().ok()) {
             ("--seeds", Some(v)) => seeds = v,
             ("--samples", Some(v)) => samples = v as usize,
+            ("--only", _) => only = Some(v),
             _ => {
-                eprintln!("usage: calibrate [--seeds N] [--samples N]");
+                eprintln!("usage: calibrate [--seeds N] [--samples N] [--only SAMPLER]");
                 std::process::exit(2);
             }
         }
@@ -91,6 +92,13 @@ fn main() {
     println!("|---|---|---|---|---|---|---|");
     for s in subjects {
         let (label, subject) = match s {
+            Ok(x)
+                if only
+                    .as_ref()
+                    .is_some_and(|o| !x.0.starts_with(&format!("{o},"))) =>
+            {
+                continue;
+            }
             Ok(x) => x,
             Err(e) => {
                 eprintln!("cannot build subject: {e}");

@@ -28,7 +28,10 @@ impl UniformHemisphere {
         let z = 1.0 - u[0]; // in (0, 1]: never exactly on the horizon
         let r = (1.0 - z * z).max(0.0).sqrt();
         let phi = TAU * u[1];
-        DirSample { wi: Vec3::new(r * phi.cos(), r * phi.sin(), z), pdf: 1.0 / TAU }
+        DirSample {
+            wi: Vec3::new(r * phi.cos(), r * phi.sin(), z),
+            pdf: 1.0 / TAU,
+        }
     }
 }
 
@@ -39,7 +42,10 @@ impl CosineHemisphere {
         let r = r2.sqrt();
         let phi = TAU * u[1];
         let z = (1.0 - r2).max(0.0).sqrt();
-        DirSample { wi: Vec3::new(r * phi.cos(), r * phi.sin(), z), pdf: z * FRAC_1_PI }
+        DirSample {
+            wi: Vec3::new(r * phi.cos(), r * phi.sin(), z),
+            pdf: z * FRAC_1_PI,
+        }
     }
 }
 
@@ -70,7 +76,11 @@ impl DirectionSampler for CosineHemisphere {
         Self::sample_square([u0, u1])
     }
     fn pdf(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
-        if wi.z > 0.0 { wi.z / wi.norm() * FRAC_1_PI } else { 0.0 }
+        if wi.z > 0.0 {
+            wi.z / wi.norm() * FRAC_1_PI
+        } else {
+            0.0
+        }
     }
     fn bytes_used(&self) -> usize {
         0
@@ -93,7 +103,12 @@ mod tests {
                 let d = s.sample(&wo, &mut rng);
                 assert!((d.wi.norm() - 1.0).abs() < 1e-12 && d.wi.z > 0.0);
                 let p = s.pdf(&wo, &d.wi);
-                assert!((p - d.pdf).abs() <= 1e-12 * p.max(1.0), "{} {p} {}", s.name(), d.pdf);
+                assert!(
+                    (p - d.pdf).abs() <= 1e-12 * p.max(1.0),
+                    "{} {p} {}",
+                    s.name(),
+                    d.pdf
+                );
             }
         }
     }

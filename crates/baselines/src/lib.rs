@@ -39,5 +39,5 @@ pub mod registry;
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use parallel::sample_par;
 pub use partition_sampler::Rect;
-pub use registry::{DIRECTION_SAMPLERS, build_direction_sampler};
 pub use piecewise_constant::{PiecewiseConstant1D, PiecewiseConstant2D, Sample1, TabulatedError};
+pub use registry::{DIRECTION_SAMPLERS, build_direction_sampler};

@@ -36,10 +36,10 @@ fn weights(set: &QuadTreeSet, brdf: &dyn Brdf, theta_deg: f64, n: usize) -> (f64
 fn main() {
     let n = 200_000;
     println!(
-        "| model                  | slices | θo (between) | albedo  | Var nearest | Var mixture | ratio | evals/sample n / m |"
+        "| model                  | slices | θo (between) | albedo  | Var nearest | Var mixture |    ratio | evals/sample n / m |"
     );
     println!(
-        "|------------------------|--------|--------------|---------|-------------|-------------|-------|--------------------|"
+        "|------------------------|--------|--------------|---------|-------------|-------------|----------|--------------------|"
     );
     for spec in [
         "phong:n=50",
@@ -76,7 +76,7 @@ fn main() {
                 let (mean, vn) = weights(&near, brdf.as_ref(), theta, n);
                 let (_, vm) = weights(&mix, brdf.as_ref(), theta, n);
                 println!(
-                    "| {spec:<22} | {:>6} | {theta:>12.2} | {mean:>7.4} | {vn:>11.3e} | {vm:>11.3e} | {:>5.2} | {cost_n:>8.3} / {cost_m:<7.3} |",
+                    "| {spec:<22} | {:>6} | {theta:>12.2} | {mean:>7.4} | {vn:>11.3e} | {vm:>11.3e} | {:>8.1e} | {cost_n:>8.3} / {cost_m:<7.3} |",
                     near.layout().len(),
                     vm / vn
                 );

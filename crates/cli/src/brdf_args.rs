@@ -39,22 +39,35 @@ pub(crate) struct SetArgs {
 
 impl SetArgs {
     pub(crate) fn options(&self) -> SetOptions {
-        SetOptions { slices: self.slices, n_max: self.n_max, max_depth: self.max_depth, ..SetOptions::default() }
+        SetOptions {
+            slices: self.slices,
+            n_max: self.n_max,
+            max_depth: self.max_depth,
+            ..SetOptions::default()
+        }
     }
 }
 
 /// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure).
 pub(crate) fn parse_brdf(spec: &str) -> CliResult<Arc<dyn Brdf>> {
-    brdf::parse_spec(spec).map(Arc::from).map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))
+    brdf::parse_spec(spec)
+        .map(Arc::from)
+        .map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))
 }
 
 /// The outgoing direction of `--theta-o/--phi-o`, validated.
 pub(crate) fn outgoing(args: &BrdfArgs) -> CliResult<Vec3> {
     if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
-        return Err(CliError::input(format!("--theta-o must be in [0, 90) degrees, got {}", args.theta_o)));
+        return Err(CliError::input(format!(
+            "--theta-o must be in [0, 90) degrees, got {}",
+            args.theta_o
+        )));
     }
     if !args.phi_o.is_finite() {
-        return Err(CliError::input(format!("--phi-o must be finite, got {}", args.phi_o)));
+        return Err(CliError::input(format!(
+            "--phi-o must be finite, got {}",
+            args.phi_o
+        )));
     }
     Ok(brdf::direction_from_angles(args.theta_o, args.phi_o))
 }
@@ -77,7 +90,12 @@ impl Built {
 }
 
 /// Builds sampler `name` for `brdf` (spec recorded), with a progress bar over the slices.
-pub(crate) fn build(name: &str, spec: &str, brdf: Arc<dyn Brdf>, options: &SetOptions) -> CliResult<Built> {
+pub(crate) fn build(
+    name: &str,
+    spec: &str,
+    brdf: Arc<dyn Brdf>,
+    options: &SetOptions,
+) -> CliResult<Built> {
     let pb = progress::bar(0, "building");
     let tick = |done: usize, total: usize| {
         pb.set_length(total as u64);
@@ -88,7 +106,9 @@ pub(crate) fn build(name: &str, spec: &str, brdf: Arc<dyn Brdf>, options: &SetOp
             .map(|s| Built::Set(Box::new(s.with_spec(spec))))
             .map_err(CliError::input)
     } else {
-        baselines::build_direction_sampler(name, brdf, options, Some(&tick)).map(Built::Other).map_err(CliError::input)
+        baselines::build_direction_sampler(name, brdf, options, Some(&tick))
+            .map(Built::Other)
+            .map_err(CliError::input)
     };
     pb.finish_and_clear();
     built
@@ -108,9 +128,14 @@ pub(crate) fn print_set_report(built: &Built) {
         r.leaves,
         r.max_depth
     );
-    let measured = r.measured_mean_trials.map_or("n/a".into(), |t| format!("{t:.4}"));
+    let measured = r
+        .measured_mean_trials
+        .map_or("n/a".into(), |t| format!("{t:.4}"));
     println!(
         "trials     expected {:.4} (worst slice {:.4}), measured {measured}; bound violations {}; grid evaluations {}",
-        r.expected_mean_trials, r.worst_expected_mean_trials, r.bound_violations, r.grid_evaluations
+        r.expected_mean_trials,
+        r.worst_expected_mean_trials,
+        r.bound_violations,
+        r.grid_evaluations
     );
 }

@@ -1,6 +1,5 @@
 //! `brdf-lab envmap`: sample directions ∝ luminance per solid angle of a lat-long map.
 
-
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -76,7 +75,12 @@ fn sampler_kind(name: EnvSamplerName, args: &EnvmapArgs, leaf: LeafChoiceName) -
         LeafChoiceName::Alias => LeafChoice::Alias,
         LeafChoiceName::Descent => LeafChoice::Descent,
     };
-    let options = |scheme| AdaptiveOptions { scheme, leaf_choice, n_max: args.n_max, max_depth: args.max_depth };
+    let options = |scheme| AdaptiveOptions {
+        scheme,
+        leaf_choice,
+        n_max: args.n_max,
+        max_depth: args.max_depth,
+    };
     match name {
         EnvSamplerName::Adaptive => SamplerKind::Adaptive(options(Scheme::Envelope)),
         EnvSamplerName::AdaptivePaper => SamplerKind::Adaptive(options(Scheme::Paper)),
@@ -87,11 +91,15 @@ fn sampler_kind(name: EnvSamplerName, args: &EnvmapArgs, leaf: LeafChoiceName) -
 /// Runs `brdf-lab envmap`.
 pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     if !(args.n_max >= 1.0 && args.n_max.is_finite()) {
-        return Err(CliError::input(format!("--n-max must be a finite number ≥ 1, got {}", args.n_max)));
+        return Err(CliError::input(format!(
+            "--n-max must be a finite number ≥ 1, got {}",
+            args.n_max
+        )));
     }
     let (map, map_name) = match &args.map {
         Some(path) => {
-            let map = EnvMap::load(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+            let map = EnvMap::load(path)
+                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
             (map, path.display().to_string())
         }
         None => {
@@ -99,7 +107,11 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
             (map, "built-in procedural sky with a sun".to_string())
         }
     };
-    println!("map        {map_name} ({} x {} pixels)", map.width(), map.height());
+    println!(
+        "map        {map_name} ({} x {} pixels)",
+        map.width(),
+        map.height()
+    );
 
     let kind = sampler_kind(args.sampler, args, args.leaf_choice);
     let sampler = EnvMapSampler::new(&map, kind).map_err(CliError::input)?;
@@ -133,8 +145,13 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
         rayon::current_num_threads()
     );
     if let Some(stats) = sampler.stats() {
-        let measured = stats.measured_mean_trials.map_or("n/a".to_string(), |t| format!("{t:.4}"));
-        println!("trials     measured {measured} per sample; bound violations {}", stats.bound_violations);
+        let measured = stats
+            .measured_mean_trials
+            .map_or("n/a".to_string(), |t| format!("{t:.4}"));
+        println!(
+            "trials     measured {measured} per sample; bound violations {}",
+            stats.bound_violations
+        );
     }
     let mean = estimate.mean();
     println!(
@@ -144,7 +161,10 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
 
     if let Some(path) = &args.out {
         write_samples(path, &blocks)?;
-        println!("wrote      {} ({n} rows: u,v,pdf_uv,pdf_sa)", path.display());
+        println!(
+            "wrote      {} ({n} rows: u,v,pdf_uv,pdf_sa)",
+            path.display()
+        );
     }
     if args.compare {
         compare(&map, args)?;
@@ -168,7 +188,8 @@ fn print_sampler_summary(sampler: &EnvMapSampler) {
             s.expected_mean_trials,
             s.integral,
             s.integral_source,
-            s.integral_rel_err.map_or(String::new(), |e| format!(", rel. err. {e:.1e}"))
+            s.integral_rel_err
+                .map_or(String::new(), |e| format!(", rel. err. {e:.1e}"))
         );
     }
 }
@@ -179,7 +200,8 @@ fn exact_luminance_integral(map: &EnvMap) -> f64 {
     let lum = map.luminance();
     let mut total = 0.0;
     for row in 0..h {
-        let band = envmap::latlong::sin_integral(row as f64 / h as f64, (row + 1) as f64 / h as f64);
+        let band =
+            envmap::latlong::sin_integral(row as f64 / h as f64, (row + 1) as f64 / h as f64);
         let row_sum: f64 = lum[row * w..(row + 1) * w].iter().sum();
         // ∫ over the band of sinθ dθ dφ with θ = πv, φ = 2πu: (2π/W)·π·∫ sin(πv) dv per pixel.
         total += row_sum * (2.0 * std::f64::consts::PI / w as f64) * std::f64::consts::PI * band;
@@ -204,7 +226,11 @@ impl KahanMean {
         self.n += 1;
     }
     fn mean(&self) -> f64 {
-        if self.n == 0 { 0.0 } else { self.sum / self.n as f64 }
+        if self.n == 0 {
+            0.0
+        } else {
+            self.sum / self.n as f64
+        }
     }
 }
 
@@ -227,7 +253,6 @@ fn write_samples(path: &std::path::Path, blocks: &[Vec<Sample2>]) -> CliResult<(
     result
 }
 
-
 /// `--compare`: build time, memory, mean trials and samples/s (1 thread and all threads) of
 /// every variant, measured in this run.
 fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
@@ -238,13 +263,23 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
         (EnvSamplerName::AdaptivePaper, LeafChoiceName::Descent),
         (EnvSamplerName::TabulatedCdf, LeafChoiceName::Alias),
     ];
-    let n = usize::try_from(args.n).map_err(CliError::input)?.clamp(100_000, 4_000_000);
+    let n = usize::try_from(args.n)
+        .map_err(CliError::input)?
+        .clamp(100_000, 4_000_000);
     let threads = rayon::current_num_threads();
     println!();
-    println!("compare    {n} samples per variant, median of 5 builds, {threads} threads for the parallel column");
+    println!(
+        "compare    {n} samples per variant, median of 5 builds, {threads} threads for the parallel column"
+    );
     println!(
         "{:<16} {:<8} {:>10} {:>12} {:>8} {:>14} {:>14}",
-        "sampler", "leaves", "build ms", "memory KiB", "trials", "M/s 1 thread", format!("M/s {threads} thr")
+        "sampler",
+        "leaves",
+        "build ms",
+        "memory KiB",
+        "trials",
+        "M/s 1 thread",
+        format!("M/s {threads} thr")
     );
     let pb = progress::bar(variants.len() as u64, "comparing");
     let mut rows = Vec::new();

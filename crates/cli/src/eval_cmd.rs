@@ -30,7 +30,8 @@ pub(crate) struct EvalArgs {
 
 /// Reads the directions of a CSV file (exit 2 naming the bad line).
 fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
     let mut dirs = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
@@ -38,7 +39,11 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
             continue;
         }
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let parsed: Option<Vec<f64>> = fields.iter().take(3).map(|f| f.parse::<f64>().ok()).collect();
+        let parsed: Option<Vec<f64>> = fields
+            .iter()
+            .take(3)
+            .map(|f| f.parse::<f64>().ok())
+            .collect();
         match parsed {
             Some(v) if v.len() == 3 => {
                 let d = Vec3::new(v[0], v[1], v[2]);
@@ -52,7 +57,9 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
                 dirs.push(d);
             }
             // A header row (first non-empty line that is not numeric) is skipped.
-            _ if dirs.is_empty() && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) && i < 1 => {}
+            _ if dirs.is_empty()
+                && fields.first().is_some_and(|f| f.parse::<f64>().is_err())
+                && i < 1 => {}
             _ => {
                 return Err(CliError::input(format!(
                     "{}:{}: expected three numbers `x,y,z`, got `{line}`",
@@ -63,7 +70,10 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
         }
     }
     if dirs.is_empty() {
-        return Err(CliError::input(format!("{}: no directions", path.display())));
+        return Err(CliError::input(format!(
+            "{}: no directions",
+            path.display()
+        )));
     }
     Ok(dirs)
 }
@@ -74,7 +84,12 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
     let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
     let dirs = read_directions(&args.dirs)?;
     let built = match &args.sampler {
-        Some(name) => Some(brdf_args::build(name, &args.brdf.spec, brdf.clone(), &args.set.options())?),
+        Some(name) => Some(brdf_args::build(
+            name,
+            &args.brdf.spec,
+            brdf.clone(),
+            &args.set.options(),
+        )?),
         None => None,
     };
     let rows: Vec<(Vec3, f64, Option<f64>)> = dirs
@@ -88,7 +103,15 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
         })
         .collect();
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
-        writeln!(w, "{}", if built.is_some() { "x,y,z,f,pdf" } else { "x,y,z,f" })?;
+        writeln!(
+            w,
+            "{}",
+            if built.is_some() {
+                "x,y,z,f,pdf"
+            } else {
+                "x,y,z,f"
+            }
+        )?;
         for (d, f, pdf) in &rows {
             write!(w, "{},{},{},{}", num(d.x), num(d.y), num(d.z), num(*f))?;
             if let Some(p) = pdf {

@@ -11,11 +11,21 @@ pub(crate) fn run() -> CliResult<()> {
             brdf::Isotropy::Never => "anisotropic",
             brdf::Isotropy::WhenParamsEqual => "anisotropic (isotropic by default)",
         };
-        let aliases = if m.aliases.is_empty() { String::new() } else { format!(" (also: {})", m.aliases.join(", ")) };
+        let aliases = if m.aliases.is_empty() {
+            String::new()
+        } else {
+            format!(" (also: {})", m.aliases.join(", "))
+        };
         println!("\n  {}{aliases} — {iso}", m.name);
         println!("      {}", m.summary);
         for p in m.params {
-            println!("      {:<10} default {:<10} range {:<16} {}", p.key, p.default.to_string(), p.range.to_string(), p.doc);
+            println!(
+                "      {:<10} default {:<10} range {:<16} {}",
+                p.key,
+                p.default.to_string(),
+                p.range.to_string(),
+                p.doc
+            );
         }
     }
     println!("\nSamplers (--sampler NAME)");

@@ -5,12 +5,13 @@
 mod brdf_args;
 mod build_cmd;
 mod envmap_cmd;
-mod eval_cmd;
 mod error;
+mod eval_cmd;
 mod list_cmd;
 mod output;
 mod progress;
 mod sample_cmd;
+mod validate_cmd;
 
 use clap::{Parser, Subcommand};
 use error::CliError;
@@ -33,6 +34,8 @@ enum Command {
     Eval(eval_cmd::EvalArgs),
     /// Build (and save) a BRDF's set of adaptive quadtrees, with its report.
     Build(build_cmd::BuildArgs),
+    /// Run the statistical validation suite (exit 1 if a test fails).
+    Validate(validate_cmd::ValidateArgs),
     /// Sample an environment map (directions ∝ luminance per solid angle) and print a summary.
     Envmap(envmap_cmd::EnvmapArgs),
 }
@@ -50,7 +53,11 @@ fn main() {
                 _ => {
                     // One line: clap's own message without the usage block.
                     let text = e.to_string();
-                    let line = text.lines().next().unwrap_or("bad usage").trim_start_matches("error: ");
+                    let line = text
+                        .lines()
+                        .next()
+                        .unwrap_or("bad usage")
+                        .trim_start_matches("error: ");
                     eprintln!("brdf-lab: error: {line} (see `brdf-lab --help`)");
                     std::process::exit(2);
                 }
@@ -62,6 +69,7 @@ fn main() {
         Command::Sample(args) => sample_cmd::run(&args),
         Command::Eval(args) => eval_cmd::run(&args),
         Command::Build(args) => build_cmd::run(&args),
+        Command::Validate(args) => validate_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
     };
     if let Err(e) = result {

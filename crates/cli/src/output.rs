@@ -15,7 +15,9 @@ pub(crate) fn write_atomically(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let fail = |e: &dyn std::fmt::Display| CliError::input(format!("cannot write {}: {e}", path.display()));
+    let fail = |e: &dyn std::fmt::Display| {
+        CliError::input(format!("cannot write {}: {e}", path.display()))
+    };
     let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| fail(&e))?;
     {
         let mut w = BufWriter::new(tmp.as_file());

@@ -43,10 +43,22 @@ pub(crate) struct SampleArgs {
 pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     let wo = brdf_args::outgoing(&args.brdf)?;
     let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
-    let built = brdf_args::build(&args.sampler, &args.brdf.spec, brdf.clone(), &args.set.options())?;
+    let built = brdf_args::build(
+        &args.sampler,
+        &args.brdf.spec,
+        brdf.clone(),
+        &args.set.options(),
+    )?;
     let sampler = built.sampler();
-    println!("brdf       {} at θo = {}°, φo = {}°", args.brdf.spec, args.brdf.theta_o, args.brdf.phi_o);
-    println!("sampler    {} ({} bytes)", sampler.name(), sampler.bytes_used());
+    println!(
+        "brdf       {} at θo = {}°, φo = {}°",
+        args.brdf.spec, args.brdf.theta_o, args.brdf.phi_o
+    );
+    println!(
+        "sampler    {} ({} bytes)",
+        sampler.name(),
+        sampler.bytes_used()
+    );
 
     let n = usize::try_from(args.n).map_err(CliError::input)?;
     let chunks = n.div_ceil(CHUNK);
@@ -73,7 +85,11 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by quadrature.
     let (mut sum, mut sum2) = (0.0, 0.0);
     for s in samples.iter().flatten() {
-        let v = if s.pdf > 0.0 && s.wi.z > 0.0 { brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf } else { 0.0 };
+        let v = if s.pdf > 0.0 && s.wi.z > 0.0 {
+            brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf
+        } else {
+            0.0
+        };
         sum += v;
         sum2 += v * v;
     }
@@ -87,7 +103,14 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         write_atomically(path, |w| {
             writeln!(w, "x,y,z,pdf")?;
             for s in samples.iter().flatten() {
-                writeln!(w, "{},{},{},{}", num(s.wi.x), num(s.wi.y), num(s.wi.z), num(s.pdf))?;
+                writeln!(
+                    w,
+                    "{},{},{},{}",
+                    num(s.wi.x),
+                    num(s.wi.y),
+                    num(s.wi.z),
+                    num(s.pdf)
+                )?;
             }
             Ok(())
         })?;

@@ -132,4 +132,8 @@ impl<D: RegionStats + Send> SamplerUnderTest<Point2> for FloorSplit<D> {
     fn bound_violations(&self) -> Option<u64> {
         Some(self.sampler.stats().bound_violations)
     }
+
+    fn normaliser_rel_err(&self) -> Option<f64> {
+        self.sampler.stats().integral_rel_err
+    }
 }

@@ -1,0 +1,137 @@
+//! `brdf-lab validate`: the statistical validation suite over samplers, BRDFs and angles.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use validation::{ProgressEvent, ValidateConfig};
+
+use crate::error::{CliError, CliResult};
+use crate::output::write_atomically;
+use crate::progress;
+
+/// Arguments of `brdf-lab validate`.
+#[derive(Debug, Args)]
+pub(crate) struct ValidateArgs {
+    /// BRDF spec to test (repeatable); default: the tier's list.
+    #[arg(long = "brdf")]
+    brdfs: Vec<String>,
+    /// Sampler to test (repeatable); default: every sampler of the project.
+    #[arg(long = "sampler")]
+    samplers: Vec<String>,
+    /// Outgoing polar angle in degrees (repeatable); default: the tier's list.
+    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    theta_o: Vec<f64>,
+    /// Samples per case; default: the tier's count.
+    #[arg(long)]
+    samples: Option<usize>,
+    /// Master seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The quick tier (what CI runs) instead of the full tier.
+    #[arg(long)]
+    quick: bool,
+    /// Also run the deliberately broken samplers; every one must be caught.
+    #[arg(long)]
+    mutants: bool,
+    /// Family-wise significance level (Šidák-corrected over the run's tests).
+    #[arg(long, default_value_t = 0.01)]
+    alpha: f64,
+    /// Write the report as JSON (schema in design.md §5).
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write a readable markdown report of every test.
+    #[arg(long)]
+    report: Option<PathBuf>,
+}
+
+/// Runs `brdf-lab validate`: exit 0 when everything passed, 1 when a test failed (or a mutant
+/// escaped), 2 on bad input.
+pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
+    let base = if args.quick {
+        ValidateConfig::quick()
+    } else {
+        ValidateConfig::default()
+    };
+    let config = ValidateConfig {
+        brdfs: if args.brdfs.is_empty() {
+            base.brdfs.clone()
+        } else {
+            args.brdfs.clone()
+        },
+        samplers: if args.samplers.is_empty() {
+            base.samplers.clone()
+        } else {
+            args.samplers.clone()
+        },
+        theta_o: if args.theta_o.is_empty() {
+            base.theta_o.clone()
+        } else {
+            args.theta_o.clone()
+        },
+        samples: args.samples.or(base.samples),
+        seed: args.seed,
+        quick: args.quick,
+        mutants: args.mutants,
+        alpha: args.alpha,
+        ..base
+    };
+    let pb = progress::bar(0, "validating");
+    let on_progress = |e: ProgressEvent| match e {
+        ProgressEvent::Started { total } => pb.set_length(total as u64),
+        ProgressEvent::Finished { done, .. } => pb.set_position(done as u64),
+    };
+    let report = validation::run(&config, &on_progress).map_err(CliError::input);
+    pb.finish_and_clear();
+    let report = report?;
+
+    if let Some(path) = &args.json {
+        let json = report.to_json();
+        write_atomically(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    if let Some(path) = &args.report {
+        let md = report.to_markdown();
+        write_atomically(path, |w| w.write_all(md.as_bytes()))?;
+    }
+    let failed: Vec<_> = report.tests.iter().filter(|t| !t.passed).collect();
+    println!(
+        "validate   {} tests, {} failed, α = {} (Šidák-corrected per test)",
+        report.tests.len(),
+        failed.len(),
+        report.alpha
+    );
+    for t in failed.iter().take(20) {
+        println!(
+            "  FAILED   {} | {} | θo {} | {}: statistic {:.4e}, p = {}",
+            t.sampler,
+            t.brdf,
+            t.theta_o.map_or("-".to_string(), |a| format!("{a}°")),
+            t.test,
+            t.statistic,
+            t.p_value.map_or("-".to_string(), |p| format!("{p:.3e}"))
+        );
+    }
+    if !report.mutants.is_empty() {
+        let caught = report.mutants.iter().filter(|m| m.detected).count();
+        println!("mutants    {caught}/{} caught", report.mutants.len());
+        for m in &report.mutants {
+            let by = if m.caught_by.is_empty() {
+                "-".to_string()
+            } else {
+                m.caught_by.join(", ")
+            };
+            println!(
+                "  {:<8} {:<32} caught by: {by}",
+                if m.detected { "caught" } else { "ESCAPED" },
+                m.name
+            );
+        }
+    }
+    if report.passed() {
+        println!("result     PASSED");
+        Ok(())
+    } else {
+        Err(CliError::TestFailed(
+            "validation failed (see the lines above)".to_string(),
+        ))
+    }
+}
