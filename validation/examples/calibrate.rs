@@ -56,7 +56,7 @@ fn standalone(name: &str, target: &str) -> Result<(String, AnySubject), String> 
         .find(|c| c.target == target)
         .ok_or_else(|| format!("{name} has no target {target}"))?;
     Ok((
-        format!("{name} | {target}"),
+        format!("{name}, {target}"),
         AnySubject::Planar(case.subject),
     ))
 }

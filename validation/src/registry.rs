@@ -137,6 +137,26 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         },
     },
     SamplerEntry {
+        name: "uniform",
+        summary: "uniform directions on the hemisphere, p = 1/(2π) (baselines)",
+        kind: SamplerBuild::Direction {
+            domain: Domain::Hemisphere,
+            build: |_| {
+                Ok(BuiltDirection::plain(Arc::new(
+                    baselines::UniformHemisphere,
+                )))
+            },
+        },
+    },
+    SamplerEntry {
+        name: "cosine",
+        summary: "cosine-weighted directions on the hemisphere, p = cosθ/π (baselines)",
+        kind: SamplerBuild::Direction {
+            domain: Domain::Hemisphere,
+            build: |_| Ok(BuiltDirection::plain(Arc::new(baselines::CosineHemisphere))),
+        },
+    },
+    SamplerEntry {
         name: "quadtree-disc",
         summary: "partition-sampler quadtree over a SampledGridDensity (512^2, safety 1.25) of f_r(wo, h^-1(x)) on the disc",
         kind: SamplerBuild::BrdfDisc(quadtree_disc),

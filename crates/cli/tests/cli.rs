@@ -1,0 +1,293 @@
+//! End-to-end tests of the `brdf-lab` binary: the CLI contract of design.md §5 (columns, pdf
+//! conventions, exit codes, one-line errors, atomic outputs).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn brdf_lab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .args(args)
+        .output()
+        .expect("run brdf-lab")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// Bad usage or input: exit code 2 and exactly one line on stderr, never a panic.
+fn assert_input_error(args: &[&str], needle: &str) {
+    let o = brdf_lab(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).expect("csv");
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default().to_string();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse::<f64>().expect("number"))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn bad_inputs_exit_2_with_one_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let truncated = dir.path().join("truncated.hdr");
+    std::fs::write(
+        &truncated,
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n\x02\x02",
+    )
+    .expect("write");
+    let garbage = dir.path().join("garbage.pfm");
+    std::fs::write(&garbage, b"PF\n3 x\n-1.0\n").expect("write");
+    let t = truncated.to_str().expect("path");
+    let g = garbage.to_str().expect("path");
+    assert_input_error(&["envmap", "-n", "10", "--map", t], "truncated.hdr");
+    assert_input_error(&["envmap", "-n", "10", "--map", g], "garbage.pfm");
+    assert_input_error(
+        &["envmap", "-n", "10", "--map", "/no/such/map.hdr"],
+        "map.hdr",
+    );
+    assert_input_error(&["envmap", "-n", "10", "--map", "map.png"], "map.png");
+    assert_input_error(&["envmap", "-n", "0"], "--samples");
+    assert_input_error(&["envmap", "-n", "10", "--n-max", "0.5"], "--n-max");
+    assert_input_error(&["envmap", "-n", "10", "--n-max", "NaN"], "--n-max");
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "phong:n=-3",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+        ],
+        "phong",
+    );
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "phong:q=1",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+        ],
+        "valid keys",
+    );
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "nosuchmodel",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+        ],
+        "nosuchmodel",
+    );
+    assert_input_error(
+        &["sample", "--brdf", "lambert", "--theta-o", "95", "-n", "10"],
+        "--theta-o",
+    );
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "lambert",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+            "--sampler",
+            "x",
+        ],
+        "known",
+    );
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "merl:/no/such.binary",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+        ],
+        "such.binary",
+    );
+    assert_input_error(&["validate", "--quick", "--sampler", "nope"], "nope");
+    assert_input_error(&["nosuchcommand"], "nosuchcommand");
+}
+
+#[test]
+fn envmap_csv_follows_the_contract_and_output_is_atomic() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("s.csv");
+    let o = brdf_lab(&[
+        "envmap",
+        "-n",
+        "5000",
+        "--seed",
+        "3",
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = read_csv(&out);
+    assert_eq!(header, "u,v,pdf_uv,pdf_sa");
+    assert_eq!(rows.len(), 5000);
+    for r in &rows {
+        let (u, v, pdf_uv, pdf_sa) = (r[0], r[1], r[2], r[3]);
+        assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+        let expected =
+            pdf_uv / (2.0 * std::f64::consts::PI.powi(2) * (std::f64::consts::PI * v).sin());
+        assert!((pdf_sa - expected).abs() <= 1e-9 * expected, "{r:?}");
+    }
+    // Same seed, same samples; no temporary files left behind.
+    let again = dir.path().join("t.csv");
+    let o = brdf_lab(&[
+        "envmap",
+        "-n",
+        "5000",
+        "--seed",
+        "3",
+        "--out",
+        again.to_str().expect("path"),
+    ]);
+    assert!(o.status.success());
+    assert_eq!(
+        std::fs::read(&out).expect("a"),
+        std::fs::read(&again).expect("b")
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 2);
+    // A failing run does not replace an existing output.
+    let o = brdf_lab(&[
+        "envmap",
+        "-n",
+        "10",
+        "--map",
+        "/no/such.hdr",
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(read_csv(&out).1.len(), 5000);
+}
+
+#[test]
+fn eval_reports_the_pdf_that_sample_reported() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let samples = dir.path().join("s.csv");
+    let evals = dir.path().join("e.csv");
+    let common = [
+        "--brdf",
+        "phong:n=50,ks=0.7,kd=0.3",
+        "--theta-o",
+        "37",
+        "--phi-o",
+        "20",
+        "--slices",
+        "9",
+    ];
+    let mut args = vec![
+        "sample",
+        "-n",
+        "3000",
+        "--sampler",
+        "adaptive",
+        "--out",
+        samples.to_str().expect("p"),
+    ];
+    args.extend(common);
+    let o = brdf_lab(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut args = vec![
+        "eval",
+        "--sampler",
+        "adaptive",
+        "--dirs",
+        samples.to_str().expect("p"),
+    ];
+    args.extend(["--out", evals.to_str().expect("p")]);
+    args.extend(common);
+    let o = brdf_lab(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (h1, s) = read_csv(&samples);
+    let (h2, e) = read_csv(&evals);
+    assert_eq!(h1, "x,y,z,pdf");
+    assert_eq!(h2, "x,y,z,f,pdf");
+    assert_eq!(s.len(), e.len());
+    for (a, b) in s.iter().zip(&e) {
+        assert_eq!(&a[..3], &b[..3]);
+        assert!(
+            (a[3] - b[4]).abs() <= 1e-12 * a[3].max(1e-300),
+            "{a:?} vs {b:?}"
+        );
+        assert!(b[3] >= 0.0 && a[2] > 0.0);
+    }
+}
+
+#[test]
+fn validate_quick_case_passes_and_writes_the_json_schema() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let json = dir.path().join("v.json");
+    let md = dir.path().join("v.md");
+    let o = brdf_lab(&[
+        "validate",
+        "--quick",
+        "--sampler",
+        "cosine",
+        "--brdf",
+        "lambert",
+        "--theta-o",
+        "30",
+        "--json",
+        json.to_str().expect("p"),
+        "--report",
+        md.to_str().expect("p"),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+    assert_eq!(v["passed"], true);
+    assert!(v["alpha"].is_number());
+    let t = &v["tests"][0];
+    for key in [
+        "brdf",
+        "sampler",
+        "theta_o",
+        "test",
+        "statistic",
+        "p_value",
+        "passed",
+    ] {
+        assert!(t.get(key).is_some(), "missing {key}");
+    }
+    assert!(
+        std::fs::read_to_string(&md)
+            .expect("md")
+            .contains("| sampler |")
+    );
+}
