@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme};
-use partition_sampler::{DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, PAR_CHUNK, Sample2, chunk_seed};
+use partition_sampler::{DEFAULT_MAX_DEPTH, PAR_CHUNK, Sample2, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -40,7 +40,7 @@ pub(crate) struct EnvmapArgs {
     #[arg(long, value_enum, default_value_t = EnvSamplerName::Adaptive)]
     sampler: EnvSamplerName,
     /// Split threshold n_max ≥ 1 of the adaptive sampler (mean trials per sample ≤ n_max).
-    #[arg(long, default_value_t = DEFAULT_N_MAX)]
+    #[arg(long, default_value_t = envmap::ENVMAP_N_MAX)]
     n_max: f64,
     /// Maximum quadtree depth of the adaptive sampler.
     #[arg(long, default_value_t = DEFAULT_MAX_DEPTH)]

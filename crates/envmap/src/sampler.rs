@@ -4,15 +4,22 @@ use std::time::{Duration, Instant};
 
 use baselines::PiecewiseConstant2D;
 use partition_sampler::{
-    DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, LeafChoice, MemoryReport, Point2, QuadTreeBuilder,
-    QuadTreeSampler, Rect, Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity,
-    UniformSource,
+    DEFAULT_MAX_DEPTH, LeafChoice, MemoryReport, Point2, QuadTreeBuilder, QuadTreeSampler, Rect,
+    Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity, UniformSource,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
 use crate::{EnvMap, EnvMapError};
+
+/// Default split threshold for environment maps: 1.6 rather than the generic 2.
+///
+/// A map is tabulated, so its bounds are exact and deeper trees cost little: on the 1024×512
+/// maps of `docs/benchmarks.md`, `n_max = 1.6` lowers the mean trials per sample from 1.33–1.78
+/// to 1.19–1.35 and raises 2-thread throughput above 30 M samples/s on every map, while the build
+/// stays under 8 ms.
+pub const ENVMAP_N_MAX: f64 = 1.6;
 
 /// Parameters of the adaptive-partition sampler.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -21,7 +28,7 @@ pub struct AdaptiveOptions {
     pub scheme: Scheme,
     /// [`LeafChoice::Alias`] (default, O(1)) or [`LeafChoice::Descent`] (the papers').
     pub leaf_choice: LeafChoice,
-    /// Split threshold `n_max ≥ 1` (default [`DEFAULT_N_MAX`]).
+    /// Split threshold `n_max ≥ 1` (default [`ENVMAP_N_MAX`]).
     pub n_max: f64,
     /// Maximum quadtree depth (default [`DEFAULT_MAX_DEPTH`]).
     pub max_depth: u32,
@@ -32,7 +39,7 @@ impl Default for AdaptiveOptions {
         Self {
             scheme: Scheme::Envelope,
             leaf_choice: LeafChoice::Alias,
-            n_max: DEFAULT_N_MAX,
+            n_max: ENVMAP_N_MAX,
             max_depth: DEFAULT_MAX_DEPTH,
         }
     }
