@@ -8,11 +8,12 @@
 //! The albedo is largest at normal incidence (checked numerically in the tests), so the model
 //! conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
+use super::half_vector_lobe::HalfVectorLobe;
 use super::phong::PhongParams;
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::Vec3;
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "blinn";
 
@@ -30,9 +31,7 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
 /// Blinn–Phong BRDF (normalised half-vector cosine lobe).
 #[derive(Debug, Clone)]
 pub struct Blinn {
-    params: PhongParams,
-    diffuse: f64,
-    spec_scale: f64,
+    lobe: HalfVectorLobe,
 }
 
 /// Default parameters of [`Blinn`] (n = 100, ks = 0.6, kd = 0.4).
@@ -48,15 +47,13 @@ impl Blinn {
         let n = params.n;
         let norm = (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()));
         Ok(Self {
-            params,
-            diffuse: params.kd * FRAC_1_PI,
-            spec_scale: params.ks * norm,
+            lobe: HalfVectorLobe::new(params, norm),
         })
     }
 
     /// The parameters this model was built with.
     pub fn params(&self) -> &PhongParams {
-        &self.params
+        &self.lobe.params
     }
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
@@ -74,12 +71,7 @@ impl Default for Blinn {
 impl Brdf for Blinn {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
-            return 0.0;
-        }
-        let h = wo + wi;
-        let nh = h.z / h.norm();
-        self.diffuse + self.spec_scale * nh.powf(self.params.n)
+        self.lobe.eval(wo, wi)
     }
     fn is_isotropic(&self) -> bool {
         true
@@ -88,7 +80,7 @@ impl Brdf for Blinn {
         true
     }
     fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
+        self.lobe.conserves_energy()
     }
     fn name(&self) -> &str {
         NAME

@@ -9,11 +9,12 @@
 //! (default 0.4). Reciprocal and isotropic. (Lewis' normalisation of the mirror-direction lobe,
 //! `(n+2)/(2π)`, is the [`Phong`](super::Phong) model of this crate.)
 
+use super::half_vector_lobe::HalfVectorLobe;
 use super::phong::PhongParams;
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::Vec3;
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "lewis";
 
@@ -26,9 +27,7 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
 /// Lewis-normalised Blinn–Phong BRDF.
 #[derive(Debug, Clone)]
 pub struct Lewis {
-    params: PhongParams,
-    diffuse: f64,
-    spec_scale: f64,
+    lobe: HalfVectorLobe,
 }
 
 /// Default parameters of [`Lewis`] (n = 50, ks = 0.6, kd = 0.4).
@@ -44,15 +43,13 @@ impl Lewis {
         let n = params.n;
         let norm = (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()));
         Ok(Self {
-            params,
-            diffuse: params.kd * FRAC_1_PI,
-            spec_scale: params.ks * norm,
+            lobe: HalfVectorLobe::new(params, norm),
         })
     }
 
     /// The parameters this model was built with.
     pub fn params(&self) -> &PhongParams {
-        &self.params
+        &self.lobe.params
     }
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
@@ -70,12 +67,7 @@ impl Default for Lewis {
 impl Brdf for Lewis {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
-            return 0.0;
-        }
-        let h = wo + wi;
-        let nh = h.z / h.norm();
-        self.diffuse + self.spec_scale * nh.powf(self.params.n)
+        self.lobe.eval(wo, wi)
     }
     fn is_isotropic(&self) -> bool {
         true
@@ -84,7 +76,7 @@ impl Brdf for Lewis {
         true
     }
     fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
+        self.lobe.conserves_energy()
     }
     fn name(&self) -> &str {
         NAME

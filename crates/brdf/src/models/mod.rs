@@ -6,6 +6,7 @@ pub mod beard_maxwell;
 pub mod blinn;
 pub mod cook_torrance;
 pub mod coupled;
+mod half_vector_lobe;
 pub mod htsg;
 pub mod lafortune;
 pub mod lambert;

@@ -1,0 +1,42 @@
+//! The shared core of the half-vector lobe models ([`Blinn`](super::Blinn),
+//! [`Lewis`](super::Lewis)): `f_r = kd/π + ks · norm(n) · (n·h)^n`, `h = (ωo+ωi)/|ωo+ωi|`.
+//! The models differ only in `norm(n)`.
+
+use super::phong::PhongParams;
+use crate::geometry::{Vec3, both_above};
+use std::f64::consts::FRAC_1_PI;
+
+/// `kd/π + ks·norm·(n·h)^n` with its constants precomputed.
+#[derive(Debug, Clone)]
+pub(crate) struct HalfVectorLobe {
+    pub(crate) params: PhongParams,
+    diffuse: f64,
+    spec_scale: f64,
+}
+
+impl HalfVectorLobe {
+    /// The lobe for validated `params` and the model's normalisation `norm`.
+    pub(crate) fn new(params: PhongParams, norm: f64) -> Self {
+        Self {
+            params,
+            diffuse: params.kd * FRAC_1_PI,
+            spec_scale: params.ks * norm,
+        }
+    }
+
+    /// `f_r(ωo, ωi)`, 0 unless both directions are above the horizon.
+    #[inline]
+    pub(crate) fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        if !both_above(wo, wi) {
+            return 0.0;
+        }
+        let h = wo + wi;
+        let nh = h.z / h.norm();
+        self.diffuse + self.spec_scale * nh.powf(self.params.n)
+    }
+
+    /// Both models' albedo is at most `kd + ks` (checked numerically in their tests).
+    pub(crate) fn conserves_energy(&self) -> bool {
+        self.params.kd + self.params.ks <= 1.0
+    }
+}
