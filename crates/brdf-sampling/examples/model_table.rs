@@ -9,7 +9,7 @@
 //! second on one thread at random outgoing directions.
 //!
 //! Options: `--runs R` (default 3), `--grid N`, `--depth D`, `--tol T`, `--slices K`, `--nmax X`,
-//! `--safety S`,
+//! `--safety S`, `--dilation D`, `--disc-map auto|projected|equal-area`, `--ea-from DEG`,
 //! `--variant adaptive|adaptive-paper`, `--only name,name`, `--per-slice S` (default 2000).
 
 use std::sync::Arc;
@@ -135,6 +135,21 @@ fn main() {
     if let Some(s) = arg(&args, "--safety") {
         opts.safety_factor = s;
     }
+    if let Some(a) = arg(&args, "--ea-from") {
+        opts.equal_area_from_deg = a;
+    }
+    if let Some(d) = arg(&args, "--dilation") {
+        opts.bound_dilation = d;
+    }
+    if let Some(m) = arg::<String>(&args, "--disc-map") {
+        match brdf_sampling::DiscMapPolicy::parse(&m) {
+            Some(p) => opts.disc_map = p,
+            None => {
+                eprintln!("--disc-map must be auto, projected or equal-area");
+                std::process::exit(2);
+            }
+        }
+    }
     let variant = match arg::<String>(&args, "--variant").as_deref() {
         Some("adaptive-paper") => Variant::Paper,
         _ => Variant::Adaptive,
@@ -146,14 +161,16 @@ fn main() {
     let wanted = |n: &str| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n));
 
     println!(
-        "options: slices {} (anisotropic {:?}), n_max {}, max_depth {}, grid {}, safety {}, volume_tolerance {}, variant {:?}, {} rayon threads",
+        "options: slices {} (anisotropic {:?}), n_max {}, max_depth {}, grid {}, safety {}, dilation {}, volume_tolerance {}, disc map {:?}, variant {:?}, {} rayon threads",
         opts.slices,
         opts.anisotropic_slices,
         opts.n_max,
         opts.max_depth,
         opts.grid,
         opts.safety_factor,
+        opts.bound_dilation,
         opts.volume_tolerance,
+        opts.disc_map,
         variant,
         rayon::current_num_threads()
     );

@@ -4,6 +4,14 @@
 //! `h⁻¹(x, y) = (x, y, √(1 − x² − y²))`. Area on D equals projected solid angle on Ω,
 //! `dx dy = cos θ dσ`, so a density on D proportional to `f_r(ωo, h⁻¹(x))` is proportional to
 //! `f_r cos θ` with respect to solid angle, and the sampler never evaluates the cosine.
+//!
+//! That density is `f_r` itself, so it is unbounded for models with `1/cos θi`-type factors
+//! ([`brdf::Brdf::bounded_at_horizon`] is `false`), and near the rim the map squeezes θ without
+//! bound (`dθ/dr = 1/cos θ`). [`DiscMap::EqualArea`] is the alternative for such slices: the
+//! Lambert azimuthal equal-area map `h_e(v) = (v.x, v.y)/√(1 + v.z)`, inverse
+//! `h_e⁻¹(x, y) = (x √(2 − r²), y √(2 − r²), 1 − r²)` with `r² = x² + y²`, for which
+//! `dσ = 2 dx dy`. Its density `2 f_r cos θi` keeps the cosine (bounded whenever `f_r cos θi`
+//! is) and integrates to the same directional albedo as the projected one.
 
 use std::cell::Cell;
 use std::sync::Arc;
@@ -12,6 +20,80 @@ use brdf::{Brdf, Vec3};
 use partition_sampler::{
     Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats,
 };
+use serde::{Deserialize, Serialize};
+
+/// How a slice maps the upper hemisphere onto the unit disc.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum DiscMap {
+    /// `h(v) = (v.x, v.y)` (design.md §2, the papers' map): `dx dy = cos θ dσ`, density `f_r`.
+    #[default]
+    Projected,
+    /// Lambert azimuthal equal-area map `h_e(v) = (v.x, v.y)/√(1 + v.z)`: `dx dy = dσ / 2`,
+    /// density `2 f_r cos θi`.
+    EqualArea,
+}
+
+impl DiscMap {
+    /// Short name (`"projected"`, `"equal-area"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DiscMap::Projected => "projected",
+            DiscMap::EqualArea => "equal-area",
+        }
+    }
+
+    /// The disc point of a direction (meaningful for `v.z ≥ 0`).
+    #[inline]
+    pub fn to_disc(self, v: &Vec3) -> Point2 {
+        match self {
+            DiscMap::Projected => [v.x, v.y],
+            DiscMap::EqualArea => {
+                let s = 1.0 / (1.0 + v.z.max(0.0)).sqrt();
+                [v.x * s, v.y * s]
+            }
+        }
+    }
+
+    /// The direction of a disc point (`z = 0` on and outside the circle).
+    #[inline]
+    pub fn to_direction(self, p: Point2) -> Vec3 {
+        let r2 = p[0] * p[0] + p[1] * p[1];
+        match self {
+            DiscMap::Projected => disc_to_direction(p),
+            DiscMap::EqualArea => {
+                let r2 = r2.min(1.0);
+                let s = (2.0 - r2).sqrt();
+                Vec3::new(p[0] * s, p[1] * s, 1.0 - r2)
+            }
+        }
+    }
+
+    /// `dσ / dA` at a direction above the horizon: `1/cos θ` (projected) or 2 (equal-area).
+    /// Converts a density w.r.t. area on the disc at `to_disc(ωi)` into one w.r.t. solid angle:
+    /// `p_σ = p_A · dA/dσ` (0 at or below the horizon).
+    #[inline]
+    pub fn area_to_solid_angle(self, pdf_area: f64, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        match self {
+            DiscMap::Projected => pdf_area * wi.z,
+            DiscMap::EqualArea => pdf_area * 0.5,
+        }
+    }
+
+    /// Inverse of [`DiscMap::area_to_solid_angle`] (0 at or below the horizon).
+    #[inline]
+    pub fn solid_angle_to_area(self, pdf_sa: f64, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        match self {
+            DiscMap::Projected => pdf_sa / wi.z,
+            DiscMap::EqualArea => pdf_sa * 2.0,
+        }
+    }
+}
 
 /// `h(v) = (v.x, v.y)`: the disc point of a direction (meaningful for `v.z ≥ 0`).
 #[inline]
@@ -51,15 +133,17 @@ pub fn thread_evaluations() -> u64 {
     EVALUATIONS.with(Cell::get)
 }
 
-/// The density `x ↦ f_r(ωo, h⁻¹(x))` on the unit disc for one fixed outgoing direction
-/// (0 outside the disc and on its boundary circle, where `h⁻¹(x)` is on the horizon).
+/// The density of `f_r(ωo, ·) cos θi` on the unit disc for one fixed outgoing direction,
+/// under a [`DiscMap`]: `x ↦ f_r(ωo, h⁻¹(x))` (projected) or `x ↦ 2 f_r(ωo, h_e⁻¹(x)) cos θi`
+/// (equal-area); 0 outside the disc and on its boundary circle (the horizon).
 ///
-/// With respect to area on the disc this is proportional to `f_r · cos θi` with respect to
-/// solid angle. Every call increments the calling thread's [`thread_evaluations`] counter.
+/// Either way its integral over the disc is the directional albedo `∫ f_r cos θi dσ`. Every
+/// call inside the disc increments the calling thread's [`thread_evaluations`] counter.
 #[derive(Clone)]
 pub struct DiscBrdf {
     brdf: Arc<dyn Brdf>,
     wo: Vec3,
+    map: DiscMap,
 }
 
 impl std::fmt::Debug for DiscBrdf {
@@ -67,14 +151,25 @@ impl std::fmt::Debug for DiscBrdf {
         f.debug_struct("DiscBrdf")
             .field("brdf", &self.brdf.name())
             .field("wo", &self.wo)
+            .field("map", &self.map)
             .finish()
     }
 }
 
 impl DiscBrdf {
-    /// The density of `brdf` for the outgoing direction `wo` (unit, `wo.z > 0`).
+    /// The projected-disc density of `brdf` for the outgoing direction `wo` (unit, `wo.z > 0`).
     pub fn new(brdf: Arc<dyn Brdf>, wo: Vec3) -> Self {
-        Self { brdf, wo }
+        Self::with_map(brdf, wo, DiscMap::Projected)
+    }
+
+    /// The density of `brdf` for `wo` under `map`.
+    pub fn with_map(brdf: Arc<dyn Brdf>, wo: Vec3, map: DiscMap) -> Self {
+        Self { brdf, wo, map }
+    }
+
+    /// The hemisphere-to-disc map.
+    pub fn map(&self) -> DiscMap {
+        self.map
     }
 
     /// The outgoing direction.
@@ -91,13 +186,23 @@ impl DiscBrdf {
 impl Density for DiscBrdf {
     #[inline]
     fn eval(&self, p: Point2) -> f64 {
-        let z2 = 1.0 - p[0] * p[0] - p[1] * p[1];
-        if !(z2 > 0.0) {
+        let r2 = p[0] * p[0] + p[1] * p[1];
+        if !(r2 < 1.0) {
             return 0.0;
         }
         EVALUATIONS.with(|c| c.set(c.get() + 1));
-        let wi = Vec3::new(p[0], p[1], z2.sqrt());
-        self.brdf.eval(&self.wo, &wi)
+        match self.map {
+            DiscMap::Projected => {
+                let wi = Vec3::new(p[0], p[1], (1.0 - r2).sqrt());
+                self.brdf.eval(&self.wo, &wi)
+            }
+            DiscMap::EqualArea => {
+                let s = (2.0 - r2).sqrt();
+                let z = 1.0 - r2;
+                let wi = Vec3::new(p[0] * s, p[1] * s, z);
+                2.0 * z * self.brdf.eval(&self.wo, &wi)
+            }
+        }
     }
 }
 
@@ -111,9 +216,14 @@ pub struct SliceDensity {
 }
 
 impl SliceDensity {
-    /// The disc density `x ↦ f_r(ωo_slice, h⁻¹(x))`.
+    /// The disc density of the slice (see [`DiscBrdf`]).
     pub fn disc_brdf(&self) -> &DiscBrdf {
         &self.f
+    }
+
+    /// The slice's hemisphere-to-disc map.
+    pub fn map(&self) -> DiscMap {
+        self.f.map
     }
 }
 
@@ -163,6 +273,50 @@ mod tests {
         );
         assert_eq!(area_pdf_to_solid_angle(2.0, &Vec3::new(1.0, 0.0, 0.0)), 0.0);
         assert_eq!(disc_to_direction([1.0, 1.0]).z, 0.0);
+    }
+
+    #[test]
+    fn equal_area_map_round_trips_and_preserves_area() {
+        let m = DiscMap::EqualArea;
+        for (t, p) in [(0.0, 0.0), (40.0, 120.0), (85.0, 300.0), (89.99, 10.0)] {
+            let v = brdf::direction_from_angles(t, p);
+            let d = m.to_disc(&v);
+            assert_relative_eq!(m.to_direction(d), v, epsilon = 1e-12);
+            // r² = 1 − cos θ.
+            assert_relative_eq!(d[0] * d[0] + d[1] * d[1], 1.0 - v.z, epsilon = 1e-12);
+        }
+        // dσ = 2 dA: the solid angle of the cap θ ≤ 60° (2π(1 − cos 60°) = π) is twice the
+        // area of its disc image (radius² = 1 − cos 60° = ½, area π/2).
+        let cap = brdf::direction_from_angles(60.0, 0.0);
+        let r2 = m.to_disc(&cap)[0].powi(2);
+        assert_relative_eq!(
+            2.0 * std::f64::consts::PI * r2,
+            std::f64::consts::PI,
+            epsilon = 1e-12
+        );
+        let v = brdf::direction_from_angles(30.0, 0.0);
+        assert_relative_eq!(m.area_to_solid_angle(3.0, &v), 1.5);
+        assert_relative_eq!(m.solid_angle_to_area(1.5, &v), 3.0);
+        assert_eq!(m.area_to_solid_angle(3.0, &Vec3::new(1.0, 0.0, 0.0)), 0.0);
+    }
+
+    #[test]
+    fn both_maps_integrate_to_the_albedo() {
+        // Midpoint rule over the disc: ∫ density dA = ∫ f cos dσ for both maps (Lambert ρ).
+        let b: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("lambert:rho=0.5").unwrap());
+        let wo = brdf::direction_from_angles(20.0, 0.0);
+        for map in [DiscMap::Projected, DiscMap::EqualArea] {
+            let d = DiscBrdf::with_map(b.clone(), wo, map);
+            let n = 1000;
+            let h = 2.0 / n as f64;
+            let mut s = 0.0;
+            for j in 0..n {
+                for i in 0..n {
+                    s += d.eval([-1.0 + (i as f64 + 0.5) * h, -1.0 + (j as f64 + 0.5) * h]);
+                }
+            }
+            assert_relative_eq!(s * h * h, 0.5, max_relative = 2e-3);
+        }
     }
 
     #[test]

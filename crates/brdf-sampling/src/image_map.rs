@@ -205,21 +205,27 @@ impl RimBand {
 /// Image map + rim band of one slice (build time only).
 pub(crate) struct SliceImageMap<'a> {
     grid: SampledGridDensity<Counted<'a>>,
-    band: RimBand,
+    /// `None` for the equal-area map, which has no rim singularity.
+    band: Option<RimBand>,
     safety: f64,
     /// Bounds are taken over the cell grown by this many fine cells on every side.
     dilation: f64,
 }
 
 impl<'a> SliceImageMap<'a> {
-    /// Evaluates the image map (`grid²` cells) and the rim band of `f`.
+    /// Evaluates the image map (`grid²` cells) and, with `rim_band`, the rim band of `f`.
     pub(crate) fn new(
         f: Counted<'a>,
         grid: usize,
         safety: f64,
         dilation: u32,
+        rim_band: bool,
     ) -> Result<Self, DensityError> {
-        let band = RimBand::new(&f, grid)?;
+        let band = if rim_band {
+            Some(RimBand::new(&f, grid)?)
+        } else {
+            None
+        };
         let h = 2.0 / grid as f64;
         let grid =
             SampledGridDensity::new(f, Domain::UnitDisc, grid)?.with_safety_factor(safety)?;
@@ -256,7 +262,7 @@ impl RegionStats for SliceImageMap<'_> {
             );
             est.max_bound = est.max_bound.max(self.grid.region(&grown).max_bound);
         }
-        if let Some(m) = self.band.max_in(cell) {
+        if let Some(m) = self.band.as_ref().and_then(|b| b.max_in(cell)) {
             est.max_bound = est.max_bound.max(self.safety * m);
         }
         est
@@ -279,7 +285,11 @@ impl RegionStats for SliceImageMap<'_> {
     }
 
     fn bytes_used(&self) -> usize {
-        self.grid.bytes_used() + self.band.values.capacity() * 8 + self.band.radii.capacity() * 8
+        self.grid.bytes_used()
+            + self
+                .band
+                .as_ref()
+                .map_or(0, |b| b.values.capacity() * 8 + b.radii.capacity() * 8)
     }
 }
 
@@ -302,6 +312,7 @@ mod tests {
             64,
             1.1,
             0,
+            true,
         )
         .unwrap();
         let cell = Rect::new(0.5, -0.25, 1.0, 0.25);

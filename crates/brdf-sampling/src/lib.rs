@@ -81,7 +81,7 @@ mod set;
 
 pub use direction_sampler::{DirSample, DirectionSampler};
 pub use disc::{
-    DiscBrdf, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
+    DiscBrdf, DiscMap, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
     solid_angle_pdf_to_area,
 };
 pub use error::{PersistError, SamplerError, SetError};
@@ -90,9 +90,10 @@ pub use factory::{
 };
 pub use layout::{SliceChoice, SliceLayout};
 pub use options::{
-    DEFAULT_ANISOTROPIC_SLICES, DEFAULT_GRID, DEFAULT_MAX_DEPTH, DEFAULT_N_MAX,
-    DEFAULT_REFINE_LEVELS, DEFAULT_REFINE_THRESHOLD, DEFAULT_SAFETY_FACTOR, DEFAULT_SLICES,
-    DEFAULT_VOLUME_TOLERANCE, MAX_GRID, MAX_SLICES, OptionsError, SetOptions,
+    DEFAULT_ANISOTROPIC_SLICES, DEFAULT_EQUAL_AREA_FROM_DEG, DEFAULT_GRID, DEFAULT_MAX_DEPTH,
+    DEFAULT_N_MAX, DEFAULT_REFINE_LEVELS, DEFAULT_REFINE_THRESHOLD, DEFAULT_SAFETY_FACTOR,
+    DEFAULT_SLICES, DEFAULT_VOLUME_TOLERANCE, DiscMapPolicy, MAX_GRID, MAX_SLICES, OptionsError,
+    SetOptions,
 };
 pub use persist::SET_FORMAT_VERSION;
 pub use report::{CostMeasurement, SetReport};

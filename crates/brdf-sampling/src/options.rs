@@ -2,6 +2,57 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::disc::DiscMap;
+
+/// Which [`DiscMap`] the slices of a set use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum DiscMapPolicy {
+    /// **Default.** The papers' [`DiscMap::Projected`] for slices with
+    /// `θo < `[`SetOptions::equal_area_from_deg`], [`DiscMap::EqualArea`] above (grazing lobes
+    /// are squeezed against the rim of the projected disc, `dθ/dr = 1/cos θ`), and
+    /// [`DiscMap::EqualArea`] for every slice of a BRDF that is unbounded at the horizon
+    /// ([`brdf::Brdf::bounded_at_horizon`] is `false`): its projected density `f_r` has no
+    /// finite leaf bound.
+    #[default]
+    Auto,
+    /// Every slice on the projected disc (the papers' method, whatever the BRDF).
+    Projected,
+    /// Every slice on the equal-area disc.
+    EqualArea,
+}
+
+impl DiscMapPolicy {
+    /// The map of the slice of `brdf` at outgoing polar angle `theta_o_deg`, with `Auto`
+    /// switching to equal-area at `equal_area_from_deg`.
+    pub fn map_for(
+        self,
+        brdf: &dyn brdf::Brdf,
+        theta_o_deg: f64,
+        equal_area_from_deg: f64,
+    ) -> DiscMap {
+        match self {
+            DiscMapPolicy::Projected => DiscMap::Projected,
+            DiscMapPolicy::EqualArea => DiscMap::EqualArea,
+            DiscMapPolicy::Auto
+                if brdf.bounded_at_horizon() && theta_o_deg < equal_area_from_deg =>
+            {
+                DiscMap::Projected
+            }
+            DiscMapPolicy::Auto => DiscMap::EqualArea,
+        }
+    }
+
+    /// Parses `auto`, `projected` or `equal-area`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(DiscMapPolicy::Auto),
+            "projected" => Some(DiscMapPolicy::Projected),
+            "equal-area" => Some(DiscMapPolicy::EqualArea),
+            _ => None,
+        }
+    }
+}
+
 /// Default number of θ slices for isotropic BRDFs (the papers used 60 and 90).
 pub const DEFAULT_SLICES: usize = 90;
 
@@ -31,6 +82,9 @@ pub const DEFAULT_REFINE_LEVELS: u32 = 2;
 
 /// Default [`SetOptions::refine_threshold`].
 pub const DEFAULT_REFINE_THRESHOLD: f64 = 3.0;
+
+/// Default [`SetOptions::equal_area_from_deg`].
+pub const DEFAULT_EQUAL_AREA_FROM_DEG: f64 = 80.0;
 
 /// Largest accepted slice count per axis.
 pub const MAX_SLICES: usize = 4096;
@@ -78,6 +132,11 @@ pub struct SetOptions {
     /// Sample the mixture of the two θ-neighbouring slices (linear weights in θ) instead of the
     /// nearest slice (default `false`).
     pub mixture: bool,
+    /// Hemisphere-to-disc map of the slices (default [`DiscMapPolicy::Auto`]).
+    pub disc_map: DiscMapPolicy,
+    /// Outgoing polar angle (degrees) from which [`DiscMapPolicy::Auto`] uses the equal-area
+    /// map (default [`DEFAULT_EQUAL_AREA_FROM_DEG`]; 90 = never for bounded BRDFs).
+    pub equal_area_from_deg: f64,
 }
 
 impl Default for SetOptions {
@@ -94,6 +153,8 @@ impl Default for SetOptions {
             refine_levels: DEFAULT_REFINE_LEVELS,
             refine_threshold: DEFAULT_REFINE_THRESHOLD,
             mixture: false,
+            disc_map: DiscMapPolicy::Auto,
+            equal_area_from_deg: DEFAULT_EQUAL_AREA_FROM_DEG,
         }
     }
 }
@@ -129,6 +190,9 @@ pub enum OptionsError {
     /// The volume tolerance must be finite and ≥ 0.
     #[error("volume_tolerance = {0} must be finite and ≥ 0")]
     InvalidVolumeTolerance(f64),
+    /// The equal-area switch angle must be in `[0, 90]` degrees.
+    #[error("equal_area_from_deg = {0} must be in [0, 90] degrees")]
+    InvalidEqualAreaAngle(f64),
     /// Refinement would need a grid above [`MAX_GRID`] or a threshold that is not finite ≥ 1.
     #[error(
         "refinement: grid {grid} · 2^{levels} exceeds {MAX_GRID}, or threshold {threshold} is not finite and ≥ 1"
@@ -174,6 +238,11 @@ impl SetOptions {
         }
         if !(self.volume_tolerance.is_finite() && self.volume_tolerance >= 0.0) {
             return Err(OptionsError::InvalidVolumeTolerance(self.volume_tolerance));
+        }
+        if !(0.0..=90.0).contains(&self.equal_area_from_deg) {
+            return Err(OptionsError::InvalidEqualAreaAngle(
+                self.equal_area_from_deg,
+            ));
         }
         let finest_grid = (self.grid as u64)
             .checked_shl(self.refine_levels.min(40))
@@ -264,6 +333,10 @@ mod tests {
         assert!(matches!(
             bad(|o| o.refine_threshold = f64::NAN),
             OptionsError::InvalidRefinement { .. }
+        ));
+        assert!(matches!(
+            bad(|o| o.equal_area_from_deg = f64::NAN),
+            OptionsError::InvalidEqualAreaAngle(_)
         ));
         assert_eq!(SetOptions::default().with_depth(5).grid, 64);
         assert_eq!(SetOptions::default().with_depth(5).validate(), Ok(()));

@@ -2,7 +2,7 @@
 //!
 //! Layout: `b"BRQS"`, [`SET_FORMAT_VERSION`] as little-endian `u32`, then the postcard encoding
 //! of the set: BRDF spec and name, 32 probe values of the BRDF, variant, options, layout, build
-//! evaluation count, and every tree in partition-sampler's own versioned format
+//! evaluation count, each slice's [`DiscMap`], and every tree in partition-sampler's own versioned format
 //! ([`partition_sampler::FORMAT_VERSION`]). The BRDF itself is not stored: it is re-attached on
 //! load, which checks that the spec string matches and that the BRDF reproduces the probes
 //! (relative 1e-9).
@@ -15,14 +15,14 @@ use brdf::{Brdf, direction_from_angles};
 use partition_sampler::{Domain, QuadTree, QuadTreeSampler};
 use serde::{Deserialize, Serialize};
 
-use crate::disc::{DiscBrdf, SliceDensity};
+use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::PersistError;
 use crate::layout::SliceLayout;
 use crate::options::SetOptions;
 use crate::set::{QuadTreeSet, Variant, layout_for, sampler_name};
 
 /// Version of the stored set format; bumped on any incompatible change.
-pub const SET_FORMAT_VERSION: u32 = 1;
+pub const SET_FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 4] = b"BRQS";
 
@@ -38,6 +38,7 @@ struct Stored {
     options: SetOptions,
     layout: SliceLayout,
     grid_evaluations: u64,
+    maps: Vec<DiscMap>,
     trees: Vec<Vec<u8>>,
 }
 
@@ -89,6 +90,7 @@ impl QuadTreeSet {
             options: self.options,
             layout: self.layout,
             grid_evaluations: self.grid_evaluations,
+            maps: self.trees.iter().map(|t| t.density().map()).collect(),
             trees: self.trees.iter().map(|t| t.tree().to_bytes()).collect(),
         };
         let mut out = Vec::new();
@@ -145,12 +147,16 @@ impl QuadTreeSet {
         s.options
             .validate()
             .map_err(|e| PersistError::Corrupt(format!("options: {e}")))?;
-        if layout_for(brdf.as_ref(), &s.options) != s.layout || s.layout.len() != s.trees.len() {
+        if layout_for(brdf.as_ref(), &s.options) != s.layout
+            || s.layout.len() != s.trees.len()
+            || s.maps.len() != s.trees.len()
+        {
             return Err(PersistError::Corrupt(format!(
-                "layout {} × {} with {} trees does not fit the options and the BRDF's isotropy",
+                "layout {} × {} with {} trees and {} maps does not fit the options and the BRDF's isotropy",
                 s.layout.theta,
                 s.layout.phi,
-                s.trees.len()
+                s.trees.len(),
+                s.maps.len()
             )));
         }
         let mut trees = Vec::with_capacity(s.trees.len());
@@ -163,7 +169,8 @@ impl QuadTreeSet {
                 )));
             }
             let shape = *tree.shape();
-            let f = DiscBrdf::new(Arc::clone(&brdf), s.layout.direction_of(slice));
+            let map = s.maps.get(slice).copied().unwrap_or_default();
+            let f = DiscBrdf::with_map(Arc::clone(&brdf), s.layout.direction_of(slice), map);
             let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
                 .map_err(|source| PersistError::Attach { slice, source })?;
             trees.push(sampler);

@@ -44,6 +44,8 @@ pub struct SetReport {
     pub layout: SliceLayout,
     /// Number of trees.
     pub trees: usize,
+    /// Trees on the equal-area disc ([`crate::DiscMap::EqualArea`]); the rest are projected.
+    pub equal_area_trees: usize,
     /// Wall-clock build time (zero for a loaded set).
     pub build_time: Duration,
     /// Bytes of all trees, their attached densities and the set itself.
@@ -81,8 +83,8 @@ impl std::fmt::Display for SetReport {
         writeln!(f, "brdf               {} (spec `{}`)", self.brdf, self.spec)?;
         writeln!(
             f,
-            "slices             {} θ × {} φ = {} trees",
-            self.layout.theta, self.layout.phi, self.trees
+            "slices             {} θ × {} φ = {} trees ({} on the equal-area disc)",
+            self.layout.theta, self.layout.phi, self.trees, self.equal_area_trees
         )?;
         writeln!(
             f,

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::direction_sampler::{DirSample, DirectionSampler};
-use crate::disc::{DiscBrdf, SliceDensity, disc_to_direction, thread_evaluations};
+use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout};
@@ -138,7 +138,10 @@ fn build_slice(
 ) -> Result<(QuadTreeSampler<SliceDensity>, u64), SetError> {
     let (t, p) = layout.angles_of(index);
     let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
-    let f = DiscBrdf::new(Arc::clone(brdf), layout.direction_of(index));
+    let disc_map = options
+        .disc_map
+        .map_for(brdf.as_ref(), theta_deg, options.equal_area_from_deg);
+    let f = DiscBrdf::with_map(Arc::clone(brdf), layout.direction_of(index), disc_map);
     let counter = EvalCounter::new();
     let map = SliceImageMap::new(
         Counted {
@@ -148,6 +151,7 @@ fn build_slice(
         options.grid,
         options.safety_factor,
         options.dilation_for(brdf.as_ref()),
+        disc_map == DiscMap::Projected,
     )
     .map_err(|source| SetError::Density {
         slice: index,
@@ -355,12 +359,13 @@ impl QuadTreeSet {
         let Some(tree) = self.trees.get(c.index) else {
             return 0.0;
         };
+        let map = tree.density().map();
         let v = rotate_z(wi, -c.rotation);
-        tree.pdf([v.x, v.y]) * wi.z
+        map.area_to_solid_angle(tree.pdf(map.to_disc(&v)), wi)
     }
 
     /// Density of `wi` under slice choice `c` alone, w.r.t. area on the disc of that slice
-    /// (the tree's own pdf `f / Î`).
+    /// (the tree's own pdf `f / Î`, under the slice's [`DiscMap`]).
     pub fn slice_area_pdf(&self, c: &SliceChoice, wi: &Vec3) -> f64 {
         if !(wi.z > 0.0) {
             return 0.0;
@@ -368,8 +373,9 @@ impl QuadTreeSet {
         let Some(tree) = self.trees.get(c.index) else {
             return 0.0;
         };
+        let map = tree.density().map();
         let v = rotate_z(wi, -c.rotation);
-        tree.pdf([v.x, v.y])
+        tree.pdf(map.to_disc(&v))
     }
 
     /// The mixture pdf `Σ w_k p_k` given the pdf of the component that drew `wi`.
@@ -410,9 +416,10 @@ impl QuadTreeSet {
             return up;
         };
         let s = draw(tree, u);
-        let v = disc_to_direction(s.point);
+        let map = tree.density().map();
+        let v = map.to_direction(s.point);
         let wi = rotate_z(&v, c.rotation);
-        let p = s.pdf * v.z;
+        let p = map.area_to_solid_angle(s.pdf, &v);
         let pdf = if cs[1 - drawn].weight > 0.0 {
             self.combine(&cs, drawn, p, &wi)
         } else {
@@ -466,6 +473,11 @@ impl QuadTreeSet {
             spec: self.spec.clone(),
             layout: self.layout,
             trees: self.trees.len(),
+            equal_area_trees: self
+                .trees
+                .iter()
+                .filter(|t| t.density().map() == DiscMap::EqualArea)
+                .count(),
             build_time: self.build_time,
             memory_bytes: self.bytes_used(),
             nodes: 0,
@@ -547,14 +559,15 @@ impl DirectionSampler for QuadTreeSet {
                     return Vec::new();
                 };
                 let batch = tree.sample_batch(n, AllocationMode::RandomizedRemainder, u);
+                let map = tree.density().map();
                 batch
                     .samples
                     .iter()
                     .map(|s| {
-                        let v = disc_to_direction(s.point);
+                        let v = map.to_direction(s.point);
                         DirSample {
                             wi: rotate_z(&v, c.rotation),
-                            pdf: s.pdf * v.z,
+                            pdf: map.area_to_solid_angle(s.pdf, &v),
                         }
                     })
                     .collect()

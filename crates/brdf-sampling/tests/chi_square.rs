@@ -108,3 +108,16 @@ fn ggx_alpha_01() {
 fn oren_nayar() {
     check_model("oren-nayar", 60, false);
 }
+
+#[test]
+fn strauss_unbounded_at_horizon_on_the_equal_area_disc() {
+    // f_r ∝ 1/cos θi: every slice is on the equal-area disc (density 2 f_r cos θi).
+    let set = build("strauss", Variant::Adaptive, &test_options());
+    assert_eq!(set.report().equal_area_trees, set.len());
+    check_model("strauss", 70, true);
+}
+
+#[test]
+fn minnaert_limb_darkening() {
+    check_model("minnaert:k=0.5", 80, false);
+}

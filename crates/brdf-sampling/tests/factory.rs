@@ -5,8 +5,8 @@ mod common;
 use std::sync::Mutex;
 
 use brdf_sampling::{
-    OptionsError, SAMPLER_NAMES, SamplerError, SetError, SetOptions, build_sampler,
-    build_sampler_with_progress, build_set,
+    DiscMap, DiscMapPolicy, OptionsError, SAMPLER_NAMES, SamplerError, SetError, SetOptions,
+    build_sampler, build_sampler_with_progress, build_set,
 };
 use common::*;
 
@@ -127,6 +127,7 @@ fn grazing_slices_are_refined() {
     let base = SetOptions {
         slices: 18,
         refine_levels: 0,
+        disc_map: DiscMapPolicy::Projected,
         ..SetOptions::default()
     };
     let plain = build("ashikhmin-shirley", brdf_sampling::Variant::Adaptive, &base).report();
@@ -148,4 +149,36 @@ fn grazing_slices_are_refined() {
         plain.worst_expected_mean_trials
     );
     assert!(refined.grid_evaluations > plain.grid_evaluations);
+}
+
+#[test]
+fn auto_disc_map_switches_at_grazing_and_for_unbounded_models() {
+    let opts = SetOptions {
+        slices: 18,
+        ..SetOptions::default()
+    };
+    // Bounded model: slices with θo ≥ 80° (centres 82.5°, 87.5°) are equal-area.
+    let phong = build("phong:n=50", brdf_sampling::Variant::Adaptive, &opts);
+    let maps: Vec<DiscMap> = (0..phong.len())
+        .map(|i| phong.tree(i).unwrap().density().map())
+        .collect();
+    assert_eq!(maps.iter().filter(|m| **m == DiscMap::EqualArea).count(), 2);
+    assert_eq!(maps[17], DiscMap::EqualArea);
+    assert_eq!(maps[15], DiscMap::Projected);
+    // Unbounded model (1/cos θi): on the projected disc no finite leaf bound exists and the
+    // rejection volume explodes near the rim; the equal-area disc keeps it near n_max.
+    let auto = build("strauss", brdf_sampling::Variant::Adaptive, &opts).report();
+    let projected = build(
+        "strauss",
+        brdf_sampling::Variant::Adaptive,
+        &SetOptions {
+            disc_map: DiscMapPolicy::Projected,
+            ..opts
+        },
+    )
+    .report();
+    assert_eq!(auto.equal_area_trees, 18);
+    assert_eq!(projected.equal_area_trees, 0);
+    assert!(auto.worst_expected_mean_trials < 2.5, "{auto}");
+    assert!(projected.worst_expected_mean_trials > 10.0, "{projected}");
 }

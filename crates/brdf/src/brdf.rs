@@ -49,6 +49,17 @@ pub trait Brdf: Send + Sync {
         false
     }
 
+    /// True when `f_r(ωo, ωi)` stays bounded as `θi → 90°`, for every `ωo` above the horizon
+    /// (with the current parameters). Default `true`.
+    ///
+    /// Samplers that absorb `cos θi` into their measure (the projected disc, where the density
+    /// is `f_r` itself) need a bounded `f_r`; models with `1/cos θi`-type factors (Strauss,
+    /// Beard–Maxwell, Ward's normalised lobe, Minnaert with `k < 1`) return `false`, and the
+    /// quadtree sets sample them on a measure whose density keeps the cosine.
+    fn bounded_at_horizon(&self) -> bool {
+        true
+    }
+
     /// Short model name (the registry key, e.g. `"phong"`).
     fn name(&self) -> &str {
         "custom"
@@ -74,6 +85,9 @@ macro_rules! forward_brdf {
             }
             fn conserves_energy(&self) -> bool {
                 (**self).conserves_energy()
+            }
+            fn bounded_at_horizon(&self) -> bool {
+                (**self).bounded_at_horizon()
             }
             fn name(&self) -> &str {
                 (**self).name()

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions};
+use brdf_sampling::{DirectionSampler, DiscMapPolicy, QuadTreeSet, SetOptions};
 use clap::Args;
 
 use crate::error::{CliError, CliResult};
@@ -35,6 +35,18 @@ pub(crate) struct SetArgs {
     /// Maximum quadtree depth.
     #[arg(long, default_value_t = brdf_sampling::DEFAULT_MAX_DEPTH)]
     pub(crate) max_depth: u32,
+    /// Hemisphere-to-disc map of the slices: `auto` (projected disc; equal-area from
+    /// --equal-area-from degrees and for BRDFs unbounded at the horizon), `projected`
+    /// (the papers') or `equal-area`.
+    #[arg(long, default_value = "auto", value_parser = parse_disc_map)]
+    pub(crate) disc_map: DiscMapPolicy,
+    /// Outgoing polar angle (degrees) from which `--disc-map auto` uses the equal-area map.
+    #[arg(long, default_value_t = brdf_sampling::DEFAULT_EQUAL_AREA_FROM_DEG)]
+    pub(crate) equal_area_from: f64,
+}
+
+fn parse_disc_map(s: &str) -> Result<DiscMapPolicy, String> {
+    DiscMapPolicy::parse(s).ok_or_else(|| format!("`{s}`: expected auto, projected or equal-area"))
 }
 
 impl SetArgs {
@@ -43,6 +55,8 @@ impl SetArgs {
             slices: self.slices,
             n_max: self.n_max,
             max_depth: self.max_depth,
+            disc_map: self.disc_map,
+            equal_area_from_deg: self.equal_area_from,
             ..SetOptions::default()
         }
     }

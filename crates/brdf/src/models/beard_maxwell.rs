@@ -201,6 +201,10 @@ impl Brdf for BeardMaxwell {
         let vol = p.rd * FRAC_1_PI + 2.0 * p.rv * FRAC_1_PI / (ci + co);
         first + vol
     }
+    fn bounded_at_horizon(&self) -> bool {
+        // The first-surface term carries 1/(cosθi cosθo).
+        false
+    }
     fn is_isotropic(&self) -> bool {
         true
     }

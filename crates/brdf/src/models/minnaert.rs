@@ -88,6 +88,10 @@ impl Brdf for Minnaert {
         let c = (wi.z * wo.z).max(1e-300);
         self.scale * c.powf(self.params.k - 1.0)
     }
+    fn bounded_at_horizon(&self) -> bool {
+        // (cosθi cosθo)^{k−1} grows without bound as θi → 90° when k < 1.
+        self.params.k >= 1.0 || self.params.rho == 0.0
+    }
     fn is_isotropic(&self) -> bool {
         true
     }

@@ -133,6 +133,10 @@ impl Brdf for Strauss {
         let spec = rj * cs * c.powf(self.exponent) * FRAC_1_PI / wi.z.max(1e-12);
         self.diffuse + spec.max(0.0)
     }
+    fn bounded_at_horizon(&self) -> bool {
+        // The specular term is divided by cosθi.
+        false
+    }
     fn is_isotropic(&self) -> bool {
         true
     }
