@@ -69,8 +69,8 @@ pub use binning::{
 pub use calibration::{Calibration, calibrate};
 pub use cdf::{Projection, TabulatedCdf, project, projection_cdf};
 pub use checks::{
-    chi_square_test, ks_projection_test, mean_z_test, normalisation, pdf_consistency,
-    support_coverage,
+    COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test, mean_z_test, normalisation,
+    pdf_consistency, support_coverage,
 };
 pub use chi_square::{ChiSquareResult, DEFAULT_MIN_EXPECTED, chi_square_gof, chi_square_sf};
 pub use error::StatsError;

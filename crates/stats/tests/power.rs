@@ -265,6 +265,24 @@ fn support_coverage_finds_holes_in_the_pdf() {
     };
     let o = support_coverage(&disc, &uniform_disc_pdf, &holed, 4, &opts()).unwrap();
     assert!(!o.passed, "{o}");
+    // The verdict is on the uncovered target mass: a hole where the target has underflowed to
+    // 1e-300 (relative mass ~1e-301) passes; the same hole with a relative mass of ~1e-9 fails.
+    let ring = |p: [f64; 2]| {
+        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        r > 0.995 && r < 0.999
+    };
+    for (level, pass) in [(1e-300, true), (1e-7, false)] {
+        let target = move |p: [f64; 2]| {
+            if ring(p) {
+                level * uniform_disc_pdf(p)
+            } else {
+                uniform_disc_pdf(p)
+            }
+        };
+        let o = support_coverage(&disc, &target, &holed, 4, &opts()).unwrap();
+        assert_eq!(o.passed, pass, "{o}");
+        assert!(o.statistic < 10.0 * level, "{o}");
+    }
 }
 
 // ---------------- unbiasedness ----------------
