@@ -36,7 +36,9 @@
 //! # Samplers ([`build_sampler`], [`SAMPLER_NAMES`])
 //! * `adaptive` — [`Variant::Adaptive`]: envelope scheme (leaf ∝ `V_i`, restart on
 //!   rejection), alias leaf choice. Exact: samples have density `f / ∫ f` whenever the bounds
-//!   hold; the reported pdf is `f / Î` (`Î` = grid integral, relative error reported).
+//!   hold; the reported pdf is `f / Î` with `Î` integrated over the tree's leaves by an
+//!   order-8 Gauss–Legendre rule (`normalisation.rs`; relative error estimated against order 5
+//!   and reported).
 //! * `adaptive-paper` — [`Variant::Paper`]: leaf ∝ `I_i` by the per-node CDF descent, rejection
 //!   inside the leaf, image-map bounds and rectangle adjustment; exact only when the `I_i` are.
 //! * `adaptive-mixture`, `adaptive-paper-mixture` — the same with the two-slice mixture.
@@ -83,6 +85,7 @@ mod error;
 mod factory;
 mod image_map;
 mod layout;
+mod normalisation;
 mod options;
 mod persist;
 mod report;

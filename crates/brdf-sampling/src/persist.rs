@@ -2,7 +2,7 @@
 //!
 //! Layout: `b"BRQS"`, [`SET_FORMAT_VERSION`] as little-endian `u32`, then the postcard encoding
 //! of the set: BRDF spec and name, 32 probe values of the BRDF, variant, options, layout, build
-//! evaluation count, each slice's [`DiscMap`], and every tree in partition-sampler's own versioned format
+//! evaluation count, each slice's [`DiscMap`] and normalisation factor, and every tree in partition-sampler's own versioned format
 //! ([`partition_sampler::FORMAT_VERSION`]). The BRDF itself is not stored: it is re-attached on
 //! load, which checks that the spec string matches and that the BRDF reproduces the probes
 //! (relative 1e-9).
@@ -19,7 +19,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::PersistError;
 use crate::layout::SliceLayout;
 use crate::options::SetOptions;
-use crate::set::{QuadTreeSet, Variant, layout_for, sampler_name};
+use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for, sampler_name};
 
 /// Version of the stored set format; bumped on any incompatible change.
 pub const SET_FORMAT_VERSION: u32 = 2;
@@ -39,6 +39,7 @@ struct Stored {
     layout: SliceLayout,
     grid_evaluations: u64,
     maps: Vec<DiscMap>,
+    norms: Vec<SliceNorm>,
     trees: Vec<Vec<u8>>,
 }
 
@@ -91,6 +92,7 @@ impl QuadTreeSet {
             layout: self.layout,
             grid_evaluations: self.grid_evaluations,
             maps: self.trees.iter().map(|t| t.density().map()).collect(),
+            norms: self.norms.clone(),
             trees: self.trees.iter().map(|t| t.tree().to_bytes()).collect(),
         };
         let mut out = Vec::new();
@@ -150,6 +152,7 @@ impl QuadTreeSet {
         if layout_for(brdf.as_ref(), &s.options) != s.layout
             || s.layout.len() != s.trees.len()
             || s.maps.len() != s.trees.len()
+            || s.norms.len() != s.trees.len()
         {
             return Err(PersistError::Corrupt(format!(
                 "layout {} × {} with {} trees and {} maps does not fit the options and the BRDF's isotropy",
@@ -157,6 +160,15 @@ impl QuadTreeSet {
                 s.layout.phi,
                 s.trees.len(),
                 s.maps.len()
+            )));
+        }
+        if let Some(slice) = s
+            .norms
+            .iter()
+            .position(|n| !(n.factor.is_finite() && n.factor > 0.0))
+        {
+            return Err(PersistError::Corrupt(format!(
+                "slice {slice}: invalid normalisation factor"
             )));
         }
         let mut trees = Vec::with_capacity(s.trees.len());
@@ -182,6 +194,7 @@ impl QuadTreeSet {
             options: s.options,
             layout: s.layout,
             trees,
+            norms: s.norms,
             build_time: Duration::ZERO,
             grid_evaluations: s.grid_evaluations,
             name: sampler_name(s.variant, s.options.mixture),

@@ -20,6 +20,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout};
+use crate::normalisation::leaf_quadrature;
 use crate::options::SetOptions;
 use crate::report::{CostMeasurement, SetReport};
 
@@ -89,6 +90,8 @@ pub struct QuadTreeSet {
     pub(crate) options: SetOptions,
     pub(crate) layout: SliceLayout,
     pub(crate) trees: Vec<QuadTreeSampler<SliceDensity>>,
+    /// One per tree.
+    pub(crate) norms: Vec<SliceNorm>,
     pub(crate) build_time: Duration,
     pub(crate) grid_evaluations: u64,
     pub(crate) name: String,
@@ -128,14 +131,25 @@ pub(crate) fn sampler_name(variant: Variant, mixture: bool) -> String {
     }
 }
 
-/// Builds the tree of slice `index`; returns it with the number of BRDF evaluations spent.
+/// Normalisation of one slice's pdf: the tree's pdf `f / Î_grid` is multiplied by `factor`
+/// (`Î_grid / Î_leaves`, see [`crate::normalisation`]; 1 for the papers' variant, whose leaf
+/// probabilities are the grid integrals themselves).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(crate) struct SliceNorm {
+    pub(crate) factor: f64,
+    /// Estimated relative error of the integral the pdf is normalised with.
+    pub(crate) rel_err: Option<f64>,
+}
+
+/// Builds the tree of slice `index`; returns it with the number of BRDF evaluations spent and
+/// its normalisation.
 fn build_slice(
     brdf: &Arc<dyn Brdf>,
     layout: SliceLayout,
     index: usize,
     options: &SetOptions,
     variant: Variant,
-) -> Result<(QuadTreeSampler<SliceDensity>, u64), SetError> {
+) -> Result<(QuadTreeSampler<SliceDensity>, u64, SliceNorm), SetError> {
     let (t, p) = layout.angles_of(index);
     let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
     let disc_map = options
@@ -173,6 +187,30 @@ fn build_slice(
             source,
         })?;
     drop(map);
+    let norm = match variant {
+        Variant::Adaptive => {
+            let counted = Counted {
+                f: &f,
+                counter: &counter,
+            };
+            let (i_leaves, rel_err) = leaf_quadrature(&counted, tree.leaves());
+            if i_leaves.is_finite() && i_leaves > 0.0 {
+                SliceNorm {
+                    factor: tree.integral() / i_leaves,
+                    rel_err: Some(rel_err),
+                }
+            } else {
+                SliceNorm {
+                    factor: 1.0,
+                    rel_err: None,
+                }
+            }
+        }
+        Variant::Paper => SliceNorm {
+            factor: 1.0,
+            rel_err: None,
+        },
+    };
     // A clone holds its arrays with exact capacities (the builder grows them amortised).
     let tree = tree.clone();
     let shape = *tree.shape();
@@ -183,7 +221,11 @@ fn build_slice(
                 source,
             }
         })?;
-    Ok((sampler, counter.total()))
+    let norm = SliceNorm {
+        rel_err: norm.rel_err.or(sampler.stats().integral_rel_err),
+        ..norm
+    };
+    Ok((sampler, counter.total(), norm))
 }
 
 impl QuadTreeSet {
@@ -216,7 +258,7 @@ impl QuadTreeSet {
                 p(d, total.load(Ordering::Relaxed));
             }
         };
-        let mut built: Vec<(QuadTreeSampler<SliceDensity>, u64)> = (0..layout.len())
+        let mut built: Vec<(QuadTreeSampler<SliceDensity>, u64, SliceNorm)> = (0..layout.len())
             .into_par_iter()
             .map(|i| {
                 let r = build_slice(&brdf, layout, i, options, variant);
@@ -231,7 +273,7 @@ impl QuadTreeSet {
             let mut worst: Vec<(f64, usize)> = built
                 .iter()
                 .enumerate()
-                .map(|(i, (t, _))| (t.tree().expected_mean_trials(), i))
+                .map(|(i, (t, _, _))| (t.tree().expected_mean_trials(), i))
                 .filter(|&(e, _)| e > options.refine_threshold)
                 .collect();
             if worst.is_empty() {
@@ -242,7 +284,7 @@ impl QuadTreeSet {
             level_opts = level_opts.with_depth(level_opts.max_depth + 1);
             let opts = level_opts;
             total.fetch_add(worst.len(), Ordering::Relaxed);
-            let redone: Vec<(usize, (QuadTreeSampler<SliceDensity>, u64))> = worst
+            let redone: Vec<(usize, (QuadTreeSampler<SliceDensity>, u64, SliceNorm))> = worst
                 .par_iter()
                 .map(|&(_, i)| {
                     let r = build_slice(&brdf, layout, i, &opts, variant).map(|b| (i, b));
@@ -250,17 +292,19 @@ impl QuadTreeSet {
                     r
                 })
                 .collect::<Result<_, _>>()?;
-            for (i, (tree, evals)) in redone {
+            for (i, (tree, evals, norm)) in redone {
                 let old = &mut built[i];
                 let better =
                     tree.tree().expected_mean_trials() < old.0.tree().expected_mean_trials();
                 old.1 += evals;
                 if better {
                     old.0 = tree;
+                    old.2 = norm;
                 }
             }
         }
         let grid_evaluations = built.iter().map(|b| b.1).sum();
+        let norms = built.iter().map(|b| b.2).collect();
         let trees = built.into_iter().map(|b| b.0).collect();
         let spec = brdf.name().to_string();
         Ok(Self {
@@ -270,6 +314,7 @@ impl QuadTreeSet {
             options: *options,
             layout,
             trees,
+            norms,
             build_time: start.elapsed(),
             grid_evaluations,
             name: sampler_name(variant, options.mixture),
@@ -361,7 +406,13 @@ impl QuadTreeSet {
         };
         let map = tree.density().map();
         let v = rotate_z(wi, -c.rotation);
-        map.area_to_solid_angle(tree.pdf(map.to_disc(&v)), wi)
+        map.area_to_solid_angle(tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index), wi)
+    }
+
+    /// The factor turning tree `index`'s pdf `f / Î_grid` into the set's `f / Î_leaves`.
+    #[inline]
+    fn norm_factor(&self, index: usize) -> f64 {
+        self.norms.get(index).map_or(1.0, |n| n.factor)
     }
 
     /// Density of `wi` under slice choice `c` alone, w.r.t. area on the disc of that slice
@@ -375,7 +426,7 @@ impl QuadTreeSet {
         };
         let map = tree.density().map();
         let v = rotate_z(wi, -c.rotation);
-        tree.pdf(map.to_disc(&v))
+        tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index)
     }
 
     /// The mixture pdf `Σ w_k p_k` given the pdf of the component that drew `wi`.
@@ -419,7 +470,7 @@ impl QuadTreeSet {
         let map = tree.density().map();
         let v = map.to_direction(s.point);
         let wi = rotate_z(&v, c.rotation);
-        let p = map.area_to_solid_angle(s.pdf, &v);
+        let p = map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v);
         let pdf = if cs[1 - drawn].weight > 0.0 {
             self.combine(&cs, drawn, p, &wi)
         } else {
@@ -505,7 +556,9 @@ impl QuadTreeSet {
             trials += s.measured_mean_trials.unwrap_or(0.0) * s.samples as f64;
             r.bound_violations += s.bound_violations;
             r.exhausted += s.exhausted;
-            if let Some(e) = s.integral_rel_err {
+        }
+        for n in &self.norms {
+            if let Some(e) = n.rel_err {
                 r.max_integral_rel_err = Some(r.max_integral_rel_err.unwrap_or(0.0).max(e));
             }
         }
@@ -567,7 +620,7 @@ impl DirectionSampler for QuadTreeSet {
                         let v = map.to_direction(s.point);
                         DirSample {
                             wi: rotate_z(&v, c.rotation),
-                            pdf: map.area_to_solid_angle(s.pdf, &v),
+                            pdf: map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v),
                         }
                     })
                     .collect()

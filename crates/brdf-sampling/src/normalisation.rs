@@ -1,0 +1,172 @@
+//! Per-slice normalisation by Gauss–Legendre quadrature on the tree's own leaves.
+//!
+//! The envelope scheme samples exactly `∝ f` whatever the leaf integrals are; only the reported
+//! pdf `f / Î` depends on `Î`. The image map's `Î` (midpoint rule on `grid²` cells, boundary
+//! cells on a sub-grid) is off by up to ~1 % for lobes that are narrow compared with a fine
+//! cell — grazing Beard–Maxwell and Cook–Torrance slices in the all-model validation. The tree
+//! itself is an adaptive partition that resolves those lobes, so integrating `f` over every
+//! sampleable leaf with a tensor Gauss–Legendre rule of order [`HIGH_ORDER`] gives a far better
+//! `Î`. Leaves crossed by the circle are integrated exactly over `rect ∩ disc` as iterated
+//! integrals (x outer, the chord `|y| ≤ √(1 − x²)` inner), with the outer interval split where
+//! the circle crosses the rectangle's top or bottom edge, so every piece has a smooth integrand.
+//! The relative error is estimated as `|Î_high − Î_low| / Î_high` with order [`LOW_ORDER`].
+
+use brdf::quadrature::GaussLegendre;
+use partition_sampler::{Density, LeafInfo, Rect};
+
+/// Order of the reported integral.
+pub(crate) const HIGH_ORDER: usize = 8;
+/// Order of the comparison integral for the error estimate.
+pub(crate) const LOW_ORDER: usize = 5;
+
+/// `∫_{[a, b]} g` by the rule mapped to `[a, b]`.
+fn integrate_1d(rule: &GaussLegendre, a: f64, b: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
+    let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
+    rule.nodes()
+        .iter()
+        .zip(rule.weights())
+        .map(|(x, w)| w * g(c + h * x))
+        .sum::<f64>()
+        * h
+}
+
+/// `∫_{rect ∩ D} f dA` by the iterated rule (see the module docs).
+fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
+    let chord = |x: f64| (1.0 - x * x).max(0.0).sqrt();
+    let inner = |x: f64| {
+        let half = chord(x);
+        let (ya, yb) = (rect.y0.max(-half), rect.y1.min(half));
+        if yb > ya {
+            integrate_1d(rule, ya, yb, |y| f.eval([x, y]))
+        } else {
+            0.0
+        }
+    };
+    // Outer breakpoints: where the circle meets the lines y = y0 and y = y1 inside the rect.
+    let mut cuts = vec![rect.x0, rect.x1];
+    for y in [rect.y0, rect.y1] {
+        if y.abs() < 1.0 {
+            let x = chord(y);
+            for c in [-x, x] {
+                if c > rect.x0 && c < rect.x1 {
+                    cuts.push(c);
+                }
+            }
+        }
+    }
+    // The disc's x-extent bounds the integration as well.
+    cuts.retain(|c| (-1.0..=1.0).contains(c) || *c == rect.x0 || *c == rect.x1);
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    cuts.windows(2)
+        .map(|w| {
+            let (a, b) = (w[0].max(-1.0), w[1].min(1.0));
+            if b > a {
+                integrate_1d(rule, a, b, inner)
+            } else {
+                0.0
+            }
+        })
+        .sum()
+}
+
+/// `(Î, relative error estimate)` of `f` over the union of `leaves` (their rejection rectangles
+/// contain `cell ∩ D` and lie in their cells, so `f`, zero off the disc, integrates to the same
+/// value over them).
+pub(crate) fn leaf_quadrature(
+    f: &dyn Density,
+    leaves: impl Iterator<Item = LeafInfo>,
+) -> (f64, f64) {
+    let (hi, lo) = (
+        GaussLegendre::new(HIGH_ORDER),
+        GaussLegendre::new(LOW_ORDER),
+    );
+    let (mut i_hi, mut i_lo) = (0.0, 0.0);
+    for leaf in leaves {
+        i_hi += integrate_leaf(f, &leaf.rect, &hi);
+        i_lo += integrate_leaf(f, &leaf.rect, &lo);
+    }
+    let err = if i_hi > 0.0 {
+        (i_hi - i_lo).abs() / i_hi
+    } else {
+        f64::INFINITY
+    };
+    (i_hi, err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn leaf(x0: f64, y0: f64, x1: f64, y1: f64) -> LeafInfo {
+        LeafInfo {
+            rect: Rect::new(x0, y0, x1, y1),
+            max_bound: 1.0,
+            integral: 0.0,
+            volume: 0.0,
+        }
+    }
+
+    #[test]
+    fn disc_area_and_a_smooth_moment_are_exact() {
+        let inside = |p: [f64; 2]| f64::from(u8::from(p[0] * p[0] + p[1] * p[1] < 1.0));
+        // Four quadrants, each crossed by the circle: area π.
+        let q = [
+            leaf(-1.0, -1.0, 0.0, 0.0),
+            leaf(0.0, -1.0, 1.0, 0.0),
+            leaf(-1.0, 0.0, 0.0, 1.0),
+            leaf(0.0, 0.0, 1.0, 1.0),
+        ];
+        let (a, _) = leaf_quadrature(&inside, q.iter().copied());
+        assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-3);
+        // ∫_D (1 − r²) dA = π/2 on a 4 × 4 partition of the square.
+        let g = |p: [f64; 2]| {
+            let r2 = p[0] * p[0] + p[1] * p[1];
+            if r2 < 1.0 { 1.0 - r2 } else { 0.0 }
+        };
+        let cells: Vec<LeafInfo> = (0..16)
+            .map(|k| {
+                let (i, j) = ((k % 4) as f64, (k / 4) as f64);
+                leaf(
+                    -1.0 + 0.5 * i,
+                    -1.0 + 0.5 * j,
+                    -0.5 + 0.5 * i,
+                    -0.5 + 0.5 * j,
+                )
+            })
+            .collect();
+        let (v, err) = leaf_quadrature(&g, cells.iter().copied());
+        assert_relative_eq!(v, std::f64::consts::FRAC_PI_2, max_relative = 1e-5);
+        assert!(err < 1e-3, "{err}");
+    }
+
+    #[test]
+    fn a_narrow_peak_inside_one_leaf_beats_the_midpoint_rule() {
+        // Gaussian of σ = 0.004 in a 0.03-wide leaf: a 4-point midpoint rule is off by
+        // −70 %, the order-8 rule by < 2e-3.
+        let s = 0.004f64;
+        let g = |p: [f64; 2]| {
+            let (dx, dy) = (p[0] - 0.3, p[1] - 0.2);
+            (-(dx * dx + dy * dy) / (2.0 * s * s)).exp()
+        };
+        // Exact integral over the leaf (±3.75 σ): 2π σ² erf(3.75/√2)².
+        let e = statrs::function::erf::erf(0.015 / (s * std::f64::consts::SQRT_2));
+        let exact = 2.0 * std::f64::consts::PI * s * s * e * e;
+        let (v, _) = leaf_quadrature(&g, [leaf(0.285, 0.185, 0.315, 0.215)].into_iter());
+        assert_relative_eq!(v, exact, max_relative = 2e-3);
+        let midpoint: f64 = [
+            [0.2925, 0.1925],
+            [0.3075, 0.1925],
+            [0.2925, 0.2075],
+            [0.3075, 0.2075],
+        ]
+        .iter()
+        .map(|&p| g(p) * 0.015 * 0.015)
+        .sum();
+        assert!(
+            (midpoint / exact - 1.0).abs() > 0.1,
+            "{midpoint} vs {exact}"
+        );
+    }
+}
