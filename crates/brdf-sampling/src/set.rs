@@ -141,6 +141,9 @@ pub(crate) struct SliceNorm {
     pub(crate) rel_err: Option<f64>,
 }
 
+/// A built slice: its tree, the BRDF evaluations spent and its normalisation.
+type BuiltSlice = (QuadTreeSampler<SliceDensity>, u64, SliceNorm);
+
 /// Builds the tree of slice `index`; returns it with the number of BRDF evaluations spent and
 /// its normalisation.
 fn build_slice(
@@ -149,7 +152,7 @@ fn build_slice(
     index: usize,
     options: &SetOptions,
     variant: Variant,
-) -> Result<(QuadTreeSampler<SliceDensity>, u64, SliceNorm), SetError> {
+) -> Result<BuiltSlice, SetError> {
     let (t, p) = layout.angles_of(index);
     let (theta_deg, phi_deg) = (t.to_degrees(), p.to_degrees());
     let disc_map = options
@@ -258,7 +261,7 @@ impl QuadTreeSet {
                 p(d, total.load(Ordering::Relaxed));
             }
         };
-        let mut built: Vec<(QuadTreeSampler<SliceDensity>, u64, SliceNorm)> = (0..layout.len())
+        let mut built: Vec<BuiltSlice> = (0..layout.len())
             .into_par_iter()
             .map(|i| {
                 let r = build_slice(&brdf, layout, i, options, variant);
@@ -284,7 +287,7 @@ impl QuadTreeSet {
             level_opts = level_opts.with_depth(level_opts.max_depth + 1);
             let opts = level_opts;
             total.fetch_add(worst.len(), Ordering::Relaxed);
-            let redone: Vec<(usize, (QuadTreeSampler<SliceDensity>, u64, SliceNorm))> = worst
+            let redone: Vec<(usize, BuiltSlice)> = worst
                 .par_iter()
                 .map(|&(_, i)| {
                     let r = build_slice(&brdf, layout, i, &opts, variant).map(|b| (i, b));
