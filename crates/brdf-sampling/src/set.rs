@@ -168,7 +168,6 @@ fn build_slice(
         options.grid,
         options.safety_factor,
         options.dilation_for(brdf.as_ref()),
-        disc_map == DiscMap::Projected,
     )
     .map_err(|source| SetError::Density {
         slice: index,
