@@ -3,11 +3,11 @@
 use crate::alias::build_alias;
 use crate::density::RegionStats;
 use crate::error::BuildError;
+use crate::leaf::{Frame, Leaf, encode_axis, encode_bound, pow2_floor};
 use crate::rect::{Domain, Rect};
 use crate::sampler_impl::QuadTreeSampler;
 use crate::tree::{
-    CDF_SKIP, EMPTY, LEAF, Leaf, LeafChoice, Node, QuadTree, Scheme, TreeCounts, TreeParams,
-    cell_rect,
+    EMPTY, LEAF, LeafChoice, Node, QuadTree, Scheme, TreeCounts, TreeParams, cell_rect,
 };
 
 /// Default split threshold (the papers' `n_max = 2`).
@@ -27,7 +27,9 @@ pub const DEFAULT_MAX_DEPTH: u32 = 12;
 /// Default [`QuadTreeBuilder::volume_tolerance`].
 pub const DEFAULT_VOLUME_TOLERANCE: f64 = 1e-6;
 
-/// Largest accepted `max_depth` (cells of `2^-24` of the domain).
+/// Largest accepted `max_depth` (cells of `2^-24` of the domain). Leaves store their
+/// rectangles as `f32` (root-normalised, or domain coordinates for dyadic roots), in which
+/// every cell edge down to this depth is exact; a deeper limit would need another encoding.
 pub const MAX_DEPTH_LIMIT: u32 = 24;
 
 /// Builds a [`QuadTreeSampler`] from a [`RegionStats`] provider.
@@ -143,45 +145,113 @@ impl QuadTreeBuilder {
             min_size: [mw.max(p.min_leaf_size), mh.max(p.min_leaf_size)],
             leaves: Vec::new(),
             leaf_integral: Vec::new(),
-            weights: Vec::new(),
             nodes: Vec::new(),
             counts: TreeCounts::default(),
             abs_err: Some(0.0),
             split_floor: 0.0,
         };
-        let (root_code, total_weight) = b.visit(0, 0, 0)?;
-        if !(total_weight > 0.0 && total_weight.is_finite()) || b.leaves.is_empty() {
+        let root_code = b.visit(0, 0, 0)?;
+        // Every stored leaf has M_i > 0 (else its weight was 0); scale the bounds by a power
+        // of two so that the largest is in [1, 2) as an f32.
+        let max_m = b.leaves.iter().map(|r| r.m).fold(0.0f64, f64::max);
+        if !(max_m > 0.0 && max_m.is_finite()) {
             return Err(BuildError::ZeroMass);
         }
-        let alias = build_alias(&b.weights);
-        for (leaf, (prob, a)) in b.leaves.iter_mut().zip(alias) {
-            leaf.prob = prob;
-            leaf.alias = a;
-        }
+        let bound_scale = pow2_floor(max_m);
+        let frame = Frame::of_root(&root);
+        let leaves: Vec<Leaf> = b
+            .leaves
+            .iter()
+            .map(|r| r.encode(&root, &frame, bound_scale))
+            .collect();
         let integral: f64 = b.leaf_integral.iter().sum();
-        let volume: f64 = b.leaves.iter().map(|l| l.w * l.h * l.m).sum();
         if !(integral > 0.0 && integral.is_finite()) {
             return Err(BuildError::ZeroMass);
         }
         let integral_rel_err = density.total_rel_err().or(b.abs_err.map(|e| e / integral));
-        b.counts.active_leaves = b.leaves.len();
-        b.leaves.shrink_to_fit();
+        b.counts.active_leaves = leaves.len();
         b.leaf_integral.shrink_to_fit();
         b.nodes.shrink_to_fit();
-        Ok(QuadTree {
+        let mut tree = QuadTree {
             params: p,
             shape: density.shape(),
             root,
-            leaves: b.leaves,
+            leaves,
             leaf_integral: b.leaf_integral,
+            bound_scale,
             nodes: b.nodes,
+            cdf: Vec::new(),
             root_code,
             counts: b.counts,
             integral,
-            volume,
+            volume: 0.0,
             integral_source: density.integral_source(),
             integral_rel_err,
-        })
+        };
+        // Selection weights, volumes and CDFs from the stored (rounded) values, so that they
+        // are exactly what the sampler realises.
+        let weights = tree.leaf_weights();
+        let total_weight: f64 = weights.iter().sum();
+        if !(total_weight > 0.0 && total_weight.is_finite()) {
+            return Err(BuildError::ZeroMass);
+        }
+        for (leaf, (prob, a)) in tree.leaves.iter_mut().zip(build_alias(&weights)) {
+            leaf.prob = prob;
+            leaf.alias = a;
+        }
+        let extent = frame.extent;
+        tree.volume = tree
+            .leaves
+            .iter()
+            .map(|l| l.volume(extent, bound_scale))
+            .sum();
+        if !(tree.volume > 0.0 && tree.volume.is_finite()) {
+            return Err(BuildError::ZeroMass);
+        }
+        tree.set_leaf_choice(p.leaf_choice);
+        Ok(tree)
+    }
+}
+
+/// A leaf as found by the walk, before encoding.
+struct RawLeaf {
+    /// Rejection rectangle (f64, domain units).
+    rej: Rect,
+    /// `M_i`.
+    m: f64,
+    /// Cell depth and indices.
+    d: u32,
+    ix: u64,
+    iy: u64,
+}
+
+impl RawLeaf {
+    /// The stored form: rectangle in the frame's coordinates, rounded outward within the
+    /// cell, bound rounded up (see [`crate::leaf`]).
+    fn encode(&self, root: &Rect, frame: &Frame, bound_scale: f64) -> Leaf {
+        let (u0, du) = encode_axis(
+            self.rej.x0,
+            self.rej.x1,
+            frame.cell_edges(root.x0, root.width(), self.d, self.ix),
+            frame.origin[0],
+            frame.extent[0],
+        );
+        let (v0, dv) = encode_axis(
+            self.rej.y0,
+            self.rej.y1,
+            frame.cell_edges(root.y0, root.height(), self.d, self.iy),
+            frame.origin[1],
+            frame.extent[1],
+        );
+        Leaf {
+            u0,
+            v0,
+            du,
+            dv,
+            m: encode_bound(self.m, bound_scale),
+            alias: 0,
+            prob: 1.0,
+        }
     }
 }
 
@@ -192,9 +262,8 @@ struct Walker<'a, D: ?Sized> {
     root: Rect,
     params: TreeParams,
     min_size: [f64; 2],
-    leaves: Vec<Leaf>,
+    leaves: Vec<RawLeaf>,
     leaf_integral: Vec<f64>,
-    weights: Vec<f64>,
     nodes: Vec<Node>,
     counts: TreeCounts,
     abs_err: Option<f64>,
@@ -203,12 +272,16 @@ struct Walker<'a, D: ?Sized> {
 }
 
 impl<D: RegionStats + ?Sized> Walker<'_, D> {
-    /// Visits cell `(ix, iy)` at depth `d`; returns its child code and selection weight.
-    fn visit(&mut self, d: u32, ix: u64, iy: u64) -> Result<(u32, f64), BuildError> {
+    /// Visits cell `(ix, iy)` at depth `d`; returns its child code.
+    ///
+    /// Split decisions and the choice of leaves of zero weight use the unrounded `f64`
+    /// values; a leaf of positive `f64` weight keeps a positive weight once stored (its
+    /// rectangle and bound only grow).
+    fn visit(&mut self, d: u32, ix: u64, iy: u64) -> Result<u32, BuildError> {
         let cell = cell_rect(&self.root, d, ix, iy);
         let Some(rej) = self.domain.rejection_rect(&cell) else {
             self.counts.dropped += 1;
-            return Ok((EMPTY, 0.0));
+            return Ok(EMPTY);
         };
         let est = self.density.region(&cell);
         let (m, i) = (est.max_bound, est.integral);
@@ -235,27 +308,14 @@ impl<D: RegionStats + ?Sized> Walker<'_, D> {
             }
             self.nodes.push(Node {
                 children: [EMPTY; 4],
-                cdf: [0.0; 3],
             });
             self.counts.internal += 1;
             let mut children = [EMPTY; 4];
-            let mut w = [0.0f64; 4];
-            for k in 0..4u64 {
-                let (c, wk) = self.visit(d + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1))?;
-                children[k as usize] = c;
-                w[k as usize] = wk;
+            for (k, c) in (0..4u64).zip(children.iter_mut()) {
+                *c = self.visit(d + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1))?;
             }
-            let total: f64 = w.iter().sum();
-            let mut cdf = [CDF_SKIP; 3];
-            if let Some(last) = (0..4).rev().find(|&k| w[k] > 0.0) {
-                let mut acc = 0.0;
-                for k in 0..last.min(3) {
-                    acc += w[k];
-                    cdf[k] = acc / total;
-                }
-            }
-            self.nodes[idx] = Node { children, cdf };
-            return Ok((idx as u32, total));
+            self.nodes[idx] = Node { children };
+            return Ok(idx as u32);
         }
         self.counts.leaves += 1;
         self.counts.depth = self.counts.depth.max(d);
@@ -265,7 +325,7 @@ impl<D: RegionStats + ?Sized> Walker<'_, D> {
             Scheme::Paper => 0.0,
         };
         if weight.is_nan() || weight <= 0.0 {
-            return Ok((EMPTY, 0.0));
+            return Ok(EMPTY);
         }
         if self.leaves.len() >= (LEAF - 1) as usize {
             return Err(BuildError::TooManyNodes);
@@ -275,17 +335,8 @@ impl<D: RegionStats + ?Sized> Walker<'_, D> {
             _ => None,
         };
         let code = LEAF | self.leaves.len() as u32;
-        self.leaves.push(Leaf {
-            x0: rej.x0,
-            y0: rej.y0,
-            w: rej.width(),
-            h: rej.height(),
-            m,
-            prob: 1.0,
-            alias: 0,
-        });
+        self.leaves.push(RawLeaf { rej, m, d, ix, iy });
         self.leaf_integral.push(i);
-        self.weights.push(weight);
-        Ok((code, weight))
+        Ok(code)
     }
 }

@@ -50,6 +50,9 @@ mod audit;
 mod builder;
 mod density;
 mod error;
+#[cfg(test)]
+mod layout_tests;
+mod leaf;
 mod persist;
 mod pyramid;
 mod rect;

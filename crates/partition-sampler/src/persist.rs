@@ -8,7 +8,11 @@ use crate::error::PersistError;
 use crate::tree::QuadTree;
 
 /// Version of the stored tree format; bumped on any incompatible change.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// Version 2: leaves store root-normalised `f32` rectangles and bounds (with a per-tree
+/// power-of-two bound scale); descent CDFs are a separate array, empty for
+/// [`crate::LeafChoice::Alias`].
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 4] = b"PSQT";
 

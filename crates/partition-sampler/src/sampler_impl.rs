@@ -10,9 +10,10 @@ use crate::allocate::{AllocationMode, allocate, stratum_weights};
 use crate::audit::{Audit, Counters, flush_local, record_one};
 use crate::density::{IntegralSource, RegionStats};
 use crate::error::AttachError;
+use crate::leaf::{Frame, Leaf};
 use crate::rect::Domain;
 use crate::sampler::{Point2, Sample2, Sampler2D, UniformSource};
-use crate::tree::{EMPTY, LEAF, Leaf, LeafChoice, QuadTree, Scheme};
+use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
 
 /// A sample is abandoned (returned with pdf 0 and counted as exhausted) after this many
 /// rejection trials. Only reachable when the bounds or integrals badly contradict `f`.
@@ -41,6 +42,12 @@ pub struct QuadTreeSampler<D> {
     counters: Arc<Counters>,
     disc: bool,
     inv_integral: f64,
+    /// The tree's map from stored leaf coordinates to the domain.
+    frame: Frame,
+    /// Scale of the leaves' `f32` bounds.
+    bound_scale: f64,
+    /// The frame is the identity (roots `[0, 1]²`, `[−1, 1]²`, …): the hot loop skips the map.
+    identity: bool,
 }
 
 impl<D> std::fmt::Debug for QuadTreeSampler<D> {
@@ -114,12 +121,17 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     pub(crate) fn from_valid_parts(tree: QuadTree, density: D) -> Self {
         let disc = matches!(tree.shape.domain, Domain::UnitDisc);
         let inv_integral = 1.0 / tree.integral;
+        let frame = tree.frame();
+        let bound_scale = tree.bound_scale;
         Self {
             tree,
             density,
             counters: Arc::new(Counters::default()),
             disc,
             inv_integral,
+            frame,
+            bound_scale,
+            identity: frame.is_identity(),
         }
     }
 
@@ -153,9 +165,11 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         &self.density
     }
 
-    /// The same sampler with another leaf-selection method (the tree is unchanged).
+    /// The same sampler with another leaf-selection method. The leaves and nodes are
+    /// unchanged; [`LeafChoice::Descent`] (re)builds the per-node CDFs from the leaf weights
+    /// exactly as the builder does (bit-identical), [`LeafChoice::Alias`] frees them.
     pub fn with_leaf_choice(mut self, choice: LeafChoice) -> Self {
-        self.tree.params.leaf_choice = choice;
+        self.tree.set_leaf_choice(choice);
         self
     }
 
@@ -249,7 +263,11 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         let mut a = Audit::default();
         for (leaf, &k) in self.tree.leaves.iter().zip(&counts) {
             for _ in 0..k {
-                samples.push(self.draw_in_leaf(leaf, u, &mut a));
+                samples.push(if self.identity {
+                    self.draw_in_leaf::<false, U>(leaf, u, &mut a)
+                } else {
+                    self.draw_in_leaf::<true, U>(leaf, u, &mut a)
+                });
             }
         }
         self.counters.add(&a);
@@ -322,12 +340,13 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                         return leaves.get((code & !LEAF) as usize);
                     }
                     let node = self.tree.nodes.get(code as usize)?;
+                    let cdf = self.tree.cdf.get(code as usize)?;
                     let r = u.next_uniform();
-                    let k = if r < node.cdf[0] {
+                    let k = if r < cdf[0] {
                         0
-                    } else if r < node.cdf[1] {
+                    } else if r < cdf[1] {
                         1
-                    } else if r < node.cdf[2] {
+                    } else if r < cdf[2] {
                         2
                     } else {
                         3
@@ -338,23 +357,32 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         }
     }
 
-    /// One rejection trial in `leaf`: `Some((x, f(x)))` when accepted.
+    /// One rejection trial in `leaf`: `Some((x, f(x)))` when accepted. The point is uniform
+    /// in the leaf's stored rectangle mapped by the frame, `x = origin + u · extent` (the map
+    /// whose Jacobian the leaf areas and weights use, see [`Leaf::area`]). `MAP = false` skips
+    /// the map for the identity frame (where it is `0 + u · 1 = u` anyway).
     #[inline(always)]
-    fn trial<U: UniformSource + ?Sized>(
+    fn trial<const MAP: bool, U: UniformSource + ?Sized>(
         &self,
         leaf: &Leaf,
         u: &mut U,
         a: &mut Audit,
     ) -> (Point2, Option<f64>) {
-        let x = leaf.x0 + u.next_uniform() * leaf.w;
-        let y = leaf.y0 + u.next_uniform() * leaf.h;
-        let z = u.next_uniform() * leaf.m;
+        let s = f64::from(leaf.u0) + u.next_uniform() * f64::from(leaf.du);
+        let t = f64::from(leaf.v0) + u.next_uniform() * f64::from(leaf.dv);
+        let (x, y) = if MAP {
+            (self.frame.domain_coord(0, s), self.frame.domain_coord(1, t))
+        } else {
+            (s, t)
+        };
+        let m = leaf.bound(self.bound_scale);
+        let z = u.next_uniform() * m;
         a.trials += 1;
         if self.disc && x * x + y * y > 1.0 {
             return ([x, y], None);
         }
         let f = self.density.eval([x, y]);
-        if f > leaf.m {
+        if f > m {
             a.violations += 1;
         }
         ([x, y], (z < f).then_some(f))
@@ -369,7 +397,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// Rejection inside one leaf until acceptance (batch mode and [`Scheme::Paper`]); counts
     /// the sample in `a`.
     #[inline(always)]
-    fn draw_in_leaf<U: UniformSource + ?Sized>(
+    fn draw_in_leaf<const MAP: bool, U: UniformSource + ?Sized>(
         &self,
         leaf: &Leaf,
         u: &mut U,
@@ -377,7 +405,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     ) -> Sample2 {
         let start = a.trials;
         loop {
-            let (p, acc) = self.trial(leaf, u, a);
+            let (p, acc) = self.trial::<MAP, U>(leaf, u, a);
             if let Some(f) = acc {
                 a.samples += 1;
                 return Sample2 {
@@ -394,6 +422,33 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// One sample of the configured scheme (counts the sample in `a`).
     #[inline]
     fn draw<U: UniformSource + ?Sized>(&self, u: &mut U, a: &mut Audit) -> Sample2 {
+        if self.identity {
+            self.draw_with::<false, U>(u, a)
+        } else {
+            let (s, local) = self.draw_mapped(u);
+            a.merge(&local);
+            s
+        }
+    }
+
+    /// [`Self::draw`] for a non-identity frame, kept out of line so that only one copy of the
+    /// loop is inlined into callers. It counts into its own [`Audit`], returned by value: a
+    /// caller's `&mut Audit` escaping into an out-of-line call would keep the caller's counts in
+    /// memory on the inlined path too (measurably slower).
+    #[inline(never)]
+    fn draw_mapped<U: UniformSource + ?Sized>(&self, u: &mut U) -> (Sample2, Audit) {
+        let mut a = Audit::default();
+        let s = self.draw_with::<true, U>(u, &mut a);
+        (s, a)
+    }
+
+    /// The loop of [`Self::draw`]; `MAP` as in [`Self::trial`].
+    #[inline(always)]
+    fn draw_with<const MAP: bool, U: UniformSource + ?Sized>(
+        &self,
+        u: &mut U,
+        a: &mut Audit,
+    ) -> Sample2 {
         let start = a.trials;
         let mut last = self.tree.root.center();
         loop {
@@ -406,7 +461,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
             };
             match self.tree.params.scheme {
                 Scheme::Envelope => {
-                    let (p, acc) = self.trial(leaf, u, a);
+                    let (p, acc) = self.trial::<MAP, U>(leaf, u, a);
                     if let Some(f) = acc {
                         a.samples += 1;
                         return Sample2 {
@@ -419,7 +474,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                         return self.exhausted(last, a);
                     }
                 }
-                Scheme::Paper => return self.draw_in_leaf(leaf, u, a),
+                Scheme::Paper => return self.draw_in_leaf::<MAP, U>(leaf, u, a),
             }
         }
     }

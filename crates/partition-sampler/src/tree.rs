@@ -1,9 +1,11 @@
-//! The built quadtree: flat arrays of leaves (rejection rectangles, bounds, alias entries) and
-//! internal nodes (child codes and per-node CDFs for the papers' descent). Serialisable.
+//! The built quadtree: flat arrays of leaves (rejection rectangles, bounds, alias entries; see
+//! [`crate::leaf`]), internal nodes (child codes) and, only for [`LeafChoice::Descent`], the
+//! per-node CDFs of the papers' descent. Serialisable.
 
 use serde::{Deserialize, Serialize};
 
 use crate::density::{DensityShape, IntegralSource};
+use crate::leaf::{Frame, Leaf};
 use crate::rect::{Domain, Rect};
 use crate::sampler::Point2;
 
@@ -59,29 +61,11 @@ pub(crate) const EMPTY: u32 = u32::MAX;
 /// Child code flag: the low 31 bits index `leaves`.
 pub(crate) const LEAF: u32 = 1 << 31;
 
-/// One sampleable leaf: rejection rectangle, bound, and its alias-table entry (one cache line).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[repr(C, align(64))]
-pub(crate) struct Leaf {
-    pub(crate) x0: f64,
-    pub(crate) y0: f64,
-    pub(crate) w: f64,
-    pub(crate) h: f64,
-    /// `M_i`.
-    pub(crate) m: f64,
-    /// Alias threshold.
-    pub(crate) prob: f64,
-    /// Alias target.
-    pub(crate) alias: u32,
-}
-
 /// An internal node: four child codes (quadrants x-major: 0 = (lo, lo), 1 = (hi, lo),
-/// 2 = (lo, hi), 3 = (hi, hi)) and the cumulative child probabilities `F_i0..F_i2`
-/// ([`CDF_SKIP`] from the last child of positive weight on).
+/// 2 = (lo, hi), 3 = (hi, hi)). The descent CDFs live in [`QuadTree`]'s separate `cdf` array.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub(crate) struct Node {
     pub(crate) children: [u32; 4],
-    pub(crate) cdf: [f64; 3],
 }
 
 /// Counts describing a tree.
@@ -101,16 +85,17 @@ pub struct TreeCounts {
     pub depth: u32,
 }
 
-/// Geometry and statistics of one sampleable leaf.
+/// Geometry and statistics of one sampleable leaf, as stored.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LeafInfo {
-    /// Rejection rectangle (the cell, or the bounding box of cell ∩ disc).
+    /// Rejection rectangle: the cell, or the bounding box of cell ∩ disc with its edges
+    /// rounded outward to `f32` precision (never beyond the cell).
     pub rect: Rect,
-    /// `M_i`.
+    /// `M_i`, rounded up to `f32` precision (never below the provider's bound).
     pub max_bound: f64,
     /// `I_i`.
     pub integral: f64,
-    /// `V_i = area(rect) · M_i`.
+    /// `V_i = area(rect) · M_i` (the envelope scheme's selection weight).
     pub volume: f64,
 }
 
@@ -123,8 +108,17 @@ pub struct QuadTree {
     pub(crate) shape: DensityShape,
     pub(crate) root: Rect,
     pub(crate) leaves: Vec<Leaf>,
+    /// `I_i` per leaf. Kept in `f64`: `Î = Σ I_i` is exact for tabulated densities, which the
+    /// [`Scheme::Paper`] pdf and batch mode rely on.
     pub(crate) leaf_integral: Vec<f64>,
+    /// Power of two scaling the leaves' `f32` bounds (`M_i = m · bound_scale`), so that bounds
+    /// of any finite magnitude fit.
+    pub(crate) bound_scale: f64,
     pub(crate) nodes: Vec<Node>,
+    /// Per internal node, the cumulative child probabilities `F_i0..F_i2` ([`CDF_SKIP`] from the
+    /// last child of positive weight on); empty unless `params.leaf_choice` is
+    /// [`LeafChoice::Descent`] (see [`QuadTree::descent_cdfs`]).
+    pub(crate) cdf: Vec<[f64; 3]>,
     pub(crate) root_code: u32,
     pub(crate) counts: TreeCounts,
     /// `Î = Σ I_i` over sampleable leaves.
@@ -187,35 +181,98 @@ impl QuadTree {
 
     /// The sampleable leaves in storage order.
     pub fn leaves(&self) -> impl ExactSizeIterator<Item = LeafInfo> + '_ {
+        let frame = self.frame();
         self.leaves
             .iter()
             .zip(&self.leaf_integral)
-            .map(|(l, &i)| LeafInfo {
-                rect: Rect {
-                    x0: l.x0,
-                    y0: l.y0,
-                    x1: l.x0 + l.w,
-                    y1: l.y0 + l.h,
-                },
-                max_bound: l.m,
+            .map(move |(l, &i)| LeafInfo {
+                rect: l.rect(&frame),
+                max_bound: l.bound(self.bound_scale),
                 integral: i,
-                volume: l.w * l.h * l.m,
+                volume: l.volume(frame.extent, self.bound_scale),
             })
     }
 
-    /// Bytes of the leaf array (rectangles, bounds and alias entries).
+    /// Bytes of the leaf arrays: 32 per leaf (`f32` rectangle and bound, alias entry) plus 8
+    /// for its integral.
     pub fn leaf_bytes(&self) -> usize {
-        self.leaves.capacity() * std::mem::size_of::<Leaf>() + self.leaf_integral.capacity() * 8
+        self.leaves.capacity() * std::mem::size_of::<Leaf>()
+            + self.leaf_integral.capacity() * std::mem::size_of::<f64>()
     }
 
-    /// Bytes of the internal nodes (child codes and descent CDFs).
+    /// Bytes of the internal nodes: 16 per node (child codes), plus 24 per node for the descent
+    /// CDFs when [`LeafChoice::Descent`] is selected.
     pub fn node_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>()
+            + self.cdf.capacity() * std::mem::size_of::<[f64; 3]>()
     }
 
     /// Total bytes of the tree.
     pub fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>() + self.leaf_bytes() + self.node_bytes()
+    }
+
+    /// The map from stored leaf coordinates to the domain.
+    pub(crate) fn frame(&self) -> Frame {
+        Frame::of_root(&self.root)
+    }
+
+    /// Selection weights of the leaves under the tree's scheme, from the stored values:
+    /// `V_i = area_i · M_i` ([`Scheme::Envelope`]) or `I_i` ([`Scheme::Paper`]).
+    pub(crate) fn leaf_weights(&self) -> Vec<f64> {
+        match self.params.scheme {
+            Scheme::Envelope => {
+                let extent = self.frame().extent;
+                self.leaves
+                    .iter()
+                    .map(|l| l.volume(extent, self.bound_scale))
+                    .collect()
+            }
+            Scheme::Paper => self.leaf_integral.clone(),
+        }
+    }
+
+    /// The papers' per-node CDFs, bottom-up from the leaf weights ([`QuadTree::leaf_weights`]):
+    /// a node's weight is the sum of its children's (empty children weigh 0), and
+    /// `F_ik = Σ_{j ≤ k} w_j / Σ_j w_j`. The builder and
+    /// [`crate::QuadTreeSampler::with_leaf_choice`] both use this function, so their results
+    /// are bit-identical. Relies on child nodes having larger indices than their parent.
+    pub(crate) fn descent_cdfs(&self) -> Vec<[f64; 3]> {
+        let weights = self.leaf_weights();
+        let mut total = vec![0.0f64; self.nodes.len()];
+        let mut cdfs = vec![[CDF_SKIP; 3]; self.nodes.len()];
+        for k in (0..self.nodes.len()).rev() {
+            let mut w = [0.0f64; 4];
+            for (wc, &c) in w.iter_mut().zip(&self.nodes[k].children) {
+                *wc = if c == EMPTY {
+                    0.0
+                } else if c & LEAF != 0 {
+                    weights.get((c & !LEAF) as usize).copied().unwrap_or(0.0)
+                } else {
+                    total.get(c as usize).copied().unwrap_or(0.0)
+                };
+            }
+            let t: f64 = w.iter().sum();
+            total[k] = t;
+            if let Some(last) = (0..4).rev().find(|&j| w[j] > 0.0) {
+                let mut acc = 0.0;
+                for j in 0..last.min(3) {
+                    acc += w[j];
+                    cdfs[k][j] = acc / t;
+                }
+            }
+        }
+        cdfs
+    }
+
+    /// Selects the leaf choice, building the descent CDFs for [`LeafChoice::Descent`] and
+    /// freeing them for [`LeafChoice::Alias`].
+    pub(crate) fn set_leaf_choice(&mut self, choice: LeafChoice) {
+        self.params.leaf_choice = choice;
+        self.cdf = match choice {
+            LeafChoice::Descent => self.descent_cdfs(),
+            LeafChoice::Alias => Vec::new(),
+        };
     }
 
     /// Index of the sampleable leaf whose cell contains `p`, if any.
@@ -266,20 +323,16 @@ impl QuadTree {
         {
             return Err("leaf array sizes");
         }
-        for l in &self.leaves {
-            let ok = l.x0.is_finite()
-                && l.y0.is_finite()
-                && l.w.is_finite()
-                && l.w > 0.0
-                && l.h.is_finite()
-                && l.h > 0.0
-                && l.m.is_finite()
-                && l.m > 0.0
-                && (0.0..=1.0).contains(&l.prob)
-                && (l.alias as usize) < n;
-            if !ok {
-                return Err("invalid leaf");
-            }
+        if !(self.bound_scale.is_finite() && self.bound_scale > 0.0) {
+            return Err("invalid bound scale");
+        }
+        let bounds = self.frame().stored_root(&self.root);
+        if !self
+            .leaves
+            .iter()
+            .all(|l| l.is_sound(n, self.bound_scale, &bounds))
+        {
+            return Err("invalid leaf");
         }
         if !self
             .leaf_integral
@@ -304,9 +357,21 @@ impl QuadTree {
             if !node.children.iter().all(|&c| code_ok(c, Some(k))) {
                 return Err("invalid child code");
             }
-            if !node.cdf.iter().all(|c| (0.0..=CDF_SKIP).contains(c)) {
-                return Err("invalid cdf");
-            }
+        }
+        let cdf_len = match p.leaf_choice {
+            LeafChoice::Descent => self.nodes.len(),
+            LeafChoice::Alias => 0,
+        };
+        if self.cdf.len() != cdf_len {
+            return Err("descent cdf array size");
+        }
+        if !self
+            .cdf
+            .iter()
+            .flatten()
+            .all(|c| (0.0..=CDF_SKIP).contains(c))
+        {
+            return Err("invalid cdf");
         }
         if !(self.integral.is_finite()
             && self.integral > 0.0

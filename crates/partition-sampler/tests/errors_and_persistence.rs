@@ -163,6 +163,17 @@ fn persistence_errors() {
             expected: FORMAT_VERSION
         }
     );
+    // Trees of format 1 (f64 leaves, CDFs inside the nodes) are refused, not misread.
+    assert_eq!(FORMAT_VERSION, 2);
+    let mut v1 = bytes.clone();
+    v1[4..8].copy_from_slice(&1u32.to_le_bytes());
+    assert_eq!(
+        QuadTree::from_bytes(&v1).unwrap_err(),
+        PersistError::UnsupportedVersion {
+            found: 1,
+            expected: 2
+        }
+    );
     let mut magic = bytes.clone();
     magic[0] = b'X';
     assert_eq!(

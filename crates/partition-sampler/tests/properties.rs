@@ -1,5 +1,6 @@
 //! Invariants over random inputs: samples in the domain, pdf ≥ 0 and > 0 where f > 0,
-//! sample and pdf agree, serde round trips give identical samples.
+//! sample and pdf agree, serde round trips give identical samples, switching the leaf choice
+//! rebuilds exactly the builder's descent CDFs.
 
 use partition_sampler::{
     Domain, LeafChoice, QuadTree, QuadTreeBuilder, QuadTreeSampler, Rect, SampledGridDensity,
@@ -73,6 +74,21 @@ proptest! {
     }
 
     #[test]
+    fn with_leaf_choice_rebuilds_identical_cdfs((w, h, vals) in grid(), paper in any::<bool>(),
+                                               cx in -0.9f64..0.9, e in 1.0f64..200.0, seed in any::<u64>()) {
+        prop_assume!(vals.iter().any(|&v| v > 0.0));
+        let sc = if paper { Scheme::Paper } else { Scheme::Envelope };
+        let b = |lc| QuadTreeBuilder::new().scheme(sc).leaf_choice(lc);
+        let d = TabulatedDensity::new(w, h, vals, Rect::new(0.1, -0.3, 0.7, 2.0)).unwrap();
+        check_switch(b(LeafChoice::Descent).build(d.clone()).unwrap(),
+                     b(LeafChoice::Alias).build(d).unwrap(), seed)?;
+        let f = move |p: [f64; 2]| 1e-3 + (-(e * ((p[0] - cx).powi(2) + p[1] * p[1]))).exp();
+        let disc = || SampledGridDensity::new(f, Domain::UnitDisc, 32).unwrap();
+        check_switch(b(LeafChoice::Descent).build(disc()).unwrap(),
+                     b(LeafChoice::Alias).build(disc()).unwrap(), seed)?;
+    }
+
+    #[test]
     fn serde_round_trip_gives_identical_samples((w, h, vals) in grid(), (sc, lc) in scheme(), seed in any::<u64>()) {
         prop_assume!(vals.iter().any(|&v| v > 0.0));
         let d = TabulatedDensity::new(w, h, vals, Rect::UNIT).unwrap().with_row_factor(SinPiRows).unwrap();
@@ -91,6 +107,36 @@ proptest! {
             prop_assert_eq!(x, r.sample(&mut b));
         }
     }
+}
+
+/// A tree built with `Descent` and one built with `Alias` then switched to `Descent` are
+/// bit-identical (same encoding, hence the same CDFs) and draw identical samples; switching
+/// back to `Alias` frees the CDFs.
+fn check_switch<D: partition_sampler::RegionStats>(
+    descent: QuadTreeSampler<D>,
+    alias: QuadTreeSampler<D>,
+    seed: u64,
+) -> Result<(), TestCaseError> {
+    let alias_bytes = alias.tree().to_bytes();
+    let alias_node_bytes = alias.tree().node_bytes();
+    let switched = alias.with_leaf_choice(LeafChoice::Descent);
+    prop_assert_eq!(switched.tree(), descent.tree());
+    prop_assert_eq!(switched.tree().to_bytes(), descent.tree().to_bytes());
+    prop_assert_eq!(
+        switched.tree().node_bytes(),
+        alias_node_bytes + 24 * switched.tree().counts().internal
+    );
+    let (mut a, mut b) = (
+        Xoshiro256PlusPlus::seed_from_u64(seed),
+        Xoshiro256PlusPlus::seed_from_u64(seed),
+    );
+    for _ in 0..50 {
+        prop_assert_eq!(switched.sample(&mut a), descent.sample(&mut b));
+    }
+    let back = switched.with_leaf_choice(LeafChoice::Alias);
+    prop_assert_eq!(back.tree().to_bytes(), alias_bytes);
+    prop_assert_eq!(back.tree().node_bytes(), alias_node_bytes);
+    Ok(())
 }
 
 fn check<D: partition_sampler::RegionStats>(
