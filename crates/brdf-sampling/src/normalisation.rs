@@ -10,7 +10,10 @@
 //! integrals (x outer, the chord `|y| ≤ √(1 − x²)` inner), with the outer interval split where
 //! the circle crosses the rectangle's top or bottom edge and the outer variable `x = sin t`, so
 //! every piece has a smooth integrand (the disc's area to 1e-10 instead of 9e-4).
-//! The relative error is estimated as `|Î_high − Î_low| / Î_high` with order [`LOW_ORDER`].
+//! Each leaf is split into quadrants (at most [`MAX_SPLIT_DEPTH`] times) while the orders
+//! [`HIGH_ORDER`] and [`LOW_ORDER`] disagree by more than [`TOL`] of the grid's `Î`; the
+//! summed disagreement is the reported error estimate. The set keeps whichever of this and the
+//! grid's integral has the smaller estimated error.
 
 use brdf::quadrature::GaussLegendre;
 use partition_sampler::{Density, LeafInfo, Rect};
@@ -73,28 +76,66 @@ fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
         .sum()
 }
 
+/// Deepest subdivision of a leaf by the adaptive rule.
+pub(crate) const MAX_SPLIT_DEPTH: u32 = 4;
+
+/// Absolute-tolerance fraction: a piece is accepted when `|I_high − I_low| ≤ TOL · scale`.
+pub(crate) const TOL: f64 = 1e-8;
+
+/// `(∫_{rect ∩ D} f, |I_high − I_low|)`, splitting `rect` into quadrants while the two orders
+/// disagree by more than `tol_abs` (kinks such as Oren–Nayar's `max(0, cos Δφ)` or
+/// `max(θi, θo)` cross leaves; a Gauss rule converges slowly across them).
+fn integrate_adaptive(
+    f: &dyn Density,
+    rect: &Rect,
+    rules: (&GaussLegendre, &GaussLegendre),
+    tol_abs: f64,
+    depth: u32,
+) -> (f64, f64) {
+    let hi = integrate_leaf(f, rect, rules.0);
+    let lo = integrate_leaf(f, rect, rules.1);
+    let err = (hi - lo).abs();
+    if err <= tol_abs || depth >= MAX_SPLIT_DEPTH {
+        return (hi, err);
+    }
+    let c = rect.center();
+    let quads = [
+        Rect::new(rect.x0, rect.y0, c[0], c[1]),
+        Rect::new(c[0], rect.y0, rect.x1, c[1]),
+        Rect::new(rect.x0, c[1], c[0], rect.y1),
+        Rect::new(c[0], c[1], rect.x1, rect.y1),
+    ];
+    quads.iter().fold((0.0, 0.0), |acc, q| {
+        let (v, e) = integrate_adaptive(f, q, rules, 0.5 * tol_abs, depth + 1);
+        (acc.0 + v, acc.1 + e)
+    })
+}
+
 /// `(Î, relative error estimate)` of `f` over the union of `leaves` (their rejection rectangles
 /// contain `cell ∩ D` and lie in their cells, so `f`, zero off the disc, integrates to the same
-/// value over them).
+/// value over them). `scale` (e.g. the grid's `Î`) sets the absolute tolerance
+/// `TOL · scale` of each leaf's adaptive rule; the error estimate is `Σ |I_high − I_low| / Î`.
 pub(crate) fn leaf_quadrature(
     f: &dyn Density,
     leaves: impl Iterator<Item = LeafInfo>,
+    scale: f64,
 ) -> (f64, f64) {
     let (hi, lo) = (
         GaussLegendre::new(HIGH_ORDER),
         GaussLegendre::new(LOW_ORDER),
     );
-    let (mut i_hi, mut i_lo) = (0.0, 0.0);
+    let (mut total, mut err) = (0.0, 0.0);
     for leaf in leaves {
-        i_hi += integrate_leaf(f, &leaf.rect, &hi);
-        i_lo += integrate_leaf(f, &leaf.rect, &lo);
+        let (v, e) = integrate_adaptive(f, &leaf.rect, (&hi, &lo), TOL * scale, 0);
+        total += v;
+        err += e;
     }
-    let err = if i_hi > 0.0 {
-        (i_hi - i_lo).abs() / i_hi
+    let rel = if total > 0.0 {
+        err / total
     } else {
         f64::INFINITY
     };
-    (i_hi, err)
+    (total, rel)
 }
 
 #[cfg(test)]
@@ -121,10 +162,10 @@ mod tests {
             leaf(-1.0, 0.0, 0.0, 1.0),
             leaf(0.0, 0.0, 1.0, 1.0),
         ];
-        let (a, _) = leaf_quadrature(&inside, q.iter().copied());
+        let (a, _) = leaf_quadrature(&inside, q.iter().copied(), 1.0);
         assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-9);
         // One leaf over the whole square (Lambert's tree): the vertical tangents at x = ±1.
-        let (a, _) = leaf_quadrature(&inside, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter());
+        let (a, _) = leaf_quadrature(&inside, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(), 1.0);
         assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-9);
         // ∫_D (1 − r²) dA = π/2 on a 4 × 4 partition of the square.
         let g = |p: [f64; 2]| {
@@ -142,9 +183,37 @@ mod tests {
                 )
             })
             .collect();
-        let (v, err) = leaf_quadrature(&g, cells.iter().copied());
+        let (v, err) = leaf_quadrature(&g, cells.iter().copied(), 1.0);
         assert_relative_eq!(v, std::f64::consts::FRAC_PI_2, max_relative = 1e-5);
         assert!(err < 1e-3, "{err}");
+    }
+
+    #[test]
+    fn kinks_are_resolved_by_splitting() {
+        // max(0, x − 0.1) on the disc, one leaf: the kink at x = 0.1 crosses it.
+        let g = |p: [f64; 2]| {
+            if p[0] * p[0] + p[1] * p[1] < 1.0 {
+                (p[0] - 0.1).max(0.0)
+            } else {
+                0.0
+            }
+        };
+        // ∫_{0.1}^{1} (x − 0.1) · 2√(1 − x²) dx, by a fine midpoint sum.
+        let n = 2_000_000;
+        let h = 0.9 / n as f64;
+        let exact: f64 = (0..n)
+            .map(|k| {
+                let x = 0.1 + (k as f64 + 0.5) * h;
+                (x - 0.1) * 2.0 * (1.0 - x * x).sqrt() * h
+            })
+            .sum();
+        let (v, err) = leaf_quadrature(&g, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(), 1.0);
+        assert_relative_eq!(v, exact, max_relative = 1e-5);
+        assert!(err < 1e-3 && err >= (v / exact - 1.0).abs(), "{err}");
+        // Without splitting, the same rule is far off.
+        let hi = GaussLegendre::new(HIGH_ORDER);
+        let one = integrate_leaf(&g, &Rect::new(-1.0, -1.0, 1.0, 1.0), &hi);
+        assert!((one / exact - 1.0).abs() > 10.0 * (v / exact - 1.0).abs());
     }
 
     #[test]
@@ -159,7 +228,7 @@ mod tests {
         // Exact integral over the leaf (±3.75 σ): 2π σ² erf(3.75/√2)².
         let e = statrs::function::erf::erf(0.015 / (s * std::f64::consts::SQRT_2));
         let exact = 2.0 * std::f64::consts::PI * s * s * e * e;
-        let (v, _) = leaf_quadrature(&g, [leaf(0.285, 0.185, 0.315, 0.215)].into_iter());
+        let (v, _) = leaf_quadrature(&g, [leaf(0.285, 0.185, 0.315, 0.215)].into_iter(), 1e-4);
         assert_relative_eq!(v, exact, max_relative = 2e-3);
         let midpoint: f64 = [
             [0.2925, 0.1925],

@@ -195,8 +195,10 @@ fn build_slice(
                 f: &f,
                 counter: &counter,
             };
-            let (i_leaves, rel_err) = leaf_quadrature(&counted, tree.leaves());
-            if i_leaves.is_finite() && i_leaves > 0.0 {
+            let (i_leaves, rel_err) = leaf_quadrature(&counted, tree.leaves(), tree.integral());
+            // Keep the grid's Î when its own error estimate is the smaller one.
+            let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
+            if i_leaves.is_finite() && i_leaves > 0.0 && rel_err <= grid_err {
                 SliceNorm {
                     factor: tree.integral() / i_leaves,
                     rel_err: Some(rel_err),

@@ -169,6 +169,11 @@ impl QuadTree {
         self.integral
     }
 
+    /// Estimated relative error of [`QuadTree::integral`], when the provider knows one.
+    pub fn integral_rel_err(&self) -> Option<f64> {
+        self.integral_rel_err
+    }
+
     /// `Σ V_i` over sampleable leaves.
     pub fn volume(&self) -> f64 {
         self.volume
