@@ -214,6 +214,10 @@ impl RimBand {
 pub(crate) struct SliceImageMap<'a> {
     grid: SampledGridDensity<Counted<'a>>,
     band: RimBand,
+    /// The mirror direction's disc point and `f` there: glossy lobes peak at (or cusp towards)
+    /// it, and a cusp's tip falls between grid points (Beard–Maxwell's `SO(θn)` is linear in
+    /// `θn`: 51 violations per 9·10⁶ samples without this point, see `region`).
+    peak: (Point2, f64),
     safety: f64,
     /// Bounds are taken over the cell grown by this many fine cells on every side.
     dilation: f64,
@@ -228,12 +232,24 @@ impl<'a> SliceImageMap<'a> {
         dilation: u32,
     ) -> Result<Self, DensityError> {
         let band = RimBand::new(&f, grid)?;
+        let wo = f.f.wo();
+        let mirror = brdf::Vec3::new(-wo.x, -wo.y, wo.z);
+        let at = f.f.map().to_disc(&mirror);
+        let value = f.eval(at);
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(DensityError::InvalidSample {
+                x: at[0],
+                y: at[1],
+                value,
+            });
+        }
         let h = 2.0 / grid as f64;
         let grid =
             SampledGridDensity::new(f, Domain::UnitDisc, grid)?.with_safety_factor(safety)?;
         Ok(Self {
             grid,
             band,
+            peak: (at, value),
             safety,
             dilation: f64::from(dilation) * h,
         })
@@ -263,6 +279,9 @@ impl RegionStats for SliceImageMap<'_> {
                 (cell.y1 + d).min(1.0),
             );
             est.max_bound = est.max_bound.max(self.grid.region(&grown).max_bound);
+        }
+        if cell.contains(self.peak.0) {
+            est.max_bound = est.max_bound.max(self.safety * self.peak.1);
         }
         if let Some(m) = self.band.max_in(cell) {
             est.max_bound = est.max_bound.max(self.safety * m);
