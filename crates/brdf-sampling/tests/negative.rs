@@ -84,9 +84,28 @@ fn broken_pdfs_are_rejected_and_the_honest_one_passes() {
     }
 }
 
+/// A narrow retro-reflection lobe (peak at `ωi = ωo`, away from the mirror direction that the
+/// image map samples explicitly) over a weak diffuse floor.
+struct Retro;
+
+impl brdf::Brdf for Retro {
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
+        0.02 + 40.0 * (-(wi - wo).norm_squared() / 0.004).exp()
+    }
+    fn is_isotropic(&self) -> bool {
+        true
+    }
+    fn name(&self) -> &str {
+        "retro"
+    }
+}
+
 #[test]
 fn bounds_too_low_are_audited_and_rejected() {
-    // A 8 × 8 image map without safety factor cannot see a Phong lobe of exponent 200: the
+    // A 8 × 8 image map without safety factor cannot see a narrow retro-reflection lobe: the
     // leaf bounds are too low, the audit counts violations and the samples follow min(f, M).
     let opts = SetOptions {
         slices: 9,
@@ -95,7 +114,8 @@ fn bounds_too_low_are_audited_and_rejected() {
         safety_factor: 1.0,
         ..SetOptions::default()
     };
-    let set = build("phong:n=200,kd=0", Variant::Adaptive, &opts);
+    let retro: std::sync::Arc<dyn brdf::Brdf> = std::sync::Arc::new(Retro);
+    let set = QuadTreeSet::build(retro.clone(), Variant::Adaptive, &opts).unwrap();
     let wo = wo_at(35.0);
     let samples = draw(&set, &wo, 20_000, 9);
     let rep = set.report();
@@ -107,7 +127,7 @@ fn bounds_too_low_are_audited_and_rejected() {
         r.summary()
     );
     // The defaults on the same BRDF and direction: no violation, test passes.
-    let good = build("phong:n=200,kd=0", Variant::Adaptive, &test_options());
+    let good = QuadTreeSet::build(retro, Variant::Adaptive, &test_options()).unwrap();
     let samples = draw(&good, &wo, 20_000, 9);
     assert_eq!(good.report().bound_violations, 0);
     let r = chi_square(&samples, &|w| good.pdf(&wo, w));
