@@ -46,6 +46,8 @@ mod params;
 pub mod quadrature;
 mod registry;
 pub mod special;
+#[cfg(test)]
+mod test_support;
 
 pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, luminance};
 pub use geometry::{

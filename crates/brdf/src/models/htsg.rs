@@ -528,9 +528,10 @@ impl Brdf for Htsg {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{direction_from_angles, direction_from_radians, mirror};
+    use crate::geometry::direction_from_angles;
     use crate::models::{Microfacet, MicrofacetParams};
     use crate::special::beckmann_lambda;
+    use crate::test_support::compare_to_reference;
     use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
 
     /// The implementation before the speed work (shadow/K with separate `erfc` calls, Newton
@@ -672,46 +673,12 @@ mod tests {
         ]
     }
 
-    /// Deviation of `new` from `reference` on a fixed set of 48 `ωo` (θo uniform in [0°, 89°])
-    /// × 64 `ωi` (cosine-distributed) pairs. The lobe peak for each `ωo` is the largest reference
-    /// value over its 64 `ωi` and the mirror direction. Returns (worst ratio of the deviation to
-    /// the allowance `max(1e-9·|ref|, 1e-12·peak)`, max relative deviation where
-    /// `ref ≥ 1e-6·peak`, max |deviation|/peak).
+    /// [`compare_to_reference`] on 48 × 64 pairs (seed 31), allowance `max(1e-9·|ref|, 1e-12·peak)`.
     fn compare(
         new: impl Fn(&Vec3, &Vec3) -> f64,
         reference: impl Fn(&Vec3, &Vec3) -> f64,
     ) -> (f64, f64, f64) {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(31);
-        let (mut worst, mut max_rel, mut max_abs) = (0.0f64, 0.0f64, 0.0f64);
-        for _ in 0..48 {
-            let wo = direction_from_radians(
-                rng.random_range(0.0..89.0f64).to_radians(),
-                rng.random_range(0.0..2.0 * PI),
-            );
-            let wis: Vec<Vec3> = (0..64)
-                .map(|_| {
-                    let u: f64 = rng.random();
-                    direction_from_radians(u.sqrt().asin(), rng.random_range(0.0..2.0 * PI))
-                })
-                .collect();
-            let refs: Vec<f64> = wis.iter().map(|wi| reference(&wo, wi)).collect();
-            let peak = refs
-                .iter()
-                .fold(reference(&wo, &mirror(&wo)), |m, &v| m.max(v));
-            for (wi, &r) in wis.iter().zip(&refs) {
-                let v = new(&wo, wi);
-                assert!(v.is_finite(), "non-finite value at {wo:?} {wi:?}");
-                let dev = (v - r).abs();
-                worst = worst.max(dev / (1e-9 * r.abs()).max(1e-12 * peak));
-                if r >= 1e-6 * peak {
-                    max_rel = max_rel.max(dev / r);
-                }
-                if peak > 0.0 {
-                    max_abs = max_abs.max(dev / peak);
-                }
-            }
-        }
-        (worst, max_rel, max_abs)
+        compare_to_reference(new, reference, (31, 48, 64), 1e-9, 1e-12)
     }
 
     #[test]

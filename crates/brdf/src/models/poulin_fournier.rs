@@ -509,8 +509,8 @@ impl Brdf for PoulinFournier {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{direction_from_radians, mirror};
-    use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
+    use crate::geometry::mirror;
+    use crate::test_support::compare_to_reference;
 
     /// The implementation before the speed work (12-point Gauss–Legendre panels split at
     /// `atan2(s_y, s_z)` and ± the lobe width, for every exponent), kept verbatim as the
@@ -660,47 +660,14 @@ mod tests {
         }
     }
 
-    /// Worst deviation of `new` from `reference` on 40 `ωo` (θo uniform in [0°, 89°]) × 40 `ωi`
-    /// (cosine-distributed): (worst ratio to the allowance `max(rel·|ref|, abs·peak)`, max
-    /// relative deviation where `ref ≥ 10⁻⁶ peak`, max |deviation|/peak). The lobe peak of an
-    /// `ωo` is the largest reference value over its `ωi` and the mirror direction.
+    /// [`compare_to_reference`] on 40 × 40 pairs (seed 77).
     fn compare(
         new: impl Fn(&Vec3, &Vec3) -> f64,
         reference: impl Fn(&Vec3, &Vec3) -> f64,
         rel: f64,
         abs: f64,
     ) -> (f64, f64, f64) {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(77);
-        let (mut worst, mut max_rel, mut max_abs) = (0.0f64, 0.0f64, 0.0f64);
-        for _ in 0..40 {
-            let wo = direction_from_radians(
-                rng.random_range(0.0..89.0f64).to_radians(),
-                rng.random_range(0.0..2.0 * PI),
-            );
-            let wis: Vec<Vec3> = (0..40)
-                .map(|_| {
-                    let u: f64 = rng.random();
-                    direction_from_radians(u.sqrt().asin(), rng.random_range(0.0..2.0 * PI))
-                })
-                .collect();
-            let refs: Vec<f64> = wis.iter().map(|wi| reference(&wo, wi)).collect();
-            let peak = refs
-                .iter()
-                .fold(reference(&wo, &mirror(&wo)), |m, &v| m.max(v));
-            for (wi, &r) in wis.iter().zip(&refs) {
-                let v = new(&wo, wi);
-                assert!(v.is_finite(), "non-finite value at {wo:?} {wi:?}");
-                let dev = (v - r).abs();
-                worst = worst.max(dev / (rel * r.abs()).max(abs * peak));
-                if r >= 1e-6 * peak {
-                    max_rel = max_rel.max(dev / r);
-                }
-                if peak > 0.0 {
-                    max_abs = max_abs.max(dev / peak);
-                }
-            }
-        }
-        (worst, max_rel, max_abs)
+        compare_to_reference(new, reference, (77, 40, 40), rel, abs)
     }
 
     fn pf(d: f64, n: f64, ks: f64, kd: f64) -> PoulinFournierParams {
