@@ -57,11 +57,10 @@ impl DiscMap {
     /// The direction of a disc point (`z = 0` on and outside the circle).
     #[inline]
     pub fn to_direction(self, p: Point2) -> Vec3 {
-        let r2 = p[0] * p[0] + p[1] * p[1];
         match self {
             DiscMap::Projected => disc_to_direction(p),
             DiscMap::EqualArea => {
-                let r2 = r2.min(1.0);
+                let r2 = (p[0] * p[0] + p[1] * p[1]).min(1.0);
                 let s = (2.0 - r2).sqrt();
                 Vec3::new(p[0] * s, p[1] * s, 1.0 - r2)
             }

@@ -114,19 +114,7 @@ impl RimBand {
             let (s, c) = (q as f64 * TAU / angles as f64).sin_cos();
             radii
                 .iter()
-                .map(|&r| {
-                    let p = [r * c, r * s];
-                    let v = f.eval(p);
-                    if v.is_finite() && v >= 0.0 {
-                        Ok(v)
-                    } else {
-                        Err(DensityError::InvalidSample {
-                            x: p[0],
-                            y: p[1],
-                            value: v,
-                        })
-                    }
-                })
+                .map(|&r| f.eval_checked([r * c, r * s]))
                 .collect()
         };
         let cols: Vec<Vec<f64>> = (0..angles)
@@ -232,17 +220,8 @@ impl<'a> SliceImageMap<'a> {
         dilation: u32,
     ) -> Result<Self, DensityError> {
         let band = RimBand::new(&f, grid)?;
-        let wo = f.f.wo();
-        let mirror = brdf::Vec3::new(-wo.x, -wo.y, wo.z);
-        let at = f.f.map().to_disc(&mirror);
-        let value = f.eval(at);
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(DensityError::InvalidSample {
-                x: at[0],
-                y: at[1],
-                value,
-            });
-        }
+        let at = f.f.map().to_disc(&brdf::mirror(f.f.wo()));
+        let value = f.eval_checked(at)?;
         let h = 2.0 / grid as f64;
         let grid =
             SampledGridDensity::new(f, Domain::UnitDisc, grid)?.with_safety_factor(safety)?;

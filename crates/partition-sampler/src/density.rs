@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::DensityError;
 use crate::rect::{Domain, Rect};
 use crate::sampler::Point2;
 
@@ -12,6 +13,21 @@ use crate::sampler::Point2;
 pub trait Density: Sync {
     /// `f(p) ≥ 0`.
     fn eval(&self, p: Point2) -> f64;
+
+    /// `f(p)`, or [`DensityError::InvalidSample`] when it is NaN, negative or infinite (what
+    /// the region-statistics providers use on user densities).
+    fn eval_checked(&self, p: Point2) -> Result<f64, DensityError> {
+        let v = self.eval(p);
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(DensityError::InvalidSample {
+                x: p[0],
+                y: p[1],
+                value: v,
+            })
+        }
+    }
 }
 
 impl<F: Fn(Point2) -> f64 + Sync> Density for F {

@@ -58,16 +58,7 @@ fn eval_checked<D: Density>(f: &D, domain: &Domain, p: Point2) -> Result<f64, De
     if !domain.contains(p) {
         return Ok(0.0);
     }
-    let v = f.eval(p);
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(DensityError::InvalidSample {
-            x: p[0],
-            y: p[1],
-            value: v,
-        })
-    }
+    f.eval_checked(p)
 }
 
 /// Statistics of one boundary cell: (max, integral with 8×8 sub-grid, integral with 4×4).
