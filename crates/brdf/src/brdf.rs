@@ -38,6 +38,30 @@ pub trait Brdf: Send + Sync {
         false
     }
 
+    /// True when `f_r` is isotropic **and** mirror-symmetric about the tangent–normal (xz)
+    /// plane: `f_r(M ωo, M ωi) = f_r(ωo, ωi)` for the reflection `M(x, y, z) = (x, −y, z)`.
+    /// Together these mean `f_r` depends on `φi − φo` only through `cos(φi − φo)`. Then, for `ωo`
+    /// in the xz-plane (`φo = 0`, so `M ωo = ωo`), the slice `f_r(ωo, ·)` is even under
+    /// `y ↦ −y` (`φi ↦ −φi`): a sampler may rotate `ωo` to `φo = 0`, evaluate one half of the
+    /// slice and mirror it.
+    ///
+    /// Default `false` (the safe answer). Measured data keep `false` unless their table is
+    /// symmetric: MERL's `φd` fold identifies `φd` with `φd + π` but not with `−φd`.
+    fn is_mirror_symmetric(&self) -> bool {
+        false
+    }
+
+    /// True when `f_r(R_π ωo, R_π ωi) = f_r(ωo, ωi)` for the half-turn about the normal,
+    /// `R_π(x, y, z) = (−x, −y, z)`. Every isotropic BRDF has it; an anisotropic one has it when
+    /// its anisotropy is elliptical (terms in `x²`, `y²`, `x x'`, `y y'` of the two directions or
+    /// of the half vector). Then the slice at `φo + π` is the slice at `φo` turned by `π`, and a
+    /// sampler of an anisotropic BRDF may store outgoing azimuths over `[0, π)` only.
+    ///
+    /// Default `false` (the safe answer).
+    fn is_half_turn_symmetric(&self) -> bool {
+        false
+    }
+
     /// True when `f_r(ωo, ωi) = f_r(ωi, ωo)` (Helmholtz reciprocity). Default `false`.
     fn is_reciprocal(&self) -> bool {
         false
@@ -79,6 +103,12 @@ macro_rules! forward_brdf {
             }
             fn is_isotropic(&self) -> bool {
                 (**self).is_isotropic()
+            }
+            fn is_mirror_symmetric(&self) -> bool {
+                (**self).is_mirror_symmetric()
+            }
+            fn is_half_turn_symmetric(&self) -> bool {
+                (**self).is_half_turn_symmetric()
             }
             fn is_reciprocal(&self) -> bool {
                 (**self).is_reciprocal()

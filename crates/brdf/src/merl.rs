@@ -443,6 +443,12 @@ impl Brdf for MerlBrdf {
     fn is_isotropic(&self) -> bool {
         true
     }
+    // `is_mirror_symmetric` stays false: the φd fold identifies φd with φd + π, not with −φd.
+    /// The lookup depends on `(θh, θd, φd)` only, which a common rotation about the normal
+    /// (here by `π`) leaves unchanged (up to rounding at bin edges).
+    fn is_half_turn_symmetric(&self) -> bool {
+        true
+    }
     /// The φd fold maps (ωo, ωi) and (ωi, ωo) to the same bin (up to rounding at bin edges).
     fn is_reciprocal(&self) -> bool {
         true

@@ -127,6 +127,14 @@ impl Brdf for AshikhminShirley {
     fn is_isotropic(&self) -> bool {
         self.params.nu == self.params.nv
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): h_x², h_y², ωi·h and cosines only.
+        self.is_isotropic()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Even under (x, y) ↦ (−x, −y) for all nu, nv: h_x², h_y², ωi·h and cosines only.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

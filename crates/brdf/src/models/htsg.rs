@@ -517,6 +517,14 @@ impl Brdf for Htsg {
     fn is_isotropic(&self) -> bool {
         true
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): s_x² + s_y², s_z, |s| and cosines only.
+        true
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Isotropic, and R_π is a rotation about the normal.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

@@ -179,6 +179,14 @@ impl Brdf for Lafortune {
     fn is_isotropic(&self) -> bool {
         self.params.lobes.iter().all(|l| l.cx == l.cy)
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): the products ωo.x ωi.x, ωo.y ωi.y, ωo.z ωi.z.
+        self.is_isotropic()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Even under (x, y) ↦ (−x, −y) for all Cx, Cy: the products ωo.x ωi.x, ωo.y ωi.y, ωo.z ωi.z.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

@@ -192,6 +192,14 @@ impl Brdf for Microfacet {
     fn is_isotropic(&self) -> bool {
         self.params.alpha_x == self.params.alpha_y
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): squared x/y components, ωi·h, cosines.
+        self.is_isotropic()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Even under (x, y) ↦ (−x, −y) for all αx, αy: D and Λ use squared x/y components only.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

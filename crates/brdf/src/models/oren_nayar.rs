@@ -98,6 +98,14 @@ impl Brdf for OrenNayar {
     fn is_isotropic(&self) -> bool {
         true
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): ωi.x ωo.x + ωi.y ωo.y and cosines only.
+        true
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Isotropic, and R_π is a rotation about the normal.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

@@ -495,6 +495,13 @@ impl Brdf for PoulinFournier {
     fn is_isotropic(&self) -> bool {
         false
     }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // (x, y) ↦ (−x, −y) keeps A, B = −ωo,x ωi,x and cosΔ, and flips ψ ↦ −ψ: the visible and
+        // lit ranges (which use |ω_y| only) become [−γ1, −γ0], so [δa, δb] becomes [−δb, −δa],
+        // and both the diffuse term and the lobe F(δ) (even in δ) integrate to the same value.
+        // (The cylinder surface, translation-invariant in x and even in y, is half-turn symmetric.)
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

@@ -195,6 +195,14 @@ impl Brdf for Schlick {
     fn is_isotropic(&self) -> bool {
         self.params.p == 1.0
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): n·h, ωi·h, h_x²/(h_x² + h_y²) and cosines only.
+        self.is_isotropic()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Even under (x, y) ↦ (−x, −y) for all p: A(w) uses h_x²/(h_x² + h_y²) only.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }

@@ -140,6 +140,14 @@ impl Brdf for Strauss {
     fn is_isotropic(&self) -> bool {
         true
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): mirror dot product and cosines only.
+        true
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Isotropic, and R_π is a rotation about the normal.
+        true
+    }
     fn name(&self) -> &str {
         NAME
     }

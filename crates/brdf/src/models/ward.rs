@@ -173,6 +173,14 @@ impl Brdf for Ward {
     fn is_isotropic(&self) -> bool {
         self.params.alpha_x == self.params.alpha_y
     }
+    fn is_mirror_symmetric(&self) -> bool {
+        // Even under (x, y, z) ↦ (x, −y, z): h_x², h_y², h·h and cosines only.
+        self.is_isotropic()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        // Even under (x, y) ↦ (−x, −y) for all αx, αy: h_x², h_y², h·h and cosines only.
+        true
+    }
     fn is_reciprocal(&self) -> bool {
         true
     }
