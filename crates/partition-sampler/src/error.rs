@@ -73,6 +73,28 @@ pub enum DensityError {
     /// The safety factor must be finite and ≥ 1.
     #[error("safety factor {0} must be finite and ≥ 1")]
     InvalidSafetyFactor(f64),
+    /// A refinement needs power-of-two `n` and `coarsest ≥ 2` and a finite tolerance `≥ 0`.
+    #[error(
+        "invalid grid refinement: resolution {n}, coarsest {coarsest}, tolerance {tolerance} (need powers of two, coarsest ≥ 2, and a finite tolerance ≥ 0)"
+    )]
+    InvalidRefinement {
+        /// Grid resolution.
+        n: usize,
+        /// Requested coarsest resolution.
+        coarsest: usize,
+        /// Requested tolerance.
+        tolerance: f64,
+    },
+    /// Mirroring needs an even resolution and a domain symmetric about `y = 0`.
+    #[error(
+        "mirror symmetry y ↦ −y needs an even resolution ({n}) and a domain symmetric about y = 0 ({domain:?})"
+    )]
+    InvalidMirror {
+        /// Grid resolution.
+        n: usize,
+        /// The domain's bounding rectangle.
+        domain: Rect,
+    },
     /// The quadrature resolution must be even and in `2 ..= 1024`.
     #[error("quadrature resolution {0} must be even and in 2 ..= 1024")]
     InvalidQuadrature(usize),

@@ -74,7 +74,10 @@ pub use density::{
 pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
 pub use persist::FORMAT_VERSION;
 pub use rect::{Domain, Rect};
-pub use sampled::{DEFAULT_SAFETY_FACTOR, SampledGridDensity};
+pub use sampled::{
+    DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
+    Refinement, SampledGridDensity,
+};
 pub use sampler::{
     AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
 };
