@@ -3,14 +3,16 @@
 //! trials, BRDF evaluations per accepted sample, bound violations and the sampling rate.
 //!
 //! Run: `cargo run --release -p brdf-sampling --example model_table [-- OPTIONS]`
-//! Columns: median wall-clock build time on the default rayon pool (`build s`), one build on a
-//! the CPU seconds of one more build (`CPU s`; ≈ 2 × the wall time on 2 idle cores), memory, leaves per tree, expected and measured
+//! Columns: median wall-clock build time on the default rayon pool (`build s`), the CPU seconds
+//! of one more build (`CPU s`; ≈ 2 × the wall time on 2 idle cores), memory, leaves per tree, expected and measured
 //! trials per sample, BRDF evaluations per accepted sample, bound violations, samples per
 //! second on one thread at random outgoing directions.
 //!
 //! Options: `--runs R` (default 3), `--grid N`, `--depth D`, `--tol T`, `--slices K`, `--nmax X`,
 //! `--safety S`, `--dilation D`, `--disc-map auto|projected|equal-area`, `--ea-from DEG`,
-//! `--variant adaptive|adaptive-paper`, `--only name,name`, `--per-slice S` (default 2000).
+//! `--variant adaptive|adaptive-paper`, `--only name,name`, `--per-slice S` (default 2000),
+//! `--specs 'spec;spec'` (these BRDF specs instead of the model list), `--dense` (the dense
+//! image map instead of the refined one), `--no-symmetry` (ignore the BRDFs' declared symmetries).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -150,6 +152,12 @@ fn main() {
             }
         }
     }
+    if args.iter().any(|a| a == "--dense") {
+        opts.grid_refinement = None;
+    }
+    if args.iter().any(|a| a == "--no-symmetry") {
+        opts.symmetries = false;
+    }
     let variant = match arg::<String>(&args, "--variant").as_deref() {
         Some("adaptive-paper") => Variant::Paper,
         _ => Variant::Adaptive,
@@ -199,6 +207,9 @@ fn main() {
         .map(|m| m.name.to_string())
         .collect();
     specs.push("merl(phong:n=50)".to_string());
+    if let Some(list) = arg::<String>(&args, "--specs") {
+        specs = list.split(';').map(str::to_string).collect();
+    }
     for spec in specs.iter().filter(|s| wanted(s)) {
         let brdf: Arc<dyn Brdf> =
             if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {

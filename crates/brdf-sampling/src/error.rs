@@ -33,6 +33,26 @@ pub enum SetError {
         /// The cause.
         source: partition_sampler::BuildError,
     },
+    /// The BRDF declares [`brdf::Brdf::is_mirror_symmetric`] but a probe found
+    /// `f(x, y) ≠ f(x, −y)` on a slice's disc.
+    #[error(
+        "slice {slice} (θo = {theta_deg:.3}°): the BRDF declares mirror symmetry but f({x:.4}, {y:.4}) = {a} ≠ f({x:.4}, {neg_y:.4}) = {b}",
+        neg_y = -y
+    )]
+    MirrorAsymmetry {
+        /// Slice index.
+        slice: usize,
+        /// θ of the slice (degrees).
+        theta_deg: f64,
+        /// x of the probe point on the disc.
+        x: f64,
+        /// y of the probe point on the disc.
+        y: f64,
+        /// Density at `(x, y)`.
+        a: f64,
+        /// Density at `(x, −y)`.
+        b: f64,
+    },
     /// A built tree could not be attached to its density.
     #[error("slice {slice}: {source}")]
     Attach {

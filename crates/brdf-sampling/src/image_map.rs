@@ -22,8 +22,8 @@ use std::f64::consts::TAU;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 use partition_sampler::{
-    Density, DensityError, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate,
-    RegionStats, SampledGridDensity,
+    Density, DensityError, DensityShape, Domain, GridOptions, IntegralSource, Point2, Rect,
+    RegionEstimate, RegionStats, SampledGridDensity,
 };
 use rayon::prelude::*;
 
@@ -31,6 +31,9 @@ use crate::disc::{DiscBrdf, DiscMap};
 
 /// Heights `z = cos θ` of the rim band: `z_max · 2^(−m/2)`, `m = 0 .. RIM_LEVELS`.
 const RIM_LEVELS: usize = 35;
+
+/// Largest azimuth stride of the refined rim band's first columns.
+const RIM_COARSEST_STRIDE: usize = 16;
 
 /// One evaluation counter per rayon worker, each on its own cache line.
 #[repr(align(64))]
@@ -96,7 +99,14 @@ struct RimBand {
 }
 
 impl RimBand {
-    fn new(f: &Counted<'_>, grid: usize) -> Result<Self, DensityError> {
+    /// `tolerance`: refine the azimuths from a coarse set where second differences demand it
+    /// (`None`: every azimuth).
+    fn new(
+        f: &Counted<'_>,
+        grid: usize,
+        mirror: bool,
+        tolerance: Option<f64>,
+    ) -> Result<Self, DensityError> {
         let bins = 2 * grid;
         let z_max = (2.0 / (grid as f64).sqrt()).min(0.5);
         // Disc radius of height z: √(1 − z²) (projected) or √(1 − z) (equal-area).
@@ -117,10 +127,86 @@ impl RimBand {
                 .map(|&r| f.eval_checked([r * c, r * s]))
                 .collect()
         };
-        let cols: Vec<Vec<f64>> = (0..angles)
-            .into_par_iter()
-            .map(column)
-            .collect::<Result<_, _>>()?;
+        // With f(x, −y) = f(x, y), azimuth q and angles − q share a column: only
+        // q ≤ angles/2 is needed. Otherwise column `angles` is column 0 again.
+        let last = if mirror { angles / 2 } else { angles };
+        let mut cols: Vec<Option<Vec<f64>>> = vec![None; last + 1];
+        let evaluate = |qs: Vec<usize>, cols: &mut Vec<Option<Vec<f64>>>| {
+            let got: Vec<Result<Vec<f64>, DensityError>> =
+                qs.par_iter().map(|&q| column(q % angles)).collect();
+            for (q, c) in qs.into_iter().zip(got) {
+                cols[q] = Some(c?);
+            }
+            Ok::<(), DensityError>(())
+        };
+        // Coarse columns every `start` azimuths (a power of two dividing `last`), then
+        // bisection of every interval whose midpoint column shows a second difference above
+        // `tol` at some height.
+        let start = (1..=RIM_COARSEST_STRIDE.trailing_zeros())
+            .rev()
+            .map(|k| 1usize << k)
+            .find(|&st| last % st == 0);
+        match tolerance.zip(start) {
+            None => evaluate((0..=last).collect(), &mut cols)?,
+            Some((tol, start)) => {
+                evaluate((0..=last).step_by(start).collect(), &mut cols)?;
+                let mut intervals: Vec<(usize, usize)> =
+                    (0..last).step_by(start).map(|q| (q, start)).collect();
+                while !intervals.is_empty() {
+                    evaluate(
+                        intervals.iter().map(|&(q, w)| q + w / 2).collect(),
+                        &mut cols,
+                    )?;
+                    let mut next = Vec::new();
+                    let mut estimates = Vec::new();
+                    for (q, w) in intervals {
+                        if w == 2 {
+                            continue;
+                        }
+                        let h = w / 2;
+                        let (a, c, b) = (&cols[q], &cols[q + h], &cols[q + w]);
+                        let (a, c, b) = (
+                            a.as_deref().unwrap_or_default(),
+                            c.as_deref().unwrap_or_default(),
+                            b.as_deref().unwrap_or_default(),
+                        );
+                        let smooth = (0..a.len()).all(|m| {
+                            let vmax = a[m].max(b[m]).max(c[m]);
+                            (a[m] - 2.0 * c[m] + b[m]).abs() / 8.0 <= tol * vmax
+                        });
+                        if !smooth {
+                            next.extend([(q, h), (q + h, h)]);
+                            continue;
+                        }
+                        // Kept: the columns in between get the piecewise-linear interpolant
+                        // plus the quadratic excess `|Δ|/8` as upper estimates.
+                        for j in (1..w).filter(|&j| j != h) {
+                            let (lo, hi, t) = if j < h {
+                                (a, c, j as f64 / h as f64)
+                            } else {
+                                (c, b, (j - h) as f64 / h as f64)
+                            };
+                            let est: Vec<f64> = (0..a.len())
+                                .map(|m| {
+                                    let excess = (a[m] - 2.0 * c[m] + b[m]).abs() / 8.0;
+                                    (1.0 - t) * lo[m] + t * hi[m] + excess
+                                })
+                                .collect();
+                            estimates.push((q + j, est));
+                        }
+                    }
+                    for (q, est) in estimates {
+                        cols[q] = Some(est);
+                    }
+                    intervals = next;
+                }
+            }
+        }
+        let mut cols: Vec<Vec<f64>> = cols.into_iter().map(Option::unwrap_or_default).collect();
+        for q in cols.len()..=angles {
+            let mirrored = cols[angles - q].clone();
+            cols.push(mirrored);
+        }
         let mut values = vec![0.0f64; bins * RIM_LEVELS];
         for b in 0..bins {
             for q in [2 * b, 2 * b + 1, (2 * b + 2) % angles] {
@@ -212,19 +298,31 @@ pub(crate) struct SliceImageMap<'a> {
 }
 
 impl<'a> SliceImageMap<'a> {
-    /// Evaluates the image map (`grid²` cells) and the rim band of `f`.
+    /// Evaluates the image map (`grid²` cells) and the rim band of `f`; `options` chooses the
+    /// image map's points (dense or refined, mirrored when `f(x, −y) = f(x, y)`).
     pub(crate) fn new(
         f: Counted<'a>,
         grid: usize,
         safety: f64,
         dilation: u32,
+        options: &GridOptions,
     ) -> Result<Self, DensityError> {
-        let band = RimBand::new(&f, grid)?;
+        let band = RimBand::new(
+            &f,
+            grid,
+            options.mirror_y,
+            options.refinement.map(|r| r.tolerance),
+        )?;
         let at = f.f.map().to_disc(&brdf::mirror(f.f.wo()));
         let value = f.eval_checked(at)?;
         let h = 2.0 / grid as f64;
-        let grid =
-            SampledGridDensity::new(f, Domain::UnitDisc, grid)?.with_safety_factor(safety)?;
+        // Glossy lobes peak at the mirror direction: resolve its neighbourhood fully.
+        let options = GridOptions {
+            focus: Some(at),
+            ..*options
+        };
+        let grid = SampledGridDensity::with_options(f, Domain::UnitDisc, grid, &options)?
+            .with_safety_factor(safety)?;
         Ok(Self {
             grid,
             band,
@@ -308,6 +406,7 @@ mod tests {
             64,
             1.1,
             0,
+            &GridOptions::default(),
         )
         .unwrap();
         let cell = Rect::new(0.5, -0.25, 1.0, 0.25);

@@ -2,15 +2,17 @@
 //! direction.
 //!
 //! Slice `(j, k)` has the outgoing direction `ωo_jk = (θ_j, φ_k)` with θ at bin centres
-//! `θ_j = (j + ½) · (π/2) / nθ` and `φ_k = k · 2π / nφ` (`nφ = 1`, `φ_0 = 0` for isotropic
-//! BRDFs). An outgoing direction `ωo = (θo, φo)` is served by the slice with the nearest θ and
+//! `θ_j = (j + ½) · (π/2) / nθ` and `φ_k = k · P / nφ` (`nφ = 1`, `φ_0 = 0` for isotropic
+//! BRDFs), where the azimuth period `P` is 2π, or π for a half-turn-symmetric BRDF
+//! ([`brdf::Brdf::is_half_turn_symmetric`]: the slice of `φo + π` is the slice of `φo` turned
+//! by π, so only `[0, π)` is stored). An outgoing direction `ωo = (θo, φo)` is served by the slice with the nearest θ and
 //! the nearest φ (circularly); the sampled direction is rotated about the normal by
 //! `Δ = φo − φ_k`. For isotropic BRDFs this is the papers' "rotate ωo to φ = 0, sample, rotate
 //! back"; for anisotropic ones it keeps the mirror direction of `ωo` exact and errs only in the
 //! orientation of the tangent frame (by at most `π/nφ`). The choice depends only on `ωo`, so the
 //! pdf of a direction is always evaluated with the slice that sampled it.
 
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use brdf::Vec3;
 use serde::{Deserialize, Serialize};
@@ -22,6 +24,8 @@ pub struct SliceLayout {
     pub theta: usize,
     /// φ slices `nφ` (1 for isotropic BRDFs).
     pub phi: usize,
+    /// The φ slices cover `[0, π)` instead of `[0, 2π)` (half-turn-symmetric BRDFs).
+    pub half_turn: bool,
 }
 
 /// One slice chosen for an outgoing direction, with its mixture weight and azimuthal rotation.
@@ -51,9 +55,14 @@ impl SliceLayout {
         (j as f64 + 0.5) * FRAC_PI_2 / self.theta as f64
     }
 
-    /// `φ_k = k · 2π / nφ` (radians).
+    /// The azimuth period `P` of the φ slices: π for a half-turn layout, else 2π.
+    pub fn phi_period(&self) -> f64 {
+        if self.half_turn { PI } else { TAU }
+    }
+
+    /// `φ_k = k · P / nφ` (radians).
     pub fn phi_of(&self, k: usize) -> f64 {
-        k as f64 * TAU / self.phi as f64
+        k as f64 * self.phi_period() / self.phi as f64
     }
 
     /// `(θ_j, φ_k)` of slice `index` (radians).
@@ -78,8 +87,9 @@ impl SliceLayout {
         }
         let theta = wo.z.min(1.0).acos();
         let phi = wo.y.atan2(wo.x);
-        let step = TAU / self.phi as f64;
-        let k = ((phi.rem_euclid(TAU) / step).round() as usize) % self.phi;
+        let period = self.phi_period();
+        let step = period / self.phi as f64;
+        let k = ((phi.rem_euclid(period) / step).round() as usize) % self.phi;
         Some((theta, k, phi - self.phi_of(k)))
     }
 
@@ -132,7 +142,11 @@ mod tests {
 
     #[test]
     fn nearest_slice_and_rotation() {
-        let l = SliceLayout { theta: 90, phi: 1 };
+        let l = SliceLayout {
+            theta: 90,
+            phi: 1,
+            half_turn: false,
+        };
         let c = l.nearest(&direction_from_angles(30.2, 40.0)).unwrap();
         assert_eq!(c.index, 30);
         assert_relative_eq!(l.theta_of(30).to_degrees(), 30.5, epsilon = 1e-12);
@@ -150,7 +164,11 @@ mod tests {
 
     #[test]
     fn anisotropic_nearest_phi_wraps() {
-        let l = SliceLayout { theta: 4, phi: 8 };
+        let l = SliceLayout {
+            theta: 4,
+            phi: 8,
+            half_turn: false,
+        };
         // φ = 350° is nearest to φ_0 = 0 with Δ = −10°.
         let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
         assert_eq!(c.index, 2 * 8);
@@ -164,8 +182,38 @@ mod tests {
     }
 
     #[test]
+    fn half_turn_layout_serves_the_opposite_azimuth_turned_by_pi() {
+        let l = SliceLayout {
+            theta: 4,
+            phi: 4,
+            half_turn: true,
+        };
+        // Slices at φ = 0°, 45°, 90°, 135°; φo = 227° is served by 45° turned by 182°.
+        let c = l.nearest(&direction_from_angles(50.0, 227.0)).unwrap();
+        assert_eq!(c.index % 4, 1);
+        assert_relative_eq!(
+            c.rotation.to_degrees().rem_euclid(360.0),
+            182.0,
+            epsilon = 1e-9
+        );
+        // φo = 350° is nearest to 180° ≡ slice 0, turned by 350°.
+        let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
+        assert_eq!(c.index % 4, 0);
+        assert_relative_eq!(
+            c.rotation.to_degrees().rem_euclid(360.0),
+            350.0,
+            epsilon = 1e-9
+        );
+        assert_relative_eq!(l.phi_of(3).to_degrees(), 135.0, epsilon = 1e-12);
+    }
+
+    #[test]
     fn neighbour_weights_are_linear_in_theta() {
-        let l = SliceLayout { theta: 9, phi: 1 };
+        let l = SliceLayout {
+            theta: 9,
+            phi: 1,
+            half_turn: false,
+        };
         // Centres at 5°, 15°, …, 85°.
         let [a, b] = l.neighbours(&direction_from_angles(12.5, 0.0)).unwrap();
         assert_eq!((a.index, b.index), (0, 1));

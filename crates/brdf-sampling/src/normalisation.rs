@@ -114,11 +114,16 @@ impl Ord for Piece {
 /// largest disagreement is split into quadrants (kinks such as Oren–Nayar's
 /// `max(0, cos Δφ)` cross leaves, and a Gauss rule converges slowly across them). The error
 /// estimate is the final `Σ |I_high − I_low| / Î` (conservative: it is the low order's error).
+///
+/// With `mirror` (`f(x, −y) = f(x, y)`), the leaves are clipped to the half `y ≤ 0` and the
+/// result doubled: `∫_D f = 2 ∫_{D ∩ {y ≤ 0}} f`.
 pub(crate) fn leaf_quadrature(
     f: &dyn Density,
     leaves: impl Iterator<Item = LeafInfo>,
     scale: f64,
+    mirror: bool,
 ) -> (f64, f64) {
+    let factor = if mirror { 2.0 } else { 1.0 };
     let (hi, lo) = (
         GaussLegendre::new(HIGH_ORDER),
         GaussLegendre::new(LOW_ORDER),
@@ -133,9 +138,19 @@ pub(crate) fn leaf_quadrature(
         let err = (value - integrate_leaf(&counted, &rect, &lo)).abs();
         Piece { rect, value, err }
     };
-    let mut heap: std::collections::BinaryHeap<Piece> = leaves.map(|l| piece(l.rect)).collect();
+    let mut heap: std::collections::BinaryHeap<Piece> = leaves
+        .filter_map(|l| {
+            if !mirror {
+                return Some(l.rect);
+            }
+            let r = l.rect;
+            (r.y0 < 0.0).then(|| Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0)))
+        })
+        .map(piece)
+        .collect();
     let mut err: f64 = heap.iter().map(|p| p.err).sum();
-    while err > TOL * scale && evals.load(std::sync::atomic::Ordering::Relaxed) < EVALUATION_BUDGET
+    while factor * err > TOL * scale
+        && evals.load(std::sync::atomic::Ordering::Relaxed) < EVALUATION_BUDGET
     {
         let Some(worst) = heap.pop() else { break };
         let r = worst.rect;
@@ -154,8 +169,8 @@ pub(crate) fn leaf_quadrature(
     }
     // The heap's storage order depends only on the sequence of pushes: a fixed summation order.
     let pieces = heap.into_vec();
-    let total: f64 = pieces.iter().map(|p| p.value).sum();
-    let err: f64 = pieces.iter().map(|p| p.err).sum();
+    let total: f64 = factor * pieces.iter().map(|p| p.value).sum::<f64>();
+    let err: f64 = factor * pieces.iter().map(|p| p.err).sum::<f64>();
     let rel = if total > 0.0 {
         err / total
     } else {
@@ -188,10 +203,18 @@ mod tests {
             leaf(-1.0, 0.0, 0.0, 1.0),
             leaf(0.0, 0.0, 1.0, 1.0),
         ];
-        let (a, _) = leaf_quadrature(&inside, q.iter().copied(), 1.0);
+        let (a, _) = leaf_quadrature(&inside, q.iter().copied(), 1.0, false);
+        assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-9);
+        // Mirrored: the lower half, doubled.
+        let (a, _) = leaf_quadrature(&inside, q.iter().copied(), 1.0, true);
         assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-9);
         // One leaf over the whole square (Lambert's tree): the vertical tangents at x = ±1.
-        let (a, _) = leaf_quadrature(&inside, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(), 1.0);
+        let (a, _) = leaf_quadrature(
+            &inside,
+            [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(),
+            1.0,
+            false,
+        );
         assert_relative_eq!(a, std::f64::consts::PI, max_relative = 1e-9);
         // ∫_D (1 − r²) dA = π/2 on a 4 × 4 partition of the square.
         let g = |p: [f64; 2]| {
@@ -209,7 +232,7 @@ mod tests {
                 )
             })
             .collect();
-        let (v, err) = leaf_quadrature(&g, cells.iter().copied(), 1.0);
+        let (v, err) = leaf_quadrature(&g, cells.iter().copied(), 1.0, false);
         assert_relative_eq!(v, std::f64::consts::FRAC_PI_2, max_relative = 1e-5);
         assert!(err < 1e-3, "{err}");
     }
@@ -233,7 +256,7 @@ mod tests {
                 (x - 0.1) * 2.0 * (1.0 - x * x).sqrt() * h
             })
             .sum();
-        let (v, err) = leaf_quadrature(&g, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(), 1.0);
+        let (v, err) = leaf_quadrature(&g, [leaf(-1.0, -1.0, 1.0, 1.0)].into_iter(), 1.0, false);
         assert_relative_eq!(v, exact, max_relative = 5e-5);
         assert!(err < 1e-3 && err >= (v / exact - 1.0).abs(), "{err}");
         // Without splitting, the same rule is far off.
@@ -255,7 +278,12 @@ mod tests {
         // Exact integral over the leaf (±3.75 σ): 2π σ² erf(3.75/√2)².
         let e = statrs::function::erf::erf(0.015 / (s * std::f64::consts::SQRT_2));
         let exact = 2.0 * std::f64::consts::PI * s * s * e * e;
-        let (v, _) = leaf_quadrature(&g, [leaf(0.285, 0.185, 0.315, 0.215)].into_iter(), 1e-4);
+        let (v, _) = leaf_quadrature(
+            &g,
+            [leaf(0.285, 0.185, 0.315, 0.215)].into_iter(),
+            1e-4,
+            false,
+        );
         assert_relative_eq!(v, exact, max_relative = 2e-3);
         let midpoint: f64 = [
             [0.2925, 0.1925],

@@ -1,5 +1,6 @@
 //! Build options of a quadtree set, with validation and measured defaults.
 
+use partition_sampler::Refinement;
 use serde::{Deserialize, Serialize};
 
 use crate::disc::DiscMap;
@@ -141,6 +142,17 @@ pub struct SetOptions {
     /// Outgoing polar angle (degrees) from which [`DiscMapPolicy::Auto`] uses the equal-area
     /// map (default [`DEFAULT_EQUAL_AREA_FROM_DEG`]; 90 = never for bounded BRDFs).
     pub equal_area_from_deg: f64,
+    /// Curvature-driven refinement of the adaptive variant's image map (default
+    /// `Some(Refinement::default())`: blocks from 32 × 32 down to the grid, 3 % excess);
+    /// `None` = the dense image map. The papers' variant always uses the dense map, whose
+    /// cell integrals are its leaf probabilities (seed 000 §3.7).
+    pub grid_refinement: Option<Refinement>,
+    /// Use the BRDF's declared symmetries (default `true`): an isotropic slice of a
+    /// [`brdf::Brdf::is_mirror_symmetric`] BRDF evaluates its half `y ≤ 0` and mirrors it (a
+    /// probe checks the declaration on every slice); an anisotropic
+    /// [`brdf::Brdf::is_half_turn_symmetric`] BRDF stores its (even) `anisotropic_slices[1]`
+    /// azimuths over `[0, π)` only, halving the trees at the same azimuth step.
+    pub symmetries: bool,
 }
 
 impl Default for SetOptions {
@@ -159,6 +171,8 @@ impl Default for SetOptions {
             mixture: false,
             disc_map: DiscMapPolicy::Auto,
             equal_area_from_deg: DEFAULT_EQUAL_AREA_FROM_DEG,
+            grid_refinement: Some(Refinement::default()),
+            symmetries: true,
         }
     }
 }
@@ -197,6 +211,17 @@ pub enum OptionsError {
     /// The equal-area switch angle must be in `[0, 90]` degrees.
     #[error("equal_area_from_deg = {0} must be in [0, 90] degrees")]
     InvalidEqualAreaAngle(f64),
+    /// The image-map refinement needs a power-of-two `coarsest ≥ 2` (clamped to the grid) and
+    /// a finite tolerance `≥ 0`.
+    #[error(
+        "grid refinement: coarsest {coarsest} must be a power of two ≥ 2 and tolerance {tolerance} finite and ≥ 0"
+    )]
+    InvalidGridRefinement {
+        /// The coarsest resolution.
+        coarsest: usize,
+        /// The tolerance.
+        tolerance: f64,
+    },
     /// Refinement would need a grid above [`MAX_GRID`] or a threshold that is not finite ≥ 1.
     #[error(
         "refinement: grid {grid} · 2^{levels} exceeds {MAX_GRID}, or threshold {threshold} is not finite and ≥ 1"
@@ -247,6 +272,17 @@ impl SetOptions {
             return Err(OptionsError::InvalidEqualAreaAngle(
                 self.equal_area_from_deg,
             ));
+        }
+        if let Some(r) = self.grid_refinement
+            && !(r.coarsest.is_power_of_two()
+                && r.coarsest >= 2
+                && r.tolerance.is_finite()
+                && r.tolerance >= 0.0)
+        {
+            return Err(OptionsError::InvalidGridRefinement {
+                coarsest: r.coarsest,
+                tolerance: r.tolerance,
+            });
         }
         let finest_grid = (self.grid as u64)
             .checked_shl(self.refine_levels.min(40))

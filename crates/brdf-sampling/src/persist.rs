@@ -22,7 +22,7 @@ use crate::options::SetOptions;
 use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for, sampler_name};
 
 /// Version of the stored set format; bumped on any incompatible change.
-pub const SET_FORMAT_VERSION: u32 = 2;
+pub const SET_FORMAT_VERSION: u32 = 3;
 
 const MAGIC: &[u8; 4] = b"BRQS";
 

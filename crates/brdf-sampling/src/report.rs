@@ -83,8 +83,16 @@ impl std::fmt::Display for SetReport {
         writeln!(f, "brdf               {} (spec `{}`)", self.brdf, self.spec)?;
         writeln!(
             f,
-            "slices             {} θ × {} φ = {} trees ({} on the equal-area disc)",
-            self.layout.theta, self.layout.phi, self.trees, self.equal_area_trees
+            "slices             {} θ × {} φ{} = {} trees ({} on the equal-area disc)",
+            self.layout.theta,
+            self.layout.phi,
+            if self.layout.half_turn {
+                " over [0°, 180°) (half-turn symmetry)"
+            } else {
+                ""
+            },
+            self.trees,
+            self.equal_area_trees
         )?;
         writeln!(
             f,

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3, rotate_z};
 use partition_sampler::{
-    AllocationMode, Audit, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sample2, Sampler2D,
-    Scheme, UniformSource,
+    AllocationMode, Audit, Density, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler,
+    Sample2, Sampler2D, Scheme, UniformSource,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -114,11 +114,17 @@ pub fn layout_for(brdf: &dyn Brdf, options: &SetOptions) -> SliceLayout {
         SliceLayout {
             theta: options.slices,
             phi: 1,
+            half_turn: false,
         }
     } else {
+        let [theta, phi] = options.anisotropic_slices;
+        // Half-turn symmetry: the same azimuth step over [0, π) (an even count is halved).
+        let half_turn =
+            options.symmetries && brdf.is_half_turn_symmetric() && phi.is_multiple_of(2);
         SliceLayout {
-            theta: options.anisotropic_slices[0],
-            phi: options.anisotropic_slices[1],
+            theta,
+            phi: if half_turn { phi / 2 } else { phi },
+            half_turn,
         }
     }
 }
@@ -141,6 +147,23 @@ pub(crate) struct SliceNorm {
     pub(crate) rel_err: Option<f64>,
 }
 
+/// Probes a declared mirror symmetry on 64 fixed points of the slice's disc (a Fibonacci
+/// spiral in the half `y < 0`, radii up to 0.999): the first `(x, y, f(x, y), f(x, −y))` whose
+/// values differ by more than `10⁻¹² · max(1, |f|)`.
+fn mirror_asymmetry(f: &DiscBrdf) -> Option<(f64, f64, f64, f64)> {
+    const PROBES: usize = 64;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..PROBES).find_map(|i| {
+        let r = 0.999 * ((i as f64 + 0.5) / PROBES as f64).sqrt();
+        // Angles in (π, 2π): y < 0.
+        let t =
+            std::f64::consts::PI * (1.0 + ((i as f64 * golden) / std::f64::consts::TAU).fract());
+        let (x, y) = (r * t.cos(), r * t.sin());
+        let (a, b) = (f.eval([x, y]), f.eval([x, -y]));
+        ((a - b).abs() > 1e-12 * a.abs().max(1.0)).then_some((x, y, a, b))
+    })
+}
+
 /// A built slice: its tree, the BRDF evaluations spent and its normalisation.
 type BuiltSlice = (QuadTreeSampler<SliceDensity>, u64, SliceNorm);
 
@@ -160,6 +183,25 @@ fn build_slice(
         .map_for(brdf.as_ref(), theta_deg, options.equal_area_from_deg);
     let f = DiscBrdf::with_map(Arc::clone(brdf), layout.direction_of(index), disc_map);
     let counter = EvalCounter::new();
+    let mirror_y = options.symmetries && brdf.is_mirror_symmetric() && layout.phi == 1 && p == 0.0;
+    if mirror_y && let Some((x, y, a, b)) = mirror_asymmetry(&f) {
+        return Err(SetError::MirrorAsymmetry {
+            slice: index,
+            theta_deg,
+            x,
+            y,
+            a,
+            b,
+        });
+    }
+    let grid_options = GridOptions {
+        refinement: match variant {
+            Variant::Adaptive => options.grid_refinement,
+            Variant::Paper => None,
+        },
+        mirror_y,
+        focus: None,
+    };
     let map = SliceImageMap::new(
         Counted {
             f: &f,
@@ -168,6 +210,7 @@ fn build_slice(
         options.grid,
         options.safety_factor,
         options.dilation_for(brdf.as_ref()),
+        &grid_options,
     )
     .map_err(|source| SetError::Density {
         slice: index,
@@ -195,7 +238,8 @@ fn build_slice(
                 f: &f,
                 counter: &counter,
             };
-            let (i_leaves, rel_err) = leaf_quadrature(&counted, tree.leaves(), tree.integral());
+            let (i_leaves, rel_err) =
+                leaf_quadrature(&counted, tree.leaves(), tree.integral(), mirror_y);
             // Keep the grid's Î when its own error estimate is the smaller one.
             let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
             if i_leaves.is_finite() && i_leaves > 0.0 && rel_err <= grid_err {
@@ -492,7 +536,7 @@ impl QuadTreeSet {
         let before = thread_evaluations();
         let mut samples = 0u64;
         let dt = std::f64::consts::FRAC_PI_2 / self.layout.theta as f64;
-        let dp = std::f64::consts::TAU / self.layout.phi as f64;
+        let dp = self.layout.phi_period() / self.layout.phi as f64;
         for i in 0..self.trees.len() {
             let mut rng =
                 Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, i as u64));

@@ -95,7 +95,10 @@ fn ward_anisotropic() {
         Variant::Adaptive,
         &test_options(),
     );
-    assert_eq!(set.layout().phi, 8, "anisotropic BRDFs use a (θ, φ) grid");
+    // A (θ, φ) grid; Ward is half-turn symmetric, so the 8 azimuths of the options are stored
+    // as 4 over [0°, 180°).
+    assert_eq!(set.layout().phi, 4, "anisotropic BRDFs use a (θ, φ) grid");
+    assert!(set.layout().half_turn);
     check_model("ward:alpha_x=0.08,alpha_y=0.3", 40, true);
 }
 
