@@ -12,7 +12,7 @@
 //! `--safety S`, `--dilation D`, `--disc-map auto|projected|equal-area`, `--ea-from DEG`,
 //! `--variant adaptive|adaptive-paper`, `--only name,name`, `--per-slice S` (default 2000),
 //! `--specs 'spec;spec'` (these BRDF specs instead of the model list), `--dense` (the dense
-//! image map instead of the refined one), `--no-symmetry` (ignore the BRDFs' declared symmetries).
+//! image map instead of the refined one), `--refine-tol T` (the refinement's tolerance), `--no-symmetry` (ignore the BRDFs' declared symmetries).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -151,6 +151,12 @@ fn main() {
                 std::process::exit(2);
             }
         }
+    }
+    if let Some(t) = arg::<f64>(&args, "--refine-tol") {
+        opts.grid_refinement = Some(partition_sampler::Refinement {
+            tolerance: t,
+            ..Default::default()
+        });
     }
     if args.iter().any(|a| a == "--dense") {
         opts.grid_refinement = None;

@@ -22,11 +22,16 @@
 //!   the pdf is evaluated with the same slice (the choice depends only on `ωo`), so
 //!   `f_r L cos / p` stays an unbiased estimator wherever `p > 0` covers `f_r(ωo, ·)`.
 //!   Anisotropic BRDFs use a `(θ, φ)` grid (default 32 × 16; samples are rotated by
-//!   `φo − φ_k`, which keeps the mirror direction exact). Optional **mixture** of the two
+//!   `φo − φ_k`, which keeps the mirror direction exact); a half-turn-symmetric one
+//!   ([`brdf::Brdf::is_half_turn_symmetric`]) stores the azimuths of `[0, π)` only (32 × 8). Optional **mixture** of the two
 //!   θ-neighbouring slices with linear weights in θ and the exact pdf `Σ w_k p_k`.
 //! * **Trees** (partition-sampler): each slice's tree is built from the papers' image map
 //!   ([`partition_sampler::SampledGridDensity`], `grid²` cells over `[-1, 1]²`, finer than the
-//!   deepest leaf: `2^(max_depth+1) ≤ grid`) with the rectangle adjustment of seed 000 §3.8
+//!   deepest leaf: `2^(max_depth+1) ≤ grid`) — for the adaptive variant refined by curvature
+//!   ([`SetOptions::grid_refinement`]: smooth 32² blocks keep 9 values, the mirror direction's
+//!   neighbourhood is always resolved) and, for a
+//!   [`brdf::Brdf::is_mirror_symmetric`] BRDF, evaluated on the half `y ≤ 0` and mirrored
+//!   ([`SetOptions::symmetries`]) — with the rectangle adjustment of seed 000 §3.8
 //!   (rejection rectangles shrunk to the bounding box of cell ∩ disc), plus a **rim band**
 //!   that samples `f` densely in `cos θi ∈ (10⁻⁶, 2/√grid]` so that bounds near the horizon
 //!   hold (see `image_map.rs`; without it every tested glossy model violated its bounds at

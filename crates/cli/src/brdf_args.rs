@@ -133,9 +133,15 @@ pub(crate) fn print_set_report(built: &Built) {
     let Built::Set(set) = built else { return };
     let r = set.report();
     println!(
-        "set        {} slices ({:?}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
+        "set        {} slices ({} θ × {} φ{}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
         r.trees,
-        r.layout,
+        r.layout.theta,
+        r.layout.phi,
+        if r.layout.half_turn {
+            " over [0°, 180°), half-turn symmetry"
+        } else {
+            ""
+        },
         r.build_time.as_secs_f64(),
         r.memory_bytes as f64 / 1024.0,
         r.nodes,
