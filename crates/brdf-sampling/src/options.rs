@@ -58,7 +58,8 @@ impl DiscMapPolicy {
 pub const DEFAULT_SLICES: usize = 90;
 
 /// Default `[θ, φ]` slice grid for anisotropic BRDFs: 32 × 16 = 512 trees (θ step 2.8°,
-/// φ step 22.5°). See [`SetOptions::anisotropic_slices`].
+/// φ step 22.5°), 256 for a half-turn-symmetric BRDF (see [`SetOptions::symmetries`]). See
+/// [`SetOptions::anisotropic_slices`].
 pub const DEFAULT_ANISOTROPIC_SLICES: [usize; 2] = [32, 16];
 
 /// Default split threshold `n_max` of BRDF sets: 1.8, chosen by measurement
