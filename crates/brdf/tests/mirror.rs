@@ -5,38 +5,16 @@
 //! `|f(ωo', M ωi') − f(ωo', ωi')| ≤ 10⁻¹² max(1, |f|)` (the half-slice property samplers use).
 //! A chiral but isotropic BRDF is the negative control: the same checker must flag it.
 
-use brdf::{Brdf, Isotropy, Vec3, direction_from_radians, models, parse_spec, rotate_z};
-use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
-use std::f64::consts::{FRAC_1_PI, TAU};
-use std::sync::Arc;
+mod common;
 
-/// Relative tolerance of the symmetry checks.
-const TOL: f64 = 1e-12;
-/// Number of random direction pairs.
-const PAIRS: usize = 2000;
+use brdf::{Brdf, Isotropy, Vec3, models, parse_spec, rotate_z};
+use common::{close, direction_pairs};
+use std::f64::consts::FRAC_1_PI;
+use std::sync::Arc;
 
 /// The reflection across the tangent–normal plane, `(x, y, z) ↦ (x, −y, z)`.
 fn reflect_y(v: &Vec3) -> Vec3 {
     Vec3::new(v.x, -v.y, v.z)
-}
-
-/// `PAIRS` seeded pairs in the upper hemisphere: θ uniform in [0°, 89.9°], except every
-/// fourth pair whose two directions are both grazing (θ in [85°, 89.9°]); φ uniform.
-fn direction_pairs(seed: u64) -> Vec<(Vec3, Vec3)> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let max = 89.9f64.to_radians();
-    (0..PAIRS)
-        .map(|k| {
-            let lo = if k % 4 == 3 { 85f64.to_radians() } else { 0.0 };
-            let mut dir =
-                || direction_from_radians(rng.random_range(lo..max), rng.random_range(0.0..TAU));
-            (dir(), dir())
-        })
-        .collect()
-}
-
-fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= TOL * a.abs().max(1.0)
 }
 
 /// The first pair that breaks mirror symmetry, as `(ωo, ωi, a, b)` with `a` the value at the
@@ -166,9 +144,10 @@ fn declarations_follow_the_parameters() {
     }
 }
 
-/// The `Box`, `Arc` and `&` impls forward the declaration instead of using the default.
+/// The `Box`, `Arc` and `&` impls forward both symmetry declarations (mirror here, half-turn
+/// of `tests/half_turn.rs`) instead of using the defaults.
 #[test]
-fn wrappers_forward_the_declaration() {
+fn wrappers_forward_the_declarations() {
     let lambert: Box<dyn Brdf> = parse_spec("lambert").unwrap();
     assert!(lambert.is_mirror_symmetric());
     let arc: Arc<dyn Brdf> = Arc::from(lambert);
@@ -176,6 +155,13 @@ fn wrappers_forward_the_declaration() {
     assert!(Brdf::is_mirror_symmetric(&&*arc));
     let nested: Box<Arc<dyn Brdf>> = Box::new(arc);
     assert!(nested.is_mirror_symmetric());
+    let ward: Box<dyn Brdf> = parse_spec("ward:alpha_x=0.05,alpha_y=0.3").unwrap();
+    assert!(ward.is_half_turn_symmetric() && !ward.is_mirror_symmetric());
+    let arc: Arc<dyn Brdf> = Arc::from(ward);
+    assert!(arc.is_half_turn_symmetric());
+    assert!(Brdf::is_half_turn_symmetric(&&*arc));
+    let nested: Box<Arc<dyn Brdf>> = Box::new(arc);
+    assert!(nested.is_half_turn_symmetric());
 }
 
 /// Isotropic but chiral: `f = (1 + ½ (ωo × ωi)·n)/π`, where

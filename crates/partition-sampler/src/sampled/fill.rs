@@ -108,6 +108,29 @@ fn fine_max<D: Density>(lat: &Lattice<'_, D>, a: usize, b: usize) -> f64 {
         .fold(0.0f64, |m, &p| m.max(lat.get(p)))
 }
 
+/// The dense rule on single fine cells: interior cells get the largest of their corner and
+/// centre values and the midpoint integral; the cells crossing the disc boundary are returned
+/// (for [`fill_boundary`]); cells outside stay 0.
+fn fill_fine_cells<D: Density>(
+    lat: &Lattice<'_, D>,
+    geo: &Geometry,
+    cells: &mut [[f64; 2]],
+    fine: impl Iterator<Item = (usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let (n, area) = (geo.n, geo.fine_area());
+    let mut boundary = Vec::new();
+    for (a, b) in fine {
+        match geo.class(a, b, 1) {
+            Class::Inside => {
+                cells[b * n + a] = [fine_max(lat, a, b), lat.get(GridPoint::Centre(a, b)) * area];
+            }
+            Class::Boundary => boundary.push((a, b)),
+            Class::Outside => {}
+        }
+    }
+    boundary
+}
+
 /// Statistics of one boundary cell: (max, integral on the fine sub-grid, on the coarse one).
 fn boundary_cell<D: Density>(
     f: &D,
@@ -222,21 +245,8 @@ pub(super) fn dense<D: Density>(
     lat.ensure(&points)?;
     let area = geo.fine_area();
     let mut cells = vec![[0.0f64; 2]; n * n];
-    let mut boundary = Vec::new();
-    for b in 0..n {
-        for a in 0..n {
-            match geo.class(a, b, 1) {
-                Class::Inside => {
-                    cells[b * n + a] = [
-                        fine_max(&lat, a, b),
-                        lat.get(GridPoint::Centre(a, b)) * area,
-                    ];
-                }
-                Class::Boundary => boundary.push((a, b)),
-                Class::Outside => {}
-            }
-        }
-    }
+    let all = (0..n).flat_map(|b| (0..n).map(move |a| (a, b)));
+    let boundary = fill_fine_cells(&lat, &geo, &mut cells, all);
     let bnd = fill_boundary(&lat, f, &geo, mirror, &mut cells, &boundary, sub)?;
     // Richardson on 2×2 blocks of interior cells: midpoint at h vs midpoint at 2h (the block
     // centre is the lattice corner (a + 1, b + 1)).
@@ -360,19 +370,7 @@ pub(super) fn refined<D: Density>(
     // Single fine cells: the dense rule.
     let points: Vec<GridPoint> = level.iter().flat_map(|&(a, b)| fine_points(a, b)).collect();
     lat.ensure(&points)?;
-    let mut boundary = Vec::new();
-    for &(a, b) in &level {
-        match geo.class(a, b, 1) {
-            Class::Inside => {
-                cells[b * n + a] = [
-                    fine_max(&lat, a, b),
-                    lat.get(GridPoint::Centre(a, b)) * area,
-                ];
-            }
-            Class::Boundary => boundary.push((a, b)),
-            Class::Outside => {}
-        }
-    }
+    let boundary = fill_fine_cells(&lat, &geo, &mut cells, level.iter().copied());
     let bnd = fill_boundary(
         &lat,
         f,
