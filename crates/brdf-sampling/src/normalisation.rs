@@ -82,6 +82,8 @@ pub(crate) const TOL: f64 = 1e-5;
 
 /// One piece of the adaptive rule.
 struct Piece {
+    /// Index of the leaf the piece belongs to.
+    leaf: usize,
     rect: Rect,
     value: f64,
     err: f64,
@@ -123,6 +125,27 @@ pub(crate) fn leaf_quadrature(
     scale: f64,
     mirror: bool,
 ) -> (f64, f64) {
+    let q = per_leaf_quadrature(f, leaves, scale, mirror);
+    (q.total, q.rel_err)
+}
+
+/// [`leaf_quadrature`] with the integral of every leaf (storage order).
+pub(crate) struct LeafIntegrals {
+    /// `Î`.
+    pub(crate) total: f64,
+    /// Relative error estimate of `Î`.
+    pub(crate) rel_err: f64,
+    /// `∫_{leaf i} f` (with `mirror`: over the leaf's part in `y ≤ 0` only).
+    pub(crate) per_leaf: Vec<f64>,
+}
+
+/// See [`leaf_quadrature`]; also returns each leaf's integral.
+pub(crate) fn per_leaf_quadrature(
+    f: &dyn Density,
+    leaves: impl Iterator<Item = LeafInfo>,
+    scale: f64,
+    mirror: bool,
+) -> LeafIntegrals {
     let factor = if mirror { 2.0 } else { 1.0 };
     let (hi, lo) = (
         GaussLegendre::new(HIGH_ORDER),
@@ -133,20 +156,28 @@ pub(crate) fn leaf_quadrature(
         evals.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         f.eval(p)
     };
-    let piece = |rect: Rect| {
+    let piece = |leaf: usize, rect: Rect| {
         let value = integrate_leaf(&counted, &rect, &hi);
         let err = (value - integrate_leaf(&counted, &rect, &lo)).abs();
-        Piece { rect, value, err }
+        Piece {
+            leaf,
+            rect,
+            value,
+            err,
+        }
     };
+    let mut n_leaves = 0;
     let mut heap: std::collections::BinaryHeap<Piece> = leaves
-        .filter_map(|l| {
+        .enumerate()
+        .inspect(|_| n_leaves += 1)
+        .filter_map(|(i, l)| {
             if !mirror {
-                return Some(l.rect);
+                return Some((i, l.rect));
             }
             let r = l.rect;
-            (r.y0 < 0.0).then(|| Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0)))
+            (r.y0 < 0.0).then(|| (i, Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0))))
         })
-        .map(piece)
+        .map(|(i, r)| piece(i, r))
         .collect();
     let mut err: f64 = heap.iter().map(|p| p.err).sum();
     while factor * err > TOL * scale
@@ -162,7 +193,7 @@ pub(crate) fn leaf_quadrature(
             Rect::new(r.x0, c[1], c[0], r.y1),
             Rect::new(c[0], c[1], r.x1, r.y1),
         ] {
-            let p = piece(q);
+            let p = piece(worst.leaf, q);
             err += p.err;
             heap.push(p);
         }
@@ -171,12 +202,20 @@ pub(crate) fn leaf_quadrature(
     let pieces = heap.into_vec();
     let total: f64 = factor * pieces.iter().map(|p| p.value).sum::<f64>();
     let err: f64 = factor * pieces.iter().map(|p| p.err).sum::<f64>();
-    let rel = if total > 0.0 {
+    let rel_err = if total > 0.0 {
         err / total
     } else {
         f64::INFINITY
     };
-    (total, rel)
+    let mut per_leaf = vec![0.0; n_leaves];
+    for p in &pieces {
+        per_leaf[p.leaf] += p.value;
+    }
+    LeafIntegrals {
+        total,
+        rel_err,
+        per_leaf,
+    }
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout};
-use crate::normalisation::leaf_quadrature;
+use crate::normalisation::{leaf_quadrature, per_leaf_quadrature};
 use crate::options::SetOptions;
 use crate::report::{CostMeasurement, SetReport};
 
@@ -218,7 +218,7 @@ fn build_slice(
         phi_deg,
         source,
     })?;
-    let tree = QuadTreeBuilder::new()
+    let mut tree = QuadTreeBuilder::new()
         .n_max(options.n_max)
         .max_depth(options.max_depth)
         .volume_tolerance(options.volume_tolerance)
@@ -254,10 +254,31 @@ fn build_slice(
                 }
             }
         }
-        Variant::Paper => SliceNorm {
-            factor: 1.0,
-            rel_err: None,
-        },
+        Variant::Paper => {
+            // The papers' scheme picks leaves ∝ I_i, so its pdf f/Î is exact only when every
+            // I_i is: replace the image map's I_i by the leaf quadrature's when that is the
+            // more accurate (the leaves, bounds and sampling procedure are the papers').
+            let counted = Counted {
+                f: &f,
+                counter: &counter,
+            };
+            let q = per_leaf_quadrature(&counted, tree.leaves(), tree.integral(), false);
+            let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
+            if q.total.is_finite() && q.total > 0.0 && q.rel_err <= grid_err {
+                tree = tree
+                    .with_leaf_integrals(q.per_leaf, Some(q.rel_err))
+                    .map_err(|source| SetError::Tree {
+                        slice: index,
+                        theta_deg,
+                        phi_deg,
+                        source,
+                    })?;
+            }
+            SliceNorm {
+                factor: 1.0,
+                rel_err: None,
+            }
+        }
     };
     // A clone holds its arrays with exact capacities (the builder grows them amortised).
     let tree = tree.clone();

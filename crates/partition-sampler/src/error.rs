@@ -134,6 +134,10 @@ pub enum BuildError {
     /// More nodes than 32-bit indices allow.
     #[error("the tree has too many nodes")]
     TooManyNodes,
+    /// Replacement leaf integrals ([`crate::QuadTree::with_leaf_integrals`]) of the wrong
+    /// length, not finite and `≥ 0`, or summing to zero.
+    #[error("replacement leaf integrals: {0}")]
+    InvalidLeafIntegrals(&'static str),
 }
 
 /// [`crate::allocate()`] was given invalid input.

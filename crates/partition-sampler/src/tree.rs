@@ -270,6 +270,50 @@ impl QuadTree {
         cdfs
     }
 
+    /// The same tree with its leaf integrals `I_i` replaced (leaf storage order), e.g. by a
+    /// quadrature more accurate than the provider's estimate, with that value's relative error.
+    /// `Î = Σ I_i` follows, and under [`Scheme::Paper`] so do the selection weights (alias
+    /// table, descent CDFs): the papers' scheme then picks leaves with the new probabilities and
+    /// its pdf `f/Î` is exact up to their accuracy. Leaves and bounds are unchanged.
+    ///
+    /// Errors ([`crate::BuildError::InvalidLeafIntegrals`]): a length other than the number of
+    /// leaves, a value that is not finite and `≥ 0`, or a zero total.
+    pub fn with_leaf_integrals(
+        mut self,
+        integrals: Vec<f64>,
+        rel_err: Option<f64>,
+    ) -> Result<Self, crate::error::BuildError> {
+        use crate::error::BuildError::InvalidLeafIntegrals;
+        if integrals.len() != self.leaves.len() {
+            return Err(InvalidLeafIntegrals("one value per leaf needed"));
+        }
+        if !integrals.iter().all(|i| i.is_finite() && *i >= 0.0) {
+            return Err(InvalidLeafIntegrals("values must be finite and ≥ 0"));
+        }
+        let total: f64 = integrals.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return Err(InvalidLeafIntegrals(
+                "the total must be positive and finite",
+            ));
+        }
+        self.leaf_integral = integrals;
+        self.integral = total;
+        self.integral_rel_err = rel_err;
+        if self.params.scheme == Scheme::Paper {
+            let weights = self.leaf_weights();
+            for (leaf, (prob, a)) in self
+                .leaves
+                .iter_mut()
+                .zip(crate::alias::build_alias(&weights))
+            {
+                leaf.prob = prob;
+                leaf.alias = a;
+            }
+            self.set_leaf_choice(self.params.leaf_choice);
+        }
+        Ok(self)
+    }
+
     /// Selects the leaf choice, building the descent CDFs for [`LeafChoice::Descent`] and
     /// freeing them for [`LeafChoice::Alias`].
     pub(crate) fn set_leaf_choice(&mut self, choice: LeafChoice) {
