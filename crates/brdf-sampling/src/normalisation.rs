@@ -167,15 +167,18 @@ pub(crate) fn per_leaf_quadrature(
         }
     };
     let mut n_leaves = 0;
+    // Leaves crossing the plane of incidence y = 0 are cut there: isotropic models have kinks
+    // in the azimuth difference (functions of |φi − φo|) exactly on it, where a Gauss rule
+    // converges slowly and its two orders can agree on a wrong value (schlick-diffuse at
+    // θo = 0.5°: 1e-4 off with an estimate of 1e-6 on the uncut single leaf).
     let mut heap: std::collections::BinaryHeap<Piece> = leaves
         .enumerate()
         .inspect(|_| n_leaves += 1)
-        .filter_map(|(i, l)| {
-            if !mirror {
-                return Some((i, l.rect));
-            }
+        .flat_map(|(i, l)| {
             let r = l.rect;
-            (r.y0 < 0.0).then(|| (i, Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0))))
+            let lower = (r.y0 < 0.0).then(|| Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0)));
+            let upper = (!mirror && r.y1 > 0.0).then(|| Rect::new(r.x0, r.y0.max(0.0), r.x1, r.y1));
+            [lower, upper].into_iter().flatten().map(move |q| (i, q))
         })
         .map(|(i, r)| piece(i, r))
         .collect();
