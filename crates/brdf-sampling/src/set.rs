@@ -218,6 +218,12 @@ fn build_slice(
         phi_deg,
         source,
     })?;
+    let tree_error = |source| SetError::Tree {
+        slice: index,
+        theta_deg,
+        phi_deg,
+        source,
+    };
     let mut tree = QuadTreeBuilder::new()
         .n_max(options.n_max)
         .max_depth(options.max_depth)
@@ -225,12 +231,7 @@ fn build_slice(
         .scheme(variant.scheme())
         .leaf_choice(variant.leaf_choice())
         .build_tree(&map)
-        .map_err(|source| SetError::Tree {
-            slice: index,
-            theta_deg,
-            phi_deg,
-            source,
-        })?;
+        .map_err(tree_error)?;
     drop(map);
     let norm = match variant {
         Variant::Adaptive => {
@@ -267,12 +268,7 @@ fn build_slice(
             if q.total.is_finite() && q.total > 0.0 && q.rel_err <= grid_err {
                 tree = tree
                     .with_leaf_integrals(q.per_leaf, Some(q.rel_err))
-                    .map_err(|source| SetError::Tree {
-                        slice: index,
-                        theta_deg,
-                        phi_deg,
-                        source,
-                    })?;
+                    .map_err(tree_error)?;
             }
             SliceNorm {
                 factor: 1.0,
