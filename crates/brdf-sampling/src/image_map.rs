@@ -130,8 +130,8 @@ impl RimBand {
         // With f(x, −y) = f(x, y), azimuth q and angles − q share a column: only
         // q ≤ angles/2 is needed. Otherwise column `angles` is column 0 again.
         let last = if mirror { angles / 2 } else { angles };
-        let mut cols: Vec<Option<Vec<f64>>> = vec![None; last + 1];
-        let evaluate = |qs: Vec<usize>, cols: &mut Vec<Option<Vec<f64>>>| {
+        let mut cols: Columns = vec![None; last + 1];
+        let evaluate = |qs: Vec<usize>, cols: &mut Columns| {
             let got: Vec<Result<Vec<f64>, DensityError>> =
                 qs.par_iter().map(|&q| column(q % angles)).collect();
             for (q, c) in qs.into_iter().zip(got) {
@@ -150,56 +150,7 @@ impl RimBand {
             None => evaluate((0..=last).collect(), &mut cols)?,
             Some((tol, start)) => {
                 evaluate((0..=last).step_by(start).collect(), &mut cols)?;
-                let mut intervals: Vec<(usize, usize)> =
-                    (0..last).step_by(start).map(|q| (q, start)).collect();
-                while !intervals.is_empty() {
-                    evaluate(
-                        intervals.iter().map(|&(q, w)| q + w / 2).collect(),
-                        &mut cols,
-                    )?;
-                    let mut next = Vec::new();
-                    let mut estimates = Vec::new();
-                    for (q, w) in intervals {
-                        if w == 2 {
-                            continue;
-                        }
-                        let h = w / 2;
-                        let (a, c, b) = (&cols[q], &cols[q + h], &cols[q + w]);
-                        let (a, c, b) = (
-                            a.as_deref().unwrap_or_default(),
-                            c.as_deref().unwrap_or_default(),
-                            b.as_deref().unwrap_or_default(),
-                        );
-                        let smooth = (0..a.len()).all(|m| {
-                            let vmax = a[m].max(b[m]).max(c[m]);
-                            (a[m] - 2.0 * c[m] + b[m]).abs() / 8.0 <= tol * vmax
-                        });
-                        if !smooth {
-                            next.extend([(q, h), (q + h, h)]);
-                            continue;
-                        }
-                        // Kept: the columns in between get the piecewise-linear interpolant
-                        // plus the quadratic excess `|Δ|/8` as upper estimates.
-                        for j in (1..w).filter(|&j| j != h) {
-                            let (lo, hi, t) = if j < h {
-                                (a, c, j as f64 / h as f64)
-                            } else {
-                                (c, b, (j - h) as f64 / h as f64)
-                            };
-                            let est: Vec<f64> = (0..a.len())
-                                .map(|m| {
-                                    let excess = (a[m] - 2.0 * c[m] + b[m]).abs() / 8.0;
-                                    (1.0 - t) * lo[m] + t * hi[m] + excess
-                                })
-                                .collect();
-                            estimates.push((q + j, est));
-                        }
-                    }
-                    for (q, est) in estimates {
-                        cols[q] = Some(est);
-                    }
-                    intervals = next;
-                }
+                bisect_columns(&mut cols, last, start, tol, &evaluate)?;
             }
         }
         let mut cols: Vec<Vec<f64>> = cols.into_iter().map(Option::unwrap_or_default).collect();
@@ -282,6 +233,60 @@ impl RimBand {
         }
         Some(m)
     }
+}
+
+/// Rim-band columns, `None` until evaluated or estimated.
+type Columns = Vec<Option<Vec<f64>>>;
+
+/// Refines the rim band along the azimuth: every interval `[q, q + w]` between evaluated
+/// columns gets its midpoint column; where the second difference `Δ` is at most `8 · tol` of
+/// the three columns' maximum at every height, the columns in between get the
+/// piecewise-linear interpolant plus the quadratic excess `|Δ|/8` as upper estimates, else
+/// both halves are bisected again (down to single azimuths).
+fn bisect_columns<E>(
+    cols: &mut Columns,
+    last: usize,
+    start: usize,
+    tol: f64,
+    evaluate: &E,
+) -> Result<(), DensityError>
+where
+    E: Fn(Vec<usize>, &mut Columns) -> Result<(), DensityError>,
+{
+    let mut intervals: Vec<(usize, usize)> = (0..last).step_by(start).map(|q| (q, start)).collect();
+    while !intervals.is_empty() {
+        evaluate(intervals.iter().map(|&(q, w)| q + w / 2).collect(), cols)?;
+        let mut next = Vec::new();
+        let mut estimates = Vec::new();
+        for (q, w) in intervals.into_iter().filter(|&(_, w)| w > 2) {
+            let h = w / 2;
+            let column = |i: usize| cols[i].as_deref().unwrap_or_default();
+            let (a, c, b) = (column(q), column(q + h), column(q + w));
+            let excess: Vec<f64> = (0..a.len())
+                .map(|m| (a[m] - 2.0 * c[m] + b[m]).abs() / 8.0)
+                .collect();
+            if (0..a.len()).any(|m| excess[m] > tol * a[m].max(b[m]).max(c[m])) {
+                next.extend([(q, h), (q + h, h)]);
+                continue;
+            }
+            for j in (1..w).filter(|&j| j != h) {
+                let (lo, hi, t) = if j < h {
+                    (a, c, j as f64 / h as f64)
+                } else {
+                    (c, b, (j - h) as f64 / h as f64)
+                };
+                let est = (0..a.len())
+                    .map(|m| (1.0 - t) * lo[m] + t * hi[m] + excess[m])
+                    .collect();
+                estimates.push((q + j, est));
+            }
+        }
+        for (q, est) in estimates {
+            cols[q] = Some(est);
+        }
+        intervals = next;
+    }
+    Ok(())
 }
 
 /// Image map + rim band of one slice (build time only).

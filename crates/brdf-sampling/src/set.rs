@@ -200,7 +200,7 @@ fn build_slice(
             Variant::Paper => None,
         },
         mirror_y,
-        focus: None,
+        ..GridOptions::default()
     };
     let map = SliceImageMap::new(
         Counted {

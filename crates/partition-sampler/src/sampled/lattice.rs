@@ -92,23 +92,18 @@ impl<'a, D: Density> Lattice<'a, D> {
         let mut seen = std::collections::HashSet::with_capacity(todo.len());
         todo.retain(|&(id, _)| seen.insert(id));
         let (f, domain) = (self.f, self.domain);
-        let results: Vec<Result<f64, DensityError>> = todo
+        // `None`: outside the domain (0, no call to `f`).
+        let results: Vec<Result<Option<f64>, DensityError>> = todo
             .par_iter()
             .map(|&(_, p)| {
                 let x = self.position(p);
-                if domain.contains(x) {
-                    f.eval_checked(x)
-                } else {
-                    Ok(0.0)
-                }
+                domain.contains(x).then(|| f.eval_checked(x)).transpose()
             })
             .collect();
-        for (&(id, p), r) in todo.iter().zip(results) {
+        for (&(id, _), r) in todo.iter().zip(results) {
             let v = r?;
-            if domain.contains(self.position(p)) {
-                self.evaluations += 1;
-            }
-            self.values[id] = v;
+            self.evaluations += usize::from(v.is_some());
+            self.values[id] = v.unwrap_or(0.0);
         }
         if self.mirror {
             for &p in points {
