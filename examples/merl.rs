@@ -19,7 +19,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let spec = format!("merl:{}", path.display());
     let measured: Arc<dyn Brdf> = Arc::from(brdf::parse_spec(&spec)?);
-    let set = brdf_sampling::build_set("adaptive", measured.clone(), &SetOptions::default(), None)?;
+    let set = brdf_sampling::QuadTreeSet::build(
+        measured.clone(),
+        brdf_sampling::Variant::Adaptive,
+        &SetOptions::default(),
+    )?;
 
     let wo = brdf::direction_from_angles(40.0, 0.0);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);

@@ -15,17 +15,17 @@ use std::time::Instant;
 use brdf::direction_from_angles;
 use rayon::prelude::*;
 use stats::{calibrate, sidak_level};
+use validation::adapters::DirectionAtWo;
 use validation::references::{albedo_reference, lit_reference};
 use validation::targets::{BrdfReferences, brdf_direction_subject};
 use validation::{
-    AnySubject, Plan, QUICK_SAMPLES, SamplerBuild, Tier, find_sampler, run_case, seeding,
+    AnySubject, Plan, QUICK_SAMPLES, Tier, build_direction, direction_domain, run_case, seeding,
+    standalone_cases,
 };
 
 fn adaptive_phong() -> Result<(String, AnySubject), String> {
-    let entry = find_sampler("adaptive").ok_or("no adaptive sampler")?;
-    let SamplerBuild::Direction { domain, build } = entry.kind else {
-        return Err("adaptive is not a direction sampler".into());
-    };
+    let entry = samplers::find("adaptive").map_err(|e| e.to_string())?;
+    let domain = direction_domain(entry).ok_or("adaptive is not a direction sampler")?;
     let brdf: Arc<dyn brdf::Brdf> =
         Arc::from(brdf::parse_spec("phong:n=50").map_err(|e| e.to_string())?);
     let wo = direction_from_angles(45.0, 0.0);
@@ -33,11 +33,11 @@ fn adaptive_phong() -> Result<(String, AnySubject), String> {
         albedo: albedo_reference(brdf.as_ref(), &wo).map_err(|e| e.to_string())?,
         lit: lit_reference(brdf.as_ref(), &wo).map_err(|e| e.to_string())?,
     };
-    let built = build(&brdf)?;
+    let built = build_direction(entry, &brdf).map_err(|e| e.to_string())?;
     Ok((
         "adaptive, phong:n=50, 45°".into(),
         AnySubject::Direction(brdf_direction_subject(
-            Arc::new(built.at(wo)),
+            Arc::new(DirectionAtWo::new(built, wo)),
             domain,
             brdf,
             wo,
@@ -47,11 +47,10 @@ fn adaptive_phong() -> Result<(String, AnySubject), String> {
 }
 
 fn standalone(name: &str, target: &str) -> Result<(String, AnySubject), String> {
-    let entry = find_sampler(name).ok_or("unknown sampler")?;
-    let SamplerBuild::Standalone(build) = entry.kind else {
-        return Err(format!("{name} is not standalone"));
-    };
-    let case = build()?
+    let entry = samplers::find(name).map_err(|e| e.to_string())?;
+    let cases = standalone_cases(entry).ok_or_else(|| format!("{name} is not standalone"))?;
+    let case = cases
+        .map_err(|e| e.to_string())?
         .into_iter()
         .find(|c| c.target == target)
         .ok_or_else(|| format!("{name} has no target {target}"))?;
@@ -79,7 +78,7 @@ fn main() {
     let subjects = [
         adaptive_phong(),
         standalone("envmap-adaptive", "map:procedural-sky-128x64"),
-        standalone("grid-tabulated-cdf", "grid:synthetic-16x8"),
+        standalone("grid-cdf", "grid:synthetic-16x8"),
     ];
     let plan = Plan::new(Tier::Quick, samples);
     println!(

@@ -9,43 +9,19 @@ use partition_sampler::{AllocationMode, QuadTreeSampler, RegionStats, Sampler2D,
 
 use crate::subject::{Dir3, Point2, SamplerUnderTest};
 
-/// A cumulative bound-violation counter read from a sampler's audit.
-pub type AuditFn = Arc<dyn Fn() -> u64 + Send + Sync>;
-
-/// The declared relative error of a direction sampler's pdf normaliser for a given `ωo`.
-pub type NormaliserErrFn = Arc<dyn Fn(&Vec3) -> Option<f64> + Send + Sync>;
-
 /// A [`DirectionSampler`] for one fixed outgoing direction `ωo`: points are incident
 /// directions, pdfs are w.r.t. solid angle (`DirectionSampler::pdf(ωo, ωi)`), batches come
-/// from `DirectionSampler::sample_batch`.
+/// from `DirectionSampler::sample_batch`, the audit and the declared normaliser error from
+/// the sampler itself.
 pub struct DirectionAtWo {
     sampler: Arc<dyn DirectionSampler>,
     wo: Vec3,
-    audit: Option<AuditFn>,
-    normaliser_err: Option<NormaliserErrFn>,
 }
 
 impl DirectionAtWo {
     /// Adapts `sampler` at `wo` (unit, `wo.z > 0`).
     pub fn new(sampler: Arc<dyn DirectionSampler>, wo: Vec3) -> Self {
-        Self {
-            sampler,
-            wo,
-            audit: None,
-            normaliser_err: None,
-        }
-    }
-
-    /// Reads the sampler's cumulative bound violations with `audit`.
-    pub fn with_audit(mut self, audit: Option<AuditFn>) -> Self {
-        self.audit = audit;
-        self
-    }
-
-    /// Reads the sampler's declared normaliser error with `f`.
-    pub fn with_normaliser_err(mut self, f: Option<NormaliserErrFn>) -> Self {
-        self.normaliser_err = f;
-        self
+        Self { sampler, wo }
     }
 }
 
@@ -72,11 +48,11 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
     }
 
     fn bound_violations(&self) -> Option<u64> {
-        self.audit.as_ref().map(|a| a())
+        self.sampler.bound_violations()
     }
 
     fn normaliser_rel_err(&self) -> Option<f64> {
-        self.normaliser_err.as_ref().and_then(|f| f(&self.wo))
+        self.sampler.normaliser_rel_err(&self.wo)
     }
 }
 

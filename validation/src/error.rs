@@ -7,13 +7,8 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum ValidationError {
     /// No registered sampler has this name.
-    #[error("unknown sampler `{name}`; known samplers: {known}")]
-    UnknownSampler {
-        /// The name given.
-        name: String,
-        /// The registered names.
-        known: String,
-    },
+    #[error(transparent)]
+    Sampler(#[from] samplers::RegistryError),
     /// A BRDF spec did not parse or the model could not be built.
     #[error("bad BRDF spec `{spec}`: {source}")]
     Brdf {

@@ -7,7 +7,8 @@
 //!   `sample_batch`. Adapters cover any `DirectionSampler` at a fixed `ωo` (directions, pdf
 //!   w.r.t. solid angle, on the [`Domain::Hemisphere`] or [`Domain::Sphere`]) and any planar
 //!   `Sampler2D` (pdf w.r.t. area on the [`Domain::Disc`] or [`Domain::UnitSquare`]).
-//! * [`samplers`] is the registry (one entry per sampler); [`mutants()`] the broken ones.
+//! * the `samplers` crate is the registry (one entry per sampler; [`builds`] maps each kind to
+//!   a subject under test); [`mutants()`] are the broken ones.
 //! * [`run`] executes a [`ValidateConfig`] (quick or full tier) and returns a
 //!   [`ValidationReport`] ([`ValidationReport::to_json`], [`ValidationReport::to_markdown`]).
 //!
@@ -24,7 +25,7 @@
 //! use validation::{ValidateConfig, run};
 //!
 //! let config = ValidateConfig {
-//!     samplers: vec!["grid-tabulated-cdf".into()],
+//!     samplers: vec!["grid-cdf".into()],
 //!     samples: Some(20_000),
 //!     ..ValidateConfig::quick()
 //! };
@@ -40,12 +41,12 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod adapters;
+mod builds;
 mod domain;
 mod error;
 pub mod mutants;
 mod plan;
 pub mod references;
-mod registry;
 mod report;
 mod run;
 mod runner;
@@ -53,17 +54,16 @@ pub mod seeding;
 mod subject;
 pub mod targets;
 
+pub use builds::{
+    StandaloneCase, build_direction, build_disc, direction_domain, quadtree_disc_sampler,
+    standalone_cases, test_maps, uses_brdf,
+};
 pub use domain::{Domain, Resolution};
 pub use error::ValidationError;
 pub use mutants::{Mutant, mutants};
 pub use plan::{
     DEFAULT_MERL_DIR, FULL_SAMPLES, FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_SAMPLES,
     QUICK_THETA_O, Tier, ValidateConfig,
-};
-pub use registry::{
-    BuiltDirection, DISC_GRID, DISC_SAFETY, DirectionBuild, DiscBuild, SAMPLERS, SamplerBuild,
-    SamplerEntry, StandaloneBuild, StandaloneCase, find_sampler, quadtree_disc_density,
-    quadtree_disc_sampler, samplers, test_maps,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
 pub use run::{ProgressEvent, run};

@@ -9,18 +9,22 @@ use brdf::{Brdf, Vec3, direction_from_angles};
 use rayon::prelude::*;
 use stats::{TestOutcome, sidak_level};
 
+use crate::adapters::DirectionAtWo;
+use crate::builds::{
+    StandaloneCase, build_direction, build_disc, direction_domain, standalone_cases, uses_brdf,
+};
 use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
     FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
-use crate::registry::{SamplerBuild, SamplerEntry, StandaloneCase, find_sampler, samplers};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
 use crate::runner::{error_outcome, names, run_case};
 use crate::seeding::case_seed;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
+use samplers::SamplerEntry;
 
 /// Progress of a run, reported once at the start and once per finished case.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,17 +97,10 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
     }
     let mut entries: Vec<&'static SamplerEntry> = Vec::new();
     if config.samplers.is_empty() {
-        entries.extend(samplers().iter());
+        entries.extend(samplers::samplers().iter());
     } else {
         for name in &config.samplers {
-            let e = find_sampler(name).ok_or_else(|| ValidationError::UnknownSampler {
-                name: name.clone(),
-                known: samplers()
-                    .iter()
-                    .map(|e| e.name)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })?;
+            let e = samplers::find(name)?;
             if !entries.iter().any(|x| x.name == e.name) {
                 entries.push(e);
             }
@@ -137,7 +134,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
     if entries.is_empty() {
         return Err(ValidationError::Empty("no sampler selected".into()));
     }
-    if entries.iter().any(|e| e.uses_brdf()) && (brdfs.is_empty() || angles.is_empty()) {
+    if entries.iter().any(|e| uses_brdf(e)) && (brdfs.is_empty() || angles.is_empty()) {
         return Err(ValidationError::Empty(
             "BRDF samplers need at least one BRDF and one angle".into(),
         ));
@@ -202,33 +199,36 @@ fn run_brdf_job(
 ) -> Vec<CaseResult> {
     let (spec, brdf) = &r.brdfs[bi];
     // Direction samplers are built once per BRDF; disc samplers per angle.
-    let built = match entry.kind {
-        SamplerBuild::Direction { build, .. } => Some(build(brdf)),
-        _ => None,
-    };
+    let built = direction_domain(entry).map(|domain| {
+        build_direction(entry, brdf)
+            .map(|s| (s, domain))
+            .map_err(|e| e.to_string())
+    });
     let mut out = Vec::with_capacity(r.angles.len());
     for (ai, &theta) in r.angles.iter().enumerate() {
         let wo = direction_from_angles(theta, 0.0);
-        let subject: Result<AnySubject, String> =
-            refs.get(ai)
-                .cloned()
-                .unwrap_or_else(|| Err("missing reference".into()))
-                .and_then(|refs| match (&entry.kind, &built) {
-                    (SamplerBuild::Direction { domain, .. }, Some(b)) => {
-                        let b = b.as_ref().map_err(Clone::clone)?;
-                        Ok(AnySubject::Direction(brdf_direction_subject(
-                            Arc::new(b.at(wo)),
-                            *domain,
-                            Arc::clone(brdf),
-                            wo,
-                            &refs,
-                        )))
-                    }
-                    (SamplerBuild::BrdfDisc(build), _) => Ok(AnySubject::Planar(
-                        brdf_disc_subject(build(brdf, &wo)?, Arc::clone(brdf), wo, &refs),
-                    )),
-                    _ => Err("not a BRDF sampler".into()),
-                });
+        let subject: Result<AnySubject, String> = refs
+            .get(ai)
+            .cloned()
+            .unwrap_or_else(|| Err("missing reference".into()))
+            .and_then(|refs| match &built {
+                Some(b) => {
+                    let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
+                    Ok(AnySubject::Direction(brdf_direction_subject(
+                        Arc::new(DirectionAtWo::new(Arc::clone(sampler), wo)),
+                        *domain,
+                        Arc::clone(brdf),
+                        wo,
+                        &refs,
+                    )))
+                }
+                None => Ok(AnySubject::Planar(brdf_disc_subject(
+                    build_disc(entry, brdf, &wo).map_err(|e| e.to_string())?,
+                    Arc::clone(brdf),
+                    wo,
+                    &refs,
+                ))),
+            });
         let (domain, outcomes) = match &subject {
             Ok(s) => (
                 s.domain().name().to_owned(),
@@ -276,16 +276,13 @@ pub fn run(
     let standalone: Vec<(&'static SamplerEntry, Result<Vec<StandaloneCase>, String>)> = r
         .samplers
         .iter()
-        .filter_map(|e| match e.kind {
-            SamplerBuild::Standalone(build) => Some((*e, build())),
-            _ => None,
-        })
+        .filter_map(|e| standalone_cases(e).map(|cases| (*e, cases.map_err(|err| err.to_string()))))
         .collect();
     let brdf_entries: Vec<&'static SamplerEntry> = r
         .samplers
         .iter()
         .copied()
-        .filter(|e| e.uses_brdf())
+        .filter(|e| uses_brdf(e))
         .collect();
     let mut jobs: Vec<Job<'_>> = Vec::new();
     for &entry in &brdf_entries {

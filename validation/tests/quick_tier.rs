@@ -3,7 +3,8 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use validation::{ProgressEvent, ValidateConfig, mutants, run, samplers};
+use samplers::samplers;
+use validation::{ProgressEvent, ValidateConfig, mutants, run};
 
 #[test]
 #[cfg_attr(

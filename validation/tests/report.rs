@@ -8,7 +8,7 @@ fn small(mutants: bool) -> ValidateConfig {
         samplers: vec![
             "adaptive".into(),
             "quadtree-disc".into(),
-            "envmap-tabulated-cdf".into(),
+            "envmap-cdf".into(),
         ],
         brdfs: vec!["phong:n=50".into()],
         theta_o: vec![45.0],
@@ -44,7 +44,7 @@ fn json_has_the_design_schema() {
     assert!(
         tests
             .iter()
-            .any(|t| t["sampler"] == "envmap-tabulated-cdf" && t["theta_o"].is_null())
+            .any(|t| t["sampler"] == "envmap-cdf" && t["theta_o"].is_null())
     );
     assert!(
         tests

@@ -50,9 +50,6 @@ impl CosineHemisphere {
 }
 
 impl DirectionSampler for UniformHemisphere {
-    fn name(&self) -> &str {
-        "uniform"
-    }
     fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let u0 = u.next_uniform();
         let u1 = u.next_uniform();
@@ -67,9 +64,6 @@ impl DirectionSampler for UniformHemisphere {
 }
 
 impl DirectionSampler for CosineHemisphere {
-    fn name(&self) -> &str {
-        "cosine"
-    }
     fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let u0 = u.next_uniform();
         let u1 = u.next_uniform();
@@ -97,16 +91,18 @@ mod tests {
     fn reported_pdf_matches_pdf_and_samples_are_unit_upper() {
         let wo = Vec3::new(0.0, 0.0, 1.0);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
-        let samplers: [&dyn DirectionSampler; 2] = [&UniformHemisphere, &CosineHemisphere];
-        for s in samplers {
+        let samplers: [(&str, &dyn DirectionSampler); 2] = [
+            ("uniform", &UniformHemisphere),
+            ("cosine", &CosineHemisphere),
+        ];
+        for (name, s) in samplers {
             for _ in 0..10_000 {
                 let d = s.sample(&wo, &mut rng);
                 assert!((d.wi.norm() - 1.0).abs() < 1e-12 && d.wi.z > 0.0);
                 let p = s.pdf(&wo, &d.wi);
                 assert!(
                     (p - d.pdf).abs() <= 1e-12 * p.max(1.0),
-                    "{} {p} {}",
-                    s.name(),
+                    "{name} {p} {}",
                     d.pdf
                 );
             }

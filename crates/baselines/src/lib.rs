@@ -34,10 +34,8 @@
 pub mod hemisphere;
 pub mod parallel;
 pub mod piecewise_constant;
-pub mod registry;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use parallel::sample_par;
 pub use partition_sampler::Rect;
 pub use piecewise_constant::{PiecewiseConstant1D, PiecewiseConstant2D, Sample1, TabulatedError};
-pub use registry::{DIRECTION_SAMPLERS, build_direction_sampler};

@@ -58,7 +58,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|m| m.name != "merl" && !skip.iter().any(|s| s == m.name))
     {
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(m.name)?);
-        let set = brdf_sampling::build_set("adaptive", brdf.clone(), &SetOptions::default(), None)?;
+        let set = brdf_sampling::QuadTreeSet::build(
+            brdf.clone(),
+            brdf_sampling::Variant::Adaptive,
+            &SetOptions::default(),
+        )?;
         let cells: Vec<String> = ANGLES
             .iter()
             .map(|&a| {

@@ -126,13 +126,13 @@ fn main() {
         opts.grid = g;
     }
     if let Some(t) = arg(&args, "--tol") {
-        opts.volume_tolerance = t;
+        opts.tree.volume_tolerance = t;
     }
     if let Some(k) = arg(&args, "--slices") {
         opts.slices = k;
     }
     if let Some(n) = arg(&args, "--nmax") {
-        opts.n_max = n;
+        opts.tree.n_max = n;
     }
     if let Some(s) = arg(&args, "--safety") {
         opts.safety_factor = s;
@@ -178,12 +178,12 @@ fn main() {
         "options: slices {} (anisotropic {:?}), n_max {}, max_depth {}, grid {}, safety {}, dilation {}, volume_tolerance {}, disc map {:?}, variant {:?}, {} rayon threads",
         opts.slices,
         opts.anisotropic_slices,
-        opts.n_max,
-        opts.max_depth,
+        opts.tree.n_max,
+        opts.tree.max_depth,
         opts.grid,
         opts.safety_factor,
         opts.bound_dilation,
-        opts.volume_tolerance,
+        opts.tree.volume_tolerance,
         opts.disc_map,
         variant,
         rayon::current_num_threads()

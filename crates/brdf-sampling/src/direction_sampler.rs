@@ -19,9 +19,6 @@ pub struct DirSample {
 /// caller-given uniforms (so QMC streams work) and are immutable and `Sync` once built. The trait
 /// is object-safe: the CLI and the validation suite hold samplers as `Box<dyn DirectionSampler>`.
 pub trait DirectionSampler: Send + Sync {
-    /// Short name as used on the command line (e.g. `adaptive`, `cosine`).
-    fn name(&self) -> &str;
-
     /// Draws `ωi` for the outgoing direction `wo` (unit, `wo.z > 0`).
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample;
 
@@ -33,6 +30,18 @@ pub trait DirectionSampler: Send + Sync {
     /// one-sample density of that direction, so `(1/n) Σ f/pdf` stays the estimator.
     fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
         (0..n).map(|_| self.sample(wo, u)).collect()
+    }
+
+    /// Cumulative count of trials that found the density above its bound (samplers with an
+    /// audited bound, e.g. the adaptive sets); `None` for samplers that have no bound to audit.
+    fn bound_violations(&self) -> Option<u64> {
+        None
+    }
+
+    /// Declared relative error of the pdf's normalising constant at `wo` (samplers whose pdf
+    /// is `f·cos / Î` with a numerical `Î`); `None` when the pdf is exact by construction.
+    fn normaliser_rel_err(&self, _wo: &Vec3) -> Option<f64> {
+        None
     }
 
     /// Bytes of the precomputed structures this sampler needs.

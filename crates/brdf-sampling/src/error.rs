@@ -63,9 +63,9 @@ pub enum SetError {
     },
 }
 
-/// A stored set could not be read back.
+/// A set file could not be written, or its bytes read back into a set.
 #[derive(Debug, thiserror::Error)]
-pub enum PersistError {
+pub enum SetFileError {
     /// Fewer bytes than the header or the payload needs.
     #[error("truncated input")]
     Truncated,
@@ -132,26 +132,4 @@ pub enum PersistError {
         /// The cause.
         source: std::io::Error,
     },
-}
-
-/// [`crate::build_sampler`] failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SamplerError {
-    /// No sampler has this name.
-    #[error("unknown sampler `{name}`; known samplers: {}", known.join(", "))]
-    UnknownSampler {
-        /// The name given.
-        name: String,
-        /// Every name this crate can build.
-        known: Vec<String>,
-    },
-    /// Building the set failed.
-    #[error(transparent)]
-    Build(#[from] SetError),
-}
-
-impl From<OptionsError> for SamplerError {
-    fn from(e: OptionsError) -> Self {
-        SamplerError::Build(SetError::Options(e))
-    }
 }

@@ -38,7 +38,7 @@
 //!   θo ≥ 85°). Slices whose expected trials exceed [`SetOptions::refine_threshold`] are
 //!   rebuilt up to [`SetOptions::refine_levels`] levels deeper (grid doubled each time).
 //!
-//! # Samplers ([`build_sampler`], [`SAMPLER_NAMES`])
+//! # Variants ([`Variant`]; named samplers are registered in the `samplers` crate)
 //! * `adaptive` — [`Variant::Adaptive`]: envelope scheme (leaf ∝ `V_i`, restart on
 //!   rejection), alias leaf choice. Exact: samples have density `f / ∫ f` whenever the bounds
 //!   hold; the reported pdf is `f / Î` with `Î` integrated over the tree's leaves by an
@@ -60,12 +60,12 @@
 //! ```
 //! use std::sync::Arc;
 //! use brdf::{Brdf, direction_from_angles, parse_spec};
-//! use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, build_sampler};
+//! use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
 //! use rand::{SeedableRng, rngs::Xoshiro256PlusPlus};
 //!
 //! let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50")?);
 //! let opts = SetOptions { slices: 9, ..SetOptions::default() };
-//! let sampler = build_sampler("adaptive", brdf.clone(), &opts)?;
+//! let sampler = QuadTreeSet::build(brdf.clone(), Variant::Adaptive, &opts)?;
 //!
 //! let wo = direction_from_angles(30.0, 45.0);
 //! let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
@@ -90,7 +90,6 @@
 mod direction_sampler;
 pub mod disc;
 mod error;
-mod factory;
 mod image_map;
 mod layout;
 mod normalisation;
@@ -104,17 +103,9 @@ pub use disc::{
     DiscBrdf, DiscMap, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
     solid_angle_pdf_to_area,
 };
-pub use error::{PersistError, SamplerError, SetError};
-pub use factory::{
-    SAMPLER_NAMES, build_sampler, build_sampler_with_progress, build_set, parse_sampler_name,
-};
+pub use error::{SetError, SetFileError};
 pub use layout::{SliceChoice, SliceLayout};
-pub use options::{
-    DEFAULT_ANISOTROPIC_SLICES, DEFAULT_EQUAL_AREA_FROM_DEG, DEFAULT_GRID, DEFAULT_MAX_DEPTH,
-    DEFAULT_N_MAX, DEFAULT_REFINE_LEVELS, DEFAULT_REFINE_THRESHOLD, DEFAULT_SAFETY_FACTOR,
-    DEFAULT_SLICES, DEFAULT_VOLUME_TOLERANCE, DiscMapPolicy, MAX_GRID, MAX_SLICES, OptionsError,
-    SetOptions,
-};
+pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use persist::SET_FORMAT_VERSION;
 pub use report::{CostMeasurement, SetReport};
 pub use set::{Progress, QuadTreeSet, Variant, layout_for};

@@ -16,13 +16,13 @@ use partition_sampler::{Domain, QuadTree, QuadTreeSampler};
 use serde::{Deserialize, Serialize};
 
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
-use crate::error::PersistError;
+use crate::error::SetFileError;
 use crate::layout::SliceLayout;
 use crate::options::SetOptions;
-use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for, sampler_name};
+use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for};
 
 /// Version of the stored set format; bumped on any incompatible change.
-pub const SET_FORMAT_VERSION: u32 = 3;
+pub const SET_FORMAT_VERSION: u32 = 4;
 
 const MAGIC: &[u8; 4] = b"BRQS";
 
@@ -60,23 +60,23 @@ fn probes(brdf: &dyn Brdf) -> Vec<f64> {
         .collect()
 }
 
-fn decode(bytes: &[u8]) -> Result<Stored, PersistError> {
+fn decode(bytes: &[u8]) -> Result<Stored, SetFileError> {
     let (Some(magic), Some(version)) = (bytes.get(0..4), bytes.get(4..8)) else {
-        return Err(PersistError::Truncated);
+        return Err(SetFileError::Truncated);
     };
     if magic != MAGIC {
-        return Err(PersistError::BadMagic);
+        return Err(SetFileError::BadMagic);
     }
     let found = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
     if found != SET_FORMAT_VERSION {
-        return Err(PersistError::UnsupportedVersion {
+        return Err(SetFileError::UnsupportedVersion {
             found,
             expected: SET_FORMAT_VERSION,
         });
     }
     postcard::from_bytes(&bytes[8..]).map_err(|e| match e {
-        postcard::Error::DeserializeUnexpectedEnd => PersistError::Truncated,
-        other => PersistError::Decode(other.to_string()),
+        postcard::Error::DeserializeUnexpectedEnd => SetFileError::Truncated,
+        other => SetFileError::Decode(other.to_string()),
     })
 }
 
@@ -107,22 +107,22 @@ impl QuadTreeSet {
 
     /// The BRDF spec recorded in stored bytes (to parse the BRDF before
     /// [`QuadTreeSet::from_bytes`]).
-    pub fn stored_spec(bytes: &[u8]) -> Result<String, PersistError> {
+    pub fn stored_spec(bytes: &[u8]) -> Result<String, SetFileError> {
         decode(bytes).map(|s| s.spec)
     }
 
     /// Decodes a set written by [`QuadTreeSet::to_bytes`] and re-attaches `brdf`.
     ///
-    /// Errors: [`PersistError::Truncated`], [`PersistError::BadMagic`],
-    /// [`PersistError::UnsupportedVersion`], [`PersistError::Decode`],
-    /// [`PersistError::Corrupt`] (inconsistent layout or options),
-    /// [`PersistError::SpecMismatch`] (`spec` differs from the stored one after trimming),
-    /// [`PersistError::BrdfMismatch`] (the BRDF does not reproduce the stored probe values),
-    /// [`PersistError::Tree`] / [`PersistError::Attach`] for a bad tree.
-    pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
+    /// Errors: [`SetFileError::Truncated`], [`SetFileError::BadMagic`],
+    /// [`SetFileError::UnsupportedVersion`], [`SetFileError::Decode`],
+    /// [`SetFileError::Corrupt`] (inconsistent layout or options),
+    /// [`SetFileError::SpecMismatch`] (`spec` differs from the stored one after trimming),
+    /// [`SetFileError::BrdfMismatch`] (the BRDF does not reproduce the stored probe values),
+    /// [`SetFileError::Tree`] / [`SetFileError::Attach`] for a bad tree.
+    pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
         let s = decode(bytes)?;
         if s.spec != spec.trim() {
-            return Err(PersistError::SpecMismatch {
+            return Err(SetFileError::SpecMismatch {
                 stored: s.spec,
                 given: spec.trim().to_string(),
             });
@@ -131,7 +131,7 @@ impl QuadTreeSet {
         for (probe, (&a, &b)) in s.probes.iter().zip(&found).enumerate() {
             let ok = a == b || (a - b).abs() <= PROBE_TOLERANCE * a.abs().max(b.abs());
             if !ok {
-                return Err(PersistError::BrdfMismatch {
+                return Err(SetFileError::BrdfMismatch {
                     name: brdf.name().to_string(),
                     probe,
                     stored: a,
@@ -140,7 +140,7 @@ impl QuadTreeSet {
             }
         }
         if s.probes.len() != found.len() {
-            return Err(PersistError::Corrupt(format!(
+            return Err(SetFileError::Corrupt(format!(
                 "{} probes, expected {}",
                 s.probes.len(),
                 found.len()
@@ -148,13 +148,13 @@ impl QuadTreeSet {
         }
         s.options
             .validate()
-            .map_err(|e| PersistError::Corrupt(format!("options: {e}")))?;
+            .map_err(|e| SetFileError::Corrupt(format!("options: {e}")))?;
         if layout_for(brdf.as_ref(), &s.options) != s.layout
             || s.layout.len() != s.trees.len()
             || s.maps.len() != s.trees.len()
             || s.norms.len() != s.trees.len()
         {
-            return Err(PersistError::Corrupt(format!(
+            return Err(SetFileError::Corrupt(format!(
                 "layout {} × {} with {} trees and {} maps does not fit the options and the BRDF's isotropy",
                 s.layout.theta,
                 s.layout.phi,
@@ -167,16 +167,16 @@ impl QuadTreeSet {
             .iter()
             .position(|n| !(n.factor.is_finite() && n.factor > 0.0))
         {
-            return Err(PersistError::Corrupt(format!(
+            return Err(SetFileError::Corrupt(format!(
                 "slice {slice}: invalid normalisation factor"
             )));
         }
         let mut trees = Vec::with_capacity(s.trees.len());
         for (slice, raw) in s.trees.iter().enumerate() {
             let tree =
-                QuadTree::from_bytes(raw).map_err(|source| PersistError::Tree { slice, source })?;
+                QuadTree::from_bytes(raw).map_err(|source| SetFileError::Tree { slice, source })?;
             if tree.domain() != Domain::UnitDisc || tree.params().scheme != s.variant_scheme() {
-                return Err(PersistError::Corrupt(format!(
+                return Err(SetFileError::Corrupt(format!(
                     "slice {slice}: wrong domain or scheme"
                 )));
             }
@@ -184,7 +184,7 @@ impl QuadTreeSet {
             let map = s.maps.get(slice).copied().unwrap_or_default();
             let f = DiscBrdf::with_map(Arc::clone(&brdf), s.layout.direction_of(slice), map);
             let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
-                .map_err(|source| PersistError::Attach { slice, source })?;
+                .map_err(|source| SetFileError::Attach { slice, source })?;
             trees.push(sampler);
         }
         Ok(QuadTreeSet {
@@ -197,21 +197,20 @@ impl QuadTreeSet {
             norms: s.norms,
             build_time: Duration::ZERO,
             grid_evaluations: s.grid_evaluations,
-            name: sampler_name(s.variant, s.options.mixture),
         })
     }
 
     /// Writes [`QuadTreeSet::to_bytes`] to `path`.
-    pub fn save(&self, path: &Path) -> Result<(), PersistError> {
-        std::fs::write(path, self.to_bytes()).map_err(|source| PersistError::Io {
+    pub fn save(&self, path: &Path) -> Result<(), SetFileError> {
+        std::fs::write(path, self.to_bytes()).map_err(|source| SetFileError::Io {
             path: path.to_path_buf(),
             source,
         })
     }
 
     /// Reads a set from `path` and re-attaches `brdf` (see [`QuadTreeSet::from_bytes`]).
-    pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, PersistError> {
-        let bytes = std::fs::read(path).map_err(|source| PersistError::Io {
+    pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
+        let bytes = std::fs::read(path).map_err(|source| SetFileError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -34,8 +34,10 @@ impl CostMeasurement {
 /// Summary of a [`crate::QuadTreeSet`] (sums over its slices unless stated).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SetReport {
-    /// Sampler name (`adaptive`, `adaptive-paper`, `…-mixture`).
-    pub name: String,
+    /// The partition-sampler scheme of the trees.
+    pub variant: crate::Variant,
+    /// Whether the two θ-neighbouring slices are mixed.
+    pub mixture: bool,
     /// BRDF model name.
     pub brdf: String,
     /// Recorded BRDF spec.
@@ -79,7 +81,16 @@ pub struct SetReport {
 impl std::fmt::Display for SetReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let opt = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
-        writeln!(f, "sampler            {}", self.name)?;
+        writeln!(
+            f,
+            "variant            {:?}{}",
+            self.variant,
+            if self.mixture {
+                ", two-slice mixture"
+            } else {
+                ""
+            }
+        )?;
         writeln!(f, "brdf               {} (spec `{}`)", self.brdf, self.spec)?;
         writeln!(
             f,

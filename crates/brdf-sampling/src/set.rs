@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use brdf::{Brdf, Vec3, rotate_z};
 use partition_sampler::{
     AllocationMode, Audit, Density, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler,
-    Sample2, Sampler2D, Scheme, UniformSource,
+    Sample2, Sampler2D, Scheme, TreeParams, UniformSource,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -41,14 +41,6 @@ pub enum Variant {
 }
 
 impl Variant {
-    /// The sampler name (without the `-mixture` suffix).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Variant::Adaptive => "adaptive",
-            Variant::Paper => "adaptive-paper",
-        }
-    }
-
     fn scheme(&self) -> Scheme {
         match self {
             Variant::Adaptive => Scheme::Envelope,
@@ -94,13 +86,12 @@ pub struct QuadTreeSet {
     pub(crate) norms: Vec<SliceNorm>,
     pub(crate) build_time: Duration,
     pub(crate) grid_evaluations: u64,
-    pub(crate) name: String,
 }
 
 impl std::fmt::Debug for QuadTreeSet {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("QuadTreeSet")
-            .field("name", &self.name)
+            .field("variant", &self.variant)
             .field("spec", &self.spec)
             .field("layout", &self.layout)
             .field("options", &self.options)
@@ -126,14 +117,6 @@ pub fn layout_for(brdf: &dyn Brdf, options: &SetOptions) -> SliceLayout {
             phi: if half_turn { phi / 2 } else { phi },
             half_turn,
         }
-    }
-}
-
-pub(crate) fn sampler_name(variant: Variant, mixture: bool) -> String {
-    if mixture {
-        format!("{}-mixture", variant.name())
-    } else {
-        variant.name().to_string()
     }
 }
 
@@ -224,12 +207,12 @@ fn build_slice(
         phi_deg,
         source,
     };
-    let mut tree = QuadTreeBuilder::new()
-        .n_max(options.n_max)
-        .max_depth(options.max_depth)
-        .volume_tolerance(options.volume_tolerance)
-        .scheme(variant.scheme())
-        .leaf_choice(variant.leaf_choice())
+    let params = TreeParams {
+        scheme: variant.scheme(),
+        leaf_choice: variant.leaf_choice(),
+        ..options.tree
+    };
+    let mut tree = QuadTreeBuilder::from_params(params)
         .build_tree(&map)
         .map_err(tree_error)?;
     drop(map);
@@ -346,7 +329,7 @@ impl QuadTreeSet {
             }
             worst.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
             worst.truncate(cap);
-            level_opts = level_opts.with_depth(level_opts.max_depth + 1);
+            level_opts = level_opts.with_depth(level_opts.tree.max_depth + 1);
             let opts = level_opts;
             total.fetch_add(worst.len(), Ordering::Relaxed);
             let redone: Vec<(usize, BuiltSlice)> = worst
@@ -382,7 +365,6 @@ impl QuadTreeSet {
             norms,
             build_time: start.elapsed(),
             grid_evaluations,
-            name: sampler_name(variant, options.mixture),
         })
     }
 
@@ -395,7 +377,6 @@ impl QuadTreeSet {
     /// Switches between the nearest slice and the two-slice mixture (the trees are unchanged).
     pub fn with_mixture(mut self, mixture: bool) -> Self {
         self.options.mixture = mixture;
-        self.name = sampler_name(self.variant, mixture);
         self
     }
 
@@ -584,7 +565,8 @@ impl QuadTreeSet {
     /// Structure and statistics of the set (counts gathered so far by all sampling calls).
     pub fn report(&self) -> SetReport {
         let mut r = SetReport {
-            name: self.name.clone(),
+            variant: self.variant,
+            mixture: self.options.mixture,
             brdf: self.brdf.name().to_string(),
             spec: self.spec.clone(),
             layout: self.layout,
@@ -643,10 +625,6 @@ impl QuadTreeSet {
 }
 
 impl DirectionSampler for QuadTreeSet {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         self.sample_with(wo, u, &mut |t, u| t.sample(u))
     }
@@ -694,12 +672,23 @@ impl DirectionSampler for QuadTreeSet {
         }
     }
 
+    fn bound_violations(&self) -> Option<u64> {
+        Some(self.report().bound_violations)
+    }
+
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        let cs = self.choices(wo)?;
+        cs.iter()
+            .filter(|c| c.weight > 0.0)
+            .filter_map(|c| self.tree(c.index)?.stats().integral_rel_err)
+            .reduce(f64::max)
+    }
+
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
             + (self.trees.capacity() - self.trees.len())
                 * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
             + self.spec.capacity()
-            + self.name.capacity()
     }
 }

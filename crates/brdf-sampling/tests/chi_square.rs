@@ -18,8 +18,8 @@ fn check_set(spec: &str, set: &QuadTreeSet, seed: u64) {
         for s in &samples {
             assert!(
                 s.pdf > 0.0,
-                "{spec} {} θo={theta}: sample with pdf {}",
-                set.name(),
+                "{spec} {:?} θo={theta}: sample with pdf {}",
+                set.variant(),
                 s.pdf
             );
             assert!(
@@ -31,34 +31,34 @@ fn check_set(spec: &str, set: &QuadTreeSet, seed: u64) {
         let mismatch = worst_pdf_mismatch(set, &wo, &samples);
         assert!(
             mismatch <= 1e-9,
-            "{spec} {} θo={theta}: pdf mismatch {mismatch:e}",
-            set.name()
+            "{spec} {:?} θo={theta}: pdf mismatch {mismatch:e}",
+            set.variant()
         );
         let r = chi_square(&samples, &|w| set.pdf(&wo, w));
         assert!(
             r.p_value >= ALPHA,
-            "{spec} {} θo={theta}: {}",
-            set.name(),
+            "{spec} {:?} θo={theta}: {}",
+            set.variant(),
             r.summary()
         );
         let l1 = l1_to_target(set, b.as_ref(), &wo);
         println!(
-            "{spec:<28} {:<16} θo={theta:>4}°  {}  L1(pdf, f cos) = {l1:.4}",
-            set.name(),
+            "{spec:<28} {:<16?} θo={theta:>4}°  {}  L1(pdf, f cos) = {l1:.4}",
+            set.variant(),
             r.summary()
         );
     }
     let rep = set.report();
-    assert_eq!(rep.bound_violations, 0, "{spec} {}: {rep}", set.name());
-    assert_eq!(rep.exhausted, 0, "{spec} {}", set.name());
+    assert_eq!(rep.bound_violations, 0, "{spec} {:?}: {rep}", set.variant());
+    assert_eq!(rep.exhausted, 0, "{spec} {:?}", set.variant());
     // ∫ pdf dσ = ∫ f / Î: 1 up to the grid integral's error.
     let wo = wo_at(30.0);
     let total = integral(&|w| set.pdf(&wo, w));
     let tol = 2e-3_f64.max(5.0 * rep.max_integral_rel_err.unwrap_or(0.0));
     assert!(
         (total - 1.0).abs() <= tol,
-        "{spec} {}: ∫pdf = {total}, tolerance {tol:e}",
-        set.name()
+        "{spec} {:?}: ∫pdf = {total}, tolerance {tol:e}",
+        set.variant()
     );
 }
 

@@ -49,11 +49,11 @@ fn check(variant: Variant) {
             // The pdf is piecewise constant (nearest-bin lookup): a coarser quadrature target
             // (expected-count error 5% of √E) keeps the adaptive refinement cheap.
             let r = chi_square_with(&samples, &|w| set.pdf(&wo, w), &coarse);
-            println!("merl {} θo={theta}: {}", set.name(), r.summary());
+            println!("merl {:?} θo={theta}: {}", set.variant(), r.summary());
             assert!(
                 r.p_value >= ALPHA,
-                "{} θo={theta}: {}",
-                set.name(),
+                "{:?} θo={theta}: {}",
+                set.variant(),
                 r.summary()
             );
         }

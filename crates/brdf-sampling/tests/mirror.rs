@@ -66,9 +66,6 @@ impl brdf::Brdf for Chiral {
     fn is_mirror_symmetric(&self) -> bool {
         self.declares
     }
-    fn name(&self) -> &str {
-        "chiral"
-    }
 }
 
 #[test]

@@ -24,9 +24,6 @@ struct Broken<'a> {
 }
 
 impl DirectionSampler for Broken<'_> {
-    fn name(&self) -> &str {
-        "broken"
-    }
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let s = self.set.sample(wo, u);
         DirSample {
@@ -98,9 +95,6 @@ impl brdf::Brdf for Retro {
     fn is_isotropic(&self) -> bool {
         true
     }
-    fn name(&self) -> &str {
-        "retro"
-    }
 }
 
 #[test]
@@ -110,9 +104,8 @@ fn bounds_too_low_are_audited_and_rejected() {
     let opts = SetOptions {
         slices: 9,
         grid: 8,
-        max_depth: 2,
         safety_factor: 1.0,
-        ..SetOptions::default()
+        ..SetOptions::default().with_depth(2)
     };
     let retro: std::sync::Arc<dyn brdf::Brdf> = std::sync::Arc::new(Retro);
     let set = QuadTreeSet::build(retro.clone(), Variant::Adaptive, &opts).unwrap();

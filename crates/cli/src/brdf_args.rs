@@ -5,6 +5,7 @@ use std::sync::Arc;
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirectionSampler, DiscMapPolicy, QuadTreeSet, SetOptions};
 use clap::Args;
+use partition_sampler::TreeParams;
 
 use crate::error::{CliError, CliResult};
 use crate::progress;
@@ -27,13 +28,13 @@ pub(crate) struct BrdfArgs {
 #[derive(Debug, Args, Clone)]
 pub(crate) struct SetArgs {
     /// Outgoing-angle slices of an isotropic BRDF's set.
-    #[arg(long, default_value_t = brdf_sampling::DEFAULT_SLICES)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_SLICES)]
     pub(crate) slices: usize,
     /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
-    #[arg(long, default_value_t = brdf_sampling::DEFAULT_N_MAX)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_N_MAX)]
     pub(crate) n_max: f64,
     /// Maximum quadtree depth.
-    #[arg(long, default_value_t = brdf_sampling::DEFAULT_MAX_DEPTH)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_MAX_DEPTH)]
     pub(crate) max_depth: u32,
     /// Hemisphere-to-disc map of the slices: `auto` (projected disc; equal-area from
     /// --equal-area-from degrees and for BRDFs unbounded at the horizon), `projected`
@@ -41,7 +42,7 @@ pub(crate) struct SetArgs {
     #[arg(long, default_value = "auto", value_parser = parse_disc_map)]
     pub(crate) disc_map: DiscMapPolicy,
     /// Outgoing polar angle (degrees) from which `--disc-map auto` uses the equal-area map.
-    #[arg(long, default_value_t = brdf_sampling::DEFAULT_EQUAL_AREA_FROM_DEG)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_EQUAL_AREA_FROM_DEG)]
     pub(crate) equal_area_from: f64,
 }
 
@@ -51,13 +52,17 @@ fn parse_disc_map(s: &str) -> Result<DiscMapPolicy, String> {
 
 impl SetArgs {
     pub(crate) fn options(&self) -> SetOptions {
+        let defaults = SetOptions::default();
         SetOptions {
             slices: self.slices,
-            n_max: self.n_max,
-            max_depth: self.max_depth,
+            tree: TreeParams {
+                n_max: self.n_max,
+                max_depth: self.max_depth,
+                ..defaults.tree
+            },
             disc_map: self.disc_map,
             equal_area_from_deg: self.equal_area_from,
-            ..SetOptions::default()
+            ..defaults
         }
     }
 }
@@ -89,9 +94,9 @@ pub(crate) fn outgoing(args: &BrdfArgs) -> CliResult<Vec3> {
 /// A built direction sampler; adaptive sets are kept concrete for their reports.
 pub(crate) enum Built {
     /// An adaptive quadtree set.
-    Set(Box<QuadTreeSet>),
+    Set(Arc<QuadTreeSet>),
     /// Any other sampler.
-    Other(Box<dyn DirectionSampler>),
+    Other(Arc<dyn DirectionSampler>),
 }
 
 impl Built {
@@ -99,6 +104,15 @@ impl Built {
         match self {
             Built::Set(s) => s.as_ref(),
             Built::Other(s) => s.as_ref(),
+        }
+    }
+}
+
+impl From<samplers::BuiltDirection> for Built {
+    fn from(b: samplers::BuiltDirection) -> Self {
+        match b.set {
+            Some(set) => Built::Set(set),
+            None => Built::Other(b.sampler),
         }
     }
 }
@@ -115,15 +129,12 @@ pub(crate) fn build(
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     };
-    let built = if brdf_sampling::parse_sampler_name(name).is_some() {
-        brdf_sampling::build_set(name, brdf, options, Some(&tick))
-            .map(|s| Built::Set(Box::new(s.with_spec(spec))))
-            .map_err(CliError::input)
-    } else {
-        baselines::build_direction_sampler(name, brdf, options, Some(&tick))
-            .map(Built::Other)
-            .map_err(CliError::input)
-    };
+    let request = samplers::DirectionRequest::new(brdf, options)
+        .with_spec(spec)
+        .with_progress(&tick);
+    let built = samplers::build_direction(name, &request)
+        .map(Built::from)
+        .map_err(CliError::input);
     pb.finish_and_clear();
     built
 }

@@ -25,11 +25,17 @@ pub(crate) struct BuildArgs {
 
 /// Runs `brdf-lab build`.
 pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
-    if brdf_sampling::parse_sampler_name(&args.sampler).is_none() {
+    let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
+    if !matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. }) {
+        let sets: Vec<&str> = samplers::samplers()
+            .iter()
+            .filter(|e| matches!(e.constructor, samplers::Constructor::AdaptiveSet { .. }))
+            .map(|e| e.name)
+            .collect();
         return Err(CliError::input(format!(
             "--sampler {}: `build` makes adaptive quadtree sets; use one of {}",
             args.sampler,
-            brdf_sampling::SAMPLER_NAMES.join(", ")
+            sets.join(", ")
         )));
     }
     let brdf = brdf_args::parse_brdf(&args.spec)?;

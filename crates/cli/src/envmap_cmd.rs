@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme};
-use partition_sampler::{DEFAULT_MAX_DEPTH, PAR_CHUNK, Sample2, chunk_seed};
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice};
+use partition_sampler::{PAR_CHUNK, Sample2, TreeParams, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -36,29 +36,18 @@ pub(crate) struct EnvmapArgs {
     /// Also time and compare every sampler variant and the piecewise-constant CDF baseline.
     #[arg(long)]
     compare: bool,
-    /// Sampler producing the samples.
-    #[arg(long, value_enum, default_value_t = EnvSamplerName::Adaptive)]
-    sampler: EnvSamplerName,
-    /// Split threshold n_max ≥ 1 of the adaptive sampler (mean trials per sample ≤ n_max).
-    #[arg(long, default_value_t = envmap::ENVMAP_N_MAX)]
+    /// Environment-map sampler producing the samples (`brdf-lab list` shows them all).
+    #[arg(long, default_value = "envmap-adaptive")]
+    sampler: String,
+    /// Split threshold n_max ≥ 1 of the adaptive samplers (mean trials per sample ≤ n_max).
+    #[arg(long, default_value_t = AdaptiveOptions::DEFAULT_N_MAX)]
     n_max: f64,
-    /// Maximum quadtree depth of the adaptive sampler.
-    #[arg(long, default_value_t = DEFAULT_MAX_DEPTH)]
+    /// Maximum quadtree depth of the adaptive samplers.
+    #[arg(long, default_value_t = TreeParams::DEFAULT_MAX_DEPTH)]
     max_depth: u32,
     /// Leaf choice of the adaptive sampler.
     #[arg(long, value_enum, default_value_t = LeafChoiceName::Alias)]
     leaf_choice: LeafChoiceName,
-}
-
-/// Sampler names accepted by `envmap --sampler`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum EnvSamplerName {
-    /// Adaptive partition, envelope scheme (exact).
-    Adaptive,
-    /// Adaptive partition, the papers' scheme.
-    AdaptivePaper,
-    /// Classic marginal/conditional piecewise-constant CDF.
-    TabulatedCdf,
 }
 
 /// Leaf-choice names.
@@ -70,22 +59,16 @@ enum LeafChoiceName {
     Descent,
 }
 
-fn sampler_kind(name: EnvSamplerName, args: &EnvmapArgs, leaf: LeafChoiceName) -> SamplerKind {
-    let leaf_choice = match leaf {
+/// The adaptive samplers' options from the command line (the registry entry sets the scheme).
+fn adaptive_options(args: &EnvmapArgs, leaf: LeafChoiceName) -> AdaptiveOptions {
+    let mut options = AdaptiveOptions::default();
+    options.tree.n_max = args.n_max;
+    options.tree.max_depth = args.max_depth;
+    options.tree.leaf_choice = match leaf {
         LeafChoiceName::Alias => LeafChoice::Alias,
         LeafChoiceName::Descent => LeafChoice::Descent,
     };
-    let options = |scheme| AdaptiveOptions {
-        scheme,
-        leaf_choice,
-        n_max: args.n_max,
-        max_depth: args.max_depth,
-    };
-    match name {
-        EnvSamplerName::Adaptive => SamplerKind::Adaptive(options(Scheme::Envelope)),
-        EnvSamplerName::AdaptivePaper => SamplerKind::Adaptive(options(Scheme::Paper)),
-        EnvSamplerName::TabulatedCdf => SamplerKind::PiecewiseConstant,
-    }
+    options
 }
 
 /// Runs `brdf-lab envmap`.
@@ -113,9 +96,11 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
         map.height()
     );
 
-    let kind = sampler_kind(args.sampler, args, args.leaf_choice);
-    let sampler = EnvMapSampler::new(&map, kind).map_err(CliError::input)?;
-    print_sampler_summary(&sampler);
+    let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
+    let sampler = entry
+        .build_envmap(&map, &adaptive_options(args, args.leaf_choice))
+        .map_err(CliError::input)?;
+    print_sampler_summary(entry.name, &sampler);
 
     let n = usize::try_from(args.n).map_err(CliError::input)?;
     let exact = exact_luminance_integral(&map);
@@ -172,10 +157,9 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     Ok(())
 }
 
-fn print_sampler_summary(sampler: &EnvMapSampler) {
+fn print_sampler_summary(name: &str, sampler: &EnvMapSampler) {
     println!(
-        "sampler    {} built in {:.3} ms, {} bytes",
-        sampler.kind().name(),
+        "sampler    {name} built in {:.3} ms, {} bytes",
         sampler.build_time().as_secs_f64() * 1e3,
         sampler.bytes_used()
     );
@@ -274,13 +258,17 @@ fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64) -> f64 {
 /// `--compare`: build time, memory, mean trials and samples/s (1 thread and all threads) of
 /// every variant, measured in this run.
 fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
-    let variants: [(EnvSamplerName, LeafChoiceName); 5] = [
-        (EnvSamplerName::Adaptive, LeafChoiceName::Alias),
-        (EnvSamplerName::Adaptive, LeafChoiceName::Descent),
-        (EnvSamplerName::AdaptivePaper, LeafChoiceName::Alias),
-        (EnvSamplerName::AdaptivePaper, LeafChoiceName::Descent),
-        (EnvSamplerName::TabulatedCdf, LeafChoiceName::Alias),
-    ];
+    // Every registered environment-map sampler; the adaptive ones with both leaf choices.
+    let mut variants = Vec::new();
+    for entry in samplers::samplers()
+        .iter()
+        .filter(|e| e.constructor.kind() == "envmap")
+    {
+        variants.push((entry, LeafChoiceName::Alias));
+        if entry.capabilities.batch_mode {
+            variants.push((entry, LeafChoiceName::Descent));
+        }
+    }
     let n = usize::try_from(args.n)
         .map_err(CliError::input)?
         .clamp(100_000, 4_000_000);
@@ -290,7 +278,7 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
         "compare    {n} samples per variant, median of 5 builds, {threads} threads for the parallel column (samples consumed, not stored)"
     );
     println!(
-        "{:<16} {:<8} {:>10} {:>12} {:>8} {:>14} {:>14}",
+        "{:<24} {:<8} {:>10} {:>12} {:>8} {:>14} {:>14}",
         "sampler",
         "leaves",
         "build ms",
@@ -301,12 +289,12 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
     );
     let pb = progress::bar(variants.len() as u64, "comparing");
     let mut rows = Vec::new();
-    for (name, leaf) in variants {
-        let kind = sampler_kind(name, args, leaf);
+    for (entry, leaf) in variants {
+        let options = adaptive_options(args, leaf);
         let mut builds = Vec::new();
         let mut sampler = None;
         for _ in 0..5 {
-            let s = EnvMapSampler::new(map, kind).map_err(CliError::input)?;
+            let s = entry.build_envmap(map, &options).map_err(CliError::input)?;
             builds.push(s.build_time().as_secs_f64() * 1e3);
             sampler = Some(s);
         }
@@ -327,14 +315,14 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
             .stats()
             .and_then(|s| s.measured_mean_trials)
             .map_or("1 (exact)".to_string(), |t| format!("{t:.4}"));
-        let leaf_name = match (name, leaf) {
-            (EnvSamplerName::TabulatedCdf, _) => "-",
-            (_, LeafChoiceName::Alias) => "alias",
-            (_, LeafChoiceName::Descent) => "descent",
+        let leaf_name = match (sampler.as_adaptive().is_some(), leaf) {
+            (false, _) => "-",
+            (true, LeafChoiceName::Alias) => "alias",
+            (true, LeafChoiceName::Descent) => "descent",
         };
         rows.push(format!(
-            "{:<16} {:<8} {:>10.3} {:>12.1} {:>8} {:>14.2} {:>14.2}",
-            sampler.kind().name(),
+            "{:<24} {:<8} {:>10.3} {:>12.1} {:>8} {:>14.2} {:>14.2}",
+            entry.name,
             leaf_name,
             builds[builds.len() / 2],
             sampler.bytes_used() as f64 / 1024.0,

@@ -28,9 +28,17 @@ pub(crate) fn run() -> CliResult<()> {
             );
         }
     }
-    println!("\nSamplers (--sampler NAME)");
-    for (name, doc) in baselines::DIRECTION_SAMPLERS {
-        println!("  {name:<16} {doc}");
+    println!("\nSamplers (--sampler NAME; direction samplers for sample/eval/build/validate,");
+    println!("disc and grid samplers for validate, envmap samplers for envmap/validate)");
+    for kind in ["direction", "disc", "envmap", "grid"] {
+        println!("\n  {kind}");
+        for e in samplers::samplers()
+            .iter()
+            .filter(|e| e.constructor.kind() == kind)
+        {
+            println!("    {:<24} {}", e.name, e.summary);
+            println!("    {:<24} [{}]", "", e.capabilities.flags());
+        }
     }
     Ok(())
 }

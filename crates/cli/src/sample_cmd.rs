@@ -56,7 +56,7 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     );
     println!(
         "sampler    {} ({} bytes)",
-        sampler.name(),
+        args.sampler.trim(),
         sampler.bytes_used()
     );
 

@@ -63,11 +63,7 @@ fn maps() -> Vec<(String, EnvMap)> {
 
 fn kinds() -> Vec<(&'static str, SamplerKind)> {
     let a = |scheme, leaf_choice| {
-        SamplerKind::Adaptive(AdaptiveOptions {
-            scheme,
-            leaf_choice,
-            ..AdaptiveOptions::default()
-        })
+        SamplerKind::Adaptive(AdaptiveOptions::with_scheme(scheme, leaf_choice))
     };
     vec![
         ("envelope-alias", a(Scheme::Envelope, LeafChoice::Alias)),

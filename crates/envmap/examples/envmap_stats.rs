@@ -23,7 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     if n_max.is_empty() {
-        n_max.push(AdaptiveOptions::default().n_max);
+        n_max.push(AdaptiveOptions::default().tree.n_max);
     }
     if files.is_empty() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/envmaps");
@@ -61,12 +61,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 (Scheme::Envelope, LeafChoice::Descent),
                 (Scheme::Paper, LeafChoice::Alias),
             ] {
-                kinds.push(SamplerKind::Adaptive(AdaptiveOptions {
-                    scheme,
-                    leaf_choice,
-                    n_max: nm,
-                    ..AdaptiveOptions::default()
-                }));
+                let mut o = AdaptiveOptions::with_scheme(scheme, leaf_choice);
+                o.tree.n_max = nm;
+                kinds.push(SamplerKind::Adaptive(o));
             }
         }
         kinds.push(SamplerKind::PiecewiseConstant);
@@ -74,9 +71,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let s = EnvMapSampler::new(map, kind)?;
             let label = match kind {
                 SamplerKind::Adaptive(o) => {
-                    format!("{}/{:?}/n_max={}", kind.name(), o.leaf_choice, o.n_max)
+                    format!(
+                        "adaptive/{:?}/{:?}/n_max={}",
+                        o.tree.scheme, o.tree.leaf_choice, o.tree.n_max
+                    )
                 }
-                SamplerKind::PiecewiseConstant => kind.name().to_string(),
+                SamplerKind::PiecewiseConstant => "piecewise-constant".to_string(),
             };
             let mut rng = <rand::rngs::Xoshiro256PlusPlus as rand::SeedableRng>::seed_from_u64(1);
             let t = Instant::now();

@@ -17,20 +17,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => EnvMap::load(path)?,
     };
     let n_max: Option<f64> = args.get(3).map(|s| s.parse()).transpose()?;
-    let base = AdaptiveOptions {
-        n_max: n_max.unwrap_or(AdaptiveOptions::default().n_max),
-        ..AdaptiveOptions::default()
-    };
+    let mut base = AdaptiveOptions::default();
+    base.tree.n_max = n_max.unwrap_or(base.tree.n_max);
     let kind = match args.get(1).map(String::as_str).unwrap_or("adaptive") {
         "adaptive" => SamplerKind::Adaptive(base),
-        "adaptive-descent" => SamplerKind::Adaptive(AdaptiveOptions {
-            leaf_choice: LeafChoice::Descent,
-            ..base
-        }),
-        "adaptive-paper" => SamplerKind::Adaptive(AdaptiveOptions {
-            scheme: Scheme::Paper,
-            ..base
-        }),
+        "adaptive-descent" => {
+            let mut o = base;
+            o.tree.leaf_choice = LeafChoice::Descent;
+            SamplerKind::Adaptive(o)
+        }
+        "adaptive-paper" => {
+            let mut o = base;
+            o.tree.scheme = Scheme::Paper;
+            SamplerKind::Adaptive(o)
+        }
         "pwc" => SamplerKind::PiecewiseConstant,
         other => return Err(format!("unknown sampler {other}").into()),
     };

@@ -56,6 +56,6 @@ mod sky;
 pub use error::EnvMapError;
 pub use load::MapFormat;
 pub use map::{EnvMap, MAX_PIXELS, luminance};
-pub use partition_sampler::{LeafChoice, Scheme};
-pub use sampler::{AdaptiveOptions, ENVMAP_N_MAX, EnvMapSampler, EnvSample, SamplerKind};
+pub use partition_sampler::{LeafChoice, Scheme, TreeParams};
+pub use sampler::{AdaptiveOptions, EnvMapSampler, EnvSample, SamplerKind};
 pub use sky::{SUN_RADIANCE, SUN_RADIUS, SUN_UV, procedural_sky, sun_direction};

@@ -4,8 +4,8 @@ use std::time::{Duration, Instant};
 
 use baselines::PiecewiseConstant2D;
 use partition_sampler::{
-    DEFAULT_MAX_DEPTH, LeafChoice, MemoryReport, Point2, QuadTreeBuilder, QuadTreeSampler, Rect,
-    Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity, UniformSource,
+    LeafChoice, MemoryReport, Point2, QuadTreeBuilder, QuadTreeSampler, Rect, Sample2, Sampler2D,
+    SamplerStats, Scheme, SinPiRows, TabulatedDensity, TreeParams, UniformSource,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -13,34 +13,42 @@ use serde::{Deserialize, Serialize};
 use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
 use crate::{EnvMap, EnvMapError};
 
-/// Default split threshold for environment maps: 1.6 rather than the generic 2.
-///
-/// A map is tabulated, so its bounds are exact and deeper trees cost little: on the 1024×512
-/// maps of `docs/benchmarks.md`, `n_max = 1.6` lowers the mean trials per sample from 1.33–1.78
-/// to 1.19–1.35 and raises 2-thread throughput above 30 M samples/s on every map, while the build
-/// stays under 8 ms.
-pub const ENVMAP_N_MAX: f64 = 1.6;
-
-/// Parameters of the adaptive-partition sampler.
+/// Parameters of the adaptive-partition sampler of a map: the partition sampler's own
+/// [`TreeParams`], with the environment-map default [`AdaptiveOptions::DEFAULT_N_MAX`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AdaptiveOptions {
-    /// [`Scheme::Envelope`] (default, exact) or [`Scheme::Paper`].
-    pub scheme: Scheme,
-    /// [`LeafChoice::Alias`] (default, O(1)) or [`LeafChoice::Descent`] (the papers').
-    pub leaf_choice: LeafChoice,
-    /// Split threshold `n_max ≥ 1` (default [`ENVMAP_N_MAX`]).
-    pub n_max: f64,
-    /// Maximum quadtree depth (default [`DEFAULT_MAX_DEPTH`]).
-    pub max_depth: u32,
+    /// Split threshold, depth, scheme ([`Scheme::Envelope`] by default, exact) and leaf choice
+    /// ([`LeafChoice::Alias`] by default, O(1)).
+    pub tree: TreeParams,
+}
+
+impl AdaptiveOptions {
+    /// Default split threshold for environment maps: 1.6 rather than the generic
+    /// [`TreeParams::DEFAULT_N_MAX`] = 2.
+    ///
+    /// A map is tabulated, so its bounds are exact and deeper trees cost little: on the
+    /// 1024×512 maps of `docs/benchmarks.md`, `n_max = 1.6` lowers the mean trials per sample
+    /// from 1.33–1.78 to 1.19–1.35 and raises 2-thread throughput above 30 M samples/s on every
+    /// map, while the build stays under 8 ms.
+    pub const DEFAULT_N_MAX: f64 = 1.6;
+
+    /// The default options with another scheme and leaf choice.
+    pub fn with_scheme(scheme: Scheme, leaf_choice: LeafChoice) -> Self {
+        let mut o = Self::default();
+        o.tree.scheme = scheme;
+        o.tree.leaf_choice = leaf_choice;
+        o
+    }
 }
 
 impl Default for AdaptiveOptions {
+    /// [`TreeParams::default`] with `n_max = `[`AdaptiveOptions::DEFAULT_N_MAX`].
     fn default() -> Self {
         Self {
-            scheme: Scheme::Envelope,
-            leaf_choice: LeafChoice::Alias,
-            n_max: ENVMAP_N_MAX,
-            max_depth: DEFAULT_MAX_DEPTH,
+            tree: TreeParams {
+                n_max: Self::DEFAULT_N_MAX,
+                ..TreeParams::default()
+            },
         }
     }
 }
@@ -53,17 +61,6 @@ pub enum SamplerKind {
     Adaptive(AdaptiveOptions),
     /// The classic marginal/conditional CDF over `Y(pixel) · sin(π v_centre)` per pixel.
     PiecewiseConstant,
-}
-
-impl SamplerKind {
-    /// The CLI name: `adaptive`, `adaptive-paper` or `tabulated-cdf`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Adaptive(o) if o.scheme == Scheme::Paper => "adaptive-paper",
-            Self::Adaptive(_) => "adaptive",
-            Self::PiecewiseConstant => "tabulated-cdf",
-        }
-    }
 }
 
 /// One sampled direction of an environment map.
@@ -142,12 +139,7 @@ impl EnvMapSampler {
         let density =
             TabulatedDensity::new(map.width(), map.height(), map.luminance(), Rect::UNIT)?
                 .with_row_factor(SinPiRows)?;
-        let sampler = QuadTreeBuilder::new()
-            .n_max(options.n_max)
-            .max_depth(options.max_depth)
-            .scheme(options.scheme)
-            .leaf_choice(options.leaf_choice)
-            .build(density)?;
+        let sampler = QuadTreeBuilder::from_params(options.tree).build(density)?;
         Ok(Self {
             inner: Inner::Adaptive(Box::new(sampler)),
             kind: SamplerKind::Adaptive(options),

@@ -109,11 +109,7 @@ fn histogram<S: Sampler2D>(s: &S, w: usize, h: usize, n: usize, seed: u64) -> Ve
 }
 
 fn adaptive(scheme: Scheme, leaf_choice: LeafChoice) -> SamplerKind {
-    SamplerKind::Adaptive(AdaptiveOptions {
-        scheme,
-        leaf_choice,
-        ..AdaptiveOptions::default()
-    })
+    SamplerKind::Adaptive(AdaptiveOptions::with_scheme(scheme, leaf_choice))
 }
 
 const ADAPTIVE_KINDS: [(Scheme, LeafChoice); 3] = [
@@ -270,18 +266,14 @@ fn parallel_batches_are_reproducible() {
 #[test]
 fn builder_errors_are_typed() {
     let map = small_map();
-    let bad = AdaptiveOptions {
-        n_max: 0.5,
-        ..AdaptiveOptions::default()
-    };
+    let mut bad = AdaptiveOptions::default();
+    bad.tree.n_max = 0.5;
     assert!(matches!(
         EnvMapSampler::adaptive(&map, bad),
         Err(EnvMapError::Build(_))
     ));
-    let bad = AdaptiveOptions {
-        max_depth: 1000,
-        ..AdaptiveOptions::default()
-    };
+    let mut bad = AdaptiveOptions::default();
+    bad.tree.max_depth = 1000;
     assert!(matches!(
         EnvMapSampler::adaptive(&map, bad),
         Err(EnvMapError::Build(_))
@@ -289,17 +281,8 @@ fn builder_errors_are_typed() {
 }
 
 #[test]
-fn names_and_accessors() {
+fn accessors() {
     let map = small_map();
-    assert_eq!(
-        adaptive(Scheme::Paper, LeafChoice::Alias).name(),
-        "adaptive-paper"
-    );
-    assert_eq!(
-        SamplerKind::Adaptive(AdaptiveOptions::default()).name(),
-        "adaptive"
-    );
-    assert_eq!(SamplerKind::PiecewiseConstant.name(), "tabulated-cdf");
     let a = EnvMapSampler::adaptive(&map, AdaptiveOptions::default()).unwrap();
     assert!(a.as_adaptive().is_some() && a.as_piecewise_constant().is_none());
     assert!(a.memory().is_some() && a.bytes_used() > 0);
@@ -344,7 +327,7 @@ fn real_maps_and_sky_sample_cleanly() {
                 assert_eq!(st.bound_violations, 0, "{name}");
                 assert_eq!(st.exhausted, 0, "{name}");
                 let trials = st.measured_mean_trials.unwrap();
-                let n_max = AdaptiveOptions::default().n_max;
+                let n_max = AdaptiveOptions::default().tree.n_max;
                 assert!(trials <= n_max * 1.02, "{name}: {trials} trials");
                 assert!(
                     (trials / st.expected_mean_trials - 1.0).abs() < 0.05,

@@ -10,23 +10,6 @@ use crate::tree::{
     EMPTY, LEAF, LeafChoice, Node, QuadTree, Scheme, TreeCounts, TreeParams, cell_rect,
 };
 
-/// Default split threshold (the papers' `n_max = 2`).
-pub const DEFAULT_N_MAX: f64 = 2.0;
-
-/// Default maximum depth.
-///
-/// The papers used 5 for BRDF lobes on the disc. Measured with `examples/nmax_sweep.rs`
-/// (`n_max = 2`): a Phong lobe of exponent 1000 needs ≈ 3.9 trials per sample at depth 5,
-/// 1.72 at depth 7 and 1.62 from depth 8 on (the criterion then stops by itself at depth 9);
-/// a 1024 × 512 map with a sun of a few texels needs 30 trials at depth 5, 2.2 at depth 7 and
-/// 1.10 at depth 10 (texel-sized cells). Since the split criterion stops early wherever the
-/// bound is already tight, a deeper cap costs nothing there; 12 resolves texels of maps up to
-/// 4096 wide. Beyond it trees only grow where bounds stay loose.
-pub const DEFAULT_MAX_DEPTH: u32 = 12;
-
-/// Default [`QuadTreeBuilder::volume_tolerance`].
-pub const DEFAULT_VOLUME_TOLERANCE: f64 = 1e-6;
-
 /// Largest accepted `max_depth` (cells of `2^-24` of the domain). Leaves store their
 /// rectangles as `f32` (root-normalised, or domain coordinates for dyadic roots), in which
 /// every cell edge down to this depth is exact; a deeper limit would need another encoding.
@@ -46,24 +29,20 @@ pub struct QuadTreeBuilder {
 
 impl Default for QuadTreeBuilder {
     fn default() -> Self {
-        Self {
-            params: TreeParams {
-                n_max: DEFAULT_N_MAX,
-                max_depth: DEFAULT_MAX_DEPTH,
-                min_leaf_size: 0.0,
-                volume_tolerance: DEFAULT_VOLUME_TOLERANCE,
-                scheme: Scheme::Envelope,
-                leaf_choice: LeafChoice::Alias,
-            },
-        }
+        Self::from_params(TreeParams::default())
     }
 }
 
 impl QuadTreeBuilder {
-    /// Defaults: `n_max = 2`, `max_depth = DEFAULT_MAX_DEPTH`, no minimum leaf size,
-    /// [`Scheme::Envelope`], [`LeafChoice::Alias`].
+    /// The generic defaults ([`TreeParams::default`]): `n_max = 2`, `max_depth = 12`, no
+    /// minimum leaf size, [`Scheme::Envelope`], [`LeafChoice::Alias`].
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A builder with every parameter given (validated by [`QuadTreeBuilder::build`]).
+    pub fn from_params(params: TreeParams) -> Self {
+        Self { params }
     }
 
     /// Split threshold `n_max ≥ 1` (the bound on mean trials per leaf).
@@ -119,18 +98,7 @@ impl QuadTreeBuilder {
     /// Builds only the tree (e.g. to persist it), borrowing the density.
     pub fn build_tree<D: RegionStats + ?Sized>(&self, density: &D) -> Result<QuadTree, BuildError> {
         let p = self.params;
-        if !(p.n_max.is_finite() && p.n_max >= 1.0) {
-            return Err(BuildError::InvalidNMax(p.n_max));
-        }
-        if p.max_depth > MAX_DEPTH_LIMIT {
-            return Err(BuildError::MaxDepthTooLarge(p.max_depth));
-        }
-        if !(p.min_leaf_size.is_finite() && p.min_leaf_size >= 0.0) {
-            return Err(BuildError::InvalidMinLeafSize(p.min_leaf_size));
-        }
-        if !(p.volume_tolerance.is_finite() && p.volume_tolerance >= 0.0) {
-            return Err(BuildError::InvalidVolumeTolerance(p.volume_tolerance));
-        }
+        p.validate()?;
         let domain = density.domain();
         if !domain.is_valid() {
             return Err(BuildError::InvalidDomain(domain));

@@ -65,9 +65,7 @@ mod user_bound;
 
 pub use allocate::{AllocationMode, allocate, stratum_weights};
 pub use audit::{Audit, FLUSH_EVERY};
-pub use builder::{
-    DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, DEFAULT_VOLUME_TOLERANCE, MAX_DEPTH_LIMIT, QuadTreeBuilder,
-};
+pub use builder::{MAX_DEPTH_LIMIT, QuadTreeBuilder};
 pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
 };

@@ -24,10 +24,6 @@ pub fn cosine_pdf(wi: &Vec3) -> f64 {
 }
 
 impl DirectionSampler for CosineHemisphere {
-    fn name(&self) -> &str {
-        "reference-cosine"
-    }
-
     fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let wi = cosine_direction(u);
         DirSample {
@@ -128,10 +124,6 @@ impl LobeMixture {
 }
 
 impl DirectionSampler for LobeMixture {
-    fn name(&self) -> &str {
-        "reference-lobe-mixture"
-    }
-
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let wi = if u.next_uniform() < self.select_diffuse {
             cosine_direction(u)

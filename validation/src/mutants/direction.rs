@@ -15,10 +15,6 @@ use super::bases::{LobeMixture, cosine_direction};
 pub struct CosineReportedUniform;
 
 impl DirectionSampler for CosineReportedUniform {
-    fn name(&self) -> &str {
-        "mutant-cosine-as-uniform"
-    }
-
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let wi = cosine_direction(u);
         DirSample {
@@ -46,10 +42,6 @@ pub struct TruncatedCosine {
 }
 
 impl DirectionSampler for TruncatedCosine {
-    fn name(&self) -> &str {
-        "mutant-support-hole"
-    }
-
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let s2 = self.theta_max_deg.to_radians().sin().powi(2);
         let (u1, u2) = (u.next_uniform(), u.next_uniform());
@@ -100,10 +92,6 @@ impl RegionScaledPdf {
 }
 
 impl DirectionSampler for RegionScaledPdf {
-    fn name(&self) -> &str {
-        "mutant-pdf-off-in-region"
-    }
-
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let s = self.base.sample(wo, u);
         DirSample {

@@ -28,10 +28,11 @@ pub use direction::{CosineReportedUniform, RegionScaledPdf, TruncatedCosine};
 pub use planar::{FloorSplit, Remainder, ScaledBounds};
 
 use crate::adapters::{DirectionAtWo, QuadTreePlanar};
+use crate::builds::quadtree_disc_sampler;
 use crate::domain::Domain;
-use crate::registry::{quadtree_disc_density, quadtree_disc_sampler};
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
+use samplers::quadtree_disc_density;
 
 /// A mutant and its control, ready to run.
 pub struct MutantCase {
@@ -116,7 +117,9 @@ fn control_disc(
     refs: &BrdfReferences,
 ) -> Result<AnySubject, String> {
     Ok(AnySubject::Planar(brdf_disc_subject(
-        Arc::new(QuadTreePlanar(quadtree_disc_sampler(brdf, wo)?)),
+        Arc::new(QuadTreePlanar(
+            quadtree_disc_sampler(brdf, wo).map_err(|e| e.to_string())?,
+        )),
         Arc::clone(brdf),
         *wo,
         refs,
@@ -129,7 +132,10 @@ fn floor_split(
     refs: &BrdfReferences,
     remainder: Remainder,
 ) -> Result<MutantCase, String> {
-    let broken = FloorSplit::new(quadtree_disc_sampler(brdf, wo)?, remainder);
+    let broken = FloorSplit::new(
+        quadtree_disc_sampler(brdf, wo).map_err(|e| e.to_string())?,
+        remainder,
+    );
     Ok(MutantCase {
         mutant: AnySubject::Planar(brdf_disc_subject(
             Arc::new(broken),
@@ -196,7 +202,7 @@ pub static MUTANTS: &[Mutant] = &[
         brdf: "phong:n=50",
         theta_o: 45.0,
         build: |b, wo, r| {
-            let density = quadtree_disc_density(b, wo)?;
+            let density = quadtree_disc_density(b, wo).map_err(|e| e.to_string())?;
             let broken = QuadTreeBuilder::new()
                 .build(ScaledBounds {
                     inner: density,

@@ -1,0 +1,68 @@
+//! The registry's typed error.
+
+use brdf_sampling::Variant;
+
+/// A sampler could not be found or built.
+#[derive(Debug, thiserror::Error)]
+pub enum RegistryError {
+    /// No sampler has this name.
+    #[error("unknown sampler `{name}`{}; known samplers: {known}",
+        suggestion.map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
+    UnknownSampler {
+        /// The name given.
+        name: String,
+        /// The closest registered name, if one is close.
+        suggestion: Option<&'static str>,
+        /// Every registered name, comma-separated.
+        known: String,
+    },
+    /// The sampler exists but samples something else (e.g. an environment-map sampler asked
+    /// to sample a BRDF).
+    #[error(
+        "sampler `{name}` is a {found} sampler, not a {expected} sampler; {expected} samplers: {candidates}"
+    )]
+    WrongKind {
+        /// The name given.
+        name: &'static str,
+        /// The kind the caller needs.
+        expected: &'static str,
+        /// The entry's kind.
+        found: &'static str,
+        /// The names of the expected kind.
+        candidates: String,
+    },
+    /// A saved set's variant and mixture flag match no registered sampler.
+    #[error("the saved set ({variant:?}, mixture {mixture}) matches no registered sampler")]
+    UnregisteredSet {
+        /// Its variant.
+        variant: Variant,
+        /// Its mixture flag.
+        mixture: bool,
+    },
+    /// A BRDF spec (e.g. the one stored in a set file) does not parse.
+    #[error("BRDF spec `{spec}`: {source}")]
+    Brdf {
+        /// The spec.
+        spec: String,
+        /// The cause.
+        source: brdf::SpecError,
+    },
+    /// Building an adaptive quadtree set failed.
+    #[error(transparent)]
+    Set(#[from] brdf_sampling::SetError),
+    /// A set file could not be read back.
+    #[error(transparent)]
+    SetFile(#[from] brdf_sampling::SetFileError),
+    /// A sampled density could not be set up.
+    #[error(transparent)]
+    Density(#[from] partition_sampler::DensityError),
+    /// A quadtree could not be built.
+    #[error(transparent)]
+    Tree(#[from] partition_sampler::BuildError),
+    /// An environment-map sampler could not be built.
+    #[error(transparent)]
+    EnvMap(#[from] envmap::EnvMapError),
+    /// A grid sampler could not be built.
+    #[error(transparent)]
+    Grid(#[from] baselines::TabulatedError),
+}
