@@ -291,7 +291,7 @@ fn envmap_cases(kind: SamplerKind) -> Result<Vec<StandaloneCase>, String> {
 fn grid_cases() -> Result<Vec<StandaloneCase>, String> {
     let (w, h) = (16, 8);
     let values = synthetic_values(w, h, 2);
-    let table = baselines::PiecewiseConstant2D::new(w, h, values.clone(), Rect::UNIT)
+    let table = partition_sampler::PiecewiseConstant2D::new(w, h, values.clone(), Rect::UNIT)
         .map_err(|e| e.to_string())?;
     Ok(vec![StandaloneCase {
         target: "grid:synthetic-16x8".into(),

@@ -1,7 +1,8 @@
 //! Reproducibility of the parallel batch sampler.
 
-use baselines::{PiecewiseConstant2D, Rect, parallel::CHUNK};
+use baselines::parallel::CHUNK;
 use partition_sampler::Sampler2D;
+use partition_sampler::{PiecewiseConstant2D, Rect};
 
 fn table() -> PiecewiseConstant2D {
     let v: Vec<f64> = (0..64).map(|i| (i % 5) as f64).collect();

@@ -2,10 +2,10 @@
 
 use std::time::{Duration, Instant};
 
-use baselines::PiecewiseConstant2D;
 use partition_sampler::{
-    DEFAULT_MAX_DEPTH, LeafChoice, MemoryReport, Point2, QuadTreeBuilder, QuadTreeSampler, Rect,
-    Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity, UniformSource,
+    DEFAULT_MAX_DEPTH, LeafChoice, MemoryReport, PiecewiseConstant2D, Point2, QuadTreeBuilder,
+    QuadTreeSampler, Rect, Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity,
+    UniformSource,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

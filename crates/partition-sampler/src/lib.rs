@@ -25,6 +25,11 @@
 //! memory reports ([`QuadTreeSampler::memory`]). Wrap a provider in [`SharedDensity`] to
 //! build several trees over one copy of it.
 //!
+//! The crate also holds the planar tabulated CDFs the adaptive sampler is compared with: the
+//! classic marginal/conditional piecewise-constant sampler [`PiecewiseConstant2D`] (an
+//! [`InvertibleSampler2D`], as pbrt uses for environment maps) and its 1D building block
+//! [`PiecewiseConstant1D`].
+//!
 //! ```
 //! use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, SinPiRows, TabulatedDensity};
 //! use rand::{SeedableRng, rngs::Xoshiro256PlusPlus};
@@ -54,6 +59,7 @@ mod error;
 mod layout_tests;
 mod leaf;
 mod persist;
+mod piecewise_constant;
 mod pyramid;
 mod rect;
 mod sampled;
@@ -73,6 +79,9 @@ pub use density::{
 };
 pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
 pub use persist::FORMAT_VERSION;
+pub use piecewise_constant::{
+    PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1,
+};
 pub use rect::{Domain, Rect};
 pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
