@@ -19,9 +19,7 @@
 //! ```
 
 pub mod hemisphere;
-pub mod parallel;
 pub mod registry;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
-pub use parallel::sample_par;
 pub use registry::{DIRECTION_SAMPLERS, build_direction_sampler};

@@ -18,8 +18,8 @@
 //! scheme. See [`QuadTreeSampler`] for what `pdf` returns.
 //!
 //! Beyond one-sample draws: the papers' batch mode ([`QuadTreeSampler::sample_batch`] on top
-//! of the reusable [`allocate()`]), reproducible parallel batches
-//! ([`QuadTreeSampler::sample_par`], identical for any thread count), a bound audit
+//! of the reusable [`allocate()`]), reproducible parallel batches of any [`Sampler2D`]
+//! ([`sample_par()`], identical for any thread count), a bound audit
 //! ([`SamplerStats::bound_violations`], [`QuadTreeSampler::sample_audited`]), versioned
 //! persistence of the tree ([`QuadTree::to_bytes`], [`QuadTreeSampler::from_parts`]) and
 //! memory reports ([`QuadTreeSampler::memory`]). Wrap a provider in [`SharedDensity`] to
@@ -58,6 +58,7 @@ mod error;
 #[cfg(test)]
 mod layout_tests;
 mod leaf;
+mod parallel;
 mod persist;
 mod piecewise_constant;
 mod pyramid;
@@ -78,6 +79,7 @@ pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
 };
 pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
+pub use parallel::{PAR_CHUNK, chunk_rng, chunk_seed, sample_par};
 pub use persist::FORMAT_VERSION;
 pub use piecewise_constant::{
     PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1,
@@ -90,10 +92,7 @@ pub use sampled::{
 pub use sampler::{
     AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
 };
-pub use sampler_impl::{
-    Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, PAR_CHUNK, QuadTreeSampler, SamplerStats,
-    chunk_seed,
-};
+pub use sampler_impl::{Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats};
 pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;

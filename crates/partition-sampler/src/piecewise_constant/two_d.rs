@@ -186,31 +186,10 @@ impl PiecewiseConstant2D {
         ))
     }
 
-    /// Draws `n` samples in parallel in fixed chunks of [`crate::PAR_CHUNK`], chunk `c` with a
-    /// `Xoshiro256PlusPlus` seeded by [`crate::chunk_seed`]`(seed, c)`: the result depends only
-    /// on `(n, seed)`.
+    /// Draws `n` samples in parallel; the result depends only on `(n, seed)` (see
+    /// [`crate::sample_par`]).
     pub fn sample_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
-        use rand::SeedableRng;
-        use rayon::prelude::*;
-        let mut out = vec![
-            Sample2 {
-                point: [0.0, 0.0],
-                pdf: 0.0
-            };
-            n
-        ];
-        out.par_chunks_mut(crate::PAR_CHUNK)
-            .enumerate()
-            .for_each(|(chunk, slot)| {
-                let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(crate::chunk_seed(
-                    seed,
-                    chunk as u64,
-                ));
-                for s in slot {
-                    *s = self.sample(&mut rng);
-                }
-            });
-        out
+        crate::sample_par(self, n, seed)
     }
 }
 
