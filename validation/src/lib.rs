@@ -40,6 +40,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod adapters;
+mod case;
 mod domain;
 mod error;
 pub mod mutants;
@@ -47,12 +48,12 @@ mod plan;
 pub mod references;
 mod registry;
 mod report;
-mod run;
-mod runner;
 pub mod seeding;
 mod subject;
+mod suite;
 pub mod targets;
 
+pub use case::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use domain::{Domain, Resolution};
 pub use error::ValidationError;
 pub use mutants::{Mutant, mutants};
@@ -66,8 +67,7 @@ pub use registry::{
     quadtree_disc_sampler, samplers, test_maps,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
-pub use run::{ProgressEvent, run};
-pub use runner::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };
+pub use suite::{ProgressEvent, run};

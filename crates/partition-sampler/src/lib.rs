@@ -53,6 +53,7 @@ mod alias;
 pub mod allocate;
 mod audit;
 mod builder;
+pub mod contract;
 mod density;
 mod error;
 #[cfg(test)]
@@ -62,10 +63,9 @@ mod parallel;
 mod persist;
 mod piecewise_constant;
 mod pyramid;
+mod quadtree_sampler;
 mod rect;
 mod sampled;
-pub mod sampler;
-mod sampler_impl;
 mod tabulated;
 mod tree;
 mod user_bound;
@@ -74,6 +74,9 @@ pub use allocate::{AllocationMode, allocate, stratum_weights};
 pub use audit::{Audit, FLUSH_EVERY};
 pub use builder::{
     DEFAULT_MAX_DEPTH, DEFAULT_N_MAX, DEFAULT_VOLUME_TOLERANCE, MAX_DEPTH_LIMIT, QuadTreeBuilder,
+};
+pub use contract::{
+    AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
 };
 pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
@@ -84,15 +87,14 @@ pub use persist::FORMAT_VERSION;
 pub use piecewise_constant::{
     PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1,
 };
+pub use quadtree_sampler::{
+    Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats,
+};
 pub use rect::{Domain, Rect};
 pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,
 };
-pub use sampler::{
-    AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
-};
-pub use sampler_impl::{Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats};
 pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;

@@ -6,7 +6,7 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
-use crate::sampler::{Sample2, Sampler2D};
+use crate::contract::{Sample2, Sampler2D};
 
 /// Samples per chunk of [`sample_par`]; each chunk has its own generator.
 pub const PAR_CHUNK: usize = 4096;

@@ -9,6 +9,7 @@ use brdf::{Brdf, Vec3, direction_from_angles};
 use rayon::prelude::*;
 use stats::{TestOutcome, sidak_level};
 
+use crate::case::{error_outcome, names, run_case};
 use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
@@ -17,7 +18,6 @@ use crate::plan::{
 use crate::references::{albedo_reference, lit_reference};
 use crate::registry::{SamplerBuild, SamplerEntry, StandaloneCase, find_sampler, samplers};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
-use crate::runner::{error_outcome, names, run_case};
 use crate::seeding::case_seed;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};

@@ -4,11 +4,11 @@ use std::sync::Arc;
 
 use crate::allocate::{AllocationMode, allocate, stratum_weights};
 use crate::audit::{Audit, Counters, flush_local, record_one};
+use crate::contract::{Point2, Sample2, Sampler2D, UniformSource};
 use crate::density::{IntegralSource, RegionStats};
 use crate::error::AttachError;
 use crate::leaf::{Frame, Leaf};
 use crate::rect::Domain;
-use crate::sampler::{Point2, Sample2, Sampler2D, UniformSource};
 use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
 
 /// A sample is abandoned (returned with pdf 0 and counted as exhausted) after this many
