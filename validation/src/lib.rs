@@ -42,22 +42,23 @@
 
 pub mod adapters;
 mod builds;
+mod case;
 mod domain;
 mod error;
 pub mod mutants;
 mod plan;
 pub mod references;
 mod report;
-mod run;
-mod runner;
 pub mod seeding;
 mod subject;
+mod suite;
 pub mod targets;
 
 pub use builds::{
     StandaloneCase, build_direction, build_disc, direction_domain, quadtree_disc_sampler,
     standalone_cases, test_maps, uses_brdf,
 };
+pub use case::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use domain::{Domain, Resolution};
 pub use error::ValidationError;
 pub use mutants::{Mutant, mutants};
@@ -66,8 +67,7 @@ pub use plan::{
     QUICK_THETA_O, Tier, ValidateConfig,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
-pub use run::{ProgressEvent, run};
-pub use runner::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };
+pub use suite::{ProgressEvent, run};

@@ -275,7 +275,7 @@ mod tests {
     use super::*;
     use crate::adapters::PlainPlanar;
     use approx::assert_relative_eq;
-    use partition_sampler::Rect;
+    use partition_sampler::{PiecewiseConstant2D, Rect};
     use stats::RectBinning;
 
     fn integrate_square(g: &(dyn Fn(Point2) -> f64 + Sync), nx: usize, ny: usize) -> f64 {
@@ -298,7 +298,7 @@ mod tests {
     #[test]
     fn closed_form_references_match_quadrature() {
         let map = synthetic_map().unwrap();
-        let table = baselines::PiecewiseConstant2D::new(4, 2, vec![1.0; 8], Rect::UNIT).unwrap();
+        let table = PiecewiseConstant2D::new(4, 2, vec![1.0; 8], Rect::UNIT).unwrap();
         let sampler: Arc<dyn SamplerUnderTest<Point2>> = Arc::new(PlainPlanar(table));
         let env = envmap_subject(Arc::clone(&sampler), &map);
         let q = integrate_square(env.single.integrand.as_ref(), 16, 8);

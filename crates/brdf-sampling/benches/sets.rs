@@ -14,20 +14,11 @@ use partition_sampler::UniformSource;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
+/// `phong:n=50` tabulated on the MERL grid (`MerlBrdf::tabulate`): the measured-data lookup.
 fn synthetic_merl() -> Arc<dyn Brdf> {
-    let analytic = parse_spec("phong:n=50").expect("spec");
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("phong50.binary");
-    brdf::write_merl(&path, &|th, td, pd| {
-        let (wo, wi) = brdf::merl::half_diff_to_directions(th, td, pd);
-        if wo.z > 0.0 && wi.z > 0.0 {
-            analytic.eval_rgb(&wo, &wi)
-        } else {
-            [-1.0; 3]
-        }
-    })
-    .expect("write");
-    Arc::new(MerlBrdf::load(&path).expect("load"))
+    Arc::new(MerlBrdf::tabulate(
+        &*parse_spec("phong:n=50").expect("spec"),
+    ))
 }
 
 fn build(c: &mut Criterion) {

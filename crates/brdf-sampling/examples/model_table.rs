@@ -1,4 +1,4 @@
-//! Prints, for every model in `brdf::models()` at its defaults and a synthetic MERL file, the
+//! Prints, for every model in `brdf::models()` at its defaults and a synthetic MERL table, the
 //! build time of a quadtree set (median of a few runs), its memory, expected and measured
 //! trials, BRDF evaluations per accepted sample, bound violations and the sampling rate.
 //!
@@ -219,19 +219,7 @@ fn main() {
     for spec in specs.iter().filter(|s| wanted(s)) {
         let brdf: Arc<dyn Brdf> =
             if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
-                let analytic = parse_spec(inner).expect("spec");
-                let dir = tempfile::tempdir().expect("tempdir");
-                let path = dir.path().join("synthetic.binary");
-                brdf::write_merl(&path, &|th, td, pd| {
-                    let (wo, wi) = brdf::merl::half_diff_to_directions(th, td, pd);
-                    if wo.z > 0.0 && wi.z > 0.0 {
-                        analytic.eval_rgb(&wo, &wi)
-                    } else {
-                        [-1.0; 3]
-                    }
-                })
-                .expect("write_merl");
-                Arc::new(MerlBrdf::load(&path).expect("load merl"))
+                Arc::new(MerlBrdf::tabulate(&*parse_spec(inner).expect("spec")))
             } else {
                 Arc::from(parse_spec(spec).expect("spec"))
             };

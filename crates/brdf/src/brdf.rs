@@ -3,14 +3,13 @@
 use crate::geometry::Vec3;
 use std::sync::Arc;
 
-/// Rec. 709 luminance weights used to turn RGB reflectance into the scalar that is sampled.
-pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+/// Rec. 709 luminance weights used to turn RGB reflectance into the scalar that is sampled
+/// (re-exported from the `colour` crate, the project's one luminance formula).
+pub use colour::LUMINANCE_WEIGHTS;
 
-/// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B` of a linear RGB triple.
-#[inline]
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    LUMINANCE_WEIGHTS[0] * rgb[0] + LUMINANCE_WEIGHTS[1] * rgb[1] + LUMINANCE_WEIGHTS[2] * rgb[2]
-}
+/// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B` of a linear RGB triple (re-exported from
+/// the `colour` crate).
+pub use colour::luminance;
 
 /// A bidirectional reflectance distribution function `f_r(ωo, ωi)` in units of 1/sr.
 ///

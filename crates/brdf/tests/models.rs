@@ -326,3 +326,21 @@ fn constructors_validate_directly() {
     assert!(!parse_spec("minnaert:k=0.9").unwrap().conserves_energy());
     assert!(!parse_spec("ward-original").unwrap().conserves_energy());
 }
+
+#[test]
+fn half_vector_models_take_their_own_params() {
+    use brdf::models::*;
+    assert_eq!(Blinn::default().params(), &BlinnParams::default());
+    assert_eq!(blinn_defaults(), BlinnParams::default());
+    assert_eq!(LewisParams::default().n, 50.0);
+    assert_eq!(BlinnParams::default().n, 100.0);
+    let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+    let wi = Vec3::new(-0.25, 0.1, 0.95).normalize();
+    let (n, ks, kd) = (20.0, 0.5, 0.1);
+    let blinn = Blinn::new(BlinnParams { n, ks, kd }).unwrap();
+    let lewis = Lewis::new(LewisParams { n, ks, kd }).unwrap();
+    let spec = |s: &str| parse_spec(s).unwrap().eval(&wo, &wi);
+    assert_eq!(blinn.eval(&wo, &wi), spec("blinn:n=20,ks=0.5,kd=0.1"));
+    assert_eq!(lewis.eval(&wo, &wi), spec("lewis:n=20,ks=0.5,kd=0.1"));
+    assert_eq!(lewis.params(), &LewisParams { n, ks, kd });
+}

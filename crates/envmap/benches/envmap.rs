@@ -12,7 +12,6 @@
 //! `cargo bench -p envmap --bench envmap -- --warm-up-time 1 --measurement-time 3`
 
 use std::hint::black_box;
-use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use envmap::{
@@ -21,20 +20,15 @@ use envmap::{
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
+mod support;
+
 fn maps() -> Vec<(String, EnvMap)> {
     let mut maps = vec![(
         "sky".to_string(),
         procedural_sky(1024, 512).expect("procedural sky"),
     )];
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/envmaps");
-    match std::fs::read_dir(&dir) {
-        Ok(entries) => {
-            let mut paths: Vec<_> = entries
-                .flatten()
-                .map(|e| e.path())
-                .filter(|p| envmap::MapFormat::from_path(p).is_some())
-                .collect();
-            paths.sort();
+    match support::real_map_paths() {
+        Ok(paths) => {
             for p in paths {
                 let name = p
                     .file_stem()
@@ -53,7 +47,7 @@ fn maps() -> Vec<(String, EnvMap)> {
                 }
             }
         }
-        Err(_) => eprintln!(
+        Err(dir) => eprintln!(
             "{} is absent: benchmarking the procedural sky only",
             dir.display()
         ),

@@ -3,12 +3,15 @@
 //!
 //! `cargo run --release -p envmap --example envmap_stats [-- MAP.hdr ... [--n-max X]...]`
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
+
+#[path = "../benches/support/mod.rs"]
+mod support;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -26,17 +29,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         n_max.push(AdaptiveOptions::default().tree.n_max);
     }
     if files.is_empty() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/envmaps");
-        match std::fs::read_dir(&dir) {
-            Ok(entries) => files.extend(
-                entries
-                    .flatten()
-                    .map(|e| e.path())
-                    .filter(|p| envmap::MapFormat::from_path(p).is_some()),
-            ),
-            Err(_) => eprintln!("{} is absent: only the procedural sky", dir.display()),
+        match support::real_map_paths() {
+            Ok(paths) => files = paths,
+            Err(dir) => eprintln!("{} is absent: only the procedural sky", dir.display()),
         }
-        files.sort();
     }
     let mut maps = vec![("procedural-sky".to_string(), procedural_sky(1024, 512)?)];
     for f in &files {

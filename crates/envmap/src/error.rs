@@ -112,5 +112,5 @@ pub enum EnvMapError {
     Build(#[from] partition_sampler::BuildError),
     /// The piecewise-constant sampler rejected the luminance table.
     #[error("cannot build the piecewise-constant sampler: {0}")]
-    Tabulated(#[from] baselines::TabulatedError),
+    PiecewiseConstant(#[from] partition_sampler::PiecewiseConstantError),
 }

@@ -16,7 +16,8 @@
 //! carries `pdf_uv` (w.r.t. area on `[0,1]²`) and `pdf_sa = pdf_uv / (2π² sin(πv))` (w.r.t.
 //! solid angle). [`EnvMapSampler`] offers the adaptive-partition sampler of
 //! `partition_sampler` (exact target; envelope or paper scheme; alias or descent leaf choice)
-//! and the classic piecewise-constant CDF of `baselines` (midpoint approximation of the sine).
+//! and the classic piecewise-constant CDF `partition_sampler::PiecewiseConstant2D` (midpoint
+//! approximation of the sine).
 //!
 //! ```
 //! use envmap::{AdaptiveOptions, EnvMapSampler, SamplerKind, procedural_sky};

@@ -5,10 +5,11 @@ use crate::EnvMapError;
 /// Largest number of pixels a map may have (2²⁵ ≈ 33.5 M, e.g. 8192 × 4096).
 pub const MAX_PIXELS: usize = 1 << 25;
 
-/// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B` (Rec. 709 / sRGB primaries).
+/// Luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B` (Rec. 709 / sRGB primaries) of a pixel's
+/// `f32` radiance: [`colour::luminance`] of the triple widened to `f64`.
 #[inline]
 pub fn luminance(rgb: [f32; 3]) -> f64 {
-    0.2126 * rgb[0] as f64 + 0.7152 * rgb[1] as f64 + 0.0722 * rgb[2] as f64
+    colour::luminance(rgb.map(f64::from))
 }
 
 /// A lat-long (equirectangular) environment map of linear RGB radiance.

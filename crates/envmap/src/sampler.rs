@@ -2,10 +2,10 @@
 
 use std::time::{Duration, Instant};
 
-use baselines::PiecewiseConstant2D;
 use partition_sampler::{
-    LeafChoice, MemoryReport, Point2, QuadTreeBuilder, QuadTreeSampler, Rect, Sample2, Sampler2D,
-    SamplerStats, Scheme, SinPiRows, TabulatedDensity, TreeParams, UniformSource,
+    LeafChoice, MemoryReport, PiecewiseConstant2D, Point2, QuadTreeBuilder, QuadTreeSampler, Rect,
+    Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity, TreeParams,
+    UniformSource,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -250,14 +250,11 @@ impl EnvMapSampler {
         EnvSample::from_uv(self.sample_uv(u))
     }
 
-    /// `n` planar samples drawn in parallel in fixed chunks of `partition_sampler::PAR_CHUNK`,
-    /// chunk `c` with `Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, c))`:
-    /// the result depends only on `(n, seed)`, never on the thread count.
+    /// `n` planar samples drawn in parallel by [`partition_sampler::sample_par`] (fixed chunks of
+    /// `partition_sampler::PAR_CHUNK`, one generator per chunk seeded from `(seed, chunk)`): the
+    /// result depends only on `(n, seed)`, never on the thread count.
     pub fn sample_uv_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
-        match &self.inner {
-            Inner::Adaptive(s) => s.sample_par(n, seed),
-            Inner::PiecewiseConstant(t) => t.sample_par(n, seed),
-        }
+        partition_sampler::sample_par(self, n, seed)
     }
 
     /// `n` directions drawn in parallel: [`EnvMapSampler::sample_uv_par`] completed (also in
@@ -291,6 +288,14 @@ impl Sampler2D for EnvMapSampler {
     #[inline]
     fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2 {
         self.sample_uv(u)
+    }
+
+    /// The inner sampler's own `sample_into` (one dispatch per slice).
+    fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
+        match &self.inner {
+            Inner::Adaptive(s) => s.sample_into(u, out),
+            Inner::PiecewiseConstant(t) => t.sample_into(u, out),
+        }
     }
 
     /// Density w.r.t. area on `[0,1]²`.

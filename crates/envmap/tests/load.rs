@@ -6,6 +6,9 @@ use std::path::Path;
 
 use envmap::{EnvMap, EnvMapError, MapFormat};
 
+#[path = "../benches/support/mod.rs"]
+mod support;
+
 // ---------------------------------------------------------------- a tiny RGBE writer
 
 /// Encodes a colour as RGBE: shared exponent of the largest channel, 8-bit mantissas.
@@ -550,17 +553,15 @@ fn pixel_validation_in_constructor() {
 /// The real maps shipped with the project, when present.
 #[test]
 fn real_maps_load() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/envmaps");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipping: {} is absent", dir.display());
-        return;
+    let paths = match support::real_map_paths() {
+        Ok(paths) => paths,
+        Err(dir) => {
+            eprintln!("skipping: {} is absent", dir.display());
+            return;
+        }
     };
     let mut loaded = 0;
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if MapFormat::from_path(&path).is_none() {
-            continue;
-        }
+    for path in paths {
         let map = EnvMap::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(
             map.width() >= 2 * map.height() - 1,

@@ -2,7 +2,6 @@
 //! solid-angle conversion, reproducibility, real maps.
 
 use std::f64::consts::PI;
-use std::path::Path;
 
 use envmap::latlong::{sin_integral, uv_to_direction};
 use envmap::{
@@ -12,6 +11,9 @@ use envmap::{
 use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, TabulatedDensity};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
+
+#[path = "../benches/support/mod.rs"]
+mod support;
 
 /// Significance level of every chi-square test in this file.
 const ALPHA: f64 = 1e-3;
@@ -299,16 +301,13 @@ fn real_maps_and_sky_sample_cleanly() {
         "procedural sky 256×128".to_string(),
         procedural_sky(256, 128).unwrap(),
     )];
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/envmaps");
-    match std::fs::read_dir(&dir) {
-        Ok(entries) => {
-            for path in entries.flatten().map(|e| e.path()) {
-                if path.extension().is_some_and(|e| e == "hdr") {
-                    maps.push((path.display().to_string(), EnvMap::load(&path).unwrap()));
-                }
+    match support::real_map_paths() {
+        Ok(paths) => {
+            for path in paths {
+                maps.push((path.display().to_string(), EnvMap::load(&path).unwrap()));
             }
         }
-        Err(_) => eprintln!("skipping real maps: {} is absent", dir.display()),
+        Err(dir) => eprintln!("skipping real maps: {} is absent", dir.display()),
     }
     for (name, map) in &maps {
         for kind in [

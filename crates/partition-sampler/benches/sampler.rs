@@ -13,34 +13,10 @@ use partition_sampler::{
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
+mod support;
+use support::{envmap, lobe};
+
 const N: usize = 100_000;
-
-fn lobe(p: [f64; 2]) -> f64 {
-    let z2 = 1.0 - p[0] * p[0] - p[1] * p[1];
-    if z2 < 0.0 {
-        return 0.0;
-    }
-    let (s, c) = 30f64.to_radians().sin_cos();
-    let d = s * p[0] + c * z2.sqrt();
-    if d > 0.0 { d.powf(1000.0) } else { 0.0 }
-}
-
-fn envmap(w: usize, h: usize) -> Vec<f64> {
-    let (sx, sy) = (0.3 * w as f64, 0.3 * h as f64);
-    (0..w * h)
-        .map(|k| {
-            let (i, j) = ((k % w) as f64, (k / w) as f64);
-            let sky =
-                0.5 + 0.5 * (j / h as f64) + 0.1 * ((i * 0.05).sin() * (j * 0.07).cos()).abs();
-            let sun = if (i - sx).powi(2) + (j - sy).powi(2) < 4.0 {
-                1e5
-            } else {
-                0.0
-            };
-            sky + sun
-        })
-        .collect()
-}
 
 fn bench_sampling<D: RegionStats>(
     c: &mut Criterion,

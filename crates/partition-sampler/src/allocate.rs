@@ -2,8 +2,8 @@
 //!
 //! Reusable for any stratified batch (quadtree leaves, SRBF lobes, …).
 
+use crate::contract::UniformSource;
 use crate::error::AllocationError;
-use crate::sampler::UniformSource;
 
 /// How the remainder `R = N − Σ ⌊N p_i⌋` is distributed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -4,8 +4,8 @@ use crate::alias::build_alias;
 use crate::density::RegionStats;
 use crate::error::BuildError;
 use crate::leaf::{Frame, Leaf, encode_axis, encode_bound, pow2_floor};
+use crate::quadtree_sampler::QuadTreeSampler;
 use crate::rect::{Domain, Rect};
-use crate::sampler_impl::QuadTreeSampler;
 use crate::tree::{
     EMPTY, LEAF, LeafChoice, Node, QuadTree, Scheme, TreeCounts, TreeParams, cell_rect,
 };

@@ -2,9 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::contract::Point2;
 use crate::error::DensityError;
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// A non-negative function `f` on the plane, evaluated pointwise.
 ///

@@ -18,12 +18,17 @@
 //! scheme. See [`QuadTreeSampler`] for what `pdf` returns.
 //!
 //! Beyond one-sample draws: the papers' batch mode ([`QuadTreeSampler::sample_batch`] on top
-//! of the reusable [`allocate()`]), reproducible parallel batches
-//! ([`QuadTreeSampler::sample_par`], identical for any thread count), a bound audit
+//! of the reusable [`allocate()`]), reproducible parallel batches of any [`Sampler2D`]
+//! ([`sample_par()`], identical for any thread count), a bound audit
 //! ([`SamplerStats::bound_violations`], [`QuadTreeSampler::sample_audited`]), versioned
 //! persistence of the tree ([`QuadTree::to_bytes`], [`QuadTreeSampler::from_parts`]) and
 //! memory reports ([`QuadTreeSampler::memory`]). Wrap a provider in [`SharedDensity`] to
 //! build several trees over one copy of it.
+//!
+//! The crate also holds the planar tabulated CDFs the adaptive sampler is compared with: the
+//! classic marginal/conditional piecewise-constant sampler [`PiecewiseConstant2D`] (an
+//! [`InvertibleSampler2D`], as pbrt uses for environment maps) and its 1D building block
+//! [`PiecewiseConstant1D`].
 //!
 //! ```
 //! use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, SinPiRows, TabulatedDensity};
@@ -48,17 +53,19 @@ mod alias;
 pub mod allocate;
 mod audit;
 mod builder;
+pub mod contract;
 mod density;
 mod error;
 #[cfg(test)]
 mod layout_tests;
 mod leaf;
+mod parallel;
 mod persist;
+mod piecewise_constant;
 mod pyramid;
+mod quadtree_sampler;
 mod rect;
 mod sampled;
-pub mod sampler;
-mod sampler_impl;
 mod tabulated;
 mod tree;
 mod user_bound;
@@ -66,22 +73,25 @@ mod user_bound;
 pub use allocate::{AllocationMode, allocate, stratum_weights};
 pub use audit::{Audit, FLUSH_EVERY};
 pub use builder::{MAX_DEPTH_LIMIT, QuadTreeBuilder};
+pub use contract::{
+    AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
+};
 pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
 };
 pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
+pub use parallel::{PAR_CHUNK, chunk_rng, chunk_seed, sample_par};
 pub use persist::FORMAT_VERSION;
+pub use piecewise_constant::{
+    PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1,
+};
+pub use quadtree_sampler::{
+    Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats,
+};
 pub use rect::{Domain, Rect};
 pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,
-};
-pub use sampler::{
-    AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
-};
-pub use sampler_impl::{
-    Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, PAR_CHUNK, QuadTreeSampler, SamplerStats,
-    chunk_seed,
 };
 pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::sampler::Point2;
+use crate::contract::Point2;
 
 /// An axis-aligned rectangle `[x0, x1] × [y0, y1]` of the plane.
 ///

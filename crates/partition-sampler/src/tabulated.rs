@@ -4,13 +4,13 @@
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
+use crate::contract::Point2;
 use crate::density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats,
 };
 use crate::error::DensityError;
 use crate::pyramid::{CellSource, Pyramid, snap};
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// A smooth factor `g(t) ≥ 0` of the normalised row coordinate `t = (y − y0)/(y1 − y0) ∈ [0, 1]`
 /// that multiplies a tabulated density: `f(x, y) = v[i, j] · g(t)`.

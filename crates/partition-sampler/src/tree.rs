@@ -4,10 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::contract::Point2;
 use crate::density::{DensityShape, IntegralSource};
 use crate::leaf::{Frame, Leaf};
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// How a leaf is chosen for a rejection trial, and what the pdf is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

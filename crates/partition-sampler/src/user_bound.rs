@@ -1,11 +1,11 @@
 //! Densities whose region bounds the caller supplies (Lipschitz or analytic bounds).
 
+use crate::contract::Point2;
 use crate::density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats,
 };
 use crate::error::DensityError;
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// A density `f` with a caller-supplied bound `upper_bound(cell) ≥ sup_{cell ∩ D} f`;
 /// integrals by the `q × q` midpoint rule on each cell (points outside the disc count as 0),

@@ -191,7 +191,7 @@ fn grid_cdf(
     values: Vec<f64>,
     domain: Rect,
 ) -> Result<GridSampler, RegistryError> {
-    Ok(baselines::PiecewiseConstant2D::new(
+    Ok(partition_sampler::PiecewiseConstant2D::new(
         width, height, values, domain,
     )?)
 }

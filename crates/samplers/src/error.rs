@@ -64,5 +64,5 @@ pub enum RegistryError {
     EnvMap(#[from] envmap::EnvMapError),
     /// A grid sampler could not be built.
     #[error(transparent)]
-    Grid(#[from] baselines::TabulatedError),
+    Grid(#[from] partition_sampler::PiecewiseConstantError),
 }

@@ -104,7 +104,7 @@ pub type DiscBuild = fn(&Arc<dyn Brdf>, &Vec3) -> Result<DiscSampler, RegistryEr
 pub type EnvMapBuild = fn(&EnvMap, &AdaptiveOptions) -> Result<EnvMapSampler, RegistryError>;
 
 /// The grid sampler of a piecewise-constant table (pdf w.r.t. area on its rectangle).
-pub type GridSampler = baselines::PiecewiseConstant2D;
+pub type GridSampler = partition_sampler::PiecewiseConstant2D;
 
 /// Builds a grid sampler from `width × height` values (row-major, row 0 at `domain.y0`).
 pub type GridBuild = fn(usize, usize, Vec<f64>, Rect) -> Result<GridSampler, RegistryError>;

@@ -258,6 +258,13 @@ fn integrate_all_bins<B: Binning + ?Sized>(
 }
 
 /// Gauss–Legendre nodes and weights on `[−1, 1]`.
+///
+/// Independent implementation on purpose: the validation suite must not share numerics with
+/// the samplers it checks. The project's rule for BRDF-side code is
+/// `brdf::quadrature::GaussLegendre` (used by the models and by `brdf-sampling`'s leaf
+/// normalisation); a bug there must not be able to hide itself by also skewing the references
+/// and expected counts computed here, so `stats` depends on no project crate and keeps this
+/// copy.
 #[derive(Debug, Clone)]
 pub(crate) struct GaussLegendre {
     nodes: Vec<f64>,

@@ -3,13 +3,12 @@
 //! `f_r = kd/π + ks · (n+2)(n+4) / (8π (n + 2^{−n/2})) · (n·h)^n`, `h = (ωo+ωi)/|ωo+ωi|`.
 //! The constant makes the lobe's directional albedo exactly `ks` at normal incidence
 //! (`∫ (n·h)^n cosθi dσ = 8π(n + 2^{−n/2})/((n+2)(n+4))` for `ωo = n`); it is the closed form of
-//! the approximation `(n+8)/(8π)` popularised by Akenine-Möller et al. Parameters as
-//! [`Phong`](super::Phong): `n ∈ [0, 10⁵]` (default 100), `ks` (default 0.6), `kd` (default 0.4).
+//! the approximation `(n+8)/(8π)` popularised by Akenine-Möller et al. Parameters
+//! ([`BlinnParams`]): `n ∈ [0, 10⁵]` (default 100), `ks` (default 0.6), `kd` (default 0.4).
 //! The albedo is largest at normal incidence (checked numerically in the tests), so the model
 //! conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
 use super::half_vector_lobe::HalfVectorLobe;
-use super::phong::PhongParams;
 use crate::brdf::Brdf;
 use crate::geometry::Vec3;
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
@@ -31,34 +30,54 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
 /// Blinn–Phong BRDF (normalised half-vector cosine lobe).
 #[derive(Debug, Clone)]
 pub struct Blinn {
+    params: BlinnParams,
     lobe: HalfVectorLobe,
 }
 
-/// Default parameters of [`Blinn`] (n = 100, ks = 0.6, kd = 0.4).
-pub fn blinn_defaults() -> PhongParams {
-    let [n, ks, kd] = defaults(PARAMS);
-    PhongParams { n, ks, kd }
+/// Parameters of [`Blinn`] (SPEC keys `n`, `ks`, `kd`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlinnParams {
+    /// Half-vector exponent `n ∈ [0, 10⁵]`.
+    pub n: f64,
+    /// Specular albedo at normal incidence, in `[0, 1]`.
+    pub ks: f64,
+    /// Diffuse albedo, in `[0, 1]`.
+    pub kd: f64,
+}
+
+impl Default for BlinnParams {
+    /// n = 100, ks = 0.6, kd = 0.4.
+    fn default() -> Self {
+        let [n, ks, kd] = defaults(PARAMS);
+        Self { n, ks, kd }
+    }
+}
+
+/// Default parameters of [`Blinn`]: n = 100, ks = 0.6, kd = 0.4 (as [`BlinnParams::default`]).
+pub fn blinn_defaults() -> BlinnParams {
+    BlinnParams::default()
 }
 
 impl Blinn {
     /// Validate the parameters and build the model.
-    pub fn new(params: PhongParams) -> Result<Self, ParamError> {
+    pub fn new(params: BlinnParams) -> Result<Self, ParamError> {
         validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
         let n = params.n;
         let norm = (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()));
         Ok(Self {
-            lobe: HalfVectorLobe::new(params, norm),
+            params,
+            lobe: HalfVectorLobe::new(n, params.ks, params.kd, norm),
         })
     }
 
     /// The parameters this model was built with.
-    pub fn params(&self) -> &PhongParams {
-        &self.lobe.params
+    pub fn params(&self) -> &BlinnParams {
+        &self.params
     }
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [n, ks, kd] = super::take(v);
-        Self::new(PhongParams { n, ks, kd })
+        Self::new(BlinnParams { n, ks, kd })
     }
 }
 

@@ -1,26 +1,30 @@
 //! The shared core of the half-vector lobe models ([`Blinn`](super::Blinn),
 //! [`Lewis`](super::Lewis)): `f_r = kd/π + ks · norm(n) · (n·h)^n`, `h = (ωo+ωi)/|ωo+ωi|`.
-//! The models differ only in `norm(n)`.
+//! The models differ only in `norm(n)`; each has its own parameter type
+//! ([`BlinnParams`](super::BlinnParams), [`LewisParams`](super::LewisParams)).
 
-use super::phong::PhongParams;
 use crate::geometry::{Vec3, both_above};
 use std::f64::consts::FRAC_1_PI;
 
 /// `kd/π + ks·norm·(n·h)^n` with its constants precomputed.
 #[derive(Debug, Clone)]
 pub(crate) struct HalfVectorLobe {
-    pub(crate) params: PhongParams,
+    /// Half-vector exponent `n`.
+    n: f64,
     diffuse: f64,
     spec_scale: f64,
+    /// `kd + ks`, the bound of the albedo.
+    albedo_bound: f64,
 }
 
 impl HalfVectorLobe {
-    /// The lobe for validated `params` and the model's normalisation `norm`.
-    pub(crate) fn new(params: PhongParams, norm: f64) -> Self {
+    /// The lobe for validated `n`, `ks`, `kd` and the model's normalisation `norm`.
+    pub(crate) fn new(n: f64, ks: f64, kd: f64, norm: f64) -> Self {
         Self {
-            params,
-            diffuse: params.kd * FRAC_1_PI,
-            spec_scale: params.ks * norm,
+            n,
+            diffuse: kd * FRAC_1_PI,
+            spec_scale: ks * norm,
+            albedo_bound: kd + ks,
         }
     }
 
@@ -32,11 +36,11 @@ impl HalfVectorLobe {
         }
         let h = wo + wi;
         let nh = h.z / h.norm();
-        self.diffuse + self.spec_scale * nh.powf(self.params.n)
+        self.diffuse + self.spec_scale * nh.powf(self.n)
     }
 
     /// Both models' albedo is at most `kd + ks` (checked numerically in their tests).
     pub(crate) fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
+        self.albedo_bound <= 1.0
     }
 }

@@ -5,12 +5,12 @@
 //! integrate to `ks` over solid angle *without* the cosine at normal incidence
 //! (`∫ (n·h)^n dσ = 4π(2 − 2^{−n/2})/(n+2)`). The cosine-weighted albedo of the lobe is then
 //! below `ks` at normal incidence and decreases with θo (checked numerically in the tests), so the
-//! model conserves energy iff `kd + ks ≤ 1`. Parameters `n ∈ [0, 10⁵]` (default 50), `ks` (default 0.6), `kd`
-//! (default 0.4). Reciprocal and isotropic. (Lewis' normalisation of the mirror-direction lobe,
-//! `(n+2)/(2π)`, is the [`Phong`](super::Phong) model of this crate.)
+//! model conserves energy iff `kd + ks ≤ 1`. Parameters ([`LewisParams`]): `n ∈ [0, 10⁵]`
+//! (default 50), `ks` (default 0.6), `kd` (default 0.4). Reciprocal and isotropic. (Lewis'
+//! normalisation of the mirror-direction lobe, `(n+2)/(2π)`, is the [`Phong`](super::Phong)
+//! model of this crate.)
 
 use super::half_vector_lobe::HalfVectorLobe;
-use super::phong::PhongParams;
 use crate::brdf::Brdf;
 use crate::geometry::Vec3;
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
@@ -27,34 +27,54 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
 /// Lewis-normalised Blinn–Phong BRDF.
 #[derive(Debug, Clone)]
 pub struct Lewis {
+    params: LewisParams,
     lobe: HalfVectorLobe,
 }
 
-/// Default parameters of [`Lewis`] (n = 50, ks = 0.6, kd = 0.4).
-pub fn lewis_defaults() -> PhongParams {
-    let [n, ks, kd] = defaults(PARAMS);
-    PhongParams { n, ks, kd }
+/// Parameters of [`Lewis`] (SPEC keys `n`, `ks`, `kd`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LewisParams {
+    /// Half-vector exponent `n ∈ [0, 10⁵]`.
+    pub n: f64,
+    /// Specular coefficient, in `[0, 1]`.
+    pub ks: f64,
+    /// Diffuse albedo, in `[0, 1]`.
+    pub kd: f64,
+}
+
+impl Default for LewisParams {
+    /// n = 50, ks = 0.6, kd = 0.4.
+    fn default() -> Self {
+        let [n, ks, kd] = defaults(PARAMS);
+        Self { n, ks, kd }
+    }
+}
+
+/// Default parameters of [`Lewis`]: n = 50, ks = 0.6, kd = 0.4 (as [`LewisParams::default`]).
+pub fn lewis_defaults() -> LewisParams {
+    LewisParams::default()
 }
 
 impl Lewis {
     /// Validate the parameters and build the model.
-    pub fn new(params: PhongParams) -> Result<Self, ParamError> {
+    pub fn new(params: LewisParams) -> Result<Self, ParamError> {
         validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
         let n = params.n;
         let norm = (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()));
         Ok(Self {
-            lobe: HalfVectorLobe::new(params, norm),
+            params,
+            lobe: HalfVectorLobe::new(n, params.ks, params.kd, norm),
         })
     }
 
     /// The parameters this model was built with.
-    pub fn params(&self) -> &PhongParams {
-        &self.lobe.params
+    pub fn params(&self) -> &LewisParams {
+        &self.params
     }
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
         let [n, ks, kd] = super::take(v);
-        Self::new(PhongParams { n, ks, kd })
+        Self::new(LewisParams { n, ks, kd })
     }
 }
 

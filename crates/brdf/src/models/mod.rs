@@ -22,13 +22,13 @@ pub mod ward;
 
 pub use ashikhmin_shirley::{AshikhminShirley, AshikhminShirleyParams};
 pub use beard_maxwell::{BeardMaxwell, BeardMaxwellParams};
-pub use blinn::{Blinn, blinn_defaults};
+pub use blinn::{Blinn, BlinnParams, blinn_defaults};
 pub use cook_torrance::{CookTorrance, CookTorranceParams};
 pub use coupled::{Coupled, CoupledParams};
 pub use htsg::{Htsg, HtsgParams};
 pub use lafortune::{Lafortune, LafortuneLobe, LafortuneParams};
 pub use lambert::{Lambert, LambertParams};
-pub use lewis::{Lewis, lewis_defaults};
+pub use lewis::{Lewis, LewisParams, lewis_defaults};
 pub use microfacet::{Microfacet, MicrofacetParams, NormalDistribution};
 pub use minnaert::{Minnaert, MinnaertParams};
 pub use oren_nayar::{OrenNayar, OrenNayarParams};

@@ -26,7 +26,7 @@ pub(crate) const PARAMS: &[ParamInfo] = &[
     param("kd", 0.3, Range::closed(0.0, 1.0), "diffuse albedo"),
 ];
 
-/// Parameters of [`Phong`] (also used by [`Blinn`](super::Blinn) and [`Lewis`](super::Lewis)).
+/// Parameters of [`Phong`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhongParams {
     /// Cosine-lobe exponent `n ≥ 0`.

@@ -5,10 +5,10 @@ use rayon::prelude::*;
 
 use super::Refinement;
 use super::lattice::{GridPoint, Lattice};
+use crate::contract::Point2;
 use crate::density::Density;
 use crate::error::DensityError;
 use crate::rect::{Domain, Rect, interval_min_abs};
-use crate::sampler::Point2;
 
 /// Sub-samples per axis of a fine cell crossed by the disc boundary, and of the coarser
 /// Richardson partner whose signed difference estimates the boundary integral's error.

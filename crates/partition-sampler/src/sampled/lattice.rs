@@ -3,10 +3,10 @@
 
 use rayon::prelude::*;
 
+use crate::contract::Point2;
 use crate::density::Density;
 use crate::error::DensityError;
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// A point of the `n × n` fine-cell grid: a corner `(a, b)`, `0 ≤ a, b ≤ n`, or the centre of
 /// fine cell `(a, b)`, `0 ≤ a, b < n`.

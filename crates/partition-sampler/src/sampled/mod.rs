@@ -5,13 +5,13 @@
 mod fill;
 mod lattice;
 
+use crate::contract::Point2;
 use crate::density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats,
 };
 use crate::error::DensityError;
 use crate::pyramid::{CellSource, Pyramid, snap};
 use crate::rect::{Domain, Rect};
-use crate::sampler::Point2;
 
 /// Default multiplier applied to grid maxima to obtain the leaf bounds `M_i`.
 pub const DEFAULT_SAFETY_FACTOR: f64 = 1.1;

@@ -1,10 +1,10 @@
-//! Errors of the tabulated (piecewise-constant) samplers.
+//! Errors of the piecewise-constant CDF samplers.
 
 use thiserror::Error;
 
 /// Why a piecewise-constant table could not be built.
 #[derive(Debug, Clone, PartialEq, Error)]
-pub enum TabulatedError {
+pub enum PiecewiseConstantError {
     /// The grid has no cell (`width == 0` or `height == 0`).
     #[error("empty table: {width}×{height} cells")]
     Empty {

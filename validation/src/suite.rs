@@ -13,6 +13,7 @@ use crate::adapters::DirectionAtWo;
 use crate::builds::{
     StandaloneCase, build_direction, build_disc, direction_domain, standalone_cases, uses_brdf,
 };
+use crate::case::{error_outcome, names, run_case};
 use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
@@ -20,7 +21,6 @@ use crate::plan::{
 };
 use crate::references::{albedo_reference, lit_reference};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
-use crate::runner::{error_outcome, names, run_case};
 use crate::seeding::case_seed;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};

@@ -1,6 +1,6 @@
 //! Shared kernels: validation, normalised CDF construction and CDF search.
 
-use super::TabulatedError;
+use super::PiecewiseConstantError;
 
 /// The largest `f64` below 1.
 pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
@@ -16,14 +16,14 @@ pub(crate) fn clamp_unit(u: f64) -> f64 {
 }
 
 /// Checks that every value is finite and non-negative; `width` names columns in errors.
-pub(crate) fn validate_values(values: &[f64], width: usize) -> Result<(), TabulatedError> {
+pub(crate) fn validate_values(values: &[f64], width: usize) -> Result<(), PiecewiseConstantError> {
     for (i, &value) in values.iter().enumerate() {
         let (column, row) = (i % width.max(1), i / width.max(1));
         if !value.is_finite() {
-            return Err(TabulatedError::NonFinite { column, row, value });
+            return Err(PiecewiseConstantError::NonFinite { column, row, value });
         }
         if !(value >= 0.0) {
-            return Err(TabulatedError::Negative { column, row, value });
+            return Err(PiecewiseConstantError::Negative { column, row, value });
         }
     }
     Ok(())

@@ -1,9 +1,9 @@
 //! The classic marginal/conditional piecewise-constant 2D sampler.
 
-use partition_sampler::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource};
+use crate::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource};
 use serde::{Deserialize, Serialize};
 
-use super::TabulatedError;
+use super::PiecewiseConstantError;
 use super::cdf::{
     cell_of, clamp_unit, fill_cdf, find_cell, find_cell_by, invert_cell, invert_in, place,
     validate_values,
@@ -21,8 +21,7 @@ use super::cdf::{
 /// `invert ∘ sample_square` is the identity on `[0,1)²` (up to rounding).
 ///
 /// ```
-/// use baselines::PiecewiseConstant2D;
-/// use partition_sampler::{InvertibleSampler2D, Rect, Sampler2D};
+/// use partition_sampler::{InvertibleSampler2D, PiecewiseConstant2D, Rect, Sampler2D};
 /// let unit = Rect { x0: 0.0, y0: 0.0, x1: 1.0, y1: 1.0 };
 /// let t = PiecewiseConstant2D::new(2, 1, vec![1.0, 3.0], unit).unwrap();
 /// let s = t.sample_square([0.5, 0.5]);
@@ -64,13 +63,13 @@ impl PiecewiseConstant2D {
         height: usize,
         values: Vec<f64>,
         domain: Rect,
-    ) -> Result<Self, TabulatedError> {
+    ) -> Result<Self, PiecewiseConstantError> {
         if width == 0 || height == 0 {
-            return Err(TabulatedError::Empty { width, height });
+            return Err(PiecewiseConstantError::Empty { width, height });
         }
         let expected = width.saturating_mul(height);
         if values.len() != expected {
-            return Err(TabulatedError::SizeMismatch {
+            return Err(PiecewiseConstantError::SizeMismatch {
                 width,
                 height,
                 expected,
@@ -85,7 +84,7 @@ impl PiecewiseConstant2D {
             && x0 < x1
             && y0 < y1)
         {
-            return Err(TabulatedError::InvalidDomain { x0, y0, x1, y1 });
+            return Err(PiecewiseConstantError::InvalidDomain { x0, y0, x1, y1 });
         }
         validate_values(&values, width)?;
 
@@ -103,15 +102,15 @@ impl PiecewiseConstant2D {
         let mut marginal = vec![0.0; height + 1];
         let total = fill_cdf(&row_sums, &mut marginal);
         if !total.is_finite() || row_sums.iter().any(|s| !s.is_finite()) {
-            return Err(TabulatedError::TotalNotFinite);
+            return Err(PiecewiseConstantError::TotalNotFinite);
         }
         if !(total > 0.0) {
-            return Err(TabulatedError::AllZero);
+            return Err(PiecewiseConstantError::AllZero);
         }
         let cell = [(x1 - x0) / width as f64, (y1 - y0) / height as f64];
         let integral = total * cell[0] * cell[1];
         if !(integral.is_finite() && integral > 0.0) {
-            return Err(TabulatedError::TotalNotFinite);
+            return Err(PiecewiseConstantError::TotalNotFinite);
         }
         Ok(Self {
             width,
@@ -190,7 +189,7 @@ impl PiecewiseConstant2D {
     /// Draws `n` samples in parallel; the result depends only on `(n, seed)` (see
     /// [`crate::sample_par`]).
     pub fn sample_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
-        crate::parallel::sample_par(self, n, seed)
+        crate::sample_par(self, n, seed)
     }
 }
 
@@ -263,10 +262,10 @@ struct Table2DData {
 const FORMAT_VERSION: u32 = 1;
 
 impl TryFrom<Table2DData> for PiecewiseConstant2D {
-    type Error = TabulatedError;
-    fn try_from(d: Table2DData) -> Result<Self, TabulatedError> {
+    type Error = PiecewiseConstantError;
+    fn try_from(d: Table2DData) -> Result<Self, PiecewiseConstantError> {
         if d.version != FORMAT_VERSION {
-            return Err(TabulatedError::FormatVersion {
+            return Err(PiecewiseConstantError::FormatVersion {
                 found: d.version,
                 expected: FORMAT_VERSION,
             });

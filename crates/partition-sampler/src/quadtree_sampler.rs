@@ -2,25 +2,18 @@
 
 use std::sync::Arc;
 
-use rand::SeedableRng;
-use rand::rngs::Xoshiro256PlusPlus;
-use rayon::prelude::*;
-
 use crate::allocate::{AllocationMode, allocate, stratum_weights};
 use crate::audit::{Audit, Counters, flush_local, record_one};
+use crate::contract::{Point2, Sample2, Sampler2D, UniformSource};
 use crate::density::{IntegralSource, RegionStats};
 use crate::error::AttachError;
 use crate::leaf::{Frame, Leaf};
 use crate::rect::Domain;
-use crate::sampler::{Point2, Sample2, Sampler2D, UniformSource};
 use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
 
 /// A sample is abandoned (returned with pdf 0 and counted as exhausted) after this many
 /// rejection trials. Only reachable when the bounds or integrals badly contradict `f`.
 pub const MAX_TRIALS_PER_SAMPLE: u64 = 1 << 20;
-
-/// Samples per chunk of [`QuadTreeSampler::sample_par`]; each chunk has its own generator.
-pub const PAR_CHUNK: usize = 4096;
 
 /// The adaptive-partition sampler of a density `D` (seed 003 §3, seed 000 §3).
 ///
@@ -291,28 +284,12 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         }
     }
 
-    /// `n` samples drawn in parallel (rayon) in fixed chunks of [`PAR_CHUNK`]; chunk `c` uses a
-    /// `Xoshiro256PlusPlus` seeded from `(seed, c)` through SplitMix64, so the output depends
-    /// only on `seed` and `n`, never on the thread count.
+    /// `n` samples drawn in parallel: [`crate::sample_par`] (fixed chunks of
+    /// [`crate::PAR_CHUNK`], one generator per chunk seeded from `(seed, chunk)`), so the output
+    /// depends only on `seed` and `n`, never on the thread count. Trials are counted once per
+    /// chunk.
     pub fn sample_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
-        let mut out = vec![
-            Sample2 {
-                point: [0.0; 2],
-                pdf: 0.0
-            };
-            n
-        ];
-        out.par_chunks_mut(PAR_CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
-                let mut a = Audit::default();
-                for s in chunk.iter_mut() {
-                    *s = self.draw(&mut rng, &mut a);
-                }
-                self.counters.add(&a);
-            });
-        out
+        crate::sample_par(self, n, seed)
     }
 
     #[inline(always)]
@@ -490,6 +467,15 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
         s
     }
 
+    /// The draws of [`Sampler2D::sample`], counted locally and added to the shared counters once.
+    fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
+        let mut a = Audit::default();
+        for s in out.iter_mut() {
+            *s = self.draw(u, &mut a);
+        }
+        self.counters.add(&a);
+    }
+
     /// `f(p)/Î` when `p` is in the domain and in a sampleable leaf, else 0.
     fn pdf(&self, p: Point2) -> f64 {
         if !self.tree.shape.domain.contains(p) || self.tree.locate(p).is_none() {
@@ -501,18 +487,4 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
     fn bytes_used(&self) -> usize {
         self.memory().total
     }
-}
-
-/// SplitMix64 finaliser.
-#[inline]
-pub(crate) fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Seed of chunk `c` of a run seeded with `seed`.
-pub fn chunk_seed(seed: u64, c: u64) -> u64 {
-    splitmix64(splitmix64(seed) ^ splitmix64(c.wrapping_add(0x632B_E59B_D9B4_E019)))
 }

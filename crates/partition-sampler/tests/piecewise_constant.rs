@@ -1,8 +1,10 @@
 //! Integration tests of the piecewise-constant CDF samplers.
 
 use approx::assert_relative_eq;
-use baselines::{PiecewiseConstant1D, PiecewiseConstant2D, Rect, TabulatedError};
-use partition_sampler::{InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSource};
+use partition_sampler::{
+    InvertibleSampler2D, PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Point2,
+    Rect, Sample2, Sampler2D, UniformSource,
+};
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -224,14 +226,14 @@ fn construction_errors_are_typed() {
     let err = |w, h, v: Vec<f64>| PiecewiseConstant2D::new(w, h, v, UNIT).unwrap_err();
     assert_eq!(
         err(0, 3, vec![]),
-        TabulatedError::Empty {
+        PiecewiseConstantError::Empty {
             width: 0,
             height: 3
         }
     );
     assert_eq!(
         err(2, 2, vec![1.0; 3]),
-        TabulatedError::SizeMismatch {
+        PiecewiseConstantError::SizeMismatch {
             width: 2,
             height: 2,
             expected: 4,
@@ -240,7 +242,7 @@ fn construction_errors_are_typed() {
     );
     assert!(matches!(
         err(2, 2, vec![1.0, 1.0, f64::NAN, 1.0]),
-        TabulatedError::NonFinite {
+        PiecewiseConstantError::NonFinite {
             column: 0,
             row: 1,
             ..
@@ -248,7 +250,7 @@ fn construction_errors_are_typed() {
     ));
     assert!(matches!(
         err(2, 2, vec![1.0, f64::INFINITY, 1.0, 1.0]),
-        TabulatedError::NonFinite {
+        PiecewiseConstantError::NonFinite {
             column: 1,
             row: 0,
             ..
@@ -256,14 +258,17 @@ fn construction_errors_are_typed() {
     ));
     assert_eq!(
         err(2, 2, vec![1.0, 1.0, 1.0, -0.5]),
-        TabulatedError::Negative {
+        PiecewiseConstantError::Negative {
             column: 1,
             row: 1,
             value: -0.5
         }
     );
-    assert_eq!(err(2, 2, vec![0.0; 4]), TabulatedError::AllZero);
-    assert_eq!(err(2, 2, vec![f64::MAX; 4]), TabulatedError::TotalNotFinite);
+    assert_eq!(err(2, 2, vec![0.0; 4]), PiecewiseConstantError::AllZero);
+    assert_eq!(
+        err(2, 2, vec![f64::MAX; 4]),
+        PiecewiseConstantError::TotalNotFinite
+    );
     assert!(matches!(
         PiecewiseConstant2D::new(
             1,
@@ -276,7 +281,7 @@ fn construction_errors_are_typed() {
                 y1: 1.0
             }
         ),
-        Err(TabulatedError::InvalidDomain { .. })
+        Err(PiecewiseConstantError::InvalidDomain { .. })
     ));
     assert!(matches!(
         PiecewiseConstant2D::new(
@@ -290,26 +295,26 @@ fn construction_errors_are_typed() {
                 y1: 1.0
             }
         ),
-        Err(TabulatedError::InvalidDomain { .. })
+        Err(PiecewiseConstantError::InvalidDomain { .. })
     ));
     assert_eq!(
         PiecewiseConstant1D::new(vec![], 0.0, 1.0).unwrap_err(),
-        TabulatedError::Empty {
+        PiecewiseConstantError::Empty {
             width: 0,
             height: 1
         }
     );
     assert_eq!(
         PiecewiseConstant1D::new(vec![0.0, 0.0], 0.0, 1.0).unwrap_err(),
-        TabulatedError::AllZero
+        PiecewiseConstantError::AllZero
     );
     assert!(matches!(
         PiecewiseConstant1D::new(vec![1.0, -1.0], 0.0, 1.0),
-        Err(TabulatedError::Negative { column: 1, .. })
+        Err(PiecewiseConstantError::Negative { column: 1, .. })
     ));
     assert!(matches!(
         PiecewiseConstant1D::new(vec![1.0], 2.0, 1.0),
-        Err(TabulatedError::InvalidDomain { .. })
+        Err(PiecewiseConstantError::InvalidDomain { .. })
     ));
 }
 

@@ -84,6 +84,15 @@ pub trait Sampler2D: Sync {
     /// Draws one point from uniforms taken from `u`.
     fn sample<U: UniformSource + ?Sized>(&self, u: &mut U) -> Sample2;
 
+    /// Fills `out` with consecutive draws from `u`, exactly as `out.len()` calls of
+    /// [`Sampler2D::sample`] would. Samplers with per-call bookkeeping override it to do that
+    /// once per slice; [`crate::sample_par`] calls it once per chunk.
+    fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
+        for s in out {
+            *s = self.sample(u);
+        }
+    }
+
     /// Density of `p` with respect to area on the domain (0 outside the support).
     fn pdf(&self, p: Point2) -> f64;
 

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::TabulatedError;
+use super::PiecewiseConstantError;
 use super::cdf::{cell_of, clamp_unit, fill_cdf, find_cell, invert_cell, place, validate_values};
 
 /// One draw of a [`PiecewiseConstant1D`].
@@ -20,7 +20,7 @@ pub struct Sample1 {
 /// `n` equal cells: `p(x) = f_i / ∫f` with respect to length, sampled by inverting its CDF.
 ///
 /// ```
-/// use baselines::PiecewiseConstant1D;
+/// use partition_sampler::PiecewiseConstant1D;
 /// let d = PiecewiseConstant1D::new(vec![1.0, 3.0], 0.0, 2.0).unwrap();
 /// let s = d.sample(0.5); // the CDF reaches 0.25 at x = 1
 /// assert_eq!(s.index, 1);
@@ -44,15 +44,15 @@ impl PiecewiseConstant1D {
     ///
     /// Errors: empty `values`, a NaN/negative/infinite value (named by its index, reported as
     /// column), all values zero, an overflowing sum, or a degenerate interval.
-    pub fn new(values: Vec<f64>, min: f64, max: f64) -> Result<Self, TabulatedError> {
+    pub fn new(values: Vec<f64>, min: f64, max: f64) -> Result<Self, PiecewiseConstantError> {
         if values.is_empty() {
-            return Err(TabulatedError::Empty {
+            return Err(PiecewiseConstantError::Empty {
                 width: 0,
                 height: 1,
             });
         }
         if !(min.is_finite() && max.is_finite() && min < max) {
-            return Err(TabulatedError::InvalidDomain {
+            return Err(PiecewiseConstantError::InvalidDomain {
                 x0: min,
                 y0: 0.0,
                 x1: max,
@@ -63,15 +63,15 @@ impl PiecewiseConstant1D {
         let mut cdf = vec![0.0; values.len() + 1];
         let sum = fill_cdf(&values, &mut cdf);
         if !sum.is_finite() {
-            return Err(TabulatedError::TotalNotFinite);
+            return Err(PiecewiseConstantError::TotalNotFinite);
         }
         if !(sum > 0.0) {
-            return Err(TabulatedError::AllZero);
+            return Err(PiecewiseConstantError::AllZero);
         }
         let n = values.len() as f64;
         let integral = sum * (max - min) / n;
         if !(integral.is_finite() && integral > 0.0) {
-            return Err(TabulatedError::TotalNotFinite);
+            return Err(PiecewiseConstantError::TotalNotFinite);
         }
         Ok(Self {
             values,
@@ -167,10 +167,10 @@ struct Table1DData {
 const FORMAT_VERSION: u32 = 1;
 
 impl TryFrom<Table1DData> for PiecewiseConstant1D {
-    type Error = TabulatedError;
-    fn try_from(d: Table1DData) -> Result<Self, TabulatedError> {
+    type Error = PiecewiseConstantError;
+    fn try_from(d: Table1DData) -> Result<Self, PiecewiseConstantError> {
         if d.version != FORMAT_VERSION {
-            return Err(TabulatedError::FormatVersion {
+            return Err(PiecewiseConstantError::FormatVersion {
                 found: d.version,
                 expected: FORMAT_VERSION,
             });

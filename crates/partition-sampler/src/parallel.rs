@@ -1,0 +1,56 @@
+//! Reproducible parallel sampling, the one implementation every planar sampler uses: fixed
+//! chunks of [`PAR_CHUNK`] samples, one `Xoshiro256PlusPlus` per chunk seeded by
+//! [`chunk_seed`]`(seed, chunk)`, so the output depends only on `(n, seed)`.
+
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+
+use crate::contract::{Sample2, Sampler2D};
+
+/// Samples per chunk of [`sample_par`]; each chunk has its own generator.
+pub const PAR_CHUNK: usize = 4096;
+
+/// SplitMix64 finaliser.
+#[inline]
+pub(crate) fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Seed of chunk `c` of a run seeded with `seed` (SplitMix64 mixing of both).
+pub fn chunk_seed(seed: u64, c: u64) -> u64 {
+    splitmix64(splitmix64(seed) ^ splitmix64(c.wrapping_add(0x632B_E59B_D9B4_E019)))
+}
+
+/// The generator of chunk `chunk` of a run seeded with `seed`: `Xoshiro256PlusPlus` seeded with
+/// [`chunk_seed`]`(seed, chunk)`.
+pub fn chunk_rng(seed: u64, chunk: u64) -> Xoshiro256PlusPlus {
+    Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, chunk))
+}
+
+/// Draws `n` samples of `sampler` with rayon. Sample `k` comes from chunk `k / PAR_CHUNK`, whose
+/// samples are drawn in order by [`Sampler2D::sample_into`] from [`chunk_rng`]`(seed, k /
+/// PAR_CHUNK)`, so the output depends only on `(n, seed)`, never on the number of threads.
+///
+/// ```
+/// use partition_sampler::{PiecewiseConstant2D, Rect, sample_par};
+/// let table = PiecewiseConstant2D::new(2, 1, vec![1.0, 3.0], Rect::UNIT).unwrap();
+/// let batch = sample_par(&table, 10_000, 42);
+/// assert_eq!(batch, sample_par(&table, 10_000, 42));
+/// ```
+pub fn sample_par<S: Sampler2D + ?Sized>(sampler: &S, n: usize, seed: u64) -> Vec<Sample2> {
+    let mut out = vec![
+        Sample2 {
+            point: [0.0, 0.0],
+            pdf: 0.0
+        };
+        n
+    ];
+    out.par_chunks_mut(PAR_CHUNK)
+        .enumerate()
+        .for_each(|(chunk, slot)| sampler.sample_into(&mut chunk_rng(seed, chunk as u64), slot));
+    out
+}
