@@ -19,5 +19,7 @@
 //! ```
 
 pub mod hemisphere;
+pub mod options;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
+pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};

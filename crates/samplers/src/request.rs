@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
+use baselines::BaselineOptions;
 use brdf_sampling::{DirectionSampler, Progress, QuadTreeSet, SetOptions};
 
 /// Everything a direction sampler may need to be built for one BRDF.
@@ -14,6 +15,8 @@ pub struct DirectionRequest<'a> {
     pub spec: Option<&'a str>,
     /// Options of the adaptive quadtree sets.
     pub options: &'a SetOptions,
+    /// Options of the BRDF baselines (defaults unless set with [`DirectionRequest::with_baselines`]).
+    pub baselines: BaselineOptions,
     /// Called with `(steps done, total)` while a sampler with a long build is built.
     pub progress: Option<Progress<'a>>,
 }
@@ -25,8 +28,15 @@ impl<'a> DirectionRequest<'a> {
             brdf,
             spec: None,
             options,
+            baselines: BaselineOptions::default(),
             progress: None,
         }
+    }
+
+    /// The same request with these baseline options.
+    pub fn with_baselines(mut self, baselines: BaselineOptions) -> Self {
+        self.baselines = baselines;
+        self
     }
 
     /// The same request recording `spec`.

@@ -1,0 +1,21 @@
+//! Options of the BRDF baselines, one struct per family; the registry hands them to the
+//! samplers' constructors ([`BaselineOptions`]), the CLI fills them from its flags.
+
+mod cdf;
+mod factored;
+mod lobe;
+
+pub use cdf::CdfOptions;
+pub use factored::FactoredOptions;
+pub use lobe::LobeOptions;
+
+/// Options of every BRDF baseline (each family's defaults are the papers' or measured ones).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BaselineOptions {
+    /// Cosine-lobe and analytic samplers.
+    pub lobe: LobeOptions,
+    /// Tabulated and Douglas–Peucker-compressed cascade CDFs.
+    pub cdf: CdfOptions,
+    /// Lawrence 2004 NMF factorisation.
+    pub factored: FactoredOptions,
+}
