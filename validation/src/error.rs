@@ -18,6 +18,14 @@ pub enum ValidationError {
         #[source]
         source: brdf::SpecError,
     },
+    /// A saved set could not be read or re-attached to its BRDF.
+    #[error("set {path}: {reason}")]
+    Set {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why (I/O or the registry's reason).
+        reason: String,
+    },
     /// An outgoing angle is not a finite number in `[0, 90)` degrees.
     #[error("outgoing angle {0} deg is invalid: theta_o must be finite and in [0, 90)")]
     BadAngle(f64),

@@ -78,6 +78,10 @@ pub struct ValidateConfig {
     pub alpha: f64,
     /// Directory searched for MERL `.binary` files in the full tier (when `brdfs` is empty).
     pub merl_dir: Option<PathBuf>,
+    /// Saved adaptive sets (`brdf-lab build --out FILE`) to validate, each with the BRDF of
+    /// its stored spec at the run's angles. With sets and no `samplers`, only the sets run.
+    #[serde(default)]
+    pub sets: Vec<PathBuf>,
 }
 
 impl Default for ValidateConfig {
@@ -93,6 +97,7 @@ impl Default for ValidateConfig {
             mutants: false,
             alpha: 0.01,
             merl_dir: Some(PathBuf::from(DEFAULT_MERL_DIR)),
+            sets: Vec::new(),
         }
     }
 }

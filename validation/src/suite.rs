@@ -1,11 +1,12 @@
 //! A validation run: resolve the configuration, build the cases, run them in parallel, judge
 //! every p-value at the Šidák level, and collect the report.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use brdf::{Brdf, Vec3, direction_from_angles};
+use brdf_sampling::DirectionSampler;
 use rayon::prelude::*;
 use stats::{TestOutcome, sidak_level};
 
@@ -14,6 +15,7 @@ use crate::builds::{
     StandaloneCase, build_direction, build_disc, direction_domain, standalone_cases, uses_brdf,
 };
 use crate::case::{error_outcome, names, run_case};
+use crate::domain::Domain;
 use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
@@ -53,6 +55,7 @@ struct Resolved {
     brdfs: Vec<(String, Arc<dyn Brdf>)>,
     angles: Vec<f64>,
     samplers: Vec<&'static SamplerEntry>,
+    sets: Vec<LoadedSet>,
 }
 
 fn merl_specs(dir: &Path) -> Vec<String> {
@@ -95,8 +98,9 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
     {
         return Err(ValidationError::BadAngle(bad));
     }
+    let sets = load_sets(&config.sets)?;
     let mut entries: Vec<&'static SamplerEntry> = Vec::new();
-    if config.samplers.is_empty() {
+    if config.samplers.is_empty() && sets.is_empty() {
         entries.extend(samplers::samplers().iter());
     } else {
         for name in &config.samplers {
@@ -131,8 +135,13 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
             Err(source) => return Err(ValidationError::Brdf { spec, source }),
         }
     }
-    if entries.is_empty() {
+    if entries.is_empty() && sets.is_empty() {
         return Err(ValidationError::Empty("no sampler selected".into()));
+    }
+    if !sets.is_empty() && angles.is_empty() {
+        return Err(ValidationError::Empty(
+            "saved sets need at least one angle".into(),
+        ));
     }
     if entries.iter().any(|e| uses_brdf(e)) && (brdfs.is_empty() || angles.is_empty()) {
         return Err(ValidationError::Empty(
@@ -144,6 +153,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         brdfs,
         angles,
         samplers: entries,
+        sets,
     })
 }
 
@@ -176,6 +186,8 @@ enum Job<'a> {
         entry: &'static SamplerEntry,
         case: &'a StandaloneCase,
     },
+    /// A saved set (index into the run's sets), with its own BRDF.
+    Set(usize),
 }
 
 fn references_for(brdf: &dyn Brdf, wo: &Vec3) -> Result<BrdfReferences, String> {
@@ -204,6 +216,49 @@ fn run_brdf_job(
             .map(|s| (s, domain))
             .map_err(|e| e.to_string())
     });
+    let subject_at = |wo: Vec3, refs: &BrdfReferences| match &built {
+        Some(b) => {
+            let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
+            Ok(direction_subject(sampler, *domain, brdf, wo, refs))
+        }
+        None => Ok(AnySubject::Planar(brdf_disc_subject(
+            build_disc(entry, brdf, &wo).map_err(|e| e.to_string())?,
+            Arc::clone(brdf),
+            wo,
+            refs,
+        ))),
+    };
+    run_angles(entry.name, spec, r, refs, seed, on_done, &subject_at)
+}
+
+/// A direction sampler at `wo` as a subject on `domain`.
+fn direction_subject(
+    sampler: &Arc<dyn DirectionSampler>,
+    domain: Domain,
+    brdf: &Arc<dyn Brdf>,
+    wo: Vec3,
+    refs: &BrdfReferences,
+) -> AnySubject {
+    AnySubject::Direction(brdf_direction_subject(
+        Arc::new(DirectionAtWo::new(Arc::clone(sampler), wo)),
+        domain,
+        Arc::clone(brdf),
+        wo,
+        refs,
+    ))
+}
+
+/// Runs one sampler (as `subject_at` builds it per `ωo`) for one BRDF at every angle of the run.
+#[allow(clippy::too_many_arguments)]
+fn run_angles(
+    sampler: &str,
+    spec: &str,
+    r: &Resolved,
+    refs: &[Result<BrdfReferences, String>],
+    seed: u64,
+    on_done: &(dyn Fn(&CaseResult) + Sync),
+    subject_at: &(dyn Fn(Vec3, &BrdfReferences) -> Result<AnySubject, String> + Sync),
+) -> Vec<CaseResult> {
     let mut out = Vec::with_capacity(r.angles.len());
     for (ai, &theta) in r.angles.iter().enumerate() {
         let wo = direction_from_angles(theta, 0.0);
@@ -211,38 +266,21 @@ fn run_brdf_job(
             .get(ai)
             .cloned()
             .unwrap_or_else(|| Err("missing reference".into()))
-            .and_then(|refs| match &built {
-                Some(b) => {
-                    let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
-                    Ok(AnySubject::Direction(brdf_direction_subject(
-                        Arc::new(DirectionAtWo::new(Arc::clone(sampler), wo)),
-                        *domain,
-                        Arc::clone(brdf),
-                        wo,
-                        &refs,
-                    )))
-                }
-                None => Ok(AnySubject::Planar(brdf_disc_subject(
-                    build_disc(entry, brdf, &wo).map_err(|e| e.to_string())?,
-                    Arc::clone(brdf),
-                    wo,
-                    &refs,
-                ))),
-            });
+            .and_then(|refs| subject_at(wo, &refs));
         let (domain, outcomes) = match &subject {
             Ok(s) => (
                 s.domain().name().to_owned(),
                 run_case(
                     s,
                     &r.plan,
-                    case_seed(seed, &case_label(entry.name, spec, Some(theta))),
+                    case_seed(seed, &case_label(sampler, spec, Some(theta))),
                 ),
             ),
             Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
         };
         let c = CaseResult {
-            sampler: entry.name.to_owned(),
-            target: spec.clone(),
+            sampler: sampler.to_owned(),
+            target: spec.to_owned(),
             theta_o: Some(theta),
             domain,
             outcomes,
@@ -251,6 +289,43 @@ fn run_brdf_job(
         out.push(c);
     }
     out
+}
+
+/// A saved set of the run, re-attached to the BRDF of its stored spec.
+struct LoadedSet {
+    /// `NAME (set FILE)`.
+    label: String,
+    spec: String,
+    brdf: Arc<dyn Brdf>,
+    sampler: Arc<dyn DirectionSampler>,
+}
+
+fn load_sets(paths: &[PathBuf]) -> Result<Vec<LoadedSet>, ValidationError> {
+    paths
+        .iter()
+        .map(|path| {
+            let fail = |reason: String| ValidationError::Set {
+                path: path.clone(),
+                reason,
+            };
+            let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+            let (entry, built) =
+                samplers::load_set(&bytes, None).map_err(|e| fail(e.to_string()))?;
+            let set = built
+                .set
+                .ok_or_else(|| fail("not an adaptive set".into()))?;
+            let file = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |f| f.to_string_lossy().into_owned(),
+            );
+            Ok(LoadedSet {
+                label: format!("{} (set {file})", entry.name),
+                spec: set.spec().to_owned(),
+                brdf: Arc::clone(set.brdf()),
+                sampler: built.sampler,
+            })
+        })
+        .collect()
 }
 
 /// Runs a validation: every selected sampler × BRDF × angle (and the standalone samplers'
@@ -303,8 +378,9 @@ pub fn run(
             }),
         }
     }
+    jobs.extend((0..r.sets.len()).map(Job::Set));
     let mutant_list = if config.mutants { mutants() } else { &[] };
-    let total = brdf_entries.len() * r.brdfs.len() * r.angles.len()
+    let total = (brdf_entries.len() * r.brdfs.len() + r.sets.len()) * r.angles.len()
         + jobs
             .iter()
             .filter(|j| matches!(j, Job::Standalone { .. }))
@@ -358,6 +434,32 @@ pub fn run(
                 };
                 on_done(&c);
                 vec![c]
+            }
+            Job::Set(i) => {
+                let set = &r.sets[*i];
+                let refs: Vec<Result<BrdfReferences, String>> = r
+                    .angles
+                    .iter()
+                    .map(|&t| references_for(set.brdf.as_ref(), &direction_from_angles(t, 0.0)))
+                    .collect();
+                let subject_at = |wo: Vec3, refs: &BrdfReferences| {
+                    Ok(direction_subject(
+                        &set.sampler,
+                        Domain::Hemisphere,
+                        &set.brdf,
+                        wo,
+                        refs,
+                    ))
+                };
+                run_angles(
+                    &set.label,
+                    &set.spec,
+                    &r,
+                    &refs,
+                    seed,
+                    &on_done,
+                    &subject_at,
+                )
             }
         })
         .collect();

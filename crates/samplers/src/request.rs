@@ -2,8 +2,8 @@
 
 use std::sync::Arc;
 
-use brdf::{Brdf, Vec3};
 use baselines::BaselineOptions;
+use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirectionSampler, Progress, QuadTreeSet, SetOptions};
 
 /// Everything a direction sampler may need to be built for one BRDF.
