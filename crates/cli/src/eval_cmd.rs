@@ -18,7 +18,9 @@ pub(crate) struct EvalArgs {
     #[arg(long)]
     sampler: Option<String>,
     /// CSV of incident directions `x,y,z` (one per row; a header row is allowed; more columns
-    /// are ignored, so `sample --out` files work as they are).
+    /// are ignored, so `sample --out` files work as they are). Each direction is normalised
+    /// once when read; the output's x,y,z columns are that unit vector, the one both f and the
+    /// pdf are evaluated at. A zero or non-finite direction is refused.
     #[arg(long)]
     dirs: PathBuf,
     /// Write `x,y,z,f[,pdf]` here (atomically) instead of standard output.
@@ -28,7 +30,8 @@ pub(crate) struct EvalArgs {
     set: SetArgs,
 }
 
-/// Reads the directions of a CSV file (exit 2 naming the bad line).
+/// Reads the directions of a CSV file, each normalised to a unit vector (exit 2 naming the bad
+/// line). The one rule for every sampler: f and every pdf see the same unit vector.
 fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
@@ -47,14 +50,23 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
         match parsed {
             Some(v) if v.len() == 3 => {
                 let d = Vec3::new(v[0], v[1], v[2]);
-                if !(d.iter().all(|c| c.is_finite()) && d.norm() > 0.0) {
+                // Rows already unit to rounding (e.g. `sample --out`) are kept bit for bit.
+                let unit = if (d.norm_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+                    d
+                } else {
+                    d / d.norm()
+                };
+                if !(d.iter().all(|c| c.is_finite())
+                    && d.norm() > 0.0
+                    && (unit.norm() - 1.0).abs() < 1e-12)
+                {
                     return Err(CliError::input(format!(
-                        "{}:{}: direction must be finite and non-zero",
+                        "{}:{}: direction must be finite, non-zero and normalisable",
                         path.display(),
                         i + 1
                     )));
                 }
-                dirs.push(d);
+                dirs.push(unit);
             }
             // A header row (first non-empty line that is not numeric) is skipped.
             _ if dirs.is_empty()
@@ -94,12 +106,11 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
     };
     let rows: Vec<(Vec3, f64, Option<f64>)> = dirs
         .iter()
-        .map(|d| {
-            let wi = d.normalize();
-            let f = brdf.eval(&wo, &wi);
-            // The pdf at the direction exactly as given (unit rows from `sample` are unchanged).
-            let pdf = built.as_ref().map(|b| b.sampler().pdf(&wo, d));
-            (*d, f, pdf)
+        .map(|wi| {
+            // `wi` is unit (normalised when read): f and the pdf see the same vector.
+            let f = brdf.eval(&wo, wi);
+            let pdf = built.as_ref().map(|b| b.sampler().pdf(&wo, wi));
+            (*wi, f, pdf)
         })
         .collect();
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {

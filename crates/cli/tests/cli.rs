@@ -291,3 +291,51 @@ fn validate_quick_case_passes_and_writes_the_json_schema() {
             .contains("| sampler |")
     );
 }
+
+#[test]
+fn eval_normalises_directions_once_for_f_and_every_pdf() {
+    // One direction given three ways: unit, shorter (norm 0.707) and longer (norm 1.414).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    let n = (0.5f64).sqrt();
+    std::fs::write(
+        &dirs,
+        format!("x,y,z\n{},{},{}\n0.3,0.4,0.5\n0.6,0.8,1.0\n", 0.3 / n, 0.4 / n, 0.5 / n),
+    )
+    .expect("write");
+    for sampler in ["adaptive", "adaptive-paper", "cosine", "uniform"] {
+        let out = dir.path().join(format!("{sampler}.csv"));
+        let o = brdf_lab(&[
+            "eval",
+            "--brdf",
+            "phong:n=50",
+            "--theta-o",
+            "45",
+            "--slices",
+            "9",
+            "--sampler",
+            sampler,
+            "--dirs",
+            dirs.to_str().expect("p"),
+            "--out",
+            out.to_str().expect("p"),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (header, rows) = read_csv(&out);
+        assert_eq!(header, "x,y,z,f,pdf");
+        assert_eq!(rows.len(), 3);
+        for r in &rows {
+            // The written direction is the unit vector that f and the pdf saw.
+            let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+            assert!((norm - 1.0).abs() < 1e-12, "{sampler}: {r:?}");
+            for k in 0..5 {
+                assert!(
+                    (r[k] - rows[0][k]).abs() <= 1e-12 * rows[0][k].abs().max(1e-300),
+                    "{sampler}: column {k}: {r:?} vs {:?}",
+                    rows[0]
+                );
+            }
+            assert!(r[4] > 0.0, "{sampler}: {r:?}");
+        }
+    }
+}
