@@ -127,7 +127,11 @@ mod tests {
         for s in samplers {
             let unit = s.pdf(&wo, &wi.normalize());
             for k in [0.5, 2.0, 1e3] {
-                assert!((s.pdf(&wo, &(wi * k)) - unit).abs() <= 1e-15, "{}", s.name());
+                assert!(
+                    (s.pdf(&wo, &(wi * k)) - unit).abs() <= 1e-15,
+                    "{}",
+                    s.name()
+                );
             }
         }
     }

@@ -82,7 +82,8 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         rayon::current_num_threads()
     );
 
-    // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by quadrature.
+    // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by the adaptive
+    // reference quadrature (brdf_sampling::reference_albedo).
     let (mut sum, mut sum2) = (0.0, 0.0);
     for s in samples.iter().flatten() {
         let v = if s.pdf > 0.0 && s.wi.z > 0.0 {
@@ -95,8 +96,16 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     }
     let mean = sum / n as f64;
     let std_err = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-    let reference = brdf::directional_albedo(brdf.as_ref(), &wo, 64, 256);
-    println!("albedo     estimate {mean:.6} ± {std_err:.2e} (1σ); quadrature {reference:.6}");
+    // An adaptive set's pdf is normalised by a quadrature whose relative error it estimates:
+    // a systematic error of the estimate that no number of samples averages away.
+    let normalisation = match &built {
+        brdf_args::Built::Set(set) => set.report().max_integral_rel_err.map(|e| e * mean.abs()),
+        brdf_args::Built::Other(_) => None,
+    };
+    println!(
+        "albedo     {}",
+        albedo_summary(brdf.as_ref(), &wo, mean, std_err, normalisation)
+    );
     brdf_args::print_set_report(&built);
 
     if let Some(path) = &args.out {
@@ -117,4 +126,40 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         println!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
     }
     Ok(())
+}
+
+/// `estimate X ± σ (1σ); reference Y ± e; agree …` for the estimate `mean ± std_err` of the
+/// directional albedo at `wo`. Agreement: within 3 combined σ, `√(σ² + e² + s²)` with `s` the
+/// sampler's estimated normalisation error (`normalisation`, absolute), when it has one.
+fn albedo_summary(
+    brdf: &dyn brdf::Brdf,
+    wo: &brdf::Vec3,
+    mean: f64,
+    std_err: f64,
+    normalisation: Option<f64>,
+) -> String {
+    let estimate = format!("estimate {mean:.6} ± {std_err:.2e} (1σ)");
+    match brdf_sampling::reference_albedo(brdf, wo) {
+        Ok(r) => {
+            let s = normalisation.unwrap_or(0.0);
+            // Rounding floor: a zero-variance estimate of an exact reference.
+            let sigma = std_err.hypot(r.abs_err).hypot(s).max(1e-12 * mean.abs());
+            let z = (mean - r.value).abs() / sigma;
+            let incl = if normalisation.is_some() {
+                format!(", σ includes the set's normalisation error {s:.1e}")
+            } else {
+                String::new()
+            };
+            let verdict = if z <= 3.0 {
+                format!("agree within 3 combined σ ({z:.2}σ apart{incl})")
+            } else {
+                format!("DISAGREE: {z:.1} combined σ apart (> 3σ{incl})")
+            };
+            format!(
+                "{estimate}; reference {:.6} ± {:.1e} (adaptive quadrature); {verdict}",
+                r.value, r.abs_err
+            )
+        }
+        Err(e) => format!("{estimate}; no reference ({e})"),
+    }
 }

@@ -300,7 +300,12 @@ fn eval_normalises_directions_once_for_f_and_every_pdf() {
     let n = (0.5f64).sqrt();
     std::fs::write(
         &dirs,
-        format!("x,y,z\n{},{},{}\n0.3,0.4,0.5\n0.6,0.8,1.0\n", 0.3 / n, 0.4 / n, 0.5 / n),
+        format!(
+            "x,y,z\n{},{},{}\n0.3,0.4,0.5\n0.6,0.8,1.0\n",
+            0.3 / n,
+            0.4 / n,
+            0.5 / n
+        ),
     )
     .expect("write");
     for sampler in ["adaptive", "adaptive-paper", "cosine", "uniform"] {
@@ -337,5 +342,67 @@ fn eval_normalises_directions_once_for_f_and_every_pdf() {
             }
             assert!(r[4] > 0.0, "{sampler}: {r:?}");
         }
+    }
+}
+
+/// The `albedo` summary line of `sample`: (estimate, σ, reference, reference error, agree).
+fn albedo_line(text: &str) -> (f64, f64, f64, f64, bool) {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("albedo"))
+        .unwrap_or_else(|| panic!("no albedo line in {text}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let after = |w: &str| -> f64 {
+        let i = words.iter().position(|x| *x == w).expect(w);
+        words[i + 1]
+            .trim_end_matches([';', ','])
+            .parse()
+            .expect(line)
+    };
+    let pm: Vec<f64> = words
+        .iter()
+        .enumerate()
+        .filter(|(_, w)| **w == "±")
+        .map(|(i, _)| {
+            words[i + 1]
+                .trim_end_matches([';', ','])
+                .parse()
+                .expect(line)
+        })
+        .collect();
+    (
+        after("estimate"),
+        pm[0],
+        after("reference"),
+        pm[1],
+        line.contains("agree"),
+    )
+}
+
+#[test]
+fn sample_compares_with_an_adaptive_reference_albedo() {
+    // Fixed 64 × 256 grids gave 0.8536 (true 0.920846) and 0.9639 (true 0.999847) here.
+    for (spec, theta, truth) in [
+        ("ggx:alpha=0.1", "89.5", 0.920_846_217),
+        ("ggx:alpha=0.01", "45", 0.999_846_808),
+    ] {
+        let o = brdf_lab(&[
+            "sample",
+            "--brdf",
+            spec,
+            "--theta-o",
+            theta,
+            "--slices",
+            "9",
+            "-n",
+            "20000",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+        let (estimate, sigma, reference, err, agree) = albedo_line(&text);
+        assert!((reference - truth).abs() < 1e-5, "{spec}: {text}");
+        assert!(err < 1e-4, "{spec}: {text}");
+        assert!(sigma > 0.0 && estimate > 0.0, "{text}");
+        assert!(agree, "{spec}: {text}");
     }
 }
