@@ -29,6 +29,16 @@ fn assert_input_error(args: &[&str], needle: &str) {
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
 
+/// A usage error caught by clap: exit code 2 and clap's full message (several lines).
+fn assert_usage_error(args: &[&str], needle: &str) {
+    let o = brdf_lab(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    assert!(err.contains("--help"), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
 fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).expect("csv");
     let mut lines = text.lines();
@@ -63,7 +73,7 @@ fn bad_inputs_exit_2_with_one_line() {
         "map.hdr",
     );
     assert_input_error(&["envmap", "-n", "10", "--map", "map.png"], "map.png");
-    assert_input_error(&["envmap", "-n", "0"], "--samples");
+    assert_usage_error(&["envmap", "-n", "0"], "--samples");
     assert_input_error(&["envmap", "-n", "10", "--n-max", "0.5"], "--n-max");
     assert_input_error(&["envmap", "-n", "10", "--n-max", "NaN"], "--n-max");
     assert_input_error(
@@ -133,7 +143,8 @@ fn bad_inputs_exit_2_with_one_line() {
         "such.binary",
     );
     assert_input_error(&["validate", "--quick", "--sampler", "nope"], "nope");
-    assert_input_error(&["nosuchcommand"], "nosuchcommand");
+    // Usage errors carry clap's full (multi-line) message; see usage_errors_show_clap_s_….
+    assert_usage_error(&["nosuchcommand"], "nosuchcommand");
 }
 
 #[test]
@@ -405,4 +416,46 @@ fn sample_compares_with_an_adaptive_reference_albedo() {
         assert!(sigma > 0.0 && estimate > 0.0, "{text}");
         assert!(agree, "{spec}: {text}");
     }
+}
+
+#[test]
+fn usage_errors_show_clap_s_full_message() {
+    // Missing required arguments are named.
+    let o = brdf_lab(&["sample", "--brdf", "lambert"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("required arguments were not provided"),
+        "{err}"
+    );
+    assert!(
+        err.contains("--theta-o") && err.contains("--samples"),
+        "{err}"
+    );
+    assert!(err.contains("Usage:"), "{err}");
+    // Possible values and "similar argument" tips are kept.
+    let o = brdf_lab(&["envmap", "-n", "10", "--sampler", "adaptiv"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("possible values") && err.contains("tabulated-cdf"),
+        "{err}"
+    );
+    let o = brdf_lab(&["envmap", "-n", "10", "--compar"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--compare"), "{err}");
+    // No subcommand: the help on stderr, exit 2.
+    let o = brdf_lab(&[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(o.stdout.is_empty());
+    assert!(
+        err.contains("Usage:") && err.contains("sample") && err.contains("validate"),
+        "{err}"
+    );
+    // --help and --version still go to stdout with exit 0.
+    let o = brdf_lab(&["--help"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Usage:"));
 }
