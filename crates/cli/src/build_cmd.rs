@@ -25,6 +25,7 @@ pub(crate) struct BuildArgs {
 
 /// Runs `brdf-lab build`.
 pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
+    crate::output::check_all([("--out", args.out.as_deref())])?;
     if brdf_sampling::parse_sampler_name(&args.sampler).is_none() {
         return Err(CliError::input(format!(
             "--sampler {}: `build` makes adaptive quadtree sets; use one of {}",

@@ -47,6 +47,10 @@ pub(crate) struct ValidateArgs {
 /// Runs `brdf-lab validate`: exit 0 when everything passed, 1 when a test failed (or a mutant
 /// escaped), 2 on bad input.
 pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
+    crate::output::check_all([
+        ("--json", args.json.as_deref()),
+        ("--report", args.report.as_deref()),
+    ])?;
     let base = if args.quick {
         ValidateConfig::quick()
     } else {

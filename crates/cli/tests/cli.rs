@@ -459,3 +459,120 @@ fn usage_errors_show_clap_s_full_message() {
     assert_eq!(o.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&o.stdout).contains("Usage:"));
 }
+
+#[test]
+fn output_paths_are_checked_before_any_work() {
+    // A prefix without `.tmp`: the internal temporary names must not leak into messages.
+    let dir = tempfile::Builder::new()
+        .prefix("brdf-lab-test")
+        .tempdir()
+        .expect("tempdir");
+    let missing = dir.path().join("no/such/dir/out.csv");
+    let missing = missing.to_str().expect("p");
+    let sample = [
+        "sample",
+        "--brdf",
+        "phong",
+        "--theta-o",
+        "30",
+        "-n",
+        "100",
+        "--slices",
+        "9",
+    ];
+    let one_line_before_work = |args: &[&str], needle: &str| {
+        let o = brdf_lab(args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+        assert!(!err.contains(".tmp"), "{args:?}: a temporary path: {err}");
+        assert!(
+            o.stdout.is_empty(),
+            "{args:?}: work was done: {}",
+            String::from_utf8_lossy(&o.stdout)
+        );
+    };
+    let with = |extra: &[&str]| -> Vec<String> {
+        sample.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |v: Vec<String>, needle: &str| {
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        one_line_before_work(&args, needle);
+    };
+    run(with(&["--out", missing]), "does not exist");
+    run(with(&["--out", "."]), "is a directory");
+    run(
+        with(&["--out", dir.path().to_str().expect("p")]),
+        "is a directory",
+    );
+    // eval: the output is checked before the directions are read.
+    one_line_before_work(
+        &[
+            "eval",
+            "--brdf",
+            "phong",
+            "--theta-o",
+            "30",
+            "--dirs",
+            "/no/such/dirs.csv",
+            "--out",
+            missing,
+        ],
+        "does not exist",
+    );
+    one_line_before_work(
+        &[
+            "build", "--brdf", "phong", "--slices", "9", "--out", missing,
+        ],
+        "does not exist",
+    );
+    one_line_before_work(
+        &["envmap", "-n", "1000", "--out", missing],
+        "does not exist",
+    );
+    // validate: neither output is written when the other cannot be.
+    let json = dir.path().join("v.json");
+    one_line_before_work(
+        &[
+            "validate",
+            "--quick",
+            "--sampler",
+            "cosine",
+            "--brdf",
+            "lambert",
+            "--theta-o",
+            "30",
+            "--json",
+            json.to_str().expect("p"),
+            "--report",
+            missing,
+        ],
+        "does not exist",
+    );
+    assert!(!json.exists());
+    let started = std::time::Instant::now();
+    one_line_before_work(&["validate", "--json", missing], "does not exist");
+    assert!(started.elapsed().as_secs_f64() < 10.0);
+}
+
+#[cfg(unix)]
+#[test]
+fn output_files_get_the_mode_of_a_normal_new_file() {
+    use std::os::unix::fs::PermissionsExt;
+    // The process umask, as the kernel reports it (Linux); 022 elsewhere.
+    let umask = std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
+        })
+        .unwrap_or(0o022);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("s.csv");
+    let o = brdf_lab(&["envmap", "-n", "100", "--out", out.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mode = std::fs::metadata(&out).expect("meta").permissions().mode() & 0o777;
+    assert_eq!(mode, 0o666 & !umask, "{mode:o}");
+}
