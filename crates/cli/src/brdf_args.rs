@@ -128,11 +128,20 @@ pub(crate) fn build(
     built
 }
 
-/// Prints the build report of an adaptive set (nothing for other samplers).
+/// Prints the build report of an adaptive set to stdout (nothing for other samplers).
 pub(crate) fn print_set_report(built: &Built) {
-    let Built::Set(set) = built else { return };
+    for line in set_report_lines(built) {
+        println!("{line}");
+    }
+}
+
+/// The lines of the build report of an adaptive set (none for other samplers).
+pub(crate) fn set_report_lines(built: &Built) -> Vec<String> {
+    let Built::Set(set) = built else {
+        return Vec::new();
+    };
     let r = set.report();
-    println!(
+    let structure = format!(
         "set        {} slices ({} θ × {} φ{}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
         r.trees,
         r.layout.theta,
@@ -151,11 +160,12 @@ pub(crate) fn print_set_report(built: &Built) {
     let measured = r
         .measured_mean_trials
         .map_or("n/a".into(), |t| format!("{t:.4}"));
-    println!(
+    let trials = format!(
         "trials     expected {:.4} (worst slice {:.4}), measured {measured}; bound violations {}; grid evaluations {}",
         r.expected_mean_trials,
         r.worst_expected_mean_trials,
         r.bound_violations,
         r.grid_evaluations
     );
+    vec![structure, trials]
 }

@@ -138,11 +138,7 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
             write_atomically(path, write)?;
             eprintln!("wrote {} ({} rows)", path.display(), rows.len());
         }
-        None => {
-            let stdout = std::io::stdout();
-            let mut lock = stdout.lock();
-            write(&mut lock).map_err(CliError::input)?;
-        }
+        None => crate::output::write_stdout(write)?,
     }
     Ok(())
 }

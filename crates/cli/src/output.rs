@@ -113,6 +113,21 @@ pub(crate) fn write_atomically(
     Ok(())
 }
 
+/// Writes data to standard output (buffered). A closed pipe (`brdf-lab sample … | head`) ends
+/// the output quietly; other errors are reported.
+pub(crate) fn write_stdout(
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> CliResult<()> {
+    let mut out = BufWriter::new(std::io::stdout().lock());
+    match fill(&mut out).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(CliError::input(format!(
+            "cannot write to standard output: {}",
+            reason(&e)
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Formats an f64 for CSV output with full round-trip precision.
 pub(crate) fn num(x: f64) -> String {
     format!("{x:?}")

@@ -1,4 +1,7 @@
 //! `brdf-lab sample`: draw incident directions for one BRDF and outgoing direction.
+//!
+//! The samples (CSV `x,y,z,pdf`) go to `--out` or to standard output; the summary always goes
+//! to standard error.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -32,7 +35,8 @@ pub(crate) struct SampleArgs {
     /// Seed of the random streams.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Write the samples as CSV `x,y,z,pdf` (pdf w.r.t. solid angle; written atomically).
+    /// Write the samples as CSV `x,y,z,pdf` (pdf w.r.t. solid angle) here, atomically, instead
+    /// of to standard output. The summary always goes to standard error.
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
@@ -51,11 +55,11 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         &args.set.options(),
     )?;
     let sampler = built.sampler();
-    println!(
+    eprintln!(
         "brdf       {} at θo = {}°, φo = {}°",
         args.brdf.spec, args.brdf.theta_o, args.brdf.phi_o
     );
-    println!(
+    eprintln!(
         "sampler    {} ({} bytes)",
         sampler.name(),
         sampler.bytes_used()
@@ -77,7 +81,7 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         .collect();
     pb.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
-    println!(
+    eprintln!(
         "samples    {n} in {elapsed:.3} s ({:.2} M samples/s on {} threads)",
         n as f64 / elapsed / 1e6,
         rayon::current_num_threads()
@@ -103,28 +107,34 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         brdf_args::Built::Set(set) => set.report().max_integral_rel_err.map(|e| e * mean.abs()),
         brdf_args::Built::Other(_) => None,
     };
-    println!(
+    eprintln!(
         "albedo     {}",
         albedo_summary(brdf.as_ref(), &wo, mean, std_err, normalisation)
     );
-    brdf_args::print_set_report(&built);
+    for line in brdf_args::set_report_lines(&built) {
+        eprintln!("{line}");
+    }
 
-    if let Some(path) = &args.out {
-        write_atomically(path, |w| {
-            writeln!(w, "x,y,z,pdf")?;
-            for s in samples.iter().flatten() {
-                writeln!(
-                    w,
-                    "{},{},{},{}",
-                    num(s.wi.x),
-                    num(s.wi.y),
-                    num(s.wi.z),
-                    num(s.pdf)
-                )?;
-            }
-            Ok(())
-        })?;
-        println!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
+    let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
+        writeln!(w, "x,y,z,pdf")?;
+        for s in samples.iter().flatten() {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                num(s.wi.x),
+                num(s.wi.y),
+                num(s.wi.z),
+                num(s.pdf)
+            )?;
+        }
+        Ok(())
+    };
+    match &args.out {
+        Some(path) => {
+            write_atomically(path, write)?;
+            eprintln!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
+        }
+        None => crate::output::write_stdout(write)?,
     }
     Ok(())
 }

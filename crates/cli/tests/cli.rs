@@ -576,3 +576,44 @@ fn output_files_get_the_mode_of_a_normal_new_file() {
     let mode = std::fs::metadata(&out).expect("meta").permissions().mode() & 0o777;
     assert_eq!(mode, 0o666 & !umask, "{mode:o}");
 }
+
+#[test]
+fn sample_writes_csv_to_stdout_and_the_summary_to_stderr() {
+    let args = [
+        "sample",
+        "--brdf",
+        "phong",
+        "--theta-o",
+        "30",
+        "-n",
+        "500",
+        "--slices",
+        "9",
+    ];
+    let o = brdf_lab(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let mut lines = out.lines();
+    assert_eq!(lines.next(), Some("x,y,z,pdf"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().expect(l)).collect())
+        .collect();
+    assert_eq!(rows.len(), 500);
+    assert!(rows.iter().all(|r| r.len() == 4 && r[3] > 0.0));
+    let err = stderr(&o);
+    assert!(err.contains("albedo") && err.contains("sampler"), "{err}");
+    // With --out: the same rows in the file, nothing on stdout, the summary on stderr.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("s.csv");
+    let mut with_out = args.to_vec();
+    with_out.extend(["--out", path.to_str().expect("p")]);
+    let o = brdf_lab(&with_out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert!(stderr(&o).contains("albedo") && stderr(&o).contains("wrote"));
+    assert_eq!(read_csv(&path).1, rows);
+}
