@@ -32,9 +32,14 @@ pub(crate) struct SetArgs {
     /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
     #[arg(long, default_value_t = brdf_sampling::DEFAULT_N_MAX)]
     pub(crate) n_max: f64,
-    /// Maximum quadtree depth.
+    /// Maximum quadtree depth; the image map must be finer than the deepest leaf:
+    /// 2^(max_depth+1) ≤ grid, so at most 7 at the default --grid 256 (8 needs --grid 512).
     #[arg(long, default_value_t = brdf_sampling::DEFAULT_MAX_DEPTH)]
     pub(crate) max_depth: u32,
+    /// Cells per axis of each slice's sampled image map over [-1, 1]²: a power of two; the
+    /// slices refined for grazing lobes use up to 4 times as many.
+    #[arg(long, default_value_t = brdf_sampling::DEFAULT_GRID)]
+    pub(crate) grid: usize,
     /// Hemisphere-to-disc map of the slices: `auto` (projected disc; equal-area from
     /// --equal-area-from degrees and for BRDFs unbounded at the horizon), `projected`
     /// (the papers') or `equal-area`.
@@ -55,10 +60,42 @@ impl SetArgs {
             slices: self.slices,
             n_max: self.n_max,
             max_depth: self.max_depth,
+            grid: self.grid,
             disc_map: self.disc_map,
             equal_area_from_deg: self.equal_area_from,
             ..SetOptions::default()
         }
+    }
+}
+
+impl SetArgs {
+    /// Checks `--grid` and `--max-depth` with messages in terms of the options (exit 2), e.g.
+    /// which `--grid` a `--max-depth` needs.
+    pub(crate) fn check(&self) -> CliResult<()> {
+        let levels = brdf_sampling::DEFAULT_REFINE_LEVELS;
+        let largest = brdf_sampling::MAX_GRID >> levels;
+        if !(self.grid.is_power_of_two() && (4..=largest).contains(&self.grid)) {
+            return Err(CliError::input(format!(
+                "--grid {}: must be a power of two in 4 ..= {largest} (refined slices double it up to {levels} times, at most {})",
+                self.grid,
+                brdf_sampling::MAX_GRID
+            )));
+        }
+        let deepest = largest.trailing_zeros() - 1;
+        if self.max_depth > deepest {
+            return Err(CliError::input(format!(
+                "--max-depth {}: at most {deepest} (2^(max_depth+1) ≤ grid ≤ {largest})",
+                self.max_depth
+            )));
+        }
+        let needed = 1usize << (self.max_depth + 1);
+        if needed > self.grid {
+            return Err(CliError::input(format!(
+                "--max-depth {} needs --grid {needed} or more (2^(max_depth+1) ≤ grid; the grid is {})",
+                self.max_depth, self.grid
+            )));
+        }
+        Ok(())
     }
 }
 

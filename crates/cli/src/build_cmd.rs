@@ -26,6 +26,7 @@ pub(crate) struct BuildArgs {
 /// Runs `brdf-lab build`.
 pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     if brdf_sampling::parse_sampler_name(&args.sampler).is_none() {
         return Err(CliError::input(format!(
             "--sampler {}: `build` makes adaptive quadtree sets; use one of {}",

@@ -93,6 +93,7 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
 /// Runs `brdf-lab eval`.
 pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
     let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
     let dirs = read_directions(&args.dirs)?;

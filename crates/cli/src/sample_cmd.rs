@@ -46,6 +46,7 @@ pub(crate) struct SampleArgs {
 /// Runs `brdf-lab sample`.
 pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
     let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
     let built = brdf_args::build(

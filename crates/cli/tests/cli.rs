@@ -617,3 +617,31 @@ fn sample_writes_csv_to_stdout_and_the_summary_to_stderr() {
     assert!(stderr(&o).contains("albedo") && stderr(&o).contains("wrote"));
     assert_eq!(read_csv(&path).1, rows);
 }
+
+#[test]
+fn max_depth_says_which_grid_it_needs() {
+    let base = ["build", "--brdf", "lambert", "--slices", "1"];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |v: Vec<String>| {
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        brdf_lab(&args)
+    };
+    let o = run(with(&["--max-depth", "8"]));
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--grid 512"), "{err}");
+    let o = run(with(&["--max-depth", "8", "--grid", "512"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(with(&["--grid", "100"]));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--grid"), "{}", stderr(&o));
+    let o = brdf_lab(&["build", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        help.contains("--grid") && help.contains("2^(max_depth+1)"),
+        "{help}"
+    );
+}
