@@ -99,11 +99,22 @@ impl SetArgs {
     }
 }
 
-/// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure).
+/// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure); warns on
+/// stderr when its parameters are physically implausible ([`warn_if_implausible`]).
 pub(crate) fn parse_brdf(spec: &str) -> CliResult<Arc<dyn Brdf>> {
-    brdf::parse_spec(spec)
+    let brdf: Arc<dyn Brdf> = brdf::parse_spec(spec)
         .map(Arc::from)
-        .map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))
+        .map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))?;
+    warn_if_implausible(spec, brdf.as_ref());
+    Ok(brdf)
+}
+
+/// Prints `brdf-lab: warning: --brdf SPEC: …` for each of [`brdf::energy_warnings`] (albedo
+/// above 1 at some outgoing angle): accepted, but the user should know.
+pub(crate) fn warn_if_implausible(spec: &str, brdf: &dyn Brdf) {
+    for w in brdf::energy_warnings(brdf) {
+        eprintln!("brdf-lab: warning: --brdf {spec}: {w}");
+    }
 }
 
 /// The outgoing direction of `--theta-o/--phi-o`, validated.

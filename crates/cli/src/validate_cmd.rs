@@ -51,6 +51,13 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
         ("--json", args.json.as_deref()),
         ("--report", args.report.as_deref()),
     ])?;
+    // Warnings for the BRDFs the user named (a spec that does not parse is reported by the
+    // suite itself).
+    for spec in &args.brdfs {
+        if let Ok(b) = brdf::parse_spec(spec) {
+            crate::brdf_args::warn_if_implausible(spec, b.as_ref());
+        }
+    }
     let base = if args.quick {
         ValidateConfig::quick()
     } else {

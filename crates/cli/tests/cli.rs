@@ -645,3 +645,51 @@ fn max_depth_says_which_grid_it_needs() {
         "{help}"
     );
 }
+
+#[test]
+fn implausible_brdfs_are_warned_about_not_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    std::fs::write(&dirs, "0,0,1\n").expect("write");
+    let d = dirs.to_str().expect("p");
+    let cases: [&[&str]; 4] = [
+        &["sample", "--theta-o", "30", "-n", "100", "--slices", "3"],
+        &["eval", "--theta-o", "30", "--dirs", d],
+        &["build", "--slices", "3"],
+        &[
+            "validate",
+            "--quick",
+            "--sampler",
+            "cosine",
+            "--theta-o",
+            "30",
+            "--samples",
+            "20000",
+        ],
+    ];
+    for case in cases {
+        for (spec, warned) in [
+            ("phong:ks=0.9,kd=0.9", true),
+            ("phong:ks=0.7,kd=0.3", false),
+        ] {
+            let mut args = case.to_vec();
+            args.extend(["--brdf", spec]);
+            let o = brdf_lab(&args);
+            let err = stderr(&o);
+            assert!(o.status.code() != Some(2), "{args:?}: {err}");
+            let lines: Vec<&str> = err
+                .lines()
+                .filter(|l| l.starts_with("brdf-lab: warning:"))
+                .collect();
+            if warned {
+                assert_eq!(lines.len(), 1, "{args:?}: {err}");
+                assert!(
+                    lines[0].contains(spec) && lines[0].contains("1.800"),
+                    "{err}"
+                );
+            } else {
+                assert!(lines.is_empty(), "{args:?}: {err}");
+            }
+        }
+    }
+}
