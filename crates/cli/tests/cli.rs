@@ -693,3 +693,28 @@ fn implausible_brdfs_are_warned_about_not_refused() {
         }
     }
 }
+
+#[test]
+fn long_runs_print_progress_lines_when_stderr_is_not_a_terminal() {
+    // The interval is 10 s by default; 0.05 s here so that a short build shows lines.
+    let o = Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .args(["build", "--brdf", "ggx:alpha=0.05"])
+        .env("BRDF_LAB_PROGRESS_SECS", "0.05")
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("building: "))
+        .collect();
+    assert!(!lines.is_empty(), "{err}");
+    for l in &lines {
+        assert!(
+            l.ends_with("s elapsed") && l.contains('/') && l.contains(" %)"),
+            "{l}"
+        );
+    }
+    // Stdout keeps only the report.
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("building:"));
+}
