@@ -1,5 +1,6 @@
 //! Arguments shared by the BRDF commands (`sample`, `eval`, `build`) and building samplers.
 
+use std::path::Path;
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
@@ -13,8 +14,9 @@ use crate::progress;
 #[derive(Debug, Args)]
 pub(crate) struct BrdfArgs {
     /// BRDF: `name` or `name:key=value,...` (e.g. `phong:n=50,ks=0.7,kd=0.3`) or `merl:PATH`.
-    #[arg(long = "brdf")]
-    pub(crate) spec: String,
+    /// Optional with --set (the set stores it; when given, it must match).
+    #[arg(long = "brdf", required_unless_present = "set_file")]
+    pub(crate) spec: Option<String>,
     /// Outgoing polar angle θo in degrees, in [0, 90).
     #[arg(long = "theta-o", allow_negative_numbers = true)]
     pub(crate) theta_o: f64,
@@ -97,6 +99,55 @@ impl SetArgs {
         }
         Ok(())
     }
+}
+
+/// The ids of the set options, which `--set FILE` conflicts with (the stored ones apply).
+pub(crate) const SET_OPTION_IDS: [&str; 6] = [
+    "slices",
+    "n_max",
+    "max_depth",
+    "grid",
+    "disc_map",
+    "equal_area_from",
+];
+
+/// `--brdf` when no `--set` is given (clap requires it then).
+pub(crate) fn required_spec(args: &BrdfArgs) -> CliResult<&str> {
+    args.spec
+        .as_deref()
+        .ok_or_else(|| CliError::input("--brdf SPEC is required without --set"))
+}
+
+/// A set loaded from `--set FILE` (written by `build --out`): its stored spec, the BRDF parsed
+/// from it and the set. `--brdf` (`given_spec`) must be the stored spec when given, `--sampler`
+/// (`given_sampler`) the set's sampler name.
+pub(crate) fn load_set(
+    path: &Path,
+    given_spec: Option<&str>,
+    given_sampler: Option<&str>,
+) -> CliResult<(String, Arc<dyn Brdf>, Built)> {
+    let fail = |why: String| CliError::input(format!("--set {}: {why}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    let spec = QuadTreeSet::stored_spec(&bytes).map_err(|e| fail(e.to_string()))?;
+    if let Some(given) = given_spec
+        && given.trim() != spec
+    {
+        return Err(fail(format!(
+            "the set was built for --brdf {spec}, not {given} (omit --brdf or give that spec)"
+        )));
+    }
+    let brdf = parse_brdf(&spec)?;
+    let set =
+        QuadTreeSet::from_bytes(&bytes, brdf.clone(), &spec).map_err(|e| fail(e.to_string()))?;
+    if let Some(name) = given_sampler
+        && name.trim() != set.name()
+    {
+        return Err(fail(format!(
+            "the set is an `{}` sampler, not `{name}` (omit --sampler)",
+            set.name()
+        )));
+    }
+    Ok((spec, brdf, Built::Set(Box::new(set))))
 }
 
 /// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure); warns on
@@ -190,7 +241,7 @@ pub(crate) fn set_report_lines(built: &Built) -> Vec<String> {
     };
     let r = set.report();
     let structure = format!(
-        "set        {} slices ({} θ × {} φ{}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
+        "set        {} slices ({} θ × {} φ{}), {}, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
         r.trees,
         r.layout.theta,
         r.layout.phi,
@@ -199,7 +250,11 @@ pub(crate) fn set_report_lines(built: &Built) -> Vec<String> {
         } else {
             ""
         },
-        r.build_time.as_secs_f64(),
+        if r.build_time.is_zero() {
+            "loaded from a file".to_string()
+        } else {
+            format!("built in {:.3} s", r.build_time.as_secs_f64())
+        },
         r.memory_bytes as f64 / 1024.0,
         r.nodes,
         r.leaves,

@@ -17,6 +17,10 @@ pub(crate) struct EvalArgs {
     /// Also report this sampler's pdf (w.r.t. solid angle), the same value `sample` reports.
     #[arg(long)]
     sampler: Option<String>,
+    /// Report the pdf of a set written by `build --out` (it stores the BRDF spec and the
+    /// sampler): --brdf is then optional and must match, and the set's own options apply.
+    #[arg(long = "set", value_name = "FILE", conflicts_with_all = brdf_args::SET_OPTION_IDS)]
+    set_file: Option<PathBuf>,
     /// CSV of incident directions `x,y,z` (one per row; a header row is allowed; more columns
     /// are ignored, so `sample --out` files work as they are). Each direction is normalised
     /// once when read; the output's x,y,z columns are that unit vector, the one both f and the
@@ -95,16 +99,27 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
-    let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
     let dirs = read_directions(&args.dirs)?;
-    let built = match &args.sampler {
-        Some(name) => Some(brdf_args::build(
-            name,
-            &args.brdf.spec,
-            brdf.clone(),
-            &args.set.options(),
-        )?),
-        None => None,
+    let (brdf, built) = match &args.set_file {
+        Some(path) => {
+            let (_, brdf, set) =
+                brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?;
+            (brdf, Some(set))
+        }
+        None => {
+            let spec = brdf_args::required_spec(&args.brdf)?;
+            let brdf = brdf_args::parse_brdf(spec)?;
+            let built = match &args.sampler {
+                Some(name) => Some(brdf_args::build(
+                    name,
+                    spec,
+                    brdf.clone(),
+                    &args.set.options(),
+                )?),
+                None => None,
+            };
+            (brdf, built)
+        }
     };
     let rows: Vec<(Vec3, f64, Option<f64>)> = dirs
         .iter()

@@ -26,9 +26,13 @@ const CHUNK: usize = 4096;
 pub(crate) struct SampleArgs {
     #[command(flatten)]
     brdf: BrdfArgs,
-    /// Sampler name (see `brdf-lab list`).
-    #[arg(long, default_value = "adaptive")]
-    sampler: String,
+    /// Sampler name (see `brdf-lab list`; default adaptive). With --set: the set's.
+    #[arg(long)]
+    sampler: Option<String>,
+    /// Sample a set written by `build --out` (it stores the BRDF spec and the sampler):
+    /// --brdf is then optional and must match, and the set's own options apply.
+    #[arg(long = "set", value_name = "FILE", conflicts_with_all = brdf_args::SET_OPTION_IDS)]
+    set_file: Option<PathBuf>,
     /// Number of samples.
     #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     n: u64,
@@ -48,18 +52,26 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
-    let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
-    let built = brdf_args::build(
-        &args.sampler,
-        &args.brdf.spec,
-        brdf.clone(),
-        &args.set.options(),
-    )?;
+    let (spec, brdf, built) = match &args.set_file {
+        Some(path) => {
+            brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?
+        }
+        None => {
+            let spec = brdf_args::required_spec(&args.brdf)?;
+            let brdf = brdf_args::parse_brdf(spec)?;
+            let name = args.sampler.as_deref().unwrap_or("adaptive");
+            let built = brdf_args::build(name, spec, brdf.clone(), &args.set.options())?;
+            (spec.to_string(), brdf, built)
+        }
+    };
     let sampler = built.sampler();
     eprintln!(
-        "brdf       {} at θo = {}°, φo = {}°",
-        args.brdf.spec, args.brdf.theta_o, args.brdf.phi_o
+        "brdf       {spec} at θo = {}°, φo = {}°",
+        args.brdf.theta_o, args.brdf.phi_o
     );
+    if let Some(path) = &args.set_file {
+        eprintln!("set file   {}", path.display());
+    }
     eprintln!(
         "sampler    {} ({} bytes)",
         sampler.name(),

@@ -718,3 +718,78 @@ fn long_runs_print_progress_lines_when_stderr_is_not_a_terminal() {
     // Stdout keeps only the report.
     assert!(!String::from_utf8_lossy(&o.stdout).contains("building:"));
 }
+
+#[test]
+fn sets_written_by_build_are_used_by_sample_and_eval() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |name: &str| dir.path().join(name).to_str().expect("p").to_string();
+    let (set, samples, evals) = (p("phong.set"), p("s.csv"), p("e.csv"));
+    let o = brdf_lab(&[
+        "build",
+        "--brdf",
+        "phong:n=50",
+        "--slices",
+        "9",
+        "--out",
+        &set,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let at = ["--theta-o", "37", "--phi-o", "20"];
+    let run = |args: &[&str]| {
+        let mut v = args.to_vec();
+        v.extend(at);
+        brdf_lab(&v)
+    };
+    let o = run(&["sample", "--set", &set, "-n", "2000", "--out", &samples]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("9 slices"), "{}", stderr(&o));
+    let o = run(&["eval", "--set", &set, "--dirs", &samples, "--out", &evals]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, s) = read_csv(Path::new(&samples));
+    let (h, e) = read_csv(Path::new(&evals));
+    assert_eq!(h, "x,y,z,f,pdf");
+    assert_eq!(s.len(), 2000);
+    for (a, b) in s.iter().zip(&e) {
+        assert!((a[3] - b[4]).abs() <= 1e-12 * a[3], "{a:?} vs {b:?}");
+    }
+    // --brdf may be given and must match; --sampler must be the set's; set options conflict.
+    let o = run(&["sample", "--set", &set, "--brdf", "phong:n=50", "-n", "10"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let usage = |args: &[&str], needle: &str| {
+        let o = run(args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    };
+    usage(
+        &["sample", "--set", &set, "--brdf", "phong:n=60", "-n", "10"],
+        "phong:n=50",
+    );
+    usage(
+        &["eval", "--set", &set, "--brdf", "ward", "--dirs", &samples],
+        "phong:n=50",
+    );
+    usage(
+        &["sample", "--set", &set, "--sampler", "cosine", "-n", "10"],
+        "adaptive",
+    );
+    usage(
+        &[
+            "eval",
+            "--set",
+            &set,
+            "--sampler",
+            "adaptive-paper",
+            "--dirs",
+            &samples,
+        ],
+        "adaptive",
+    );
+    usage(
+        &["sample", "--set", &set, "--slices", "3", "-n", "10"],
+        "--slices",
+    );
+    usage(&["sample", "-n", "10"], "--brdf");
+    usage(&["sample", "--set", "/no/such.set", "-n", "10"], "such.set");
+    usage(&["sample", "--set", &samples, "-n", "10"], "s.csv");
+}
