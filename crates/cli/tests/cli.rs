@@ -793,3 +793,43 @@ fn sets_written_by_build_are_used_by_sample_and_eval() {
     usage(&["sample", "--set", "/no/such.set", "-n", "10"], "such.set");
     usage(&["sample", "--set", &samples, "-n", "10"], "s.csv");
 }
+
+#[cfg(unix)]
+#[test]
+fn outputs_follow_links_and_never_replace_special_files() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A symbolic link stays a link; its target receives the data (also when it is new).
+    let link = dir.path().join("link.csv");
+    let real = dir.path().join("real.csv");
+    std::os::unix::fs::symlink("real.csv", &link).expect("symlink");
+    let o = brdf_lab(&["envmap", "-n", "10", "--out", link.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .expect("link")
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(read_csv(&real).1.len(), 10);
+    // A FIFO (as `--out >(gzip > s.gz)` gives) is written in place, not replaced by a file.
+    let fifo = dir.path().join("fifo");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        return; // no mkfifo here
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    let reader = fifo.clone();
+    std::thread::spawn(move || {
+        let _ = tx.send(std::fs::read_to_string(&reader));
+    });
+    let o = brdf_lab(&["envmap", "-n", "10", "--out", fifo.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the FIFO received nothing")
+        .expect("read");
+    assert_eq!(text.lines().count(), 11, "{text}");
+    let kind = std::fs::symlink_metadata(&fifo).expect("fifo").file_type();
+    assert!(kind.is_fifo());
+}
