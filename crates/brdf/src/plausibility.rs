@@ -180,9 +180,7 @@ pub fn adaptive_albedo_rgb(brdf: &dyn Brdf, wo: &Vec3) -> ([f64; 3], [f64; 3]) {
     let total_err = |heap: &BinaryHeap<Piece>| {
         let mut e = [0.0; 3];
         for p in heap.iter() {
-            for c in 0..3 {
-                e[c] += p.err[c];
-            }
+            add3(&mut e, &p.err);
         }
         e
     };
@@ -208,12 +206,17 @@ pub fn adaptive_albedo_rgb(brdf: &dyn Brdf, wo: &Vec3) -> ([f64; 3], [f64; 3]) {
     }
     let mut value = [0.0; 3];
     for p in heap.iter() {
-        for c in 0..3 {
-            value[c] += p.value[c];
-        }
+        add3(&mut value, &p.value);
     }
     let err = total_err(&heap);
     (value.map(|v| factor * v), err.map(|e| factor * e))
+}
+
+/// `a += b` per channel.
+fn add3(a: &mut [f64; 3], b: &[f64; 3]) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
 }
 
 /// The initial partition: uniform to `INITIAL_DEPTH`, pieces within one piece size of `peak`
