@@ -2,8 +2,13 @@
 //! redistributable), load it back with `merl:PATH`, build its adaptive set and sample it.
 //! Point `merl:PATH` at your own MERL files in exactly the same way.
 //!
-//! `cargo run --release -p brdf-lab-examples --example merl`
+//! `cargo run --release -p brdf-lab-examples --example merl [-- --out blinn.binary]`
+//!
+//! With `--out PATH` the MERL file is written there and kept (use it as
+//! `brdf-lab sample --brdf merl:PATH …`); without it, it goes to a temporary directory that is
+//! removed at the end.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use brdf::{Brdf, MerlBrdf};
@@ -12,8 +17,30 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let mut out = None;
+    while let Some(a) = args.next() {
+        match (a.as_str(), a.strip_prefix("--out=")) {
+            (_, Some(p)) => out = Some(PathBuf::from(p)),
+            ("--out", None) => {
+                out = Some(args.next().ok_or("--out needs a PATH")?.into());
+            }
+            _ => {
+                return Err(format!("unexpected argument `{a}` (usage: merl [--out PATH])").into());
+            }
+        }
+    }
+    run(out.as_deref())
+}
+
+/// Writes the MERL file to `out` (kept) or to a temporary directory (removed), then loads,
+/// builds and samples it.
+fn run(out: Option<&Path>) -> Result<(), Box<dyn std::error::Error>> {
     let dir = tempfile::tempdir()?;
-    let path = dir.path().join("blinn.binary");
+    let path = match out {
+        Some(p) => p.to_path_buf(),
+        None => dir.path().join("blinn.binary"),
+    };
     let analytic = brdf::parse_spec("blinn:n=200,ks=0.5,kd=0.3")?;
     MerlBrdf::tabulate(analytic.as_ref()).write(&path)?;
 
@@ -44,5 +71,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         r.expected_mean_trials
     );
     println!("directional albedo at 40°: {:.4}", sum / n as f64);
+    match out {
+        Some(p) => println!(
+            "wrote {} (use it as --brdf merl:{})",
+            p.display(),
+            p.display()
+        ),
+        None => println!("(the MERL file was temporary; keep one with --out PATH)"),
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn out_keeps_the_merl_file() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("kept.binary");
+        super::run(Some(&path)).expect("run");
+        let b = brdf::parse_spec(&format!("merl:{}", path.display())).expect("a MERL file");
+        assert_eq!(b.name(), "merl");
+    }
 }

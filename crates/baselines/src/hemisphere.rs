@@ -11,11 +11,17 @@ use partition_sampler::UniformSource;
 
 /// Uniform directions on the upper hemisphere Ω: `p(ωi) = 1/(2π)` for `ωi.z > 0`.
 ///
+/// Its `pdf` depends only on the sign of `wi.z`, so it is the same for any positive multiple
+/// of `wi` ([`DirectionSampler::pdf`] asks for unit vectors).
+///
 /// Warp: `cosθ = u₁`, `φ = 2πu₂` (equal-area in `(cosθ, φ)`).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct UniformHemisphere;
 
 /// Cosine-weighted directions on Ω: `p(ωi) = cosθi/π` for `ωi.z > 0`.
+///
+/// Its `pdf` takes `cos θi = wi.z / |wi|`, so it is the same for any positive multiple of
+/// `wi` ([`DirectionSampler::pdf`] asks for unit vectors).
 ///
 /// Warp: a uniform point of the unit disc (polar, `r = √u₁`, `φ = 2πu₂`) lifted to the
 /// hemisphere (Malley's method: area on the disc is projected solid angle).
@@ -105,6 +111,22 @@ mod tests {
                     "{name} {p} {}",
                     d.pdf
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn pdf_is_the_same_for_any_positive_multiple_of_wi() {
+        let wo = Vec3::new(0.0, 0.0, 1.0);
+        let wi = Vec3::new(0.3, 0.4, 0.5);
+        let samplers: [(&str, &dyn DirectionSampler); 2] = [
+            ("uniform", &UniformHemisphere),
+            ("cosine", &CosineHemisphere),
+        ];
+        for (name, s) in samplers {
+            let unit = s.pdf(&wo, &wi.normalize());
+            for k in [0.5, 2.0, 1e3] {
+                assert!((s.pdf(&wo, &(wi * k)) - unit).abs() <= 1e-15, "{name}");
             }
         }
     }

@@ -23,6 +23,12 @@ pub trait DirectionSampler: Send + Sync {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample;
 
     /// Density of `wi` given `wo`, w.r.t. solid angle; the same value `sample` reports.
+    ///
+    /// Both `wo` and `wi` must be **unit** vectors (as `sample` returns them): implementations
+    /// may read a direction's components directly (the quadtree sets map `(wi.x, wi.y)` to the
+    /// disc), so the pdf of a non-unit vector is unspecified. Callers holding arbitrary vectors
+    /// (e.g. read from a file) normalise them first, once, and evaluate the BRDF at the same
+    /// unit vector.
     fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64;
 
     /// Draws `n` directions for one `wo` as a batch. The default draws `n` independent samples;

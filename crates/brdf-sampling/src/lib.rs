@@ -95,6 +95,7 @@ mod layout;
 mod normalisation;
 mod options;
 mod persist;
+mod reference;
 mod report;
 mod set;
 
@@ -107,5 +108,9 @@ pub use error::{SetError, SetFileError};
 pub use layout::{SliceChoice, SliceLayout};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use persist::SET_FORMAT_VERSION;
+pub use reference::{
+    AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,
+    reference_albedo_with_budget,
+};
 pub use report::{CostMeasurement, SetReport};
 pub use set::{Progress, QuadTreeSet, Variant, layout_for};

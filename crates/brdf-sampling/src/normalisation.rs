@@ -135,8 +135,12 @@ pub(crate) struct LeafIntegrals {
     pub(crate) total: f64,
     /// Relative error estimate of `Î`.
     pub(crate) rel_err: f64,
+    /// Absolute error estimate of `Î` (`Σ |I_high − I_low|`).
+    pub(crate) abs_err: f64,
     /// `∫_{leaf i} f` (with `mirror`: over the leaf's part in `y ≤ 0` only).
     pub(crate) per_leaf: Vec<f64>,
+    /// Evaluations of `f` spent.
+    pub(crate) evaluations: u64,
 }
 
 /// See [`leaf_quadrature`]; also returns each leaf's integral.
@@ -145,6 +149,18 @@ pub(crate) fn per_leaf_quadrature(
     leaves: impl Iterator<Item = LeafInfo>,
     scale: f64,
     mirror: bool,
+) -> LeafIntegrals {
+    adaptive_quadrature(f, leaves, TOL * scale, mirror, EVALUATION_BUDGET)
+}
+
+/// The rule of [`per_leaf_quadrature`] with an absolute target `abs_tol` for the summed
+/// disagreement and an evaluation `budget` (the albedo reference uses a larger one).
+pub(crate) fn adaptive_quadrature(
+    f: &dyn Density,
+    leaves: impl Iterator<Item = LeafInfo>,
+    abs_tol: f64,
+    mirror: bool,
+    budget: u64,
 ) -> LeafIntegrals {
     let factor = if mirror { 2.0 } else { 1.0 };
     let (hi, lo) = (
@@ -183,9 +199,7 @@ pub(crate) fn per_leaf_quadrature(
         .map(|(i, r)| piece(i, r))
         .collect();
     let mut err: f64 = heap.iter().map(|p| p.err).sum();
-    while factor * err > TOL * scale
-        && evals.load(std::sync::atomic::Ordering::Relaxed) < EVALUATION_BUDGET
-    {
+    while factor * err > abs_tol && evals.load(std::sync::atomic::Ordering::Relaxed) < budget {
         let Some(worst) = heap.pop() else { break };
         let r = worst.rect;
         let c = r.center();
@@ -217,7 +231,9 @@ pub(crate) fn per_leaf_quadrature(
     LeafIntegrals {
         total,
         rel_err,
+        abs_err: err,
         per_leaf,
+        evaluations: evals.into_inner(),
     }
 }
 

@@ -43,6 +43,7 @@ mod geometry;
 pub mod merl;
 pub mod models;
 mod params;
+pub mod plausibility;
 pub mod quadrature;
 mod registry;
 pub mod special;
@@ -56,5 +57,6 @@ pub use geometry::{
 };
 pub use merl::{MerlBrdf, MerlError, write_merl};
 pub use params::{ParamDefault, ParamError, ParamInfo, Range};
+pub use plausibility::energy_warnings;
 pub use quadrature::{directional_albedo, projected_hemisphere_integral};
 pub use registry::{Isotropy, ModelInfo, SpecError, find_model, models, parse_spec};

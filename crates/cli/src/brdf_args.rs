@@ -1,5 +1,6 @@
 //! Arguments shared by the BRDF commands (`sample`, `eval`, `build`) and building samplers.
 
+use std::path::Path;
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
@@ -14,8 +15,9 @@ use crate::progress;
 #[derive(Debug, Args)]
 pub(crate) struct BrdfArgs {
     /// BRDF: `name` or `name:key=value,...` (e.g. `phong:n=50,ks=0.7,kd=0.3`) or `merl:PATH`.
-    #[arg(long = "brdf")]
-    pub(crate) spec: String,
+    /// Optional with --set (the set stores it; when given, it must match).
+    #[arg(long = "brdf", required_unless_present = "set_file")]
+    pub(crate) spec: Option<String>,
     /// Outgoing polar angle θo in degrees, in [0, 90).
     #[arg(long = "theta-o", allow_negative_numbers = true)]
     pub(crate) theta_o: f64,
@@ -33,9 +35,14 @@ pub(crate) struct SetArgs {
     /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
     #[arg(long, default_value_t = SetOptions::DEFAULT_N_MAX)]
     pub(crate) n_max: f64,
-    /// Maximum quadtree depth.
+    /// Maximum quadtree depth; the image map must be finer than the deepest leaf:
+    /// 2^(max_depth+1) ≤ grid, so at most 7 at the default --grid 256 (8 needs --grid 512).
     #[arg(long, default_value_t = SetOptions::DEFAULT_MAX_DEPTH)]
     pub(crate) max_depth: u32,
+    /// Cells per axis of each slice's sampled image map over [-1, 1]²: a power of two; the
+    /// slices refined for grazing lobes use up to 4 times as many.
+    #[arg(long, default_value_t = SetOptions::DEFAULT_GRID)]
+    pub(crate) grid: usize,
     /// Hemisphere-to-disc map of the slices: `auto` (projected disc; equal-area from
     /// --equal-area-from degrees and for BRDFs unbounded at the horizon), `projected`
     /// (the papers') or `equal-area`.
@@ -60,6 +67,7 @@ impl SetArgs {
                 max_depth: self.max_depth,
                 ..defaults.tree
             },
+            grid: self.grid,
             disc_map: self.disc_map,
             equal_area_from_deg: self.equal_area_from,
             ..defaults
@@ -67,11 +75,102 @@ impl SetArgs {
     }
 }
 
-/// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure).
+impl SetArgs {
+    /// Checks `--grid` and `--max-depth` with messages in terms of the options (exit 2), e.g.
+    /// which `--grid` a `--max-depth` needs.
+    pub(crate) fn check(&self) -> CliResult<()> {
+        let levels = SetOptions::DEFAULT_REFINE_LEVELS;
+        let largest = SetOptions::MAX_GRID >> levels;
+        if !(self.grid.is_power_of_two() && (4..=largest).contains(&self.grid)) {
+            return Err(CliError::input(format!(
+                "--grid {}: must be a power of two in 4 ..= {largest} (refined slices double it up to {levels} times, at most {})",
+                self.grid,
+                SetOptions::MAX_GRID
+            )));
+        }
+        let deepest = largest.trailing_zeros() - 1;
+        if self.max_depth > deepest {
+            return Err(CliError::input(format!(
+                "--max-depth {}: at most {deepest} (2^(max_depth+1) ≤ grid ≤ {largest})",
+                self.max_depth
+            )));
+        }
+        let needed = 1usize << (self.max_depth + 1);
+        if needed > self.grid {
+            return Err(CliError::input(format!(
+                "--max-depth {} needs --grid {needed} or more (2^(max_depth+1) ≤ grid; the grid is {})",
+                self.max_depth, self.grid
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The ids of the set options, which `--set FILE` conflicts with (the stored ones apply).
+pub(crate) const SET_OPTION_IDS: [&str; 6] = [
+    "slices",
+    "n_max",
+    "max_depth",
+    "grid",
+    "disc_map",
+    "equal_area_from",
+];
+
+/// `--brdf` when no `--set` is given (clap requires it then).
+pub(crate) fn required_spec(args: &BrdfArgs) -> CliResult<&str> {
+    args.spec
+        .as_deref()
+        .ok_or_else(|| CliError::input("--brdf SPEC is required without --set"))
+}
+
+/// A set loaded from `--set FILE` (written by `build --out`): its stored spec, the BRDF parsed
+/// from it and the set. `--brdf` (`given_spec`) must be the stored spec when given, `--sampler`
+/// (`given_sampler`) the set's sampler name (returned last: the registry entry it was built as).
+pub(crate) fn load_set(
+    path: &Path,
+    given_spec: Option<&str>,
+    given_sampler: Option<&str>,
+) -> CliResult<(String, Arc<dyn Brdf>, Built, &'static str)> {
+    let fail = |why: String| CliError::input(format!("--set {}: {why}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    let spec = QuadTreeSet::stored_spec(&bytes).map_err(|e| fail(e.to_string()))?;
+    if let Some(given) = given_spec
+        && given.trim() != spec
+    {
+        return Err(fail(format!(
+            "the set was built for --brdf {spec}, not {given} (omit --brdf or give that spec)"
+        )));
+    }
+    let brdf = parse_brdf(&spec)?;
+    let (entry, built) = samplers::load_set(&bytes, Some((brdf.clone(), spec.as_str())))
+        .map_err(|e| fail(e.to_string()))?;
+    if let Some(name) = given_sampler
+        && name.trim() != entry.name
+    {
+        return Err(fail(format!(
+            "the set is an `{}` sampler, not `{name}` (omit --sampler)",
+            entry.name
+        )));
+    }
+    Ok((spec, brdf, Built::from(built), entry.name))
+}
+
+/// Parses a SPEC into a shareable BRDF (exit 2 with the parser's reason on failure); warns on
+/// stderr when its parameters are physically implausible ([`warn_if_implausible`]).
 pub(crate) fn parse_brdf(spec: &str) -> CliResult<Arc<dyn Brdf>> {
-    brdf::parse_spec(spec)
+    let brdf: Arc<dyn Brdf> = brdf::parse_spec(spec)
         .map(Arc::from)
-        .map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))
+        .map_err(|e| CliError::input(format!("--brdf {spec}: {e}")))?;
+    warn_if_implausible(spec, brdf.as_ref());
+    Ok(brdf)
+}
+
+/// Prints `brdf-lab: warning: --brdf SPEC: …` for each of [`brdf::energy_warnings`] (albedo
+/// above 1 at some outgoing angle): accepted, but the user should know.
+pub(crate) fn warn_if_implausible(spec: &str, brdf: &dyn Brdf) {
+    for w in brdf::energy_warnings(brdf) {
+        eprintln!("brdf-lab: warning: --brdf {spec}: {w}");
+    }
 }
 
 /// The outgoing direction of `--theta-o/--phi-o`, validated.
@@ -139,12 +238,21 @@ pub(crate) fn build(
     built
 }
 
-/// Prints the build report of an adaptive set (nothing for other samplers).
+/// Prints the build report of an adaptive set to stdout (nothing for other samplers).
 pub(crate) fn print_set_report(built: &Built) {
-    let Built::Set(set) = built else { return };
+    for line in set_report_lines(built) {
+        println!("{line}");
+    }
+}
+
+/// The lines of the build report of an adaptive set (none for other samplers).
+pub(crate) fn set_report_lines(built: &Built) -> Vec<String> {
+    let Built::Set(set) = built else {
+        return Vec::new();
+    };
     let r = set.report();
-    println!(
-        "set        {} slices ({} θ × {} φ{}), built in {:.3} s, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
+    let structure = format!(
+        "set        {} slices ({} θ × {} φ{}), {}, {:.1} KiB, {} nodes, {} leaves, depth ≤ {}",
         r.trees,
         r.layout.theta,
         r.layout.phi,
@@ -153,7 +261,11 @@ pub(crate) fn print_set_report(built: &Built) {
         } else {
             ""
         },
-        r.build_time.as_secs_f64(),
+        if r.build_time.is_zero() {
+            "loaded from a file".to_string()
+        } else {
+            format!("built in {:.3} s", r.build_time.as_secs_f64())
+        },
         r.memory_bytes as f64 / 1024.0,
         r.nodes,
         r.leaves,
@@ -162,11 +274,12 @@ pub(crate) fn print_set_report(built: &Built) {
     let measured = r
         .measured_mean_trials
         .map_or("n/a".into(), |t| format!("{t:.4}"));
-    println!(
+    let trials = format!(
         "trials     expected {:.4} (worst slice {:.4}), measured {measured}; bound violations {}; grid evaluations {}",
         r.expected_mean_trials,
         r.worst_expected_mean_trials,
         r.bound_violations,
         r.grid_evaluations
     );
+    vec![structure, trials]
 }

@@ -25,6 +25,8 @@ pub(crate) struct BuildArgs {
 
 /// Runs `brdf-lab build`.
 pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
+    crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
     if !matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. }) {
         let sets: Vec<&str> = samplers::samplers()

@@ -73,6 +73,7 @@ fn adaptive_options(args: &EnvmapArgs, leaf: LeafChoiceName) -> AdaptiveOptions 
 
 /// Runs `brdf-lab envmap`.
 pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
+    crate::output::check_all([("--out", args.out.as_deref())])?;
     if !(args.n_max >= 1.0 && args.n_max.is_finite()) {
         return Err(CliError::input(format!(
             "--n-max must be a finite number ≥ 1, got {}",

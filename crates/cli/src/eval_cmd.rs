@@ -17,8 +17,14 @@ pub(crate) struct EvalArgs {
     /// Also report this sampler's pdf (w.r.t. solid angle), the same value `sample` reports.
     #[arg(long)]
     sampler: Option<String>,
+    /// Report the pdf of a set written by `build --out` (it stores the BRDF spec and the
+    /// sampler): --brdf is then optional and must match, and the set's own options apply.
+    #[arg(long = "set", value_name = "FILE", conflicts_with_all = brdf_args::SET_OPTION_IDS)]
+    set_file: Option<PathBuf>,
     /// CSV of incident directions `x,y,z` (one per row; a header row is allowed; more columns
-    /// are ignored, so `sample --out` files work as they are).
+    /// are ignored, so `sample --out` files work as they are). Each direction is normalised
+    /// once when read; the output's x,y,z columns are that unit vector, the one both f and the
+    /// pdf are evaluated at. A zero or non-finite direction is refused.
     #[arg(long)]
     dirs: PathBuf,
     /// Write `x,y,z,f[,pdf]` here (atomically) instead of standard output.
@@ -28,7 +34,8 @@ pub(crate) struct EvalArgs {
     set: SetArgs,
 }
 
-/// Reads the directions of a CSV file (exit 2 naming the bad line).
+/// Reads the directions of a CSV file, each normalised to a unit vector (exit 2 naming the bad
+/// line). The one rule for every sampler: f and every pdf see the same unit vector.
 fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
@@ -47,14 +54,23 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
         match parsed {
             Some(v) if v.len() == 3 => {
                 let d = Vec3::new(v[0], v[1], v[2]);
-                if !(d.iter().all(|c| c.is_finite()) && d.norm() > 0.0) {
+                // Rows already unit to rounding (e.g. `sample --out`) are kept bit for bit.
+                let unit = if (d.norm_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+                    d
+                } else {
+                    d / d.norm()
+                };
+                if !(d.iter().all(|c| c.is_finite())
+                    && d.norm() > 0.0
+                    && (unit.norm() - 1.0).abs() < 1e-12)
+                {
                     return Err(CliError::input(format!(
-                        "{}:{}: direction must be finite and non-zero",
+                        "{}:{}: direction must be finite, non-zero and normalisable",
                         path.display(),
                         i + 1
                     )));
                 }
-                dirs.push(d);
+                dirs.push(unit);
             }
             // A header row (first non-empty line that is not numeric) is skipped.
             _ if dirs.is_empty()
@@ -80,26 +96,38 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
 
 /// Runs `brdf-lab eval`.
 pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
+    crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
-    let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
     let dirs = read_directions(&args.dirs)?;
-    let built = match &args.sampler {
-        Some(name) => Some(brdf_args::build(
-            name,
-            &args.brdf.spec,
-            brdf.clone(),
-            &args.set.options(),
-        )?),
-        None => None,
+    let (brdf, built) = match &args.set_file {
+        Some(path) => {
+            let (_, brdf, set, _) =
+                brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?;
+            (brdf, Some(set))
+        }
+        None => {
+            let spec = brdf_args::required_spec(&args.brdf)?;
+            let brdf = brdf_args::parse_brdf(spec)?;
+            let built = match &args.sampler {
+                Some(name) => Some(brdf_args::build(
+                    name,
+                    spec,
+                    brdf.clone(),
+                    &args.set.options(),
+                )?),
+                None => None,
+            };
+            (brdf, built)
+        }
     };
     let rows: Vec<(Vec3, f64, Option<f64>)> = dirs
         .iter()
-        .map(|d| {
-            let wi = d.normalize();
-            let f = brdf.eval(&wo, &wi);
-            // The pdf at the direction exactly as given (unit rows from `sample` are unchanged).
-            let pdf = built.as_ref().map(|b| b.sampler().pdf(&wo, d));
-            (*d, f, pdf)
+        .map(|wi| {
+            // `wi` is unit (normalised when read): f and the pdf see the same vector.
+            let f = brdf.eval(&wo, wi);
+            let pdf = built.as_ref().map(|b| b.sampler().pdf(&wo, wi));
+            (*wi, f, pdf)
         })
         .collect();
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
@@ -126,11 +154,7 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
             write_atomically(path, write)?;
             eprintln!("wrote {} ({} rows)", path.display(), rows.len());
         }
-        None => {
-            let stdout = std::io::stdout();
-            let mut lock = stdout.lock();
-            write(&mut lock).map_err(CliError::input)?;
-        }
+        None => crate::output::write_stdout(write)?,
     }
     Ok(())
 }

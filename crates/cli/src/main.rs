@@ -18,7 +18,7 @@ use error::CliError;
 
 /// Importance sampling of reflectance functions: samplers, validation and studies.
 #[derive(Debug, Parser)]
-#[command(name = "brdf-lab", version, about, long_about = None)]
+#[command(name = "brdf-lab", version, about, long_about = None, arg_required_else_help = true)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -41,29 +41,10 @@ enum Command {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
-        Err(e) => {
-            use clap::error::ErrorKind;
-            match e.kind() {
-                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-                    let _ = e.print();
-                    std::process::exit(0);
-                }
-                _ => {
-                    // One line: clap's own message without the usage block.
-                    let text = e.to_string();
-                    let line = text
-                        .lines()
-                        .next()
-                        .unwrap_or("bad usage")
-                        .trim_start_matches("error: ");
-                    eprintln!("brdf-lab: error: {line} (see `brdf-lab --help`)");
-                    std::process::exit(2);
-                }
-            }
-        }
-    };
+    // Usage errors: clap's full message (missing arguments by name, possible values, "similar
+    // argument" tips, the usage line) on stderr, exit 2. No subcommand: the help on stderr,
+    // exit 2 (`arg_required_else_help`). `--help` / `--version`: stdout, exit 0.
+    let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::List => list_cmd::run(),
         Command::Sample(args) => sample_cmd::run(&args),

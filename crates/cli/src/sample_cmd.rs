@@ -1,4 +1,7 @@
 //! `brdf-lab sample`: draw incident directions for one BRDF and outgoing direction.
+//!
+//! The samples (CSV `x,y,z,pdf`) go to `--out` or to standard output; the summary always goes
+//! to standard error.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,16 +26,21 @@ const CHUNK: usize = 4096;
 pub(crate) struct SampleArgs {
     #[command(flatten)]
     brdf: BrdfArgs,
-    /// Sampler name (see `brdf-lab list`).
-    #[arg(long, default_value = "adaptive")]
-    sampler: String,
+    /// Sampler name (see `brdf-lab list`; default adaptive). With --set: the set's.
+    #[arg(long)]
+    sampler: Option<String>,
+    /// Sample a set written by `build --out` (it stores the BRDF spec and the sampler):
+    /// --brdf is then optional and must match, and the set's own options apply.
+    #[arg(long = "set", value_name = "FILE", conflicts_with_all = brdf_args::SET_OPTION_IDS)]
+    set_file: Option<PathBuf>,
     /// Number of samples.
     #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     n: u64,
     /// Seed of the random streams.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Write the samples as CSV `x,y,z,pdf` (pdf w.r.t. solid angle; written atomically).
+    /// Write the samples as CSV `x,y,z,pdf` (pdf w.r.t. solid angle) here, atomically, instead
+    /// of to standard output. The summary always goes to standard error.
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
@@ -41,22 +49,32 @@ pub(crate) struct SampleArgs {
 
 /// Runs `brdf-lab sample`.
 pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
+    crate::output::check_all([("--out", args.out.as_deref())])?;
+    args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
-    let brdf = brdf_args::parse_brdf(&args.brdf.spec)?;
-    let built = brdf_args::build(
-        &args.sampler,
-        &args.brdf.spec,
-        brdf.clone(),
-        &args.set.options(),
-    )?;
+    let (spec, brdf, built, name) = match &args.set_file {
+        Some(path) => {
+            brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?
+        }
+        None => {
+            let spec = brdf_args::required_spec(&args.brdf)?;
+            let brdf = brdf_args::parse_brdf(spec)?;
+            let name = args.sampler.as_deref().unwrap_or("adaptive");
+            let built = brdf_args::build(name, spec, brdf.clone(), &args.set.options())?;
+            (spec.to_string(), brdf, built, name)
+        }
+    };
     let sampler = built.sampler();
-    println!(
-        "brdf       {} at θo = {}°, φo = {}°",
-        args.brdf.spec, args.brdf.theta_o, args.brdf.phi_o
+    eprintln!(
+        "brdf       {spec} at θo = {}°, φo = {}°",
+        args.brdf.theta_o, args.brdf.phi_o
     );
-    println!(
+    if let Some(path) = &args.set_file {
+        eprintln!("set file   {}", path.display());
+    }
+    eprintln!(
         "sampler    {} ({} bytes)",
-        args.sampler.trim(),
+        name.trim(),
         sampler.bytes_used()
     );
 
@@ -76,13 +94,14 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         .collect();
     pb.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
-    println!(
+    eprintln!(
         "samples    {n} in {elapsed:.3} s ({:.2} M samples/s on {} threads)",
         n as f64 / elapsed / 1e6,
         rayon::current_num_threads()
     );
 
-    // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by quadrature.
+    // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by the adaptive
+    // reference quadrature (brdf_sampling::reference_albedo).
     let (mut sum, mut sum2) = (0.0, 0.0);
     for s in samples.iter().flatten() {
         let v = if s.pdf > 0.0 && s.wi.z > 0.0 {
@@ -95,26 +114,76 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     }
     let mean = sum / n as f64;
     let std_err = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-    let reference = brdf::directional_albedo(brdf.as_ref(), &wo, 64, 256);
-    println!("albedo     estimate {mean:.6} ± {std_err:.2e} (1σ); quadrature {reference:.6}");
-    brdf_args::print_set_report(&built);
+    // An adaptive set's pdf is normalised by a quadrature whose relative error it estimates:
+    // a systematic error of the estimate that no number of samples averages away.
+    let normalisation = match &built {
+        brdf_args::Built::Set(set) => set.report().max_integral_rel_err.map(|e| e * mean.abs()),
+        brdf_args::Built::Other(_) => None,
+    };
+    eprintln!(
+        "albedo     {}",
+        albedo_summary(brdf.as_ref(), &wo, mean, std_err, normalisation)
+    );
+    for line in brdf_args::set_report_lines(&built) {
+        eprintln!("{line}");
+    }
 
-    if let Some(path) = &args.out {
-        write_atomically(path, |w| {
-            writeln!(w, "x,y,z,pdf")?;
-            for s in samples.iter().flatten() {
-                writeln!(
-                    w,
-                    "{},{},{},{}",
-                    num(s.wi.x),
-                    num(s.wi.y),
-                    num(s.wi.z),
-                    num(s.pdf)
-                )?;
-            }
-            Ok(())
-        })?;
-        println!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
+    let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
+        writeln!(w, "x,y,z,pdf")?;
+        for s in samples.iter().flatten() {
+            writeln!(
+                w,
+                "{},{},{},{}",
+                num(s.wi.x),
+                num(s.wi.y),
+                num(s.wi.z),
+                num(s.pdf)
+            )?;
+        }
+        Ok(())
+    };
+    match &args.out {
+        Some(path) => {
+            write_atomically(path, write)?;
+            eprintln!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
+        }
+        None => crate::output::write_stdout(write)?,
     }
     Ok(())
+}
+
+/// `estimate X ± σ (1σ); reference Y ± e; agree …` for the estimate `mean ± std_err` of the
+/// directional albedo at `wo`. Agreement: within 3 combined σ, `√(σ² + e² + s²)` with `s` the
+/// sampler's estimated normalisation error (`normalisation`, absolute), when it has one.
+fn albedo_summary(
+    brdf: &dyn brdf::Brdf,
+    wo: &brdf::Vec3,
+    mean: f64,
+    std_err: f64,
+    normalisation: Option<f64>,
+) -> String {
+    let estimate = format!("estimate {mean:.6} ± {std_err:.2e} (1σ)");
+    match brdf_sampling::reference_albedo(brdf, wo) {
+        Ok(r) => {
+            let s = normalisation.unwrap_or(0.0);
+            // Rounding floor: a zero-variance estimate of an exact reference.
+            let sigma = std_err.hypot(r.abs_err).hypot(s).max(1e-12 * mean.abs());
+            let z = (mean - r.value).abs() / sigma;
+            let incl = if normalisation.is_some() {
+                format!(", σ includes the set's normalisation error {s:.1e}")
+            } else {
+                String::new()
+            };
+            let verdict = if z <= 3.0 {
+                format!("agree within 3 combined σ ({z:.2}σ apart{incl})")
+            } else {
+                format!("DISAGREE: {z:.1} combined σ apart (> 3σ{incl})")
+            };
+            format!(
+                "{estimate}; reference {:.6} ± {:.1e} (adaptive quadrature); {verdict}",
+                r.value, r.abs_err
+            )
+        }
+        Err(e) => format!("{estimate}; no reference ({e})"),
+    }
 }

@@ -42,11 +42,26 @@ pub(crate) struct ValidateArgs {
     /// Write a readable markdown report of every test.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// A set saved by `build --out` to validate (repeatable), with the BRDF of its stored spec
+    /// at the run's angles; without --sampler, only the sets are validated.
+    #[arg(long = "set", value_name = "FILE")]
+    sets: Vec<PathBuf>,
 }
 
 /// Runs `brdf-lab validate`: exit 0 when everything passed, 1 when a test failed (or a mutant
 /// escaped), 2 on bad input.
 pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
+    crate::output::check_all([
+        ("--json", args.json.as_deref()),
+        ("--report", args.report.as_deref()),
+    ])?;
+    // Warnings for the BRDFs the user named (a spec that does not parse is reported by the
+    // suite itself).
+    for spec in &args.brdfs {
+        if let Ok(b) = brdf::parse_spec(spec) {
+            crate::brdf_args::warn_if_implausible(spec, b.as_ref());
+        }
+    }
     let base = if args.quick {
         ValidateConfig::quick()
     } else {
@@ -73,6 +88,7 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
         quick: args.quick,
         mutants: args.mutants,
         alpha: args.alpha,
+        sets: args.sets.clone(),
         ..base
     };
     let pb = progress::bar(0, "validating");

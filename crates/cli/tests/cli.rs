@@ -29,6 +29,16 @@ fn assert_input_error(args: &[&str], needle: &str) {
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
 
+/// A usage error caught by clap: exit code 2 and clap's full message (several lines).
+fn assert_usage_error(args: &[&str], needle: &str) {
+    let o = brdf_lab(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    assert!(err.contains("--help"), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
 fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).expect("csv");
     let mut lines = text.lines();
@@ -63,7 +73,7 @@ fn bad_inputs_exit_2_with_one_line() {
         "map.hdr",
     );
     assert_input_error(&["envmap", "-n", "10", "--map", "map.png"], "map.png");
-    assert_input_error(&["envmap", "-n", "0"], "--samples");
+    assert_usage_error(&["envmap", "-n", "0"], "--samples");
     assert_input_error(&["envmap", "-n", "10", "--n-max", "0.5"], "--n-max");
     assert_input_error(&["envmap", "-n", "10", "--n-max", "NaN"], "--n-max");
     assert_input_error(
@@ -133,7 +143,8 @@ fn bad_inputs_exit_2_with_one_line() {
         "such.binary",
     );
     assert_input_error(&["validate", "--quick", "--sampler", "nope"], "nope");
-    assert_input_error(&["nosuchcommand"], "nosuchcommand");
+    // Usage errors carry clap's full (multi-line) message; see usage_errors_show_clap_s_….
+    assert_usage_error(&["nosuchcommand"], "nosuchcommand");
 }
 
 #[test]
@@ -290,4 +301,578 @@ fn validate_quick_case_passes_and_writes_the_json_schema() {
             .expect("md")
             .contains("| sampler |")
     );
+}
+
+#[test]
+fn eval_normalises_directions_once_for_f_and_every_pdf() {
+    // One direction given three ways: unit, shorter (norm 0.707) and longer (norm 1.414).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    let n = (0.5f64).sqrt();
+    std::fs::write(
+        &dirs,
+        format!(
+            "x,y,z\n{},{},{}\n0.3,0.4,0.5\n0.6,0.8,1.0\n",
+            0.3 / n,
+            0.4 / n,
+            0.5 / n
+        ),
+    )
+    .expect("write");
+    for sampler in ["adaptive", "adaptive-paper", "cosine", "uniform"] {
+        let out = dir.path().join(format!("{sampler}.csv"));
+        let o = brdf_lab(&[
+            "eval",
+            "--brdf",
+            "phong:n=50",
+            "--theta-o",
+            "45",
+            "--slices",
+            "9",
+            "--sampler",
+            sampler,
+            "--dirs",
+            dirs.to_str().expect("p"),
+            "--out",
+            out.to_str().expect("p"),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (header, rows) = read_csv(&out);
+        assert_eq!(header, "x,y,z,f,pdf");
+        assert_eq!(rows.len(), 3);
+        for r in &rows {
+            // The written direction is the unit vector that f and the pdf saw.
+            let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+            assert!((norm - 1.0).abs() < 1e-12, "{sampler}: {r:?}");
+            for k in 0..5 {
+                assert!(
+                    (r[k] - rows[0][k]).abs() <= 1e-12 * rows[0][k].abs().max(1e-300),
+                    "{sampler}: column {k}: {r:?} vs {:?}",
+                    rows[0]
+                );
+            }
+            assert!(r[4] > 0.0, "{sampler}: {r:?}");
+        }
+    }
+}
+
+/// The `albedo` summary line of `sample`: (estimate, σ, reference, reference error, agree).
+fn albedo_line(text: &str) -> (f64, f64, f64, f64, bool) {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("albedo"))
+        .unwrap_or_else(|| panic!("no albedo line in {text}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let after = |w: &str| -> f64 {
+        let i = words.iter().position(|x| *x == w).expect(w);
+        words[i + 1]
+            .trim_end_matches([';', ','])
+            .parse()
+            .expect(line)
+    };
+    let pm: Vec<f64> = words
+        .iter()
+        .enumerate()
+        .filter(|(_, w)| **w == "±")
+        .map(|(i, _)| {
+            words[i + 1]
+                .trim_end_matches([';', ','])
+                .parse()
+                .expect(line)
+        })
+        .collect();
+    (
+        after("estimate"),
+        pm[0],
+        after("reference"),
+        pm[1],
+        line.contains("agree"),
+    )
+}
+
+#[test]
+fn sample_compares_with_an_adaptive_reference_albedo() {
+    // Fixed 64 × 256 grids gave 0.8536 (true 0.920846) and 0.9639 (true 0.999847) here.
+    for (spec, theta, truth) in [
+        ("ggx:alpha=0.1", "89.5", 0.920_846_217),
+        ("ggx:alpha=0.01", "45", 0.999_846_808),
+    ] {
+        let o = brdf_lab(&[
+            "sample",
+            "--brdf",
+            spec,
+            "--theta-o",
+            theta,
+            "--slices",
+            "9",
+            "-n",
+            "20000",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+        let (estimate, sigma, reference, err, agree) = albedo_line(&text);
+        assert!((reference - truth).abs() < 1e-5, "{spec}: {text}");
+        assert!(err < 1e-4, "{spec}: {text}");
+        assert!(sigma > 0.0 && estimate > 0.0, "{text}");
+        assert!(agree, "{spec}: {text}");
+    }
+}
+
+#[test]
+fn usage_errors_show_clap_s_full_message() {
+    // Missing required arguments are named.
+    let o = brdf_lab(&["sample", "--brdf", "lambert"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("required arguments were not provided"),
+        "{err}"
+    );
+    assert!(
+        err.contains("--theta-o") && err.contains("--samples"),
+        "{err}"
+    );
+    assert!(err.contains("Usage:"), "{err}");
+    // Possible values and "similar argument" tips are kept.
+    let o = brdf_lab(&["envmap", "-n", "10", "--sampler", "adaptiv"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("possible values") && err.contains("tabulated-cdf"),
+        "{err}"
+    );
+    let o = brdf_lab(&["envmap", "-n", "10", "--compar"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--compare"), "{err}");
+    // No subcommand: the help on stderr, exit 2.
+    let o = brdf_lab(&[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(o.stdout.is_empty());
+    assert!(
+        err.contains("Usage:") && err.contains("sample") && err.contains("validate"),
+        "{err}"
+    );
+    // --help and --version still go to stdout with exit 0.
+    let o = brdf_lab(&["--help"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Usage:"));
+}
+
+#[test]
+fn output_paths_are_checked_before_any_work() {
+    // A prefix without `.tmp`: the internal temporary names must not leak into messages.
+    let dir = tempfile::Builder::new()
+        .prefix("brdf-lab-test")
+        .tempdir()
+        .expect("tempdir");
+    let missing = dir.path().join("no/such/dir/out.csv");
+    let missing = missing.to_str().expect("p");
+    let sample = [
+        "sample",
+        "--brdf",
+        "phong",
+        "--theta-o",
+        "30",
+        "-n",
+        "100",
+        "--slices",
+        "9",
+    ];
+    let one_line_before_work = |args: &[&str], needle: &str| {
+        let o = brdf_lab(args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+        assert!(!err.contains(".tmp"), "{args:?}: a temporary path: {err}");
+        assert!(
+            o.stdout.is_empty(),
+            "{args:?}: work was done: {}",
+            String::from_utf8_lossy(&o.stdout)
+        );
+    };
+    let with = |extra: &[&str]| -> Vec<String> {
+        sample.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |v: Vec<String>, needle: &str| {
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        one_line_before_work(&args, needle);
+    };
+    run(with(&["--out", missing]), "does not exist");
+    run(with(&["--out", "."]), "is a directory");
+    run(
+        with(&["--out", dir.path().to_str().expect("p")]),
+        "is a directory",
+    );
+    // eval: the output is checked before the directions are read.
+    one_line_before_work(
+        &[
+            "eval",
+            "--brdf",
+            "phong",
+            "--theta-o",
+            "30",
+            "--dirs",
+            "/no/such/dirs.csv",
+            "--out",
+            missing,
+        ],
+        "does not exist",
+    );
+    one_line_before_work(
+        &[
+            "build", "--brdf", "phong", "--slices", "9", "--out", missing,
+        ],
+        "does not exist",
+    );
+    one_line_before_work(
+        &["envmap", "-n", "1000", "--out", missing],
+        "does not exist",
+    );
+    // validate: neither output is written when the other cannot be.
+    let json = dir.path().join("v.json");
+    one_line_before_work(
+        &[
+            "validate",
+            "--quick",
+            "--sampler",
+            "cosine",
+            "--brdf",
+            "lambert",
+            "--theta-o",
+            "30",
+            "--json",
+            json.to_str().expect("p"),
+            "--report",
+            missing,
+        ],
+        "does not exist",
+    );
+    assert!(!json.exists());
+    let started = std::time::Instant::now();
+    one_line_before_work(&["validate", "--json", missing], "does not exist");
+    assert!(started.elapsed().as_secs_f64() < 10.0);
+}
+
+#[cfg(unix)]
+#[test]
+fn output_files_get_the_mode_of_a_normal_new_file() {
+    use std::os::unix::fs::PermissionsExt;
+    // The process umask, as the kernel reports it (Linux); 022 elsewhere.
+    let umask = std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
+        })
+        .unwrap_or(0o022);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("s.csv");
+    let o = brdf_lab(&["envmap", "-n", "100", "--out", out.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mode = std::fs::metadata(&out).expect("meta").permissions().mode() & 0o777;
+    assert_eq!(mode, 0o666 & !umask, "{mode:o}");
+}
+
+#[test]
+fn sample_writes_csv_to_stdout_and_the_summary_to_stderr() {
+    let args = [
+        "sample",
+        "--brdf",
+        "phong",
+        "--theta-o",
+        "30",
+        "-n",
+        "500",
+        "--slices",
+        "9",
+    ];
+    let o = brdf_lab(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let mut lines = out.lines();
+    assert_eq!(lines.next(), Some("x,y,z,pdf"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().expect(l)).collect())
+        .collect();
+    assert_eq!(rows.len(), 500);
+    assert!(rows.iter().all(|r| r.len() == 4 && r[3] > 0.0));
+    let err = stderr(&o);
+    assert!(err.contains("albedo") && err.contains("sampler"), "{err}");
+    // With --out: the same rows in the file, nothing on stdout, the summary on stderr.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("s.csv");
+    let mut with_out = args.to_vec();
+    with_out.extend(["--out", path.to_str().expect("p")]);
+    let o = brdf_lab(&with_out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert!(stderr(&o).contains("albedo") && stderr(&o).contains("wrote"));
+    assert_eq!(read_csv(&path).1, rows);
+}
+
+#[test]
+fn max_depth_says_which_grid_it_needs() {
+    let base = ["build", "--brdf", "lambert", "--slices", "1"];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |v: Vec<String>| {
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        brdf_lab(&args)
+    };
+    let o = run(with(&["--max-depth", "8"]));
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--grid 512"), "{err}");
+    let o = run(with(&["--max-depth", "8", "--grid", "512"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(with(&["--grid", "100"]));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--grid"), "{}", stderr(&o));
+    let o = brdf_lab(&["build", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        help.contains("--grid") && help.contains("2^(max_depth+1)"),
+        "{help}"
+    );
+}
+
+#[test]
+fn implausible_brdfs_are_warned_about_not_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    std::fs::write(&dirs, "0,0,1\n").expect("write");
+    let d = dirs.to_str().expect("p");
+    let cases: [&[&str]; 4] = [
+        &["sample", "--theta-o", "30", "-n", "100", "--slices", "3"],
+        &["eval", "--theta-o", "30", "--dirs", d],
+        &["build", "--slices", "3"],
+        &[
+            "validate",
+            "--quick",
+            "--sampler",
+            "cosine",
+            "--theta-o",
+            "30",
+            "--samples",
+            "20000",
+        ],
+    ];
+    for case in cases {
+        for (spec, warned) in [
+            ("phong:ks=0.9,kd=0.9", true),
+            ("phong:ks=0.7,kd=0.3", false),
+        ] {
+            let mut args = case.to_vec();
+            args.extend(["--brdf", spec]);
+            let o = brdf_lab(&args);
+            let err = stderr(&o);
+            assert!(o.status.code() != Some(2), "{args:?}: {err}");
+            let lines: Vec<&str> = err
+                .lines()
+                .filter(|l| l.starts_with("brdf-lab: warning:"))
+                .collect();
+            if warned {
+                assert_eq!(lines.len(), 1, "{args:?}: {err}");
+                assert!(
+                    lines[0].contains(spec) && lines[0].contains("1.800"),
+                    "{err}"
+                );
+            } else {
+                assert!(lines.is_empty(), "{args:?}: {err}");
+            }
+        }
+    }
+}
+
+#[test]
+fn long_runs_print_progress_lines_when_stderr_is_not_a_terminal() {
+    // The interval is 10 s by default; 0.05 s here so that a short build shows lines.
+    let o = Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .args(["build", "--brdf", "ggx:alpha=0.05"])
+        .env("BRDF_LAB_PROGRESS_SECS", "0.05")
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("building: "))
+        .collect();
+    assert!(!lines.is_empty(), "{err}");
+    for l in &lines {
+        assert!(
+            l.ends_with("s elapsed") && l.contains('/') && l.contains(" %)"),
+            "{l}"
+        );
+    }
+    // Stdout keeps only the report.
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("building:"));
+}
+
+#[test]
+fn sets_written_by_build_are_used_by_sample_and_eval() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |name: &str| dir.path().join(name).to_str().expect("p").to_string();
+    let (set, samples, evals) = (p("phong.set"), p("s.csv"), p("e.csv"));
+    let o = brdf_lab(&[
+        "build",
+        "--brdf",
+        "phong:n=50",
+        "--slices",
+        "9",
+        "--out",
+        &set,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let at = ["--theta-o", "37", "--phi-o", "20"];
+    let run = |args: &[&str]| {
+        let mut v = args.to_vec();
+        v.extend(at);
+        brdf_lab(&v)
+    };
+    let o = run(&["sample", "--set", &set, "-n", "2000", "--out", &samples]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("9 slices"), "{}", stderr(&o));
+    let o = run(&["eval", "--set", &set, "--dirs", &samples, "--out", &evals]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, s) = read_csv(Path::new(&samples));
+    let (h, e) = read_csv(Path::new(&evals));
+    assert_eq!(h, "x,y,z,f,pdf");
+    assert_eq!(s.len(), 2000);
+    for (a, b) in s.iter().zip(&e) {
+        assert!((a[3] - b[4]).abs() <= 1e-12 * a[3], "{a:?} vs {b:?}");
+    }
+    // --brdf may be given and must match; --sampler must be the set's; set options conflict.
+    let o = run(&["sample", "--set", &set, "--brdf", "phong:n=50", "-n", "10"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let usage = |args: &[&str], needle: &str| {
+        let o = run(args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    };
+    usage(
+        &["sample", "--set", &set, "--brdf", "phong:n=60", "-n", "10"],
+        "phong:n=50",
+    );
+    usage(
+        &["eval", "--set", &set, "--brdf", "ward", "--dirs", &samples],
+        "phong:n=50",
+    );
+    usage(
+        &["sample", "--set", &set, "--sampler", "cosine", "-n", "10"],
+        "adaptive",
+    );
+    usage(
+        &[
+            "eval",
+            "--set",
+            &set,
+            "--sampler",
+            "adaptive-paper",
+            "--dirs",
+            &samples,
+        ],
+        "adaptive",
+    );
+    usage(
+        &["sample", "--set", &set, "--slices", "3", "-n", "10"],
+        "--slices",
+    );
+    usage(&["sample", "-n", "10"], "--brdf");
+    usage(&["sample", "--set", "/no/such.set", "-n", "10"], "such.set");
+    usage(&["sample", "--set", &samples, "-n", "10"], "s.csv");
+}
+
+#[test]
+fn validate_checks_a_set_written_by_build() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let set = dir.path().join("ggx.set");
+    let set = set.to_str().expect("path");
+    let o = brdf_lab(&[
+        "build",
+        "--brdf",
+        "ggx:alpha=0.3",
+        "--slices",
+        "9",
+        "--out",
+        set,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = dir.path().join("v.json");
+    let o = brdf_lab(&[
+        "validate",
+        "--quick",
+        "--set",
+        set,
+        "--theta-o",
+        "40",
+        "--samples",
+        "20000",
+        "--json",
+        json.to_str().expect("path"),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+    let tests = v["tests"].as_array().expect("tests");
+    assert!(!tests.is_empty());
+    assert!(
+        tests
+            .iter()
+            .all(|t| t["sampler"] == "adaptive (set ggx.set)" && t["brdf"] == "ggx:alpha=0.3")
+    );
+    let o = brdf_lab(&["validate", "--quick", "--set", "/no/such.set"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("such.set"), "{}", stderr(&o));
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_follow_links_and_never_replace_special_files() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A symbolic link stays a link; its target receives the data (also when it is new).
+    let link = dir.path().join("link.csv");
+    let real = dir.path().join("real.csv");
+    std::os::unix::fs::symlink("real.csv", &link).expect("symlink");
+    let o = brdf_lab(&["envmap", "-n", "10", "--out", link.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .expect("link")
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(read_csv(&real).1.len(), 10);
+    // A FIFO (as `--out >(gzip > s.gz)` gives) is written in place, not replaced by a file.
+    let fifo = dir.path().join("fifo");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        return; // no mkfifo here
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    let reader = fifo.clone();
+    std::thread::spawn(move || {
+        let _ = tx.send(std::fs::read_to_string(&reader));
+    });
+    let o = brdf_lab(&["envmap", "-n", "10", "--out", fifo.to_str().expect("p")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the FIFO received nothing")
+        .expect("read");
+    assert_eq!(text.lines().count(), 11, "{text}");
+    let kind = std::fs::symlink_metadata(&fifo).expect("fifo").file_type();
+    assert!(kind.is_fifo());
 }
