@@ -37,7 +37,7 @@ pub(crate) struct EnvmapArgs {
     #[arg(long)]
     compare: bool,
     /// Environment-map sampler producing the samples (`brdf-lab list` shows them all).
-    #[arg(long, default_value = "envmap-adaptive")]
+    #[arg(long, default_value = "envmap-adaptive", value_parser = envmap_sampler_names())]
     sampler: String,
     /// Split threshold n_max ≥ 1 of the adaptive samplers (mean trials per sample ≤ n_max).
     #[arg(long, default_value_t = AdaptiveOptions::DEFAULT_N_MAX)]
@@ -57,6 +57,16 @@ enum LeafChoiceName {
     Alias,
     /// The papers' per-node CDF descent from the root.
     Descent,
+}
+
+/// The registry's environment-map samplers, as clap's possible values of `--sampler`.
+fn envmap_sampler_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        samplers::samplers()
+            .iter()
+            .filter(|e| e.constructor.kind() == "envmap")
+            .map(|e| clap::builder::PossibleValue::new(e.name).help(e.summary)),
+    )
 }
 
 /// The adaptive samplers' options from the command line (the registry entry sets the scheme).

@@ -438,7 +438,7 @@ fn usage_errors_show_clap_s_full_message() {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("possible values") && err.contains("tabulated-cdf"),
+        err.contains("possible values") && err.contains("envmap-cdf"),
         "{err}"
     );
     let o = brdf_lab(&["envmap", "-n", "10", "--compar"]);
