@@ -8,6 +8,7 @@ use brdf_sampling::{DirectionSampler, DiscMapPolicy, QuadTreeSet, SetOptions};
 use clap::Args;
 use partition_sampler::TreeParams;
 
+use crate::baseline_args::BaselineArgs;
 use crate::error::{CliError, CliResult};
 use crate::progress;
 
@@ -51,6 +52,9 @@ pub(crate) struct SetArgs {
     /// Outgoing polar angle (degrees) from which `--disc-map auto` uses the equal-area map.
     #[arg(long, default_value_t = SetOptions::DEFAULT_EQUAL_AREA_FROM_DEG)]
     pub(crate) equal_area_from: f64,
+    /// Options of the baseline samplers (ignored by the adaptive sets).
+    #[command(flatten)]
+    pub(crate) baselines: BaselineArgs,
 }
 
 fn parse_disc_map(s: &str) -> Result<DiscMapPolicy, String> {
@@ -221,14 +225,17 @@ pub(crate) fn build(
     name: &str,
     spec: &str,
     brdf: Arc<dyn Brdf>,
-    options: &SetOptions,
+    set: &SetArgs,
 ) -> CliResult<Built> {
+    let options = set.options();
+    let baselines = set.baselines.options()?;
     let pb = progress::bar(0, "building");
     let tick = |done: usize, total: usize| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     };
-    let request = samplers::DirectionRequest::new(brdf, options)
+    let request = samplers::DirectionRequest::new(brdf, &options)
+        .with_baselines(baselines)
         .with_spec(spec)
         .with_progress(&tick);
     let built = samplers::build_direction(name, &request)

@@ -41,7 +41,7 @@ pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
         )));
     }
     let brdf = brdf_args::parse_brdf(&args.spec)?;
-    let built = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set.options())?;
+    let built = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set)?;
     println!("brdf       {}", args.spec);
     brdf_args::print_set_report(&built);
     if let (Some(path), Built::Set(set)) = (&args.out, &built) {

@@ -110,12 +110,7 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
             let spec = brdf_args::required_spec(&args.brdf)?;
             let brdf = brdf_args::parse_brdf(spec)?;
             let built = match &args.sampler {
-                Some(name) => Some(brdf_args::build(
-                    name,
-                    spec,
-                    brdf.clone(),
-                    &args.set.options(),
-                )?),
+                Some(name) => Some(brdf_args::build(name, spec, brdf.clone(), &args.set)?),
                 None => None,
             };
             (brdf, built)

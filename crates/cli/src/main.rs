@@ -2,6 +2,7 @@
 //!
 //! Exit codes: 0 success (all tests passed), 1 a statistical test failed, 2 bad usage or input.
 
+mod baseline_args;
 mod brdf_args;
 mod build_cmd;
 mod envmap_cmd;

@@ -60,7 +60,7 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
             let spec = brdf_args::required_spec(&args.brdf)?;
             let brdf = brdf_args::parse_brdf(spec)?;
             let name = args.sampler.as_deref().unwrap_or("adaptive");
-            let built = brdf_args::build(name, spec, brdf.clone(), &args.set.options())?;
+            let built = brdf_args::build(name, spec, brdf.clone(), &args.set)?;
             (spec.to_string(), brdf, built, name)
         }
     };

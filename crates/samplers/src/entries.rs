@@ -94,6 +94,11 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             build: |_| Ok(BuiltDirection::plain(Arc::new(baselines::CosineHemisphere))),
         },
     },
+    // -- lobe baselines (lobe-sphere, lobe-hemisphere, analytic) --
+
+    // -- CDF baselines (tabulated-cdf, cascade-cdf) --
+
+    // -- factored baseline (Lawrence 2004) --
     SamplerEntry {
         name: "quadtree-disc",
         summary: "the generic partition sampler applied naively to f_r(ωo, h⁻¹(x)) on the disc for one ωo (512² image map, safety 1.25; no rim band, no equal-area slices)",

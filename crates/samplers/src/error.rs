@@ -65,4 +65,9 @@ pub enum RegistryError {
     /// A grid sampler could not be built.
     #[error(transparent)]
     Grid(#[from] partition_sampler::PiecewiseConstantError),
+    // -- lobe baselines' error --
+
+    // -- CDF baselines' error --
+
+    // -- factored baseline's error --
 }
