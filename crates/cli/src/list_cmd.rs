@@ -1,10 +1,19 @@
 //! `brdf-lab list`: the BRDF models with their parameters, and the samplers.
 
+use std::io::Write;
+
 use crate::error::CliResult;
 
-/// Runs `brdf-lab list`.
+/// Runs `brdf-lab list` (a closed pipe, as in `brdf-lab list | head`, ends it quietly).
 pub(crate) fn run() -> CliResult<()> {
-    println!("BRDF models (SPEC = name or name:key=value,...; also merl:PATH for MERL files)");
+    crate::output::write_stdout(|out| write_listing(out))
+}
+
+fn write_listing(out: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH for MERL files)"
+    )?;
     for m in brdf::models() {
         let iso = match m.isotropic {
             brdf::Isotropy::Always => "isotropic",
@@ -16,28 +25,35 @@ pub(crate) fn run() -> CliResult<()> {
         } else {
             format!(" (also: {})", m.aliases.join(", "))
         };
-        println!("\n  {}{aliases} — {iso}", m.name);
-        println!("      {}", m.summary);
+        writeln!(out, "\n  {}{aliases} — {iso}", m.name)?;
+        writeln!(out, "      {}", m.summary)?;
         for p in m.params {
-            println!(
+            writeln!(
+                out,
                 "      {:<10} default {:<10} range {:<16} {}",
                 p.key,
                 p.default.to_string(),
                 p.range.to_string(),
                 p.doc
-            );
+            )?;
         }
     }
-    println!("\nSamplers (--sampler NAME; direction samplers for sample/eval/build/validate,");
-    println!("disc and grid samplers for validate, envmap samplers for envmap/validate)");
+    writeln!(
+        out,
+        "\nSamplers (--sampler NAME; direction samplers for sample/eval/build/validate,"
+    )?;
+    writeln!(
+        out,
+        "disc and grid samplers for validate, envmap samplers for envmap/validate)"
+    )?;
     for kind in ["direction", "disc", "envmap", "grid"] {
-        println!("\n  {kind}");
+        writeln!(out, "\n  {kind}")?;
         for e in samplers::samplers()
             .iter()
             .filter(|e| e.constructor.kind() == kind)
         {
-            println!("    {:<24} {}", e.name, e.summary);
-            println!("    {:<24} [{}]", "", e.capabilities.flags());
+            writeln!(out, "    {:<24} {}", e.name, e.summary)?;
+            writeln!(out, "    {:<24} [{}]", "", e.capabilities.flags())?;
         }
     }
     Ok(())

@@ -876,3 +876,22 @@ fn outputs_follow_links_and_never_replace_special_files() {
     let kind = std::fs::symlink_metadata(&fifo).expect("fifo").file_type();
     assert!(kind.is_fifo());
 }
+
+#[test]
+fn list_into_a_closed_pipe_ends_quietly() {
+    // `brdf-lab list | head -1`: the reader has gone before the listing is written (the pipe
+    // is closed right after the spawn, long before the process has started up); the listing
+    // must stop without a panic and exit 0.
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .arg("list")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn brdf-lab");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+}
