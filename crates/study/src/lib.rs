@@ -38,9 +38,11 @@
 mod config;
 mod counting;
 mod error;
+mod groups;
 mod harness;
 mod light;
 mod reference;
+mod report;
 mod results;
 
 pub use config::{
@@ -49,7 +51,9 @@ pub use config::{
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use error::StudyError;
+pub use groups::{Group, groups, is_adaptive, short_light};
 pub use harness::{ProgressFn, StepCounter, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use reference::{Reference, reference};
+pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};

@@ -1,0 +1,209 @@
+//! `brdf-lab study`: variance-versus-cost studies of the direction samplers (crate `study`),
+//! and `brdf-lab study merge` of shards.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand};
+use study::{Shard, StudyConfig, StudyPlan, StudyResults};
+
+use crate::error::{CliError, CliResult};
+use crate::output::write_atomically;
+use crate::progress;
+
+/// Arguments of `brdf-lab study`.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub(crate) struct StudyArgs {
+    #[command(subcommand)]
+    merge: Option<StudySub>,
+    /// BRDF spec (repeatable); default: the quick study's BRDFs.
+    #[arg(long = "brdf")]
+    brdfs: Vec<String>,
+    /// Registered direction sampler (repeatable); default: every registered sampler of the
+    /// preferred list (uniform, cosine, the lobe/CDF/factored baselines, the adaptive ones).
+    #[arg(long = "sampler")]
+    samplers: Vec<String>,
+    /// Outgoing polar angle θo in degrees (repeatable); default 30 and 60.
+    #[arg(long = "theta-o")]
+    theta_o: Vec<f64>,
+    /// Light (repeatable): `sky` (default, built in), `envmap:PATH`,
+    /// `area[:theta=DEG,phi=DEG,radius=DEG,radiance=L]`, `constant[:radiance=L]`.
+    #[arg(long = "light")]
+    lights: Vec<String>,
+    /// The one-minute study: every registered preferred sampler on 4+ BRDFs under a real map
+    /// from ../shared/data/envmaps (the procedural sky when it is missing, said in the report).
+    #[arg(long, conflicts_with = "paper")]
+    quick: bool,
+    /// The papers' study (reduced size, stated in the report): sphere scene lights and BRDFs.
+    #[arg(long)]
+    paper: bool,
+    /// Sample counts N of the error curves, comma-separated, strictly increasing
+    /// (default 1,25,100,225,400,900,1600,2500).
+    #[arg(long, value_delimiter = ',')]
+    n_grid: Option<Vec<usize>>,
+    /// Independent estimates per N (≥ 2).
+    #[arg(long)]
+    repetitions: Option<usize>,
+    /// Seed of the study; cell i uses a stream seeded from (seed, i).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Run only every N-th cell, starting at the K-th (K/N, 1 ≤ K ≤ N); merge the shards'
+    /// directories with `brdf-lab study merge`.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Output directory (created if missing; checked before any work).
+    #[arg(long, default_value = "study-out")]
+    out: PathBuf,
+}
+
+/// `brdf-lab study merge`.
+#[derive(Debug, Subcommand)]
+enum StudySub {
+    /// Combine the output directories of shards (`study --shard K/N`) into one report.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `brdf-lab study merge`.
+#[derive(Debug, Args)]
+struct MergeArgs {
+    /// Shard output directories (each with a results.json).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output directory of the merged study.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs `brdf-lab study`.
+pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
+    if let Some(StudySub::Merge(m)) = &args.merge {
+        return merge(m);
+    }
+    let (mut config, notes) = if args.quick {
+        StudyConfig::quick(shared_root().as_deref())
+    } else if args.paper {
+        (StudyConfig::paper(), vec![
+            "--paper runs the sphere-scene estimator study at reduced size (2 BRDFs, 3 angles, the area light and the sky); the paper tables that need the factored baseline or MERL data are produced only for the samplers and data present".to_string(),
+        ])
+    } else {
+        let (q, _) = StudyConfig::quick(None);
+        let mut c = StudyConfig::new(q.samplers, q.brdfs, q.theta_o_deg, vec!["sky".into()]);
+        c.preset = "custom".into();
+        (c, Vec::new())
+    };
+    if !args.brdfs.is_empty() {
+        config.brdfs.clone_from(&args.brdfs);
+    }
+    if !args.samplers.is_empty() {
+        config.samplers.clone_from(&args.samplers);
+    }
+    if !args.theta_o.is_empty() {
+        config.theta_o_deg.clone_from(&args.theta_o);
+    }
+    if !args.lights.is_empty() {
+        config.lights.clone_from(&args.lights);
+    }
+    if let Some(g) = &args.n_grid {
+        config.n_grid.clone_from(g);
+    }
+    if let Some(r) = args.repetitions {
+        config.repetitions = r;
+    }
+    config.seed = args.seed;
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .map_err(CliError::input)?;
+    prepare_dir(&args.out)?;
+    let plan = StudyPlan::new(config, notes).map_err(CliError::input)?;
+    let bar = progress::bar(plan.steps(shard), "study");
+    let results = plan.run(shard, &|n| bar.inc(n));
+    bar.finish_and_clear();
+    write_outputs(&args.out, &results)?;
+    summary(&args.out, &results);
+    Ok(())
+}
+
+/// `brdf-lab study merge DIR… --out DIR`.
+fn merge(args: &MergeArgs) -> CliResult<()> {
+    prepare_dir(&args.out)?;
+    let parts = args
+        .dirs
+        .iter()
+        .map(|d| {
+            let path = d.join("results.json");
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| CliError::input(format!("cannot read {}: {e}", path.display())))?;
+            StudyResults::from_json(&text, &path.display().to_string()).map_err(CliError::input)
+        })
+        .collect::<CliResult<Vec<_>>>()?;
+    let merged = StudyResults::merge(parts).map_err(CliError::input)?;
+    write_outputs(&args.out, &merged)?;
+    summary(&args.out, &merged);
+    Ok(())
+}
+
+/// The directory holding `../shared` for the quick study's data: the current directory when
+/// `../shared` is beside it, else the repository this binary was built from.
+fn shared_root() -> Option<PathBuf> {
+    let candidates = [
+        std::env::current_dir().ok(),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")),
+    ];
+    candidates
+        .into_iter()
+        .flatten()
+        .find(|d| d.join("../shared").is_dir())
+}
+
+/// Creates the output directory if needed and checks that files can be created in it, before
+/// any work (exit 2, one line, otherwise).
+fn prepare_dir(dir: &Path) -> CliResult<()> {
+    let fail = |why: String| CliError::input(format!("--out {}: {why}", dir.display()));
+    if dir.exists() && !dir.is_dir() {
+        return Err(fail("exists and is not a directory".into()));
+    }
+    for sub in [dir.to_path_buf(), dir.join("plots"), dir.join("images")] {
+        std::fs::create_dir_all(&sub)
+            .map_err(|e| fail(format!("cannot create {}: {e}", sub.display())))?;
+    }
+    tempfile::NamedTempFile::new_in(dir)
+        .map(drop)
+        .map_err(|e| fail(format!("cannot create files: {e}")))
+}
+
+/// Writes `results.json`, `results.csv` and `report.md` into `dir` (atomically each).
+fn write_outputs(dir: &Path, results: &StudyResults) -> CliResult<()> {
+    let assets = study::ReportAssets::default();
+    write_text(&dir.join("results.json"), &results.to_json())?;
+    write_text(&dir.join("results.csv"), &results.to_csv())?;
+    write_text(
+        &dir.join("report.md"),
+        &study::report_markdown(results, &assets),
+    )
+}
+
+fn write_text(path: &Path, text: &str) -> CliResult<()> {
+    write_atomically(path, |w| w.write_all(text.as_bytes()))
+}
+
+/// The one-line summary on stderr.
+fn summary(dir: &Path, results: &StudyResults) {
+    let failed = results.cells.iter().filter(|c| !c.ok()).count();
+    eprintln!(
+        "study: {} cells{}{} → {}",
+        results.cells.len(),
+        results.shard.map_or(String::new(), |s| format!(
+            " (shard {}/{})",
+            s.index, s.count
+        )),
+        if failed > 0 {
+            format!(", {failed} could not run (see the report)")
+        } else {
+            String::new()
+        },
+        dir.join("report.md").display()
+    );
+}
