@@ -174,9 +174,16 @@ fn prepare_dir(dir: &Path) -> CliResult<()> {
         .map_err(|e| fail(format!("cannot create files: {e}")))
 }
 
-/// Writes `results.json`, `results.csv` and `report.md` into `dir` (atomically each).
+/// Writes `results.json`, `results.csv`, the plots (`plots/*.png`, `plots/*.svg`) and
+/// `report.md` into `dir` (atomically each).
 fn write_outputs(dir: &Path, results: &StudyResults) -> CliResult<()> {
-    let assets = study::ReportAssets::default();
+    let mut assets = study::ReportAssets::default();
+    for p in study::study_plots(results).map_err(CliError::input)? {
+        let png = format!("plots/{}.png", p.stem);
+        write_atomically(&dir.join(&png), |w| w.write_all(&p.png))?;
+        write_text(&dir.join(format!("plots/{}.svg", p.stem)), &p.svg)?;
+        assets.plots.push((p.slug, p.caption, png));
+    }
     write_text(&dir.join("results.json"), &results.to_json())?;
     write_text(&dir.join("results.csv"), &results.to_csv())?;
     write_text(
