@@ -570,6 +570,65 @@ impl StepCounter {
 mod tests {
     use super::*;
 
+    /// A sampler reporting a wrong pdf (the cosine warp with its pdf scaled by 1.25).
+    struct BrokenCosine;
+
+    impl DirectionSampler for BrokenCosine {
+        fn sample(&self, wo: &Vec3, u: &mut dyn partition_sampler::UniformSource) -> DirSample {
+            let s = baselines_cosine().sample(wo, u);
+            DirSample {
+                pdf: 1.25 * s.pdf,
+                ..s
+            }
+        }
+        fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            1.25 * baselines_cosine().pdf(wo, wi)
+        }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+    }
+
+    fn baselines_cosine() -> std::sync::Arc<dyn DirectionSampler> {
+        samplers::build_direction(
+            "cosine",
+            &DirectionRequest::new(
+                Arc::from(brdf::parse_spec("lambert").unwrap()),
+                &SetOptions::default(),
+            ),
+        )
+        .unwrap()
+        .sampler
+    }
+
+    /// z-score of the estimator's mean over `n` samples against the reference.
+    fn z_score(sampler: &dyn DirectionSampler, n: usize) -> f64 {
+        let brdf = brdf::parse_spec("phong:n=10").unwrap();
+        let light = Light::parse("area:theta=20,phi=180,radius=15").unwrap();
+        let wo = brdf::direction_from_angles(20.0, 0.0);
+        let reference = crate::reference(brdf.as_ref(), &wo, &light).value;
+        let est = Estimator {
+            brdf: brdf.as_ref(),
+            light: &light,
+            sampler,
+            mode: Mode::OneSample,
+            wo,
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let samples = est.draw(n, &mut rng, &mut EvalCounter::default());
+        let ys: Vec<f64> = samples.iter().map(|s| est.value(s)).collect();
+        let (mean, var) = mean_var(&ys);
+        (mean - reference) / (var / n as f64).sqrt()
+    }
+
+    #[test]
+    fn the_estimator_is_unbiased_and_a_wrong_pdf_is_caught() {
+        let good = z_score(baselines_cosine().as_ref(), 200_000);
+        assert!(good.abs() < 4.0, "z = {good}");
+        let broken = z_score(&BrokenCosine, 200_000);
+        assert!(broken.abs() > 10.0, "z = {broken}");
+    }
+
     #[test]
     fn median_and_variance() {
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
