@@ -51,6 +51,12 @@ pub(crate) struct StudyArgs {
     /// directories with `brdf-lab study merge`.
     #[arg(long)]
     shard: Option<String>,
+    /// Skip the sphere images (always skipped for a shard; `study merge` renders them).
+    #[arg(long)]
+    no_images: bool,
+    /// Samples per pixel of the equal-samples sphere images.
+    #[arg(long, default_value_t = 64)]
+    spp: usize,
     /// Output directory (created if missing; checked before any work).
     #[arg(long, default_value = "study-out")]
     out: PathBuf,
@@ -72,6 +78,12 @@ struct MergeArgs {
     /// Output directory of the merged study.
     #[arg(long)]
     out: PathBuf,
+    /// Skip the sphere images.
+    #[arg(long)]
+    no_images: bool,
+    /// Samples per pixel of the equal-samples sphere images.
+    #[arg(long, default_value_t = 64)]
+    spp: usize,
 }
 
 /// Runs `brdf-lab study`.
@@ -116,12 +128,29 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         .map(Shard::parse)
         .transpose()
         .map_err(CliError::input)?;
-    prepare_dir(&args.out)?;
     let plan = StudyPlan::new(config, notes).map_err(CliError::input)?;
-    let bar = progress::bar(plan.steps(shard), "study");
+    prepare_dir(&args.out)?;
+    let images = !args.no_images && shard.is_none();
+    let render_steps = if images {
+        1 + 2 * plan.config().samplers.len() as u64
+    } else {
+        0
+    };
+    let bar = progress::bar(plan.steps(shard) + render_steps, "study");
     let results = plan.run(shard, &|n| bar.inc(n));
+    let render = images
+        .then(|| {
+            let cfg = study::RenderConfig {
+                spp: args.spp.max(1),
+                seed: args.seed,
+                ..study::RenderConfig::default()
+            };
+            plan.render(&cfg, &|n| bar.inc(n))
+        })
+        .transpose()
+        .map_err(CliError::input)?;
     bar.finish_and_clear();
-    write_outputs(&args.out, &results)?;
+    write_outputs(&args.out, &results, render.as_ref())?;
     summary(&args.out, &results);
     Ok(())
 }
@@ -140,7 +169,24 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
         })
         .collect::<CliResult<Vec<_>>>()?;
     let merged = StudyResults::merge(parts).map_err(CliError::input)?;
-    write_outputs(&args.out, &merged)?;
+    let render = if args.no_images {
+        None
+    } else {
+        let plan =
+            StudyPlan::new(merged.config.clone(), merged.notes.clone()).map_err(CliError::input)?;
+        let cfg = study::RenderConfig {
+            spp: args.spp.max(1),
+            seed: merged.config.seed,
+            ..study::RenderConfig::default()
+        };
+        let bar = progress::bar(1 + 2 * plan.config().samplers.len() as u64, "images");
+        let r = plan
+            .render(&cfg, &|n| bar.inc(n))
+            .map_err(CliError::input)?;
+        bar.finish_and_clear();
+        Some(r)
+    };
+    write_outputs(&args.out, &merged, render.as_ref())?;
     summary(&args.out, &merged);
     Ok(())
 }
@@ -176,8 +222,15 @@ fn prepare_dir(dir: &Path) -> CliResult<()> {
 
 /// Writes `results.json`, `results.csv`, the plots (`plots/*.png`, `plots/*.svg`) and
 /// `report.md` into `dir` (atomically each).
-fn write_outputs(dir: &Path, results: &StudyResults) -> CliResult<()> {
+fn write_outputs(
+    dir: &Path,
+    results: &StudyResults,
+    render: Option<&study::Render>,
+) -> CliResult<()> {
     let mut assets = study::ReportAssets::default();
+    if let Some(r) = render {
+        assets.sections.push(write_images(dir, r)?);
+    }
     for p in study::study_plots(results).map_err(CliError::input)? {
         let png = format!("plots/{}.png", p.stem);
         write_atomically(&dir.join(&png), |w| w.write_all(&p.png))?;
@@ -190,6 +243,50 @@ fn write_outputs(dir: &Path, results: &StudyResults) -> CliResult<()> {
         &dir.join("report.md"),
         &study::report_markdown(results, &assets),
     )
+}
+
+/// Writes every sphere image (PNG tone-mapped with the reference's exposure, PFM raw) and the
+/// two contact sheets; returns the report's section.
+fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
+    let exposure = study::Image::exposure_of(&r.reference);
+    let png = |img: &study::Image| img.png(exposure).map_err(CliError::input);
+    let stem = |img: &study::Image| format!("{}-{}", img.sampler, img.kind.replace(' ', "-"));
+    for img in std::iter::once(&r.reference).chain(&r.images) {
+        let name = if img.kind == "reference" {
+            "reference".to_string()
+        } else {
+            stem(img)
+        };
+        let bytes = png(img)?;
+        write_atomically(&dir.join(format!("images/{name}.png")), |w| {
+            w.write_all(&bytes)
+        })?;
+        let raw = img.pfm();
+        write_atomically(&dir.join(format!("images/{name}.pfm")), |w| {
+            w.write_all(&raw)
+        })?;
+    }
+    let mut sheets = Vec::new();
+    for kind in ["equal samples", "equal time"] {
+        let rows: Vec<image::RgbImage> = std::iter::once(&r.reference)
+            .chain(r.images.iter().filter(|i| i.kind == kind))
+            .map(|i| i.to_rgb8(exposure))
+            .collect();
+        let order: Vec<String> = r
+            .images
+            .iter()
+            .filter(|i| i.kind == kind)
+            .map(|i| format!("{} ({} spp)", i.sampler, i.spp))
+            .collect();
+        let file = format!("images/spheres-{}.png", kind.replace(' ', "-"));
+        let bytes = study::encode_png(&study::stack(&rows), &file).map_err(CliError::input)?;
+        write_atomically(&dir.join(&file), |w| w.write_all(&bytes))?;
+        sheets.push((
+            format!("{kind}, top to bottom: reference, {}", order.join(", ")),
+            file,
+        ));
+    }
+    Ok(r.markdown(&sheets))
 }
 
 fn write_text(path: &Path, text: &str) -> CliResult<()> {

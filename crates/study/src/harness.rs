@@ -16,8 +16,8 @@
 //! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use brdf::{Brdf, Vec3};
@@ -42,14 +42,14 @@ pub type ProgressFn<'a> = &'a (dyn Fn(u64) + Sync);
 
 /// A BRDF of the study: as parsed (for the estimator and references) and wrapped in a
 /// counter (for the samplers).
-struct StudyBrdf {
-    spec: String,
-    raw: Arc<dyn Brdf>,
+pub(crate) struct StudyBrdf {
+    pub(crate) spec: String,
+    pub(crate) raw: Arc<dyn Brdf>,
     counted: Arc<dyn Brdf>,
 }
 
 /// A built sampler and its build time (s), or why it could not be built.
-type BuildOutcome = Result<(samplers::BuiltDirection, f64), String>;
+pub(crate) type BuildOutcome = Result<(samplers::BuiltDirection, f64), String>;
 
 /// A cell with its indices into the plan.
 #[derive(Debug, Clone)]
@@ -63,12 +63,14 @@ struct PlanCell {
 
 /// A study whose names are all resolved: ready to run (whole or by shard).
 pub struct StudyPlan {
-    config: StudyConfig,
+    pub(crate) config: StudyConfig,
     notes: Vec<String>,
-    entries: Vec<&'static SamplerEntry>,
-    brdfs: Vec<StudyBrdf>,
-    lights: Vec<Arc<Light>>,
+    pub(crate) entries: Vec<&'static SamplerEntry>,
+    pub(crate) brdfs: Vec<StudyBrdf>,
+    pub(crate) lights: Vec<Arc<Light>>,
     cells: Vec<PlanCell>,
+    /// Samplers built so far, by `(sampler, BRDF)` index (the renderer reuses them).
+    built: Mutex<Vec<((usize, usize), BuildOutcome)>>,
 }
 
 impl std::fmt::Debug for StudyPlan {
@@ -161,7 +163,36 @@ impl StudyPlan {
             brdfs,
             lights,
             cells,
+            built: Mutex::new(Vec::new()),
         })
+    }
+
+    /// The sampler `s` built for BRDF `b` (cached), with its build time.
+    pub(crate) fn build(&self, s: usize, b: usize) -> BuildOutcome {
+        let cached = self
+            .built
+            .lock()
+            .ok()
+            .and_then(|v| v.iter().find(|(k, _)| *k == (s, b)).map(|(_, r)| r.clone()));
+        if let Some(r) = cached {
+            return r;
+        }
+        let options = SetOptions {
+            slices: self.config.slices,
+            ..SetOptions::default()
+        };
+        let brdf = &self.brdfs[b];
+        let request =
+            DirectionRequest::new(Arc::clone(&brdf.counted), &options).with_spec(&brdf.spec);
+        let start = Instant::now();
+        let r = self.entries[s]
+            .build_direction(&request)
+            .map(|d| (d, start.elapsed().as_secs_f64()))
+            .map_err(|e| format!("cannot build: {e}"));
+        if let Ok(mut v) = self.built.lock() {
+            v.push(((s, b), r.clone()));
+        }
+        r
     }
 
     /// The study's config.
@@ -210,23 +241,12 @@ impl StudyPlan {
     /// Runs the cells of `shard` (all when `None`); see the module docs.
     pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
         let cells = self.selected(shard);
-        let options = SetOptions {
-            slices: self.config.slices,
-            ..SetOptions::default()
-        };
         // Builds: one at a time, so build times are not inflated by each other.
         let built: Vec<((usize, usize), BuildOutcome)> = self
             .builds(&cells)
             .into_iter()
             .map(|(s, b)| {
-                let brdf = &self.brdfs[b];
-                let request = DirectionRequest::new(Arc::clone(&brdf.counted), &options)
-                    .with_spec(&brdf.spec);
-                let start = Instant::now();
-                let r = self.entries[s]
-                    .build_direction(&request)
-                    .map(|d| (d, start.elapsed().as_secs_f64()))
-                    .map_err(|e| format!("cannot build: {e}"));
+                let r = self.build(s, b);
                 progress(1);
                 ((s, b), r)
             })

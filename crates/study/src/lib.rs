@@ -43,6 +43,7 @@ mod harness;
 mod light;
 mod plot;
 mod reference;
+mod render;
 mod report;
 mod results;
 
@@ -57,5 +58,6 @@ pub use harness::{ProgressFn, StepCounter, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use plot::{Figure, PLOT_SIZE, PlotFile, Series, group_figures, study_plots};
 pub use reference::{Reference, reference};
+pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
 pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
