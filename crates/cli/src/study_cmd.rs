@@ -136,7 +136,8 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     } else {
         0
     };
-    let bar = progress::bar(plan.steps(shard) + render_steps, "study");
+    let table_steps = if args.paper && shard.is_none() { 4 } else { 0 };
+    let bar = progress::bar(plan.steps(shard) + render_steps + table_steps, "study");
     let results = plan.run(shard, &|n| bar.inc(n));
     let render = images
         .then(|| {
@@ -149,8 +150,13 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         })
         .transpose()
         .map_err(CliError::input)?;
+    let tables = if args.paper && shard.is_none() {
+        Some(study::paper_tables(&|n| bar.inc(n)).map_err(CliError::input)?)
+    } else {
+        None
+    };
     bar.finish_and_clear();
-    write_outputs(&args.out, &results, render.as_ref())?;
+    write_outputs(&args.out, &results, render.as_ref(), tables.as_deref())?;
     summary(&args.out, &results);
     Ok(())
 }
@@ -186,7 +192,7 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
         bar.finish_and_clear();
         Some(r)
     };
-    write_outputs(&args.out, &merged, render.as_ref())?;
+    write_outputs(&args.out, &merged, render.as_ref(), None)?;
     summary(&args.out, &merged);
     Ok(())
 }
@@ -226,10 +232,14 @@ fn write_outputs(
     dir: &Path,
     results: &StudyResults,
     render: Option<&study::Render>,
+    tables: Option<&[study::PaperTable]>,
 ) -> CliResult<()> {
     let mut assets = study::ReportAssets::default();
     if let Some(r) = render {
         assets.sections.push(write_images(dir, r)?);
+    }
+    if let Some(t) = tables {
+        assets.sections.push(study::paper_markdown(t));
     }
     for p in study::study_plots(results).map_err(CliError::input)? {
         let png = format!("plots/{}.png", p.stem);

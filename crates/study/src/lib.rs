@@ -41,6 +41,7 @@ mod error;
 mod groups;
 mod harness;
 mod light;
+mod paper;
 mod plot;
 mod reference;
 mod render;
@@ -56,6 +57,10 @@ pub use error::StudyError;
 pub use groups::{Group, groups, is_adaptive, short_light};
 pub use harness::{ProgressFn, StepCounter, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
+pub use paper::{
+    MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
+    paper_tables,
+};
 pub use plot::{Figure, PLOT_SIZE, PlotFile, Series, group_figures, study_plots};
 pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};

@@ -182,6 +182,7 @@ impl Light {
                 radiance,
             } => {
                 let (t, p) = brdf::angles_of(axis);
+                let (t, p) = (t.to_degrees(), p.to_degrees());
                 format!(
                     "disc light of angular radius {:.1}° centred at θ = {:.1}°, φ = {:.1}°, radiance {radiance}",
                     radius.to_degrees(),
