@@ -117,10 +117,7 @@ fn outcome(s: &mut String, results: &StudyResults) {
         };
         let best_adaptive = ranked.iter().find(|(c, _)| is_adaptive(&c.sampler));
         match best_adaptive {
-            Some((a, _)) if is_adaptive(&best.sampler) => {
-                wins += 1;
-                let _ = a;
-            }
+            Some(_) if is_adaptive(&best.sampler) => wins += 1,
             Some((a, eff)) => losses.push(format!(
                 "* {}: **{}** is the most efficient; the best adaptive sampler, {}, is {:.2}× less efficient (relative error at N = {}: {} vs {}).",
                 g.title(),
