@@ -70,7 +70,12 @@ fn a_study_writes_its_outputs_and_shards_merge_to_the_same_numbers() {
         assert!(whole.join(f).is_file(), "{f} missing");
     }
     let report = std::fs::read_to_string(whole.join("report.md")).expect("report");
-    for needle in ["## Outcome", "†", "plots/l0-b0-t30-error-vs-time.png", "## Sphere images"] {
+    for needle in [
+        "## Outcome",
+        "†",
+        "plots/l0-b0-t30-error-vs-time.png",
+        "## Sphere images",
+    ] {
         assert!(report.contains(needle), "report lacks {needle}");
     }
     let shards: Vec<_> = (1..=3).map(|k| dir.path().join(format!("s{k}"))).collect();
@@ -106,7 +111,10 @@ fn bad_input_exits_2_with_one_line_before_any_work() {
         (vec!["--sampler", "envmap-cdf"], "not a direction sampler"),
         (vec!["--brdf", "nope"], "unknown BRDF model"),
         (vec!["--light", "moon"], "unknown light `moon`"),
-        (vec!["--light", "envmap:/nonexistent.hdr"], "--light envmap:/nonexistent.hdr"),
+        (
+            vec!["--light", "envmap:/nonexistent.hdr"],
+            "--light envmap:/nonexistent.hdr",
+        ),
         (vec!["--n-grid", "4,2"], "strictly increasing"),
         (vec!["--theta-o", "95"], "not in [0°, 90°)"),
         (vec!["--shard", "4/3"], "--shard 4/3"),
