@@ -189,7 +189,7 @@ fn table1() -> Result<PaperTable, StudyError> {
     Ok(PaperTable {
         title: "Seed 003 Table 1 — sphere, relative error at 50² samples per pixel".into(),
         setup: format!(
-            "Reduced: one {px}×{px}-pixel sphere of `phong:n=50,ks=0.7,kd=0.3` under the default area light ({}), instead of the paper's full image; reference: {}.",
+            "Reduced: one {px}×{px}-pixel sphere of `phong:n=50,ks=0.7,kd=0.3` under the default area light ({}), instead of the paper's full image; reference: {}. The papers' measure weighs every lit pixel equally, including pixels lit only through the diffuse term, where a sampler that follows the glossy lobe rarely finds a 5° light.",
             crate::Light::parse("area")?.describe(),
             r.reference_method,
             px = PAPER_SPHERE_PX
