@@ -16,7 +16,6 @@
 //! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -568,22 +567,6 @@ fn median(x: &mut [f64]) -> f64 {
 /// Non-finite values (a zero reference) are stored as `f64::MAX` so JSON stays valid.
 fn finite(x: f64) -> f64 {
     if x.is_finite() { x } else { f64::MAX }
-}
-
-/// Progress steps counted atomically (a helper for callers that want a total).
-#[derive(Debug, Default)]
-pub struct StepCounter(AtomicU64);
-
-impl StepCounter {
-    /// Adds `n` steps.
-    pub fn add(&self, n: u64) {
-        self.0.fetch_add(n, Ordering::Relaxed);
-    }
-
-    /// Steps so far.
-    pub fn get(&self) -> u64 {
-        self.0.load(Ordering::Relaxed)
-    }
 }
 
 #[cfg(test)]

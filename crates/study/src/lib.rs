@@ -55,7 +55,7 @@ pub use config::{
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use error::StudyError;
 pub use groups::{Group, groups, is_adaptive, short_light};
-pub use harness::{ProgressFn, StepCounter, StudyPlan};
+pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use paper::{
     MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
