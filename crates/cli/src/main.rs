@@ -12,6 +12,7 @@ mod list_cmd;
 mod output;
 mod progress;
 mod sample_cmd;
+mod study_cmd;
 mod validate_cmd;
 
 use clap::{Parser, Subcommand};
@@ -39,6 +40,8 @@ enum Command {
     Validate(validate_cmd::ValidateArgs),
     /// Sample an environment map (directions ∝ luminance per solid angle) and print a summary.
     Envmap(envmap_cmd::EnvmapArgs),
+    /// Variance-versus-cost study of the direction samplers (report, CSV, JSON, plots); `study merge` combines shards.
+    Study(study_cmd::StudyArgs),
 }
 
 fn main() {
@@ -53,6 +56,7 @@ fn main() {
         Command::Build(args) => build_cmd::run(&args),
         Command::Validate(args) => validate_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
+        Command::Study(args) => study_cmd::run(&args),
     };
     if let Err(e) = result {
         report_and_exit(&e);

@@ -1,0 +1,71 @@
+//! A BRDF wrapper that counts evaluations on the calling thread.
+
+use std::cell::Cell;
+use std::sync::Arc;
+
+use brdf::{Brdf, Vec3};
+
+thread_local! {
+    static EVALUATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Evaluations of every [`CountingBrdf`] made so far on the calling thread.
+pub fn thread_evaluations() -> u64 {
+    EVALUATIONS.with(Cell::get)
+}
+
+/// Forwards everything to the wrapped BRDF and counts each `eval` / `eval_rgb` call in a
+/// thread-local counter ([`thread_evaluations`]). Samplers are built on it, so the study
+/// counts the BRDF evaluations a sampler makes per sample whatever the sampler is.
+pub struct CountingBrdf(pub Arc<dyn Brdf>);
+
+impl Brdf for CountingBrdf {
+    #[inline]
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval(wo, wi)
+    }
+    #[inline]
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval_rgb(wo, wi)
+    }
+    fn is_isotropic(&self) -> bool {
+        self.0.is_isotropic()
+    }
+    fn is_mirror_symmetric(&self) -> bool {
+        self.0.is_mirror_symmetric()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        self.0.is_half_turn_symmetric()
+    }
+    fn is_reciprocal(&self) -> bool {
+        self.0.is_reciprocal()
+    }
+    fn conserves_energy(&self) -> bool {
+        self.0.conserves_energy()
+    }
+    fn bounded_at_horizon(&self) -> bool {
+        self.0.bounded_at_horizon()
+    }
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_each_evaluation_on_this_thread() {
+        let b = CountingBrdf(Arc::from(brdf::parse_spec("lambert").unwrap()));
+        let wo = brdf::direction_from_angles(10.0, 0.0);
+        let before = thread_evaluations();
+        let _ = b.eval(&wo, &wo);
+        let _ = b.eval_rgb(&wo, &wo);
+        assert_eq!(thread_evaluations() - before, 2);
+        let other = std::thread::spawn(thread_evaluations).join().unwrap();
+        assert_eq!(other, 0);
+    }
+}

@@ -1,0 +1,643 @@
+//! The estimator harness: resolves a [`StudyConfig`] into a plan (every name checked before
+//! any work), builds each `(sampler, BRDF)` once, computes each reference once, and runs the
+//! cells.
+//!
+//! For a cell (sampler, mode, BRDF, θo, light) with `ωo = (sin θo, 0, cos θo)`:
+//! * the estimator of `L_r(ωo)` is `(1/N) Σ Y(f_r(ωo, ωk) ⊙ L(ωk)) cos θk / p_σ(ωk)` with the
+//!   sampler's solid-angle pdf; samples below the horizon (or with pdf 0) contribute 0;
+//! * relative errors: `repetitions` independent estimates at every N of the grid;
+//! * per-sample variance: `variance_samples` one-sample values (one-sample mode), or
+//!   `N · Var(L̂_N)` at the largest N (batch mode, whose samples are not independent);
+//! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
+//! * timings: after the statistics, cell by cell on the calling thread with nothing else
+//!   running, median of `timing_repeats` runs of `timing_samples` samples.
+//!
+//! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
+//! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
+//! depend on the thread count or on which shard runs it.
+
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use brdf::{Brdf, Vec3};
+use brdf_sampling::{DirSample, DirectionSampler, SetOptions};
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use samplers::{DirectionRequest, SamplerEntry};
+
+use crate::counting::{CountingBrdf, thread_evaluations};
+use crate::results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+use crate::{CellSpec, Light, Mode, Reference, Shard, StudyConfig, StudyError, reference};
+
+/// z-value of a two-sided 95 % normal confidence interval.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// Relative size (to the reference squared) below which a variance counts as zero.
+const ZERO_VARIANCE: f64 = 1e-20;
+
+/// Called with the number of steps just done (parallel workers call it concurrently).
+pub type ProgressFn<'a> = &'a (dyn Fn(u64) + Sync);
+
+/// A BRDF of the study: as parsed (for the estimator and references) and wrapped in a
+/// counter (for the samplers).
+pub(crate) struct StudyBrdf {
+    pub(crate) spec: String,
+    pub(crate) raw: Arc<dyn Brdf>,
+    counted: Arc<dyn Brdf>,
+}
+
+/// A built sampler and its build time (s), or why it could not be built.
+pub(crate) type BuildOutcome = Result<(samplers::BuiltDirection, f64), String>;
+
+/// A cell with its indices into the plan.
+#[derive(Debug, Clone)]
+struct PlanCell {
+    spec: CellSpec,
+    sampler: usize,
+    brdf: usize,
+    theta: usize,
+    light: usize,
+}
+
+/// A study whose names are all resolved: ready to run (whole or by shard).
+pub struct StudyPlan {
+    pub(crate) config: StudyConfig,
+    notes: Vec<String>,
+    pub(crate) entries: Vec<&'static SamplerEntry>,
+    pub(crate) brdfs: Vec<StudyBrdf>,
+    pub(crate) lights: Vec<Arc<Light>>,
+    cells: Vec<PlanCell>,
+    /// Samplers built so far, by `(sampler, BRDF)` index (the renderer reuses them).
+    built: Mutex<Vec<((usize, usize), BuildOutcome)>>,
+}
+
+impl std::fmt::Debug for StudyPlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StudyPlan")
+            .field("config", &self.config)
+            .field("cells", &self.cells.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl StudyPlan {
+    /// Checks the config and resolves every sampler (registered direction samplers only), BRDF
+    /// and light, before any sampling work. `notes` are carried into the report.
+    ///
+    /// Errors: the first bad setting or name.
+    pub fn new(config: StudyConfig, notes: Vec<String>) -> Result<Self, StudyError> {
+        config.check()?;
+        let entries = config
+            .samplers
+            .iter()
+            .map(|name| {
+                let e = samplers::find(name)?;
+                if !e.is_direction() {
+                    return Err(StudyError::Sampler(samplers::RegistryError::WrongKind {
+                        name: e.name,
+                        expected: "direction",
+                        found: e.constructor.kind(),
+                        candidates: samplers::names_of_kind("direction"),
+                    }));
+                }
+                Ok(e)
+            })
+            .collect::<Result<Vec<_>, StudyError>>()?;
+        let brdfs = config
+            .brdfs
+            .iter()
+            .map(|spec| {
+                let raw: Arc<dyn Brdf> =
+                    Arc::from(brdf::parse_spec(spec).map_err(|source| StudyError::Brdf {
+                        spec: spec.clone(),
+                        source,
+                    })?);
+                Ok(StudyBrdf {
+                    spec: spec.clone(),
+                    counted: Arc::new(CountingBrdf(Arc::clone(&raw))),
+                    raw,
+                })
+            })
+            .collect::<Result<Vec<_>, StudyError>>()?;
+        let lights = config
+            .lights
+            .iter()
+            .map(|s| Light::parse(s).map(Arc::new))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut cells = Vec::new();
+        for (li, light) in config.lights.iter().enumerate() {
+            for (bi, b) in config.brdfs.iter().enumerate() {
+                for (ti, &theta) in config.theta_o_deg.iter().enumerate() {
+                    for (si, e) in entries.iter().enumerate() {
+                        let modes: &[Mode] = if e.capabilities.batch_mode {
+                            &[Mode::OneSample, Mode::Batch]
+                        } else {
+                            &[Mode::OneSample]
+                        };
+                        for &mode in modes {
+                            cells.push(PlanCell {
+                                spec: CellSpec {
+                                    index: cells.len(),
+                                    sampler: e.name.to_string(),
+                                    mode,
+                                    brdf: b.clone(),
+                                    theta_o_deg: theta,
+                                    light: light.clone(),
+                                },
+                                sampler: si,
+                                brdf: bi,
+                                theta: ti,
+                                light: li,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        Ok(Self {
+            config,
+            notes,
+            entries,
+            brdfs,
+            lights,
+            cells,
+            built: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The sampler `s` built for BRDF `b` (cached), with its build time.
+    pub(crate) fn build(&self, s: usize, b: usize) -> BuildOutcome {
+        let cached = self
+            .built
+            .lock()
+            .ok()
+            .and_then(|v| v.iter().find(|(k, _)| *k == (s, b)).map(|(_, r)| r.clone()));
+        if let Some(r) = cached {
+            return r;
+        }
+        let options = SetOptions {
+            slices: self.config.slices,
+            ..SetOptions::default()
+        };
+        let brdf = &self.brdfs[b];
+        let request =
+            DirectionRequest::new(Arc::clone(&brdf.counted), &options).with_spec(&brdf.spec);
+        let start = Instant::now();
+        let r = self.entries[s]
+            .build_direction(&request)
+            .map(|d| (d, start.elapsed().as_secs_f64()))
+            .map_err(|e| format!("cannot build: {e}"));
+        if let Ok(mut v) = self.built.lock() {
+            v.push(((s, b), r.clone()));
+        }
+        r
+    }
+
+    /// The study's config.
+    pub fn config(&self) -> &StudyConfig {
+        &self.config
+    }
+
+    /// Every cell of the grid, by index.
+    pub fn cells(&self) -> Vec<CellSpec> {
+        self.cells.iter().map(|c| c.spec.clone()).collect()
+    }
+
+    /// The lights, resolved.
+    pub fn lights(&self) -> &[Arc<Light>] {
+        &self.lights
+    }
+
+    /// Progress steps of [`StudyPlan::run`] for `shard`: one per build, per reference, and two
+    /// per cell (statistics, timing).
+    pub fn steps(&self, shard: Option<Shard>) -> u64 {
+        let cells = self.selected(shard);
+        (self.builds(&cells).len() + self.references(&cells).len() + 2 * cells.len()) as u64
+    }
+
+    fn selected(&self, shard: Option<Shard>) -> Vec<&PlanCell> {
+        self.cells
+            .iter()
+            .filter(|c| shard.is_none_or(|s| s.contains(c.spec.index)))
+            .collect()
+    }
+
+    fn builds(&self, cells: &[&PlanCell]) -> Vec<(usize, usize)> {
+        let mut v: Vec<_> = cells.iter().map(|c| (c.sampler, c.brdf)).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    fn references(&self, cells: &[&PlanCell]) -> Vec<(usize, usize, usize)> {
+        let mut v: Vec<_> = cells.iter().map(|c| (c.brdf, c.theta, c.light)).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    /// Runs the cells of `shard` (all when `None`); see the module docs.
+    pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
+        let cells = self.selected(shard);
+        // Builds: one at a time, so build times are not inflated by each other.
+        let built: Vec<((usize, usize), BuildOutcome)> = self
+            .builds(&cells)
+            .into_iter()
+            .map(|(s, b)| {
+                let r = self.build(s, b);
+                progress(1);
+                ((s, b), r)
+            })
+            .collect();
+        let references: Vec<((usize, usize, usize), Reference)> = self
+            .references(&cells)
+            .into_iter()
+            .map(|(b, t, l)| {
+                let wo = brdf::direction_from_angles(self.config.theta_o_deg[t], 0.0);
+                let r = reference(self.brdfs[b].raw.as_ref(), &wo, &self.lights[l]);
+                progress(1);
+                ((b, t, l), r)
+            })
+            .collect();
+        let find_build = |c: &PlanCell| {
+            built
+                .iter()
+                .find(|(k, _)| *k == (c.sampler, c.brdf))
+                .map(|(_, r)| r)
+        };
+        let find_ref = |c: &PlanCell| {
+            references
+                .iter()
+                .find(|(k, _)| *k == (c.brdf, c.theta, c.light))
+                .map(|(_, r)| r.clone())
+                .unwrap_or(Reference {
+                    value: f64::NAN,
+                    abs_err: f64::NAN,
+                    method: String::new(),
+                })
+        };
+        let mut results: Vec<CellResult> = cells
+            .par_iter()
+            .map(|c| {
+                let r = match find_build(c) {
+                    Some(Ok((built, _))) => self.run_cell(c, built.sampler.as_ref(), find_ref(c)),
+                    Some(Err(e)) => failed(c, find_ref(c), e.clone()),
+                    None => failed(c, find_ref(c), "not built".into()),
+                };
+                progress(1);
+                r
+            })
+            .collect();
+        // Timings: one cell at a time on this thread.
+        for (c, r) in cells.iter().zip(results.iter_mut()) {
+            if let (Some(Ok((built, seconds))), true) = (find_build(c), r.ok()) {
+                r.timing =
+                    Some(self.time_cell(c, built.sampler.as_ref(), *seconds, r.variance.value));
+            }
+            progress(1);
+        }
+        StudyResults {
+            schema: SCHEMA.to_string(),
+            config: self.config.clone(),
+            shard,
+            total_cells: self.cells.len(),
+            notes: self.notes.clone(),
+            lights: self
+                .config
+                .lights
+                .iter()
+                .zip(&self.lights)
+                .map(|(spec, l)| LightInfo {
+                    spec: spec.clone(),
+                    description: l.describe(),
+                })
+                .collect(),
+            cells: results,
+        }
+    }
+
+    /// The statistics of one cell (deterministic).
+    fn run_cell(
+        &self,
+        c: &PlanCell,
+        sampler: &dyn DirectionSampler,
+        reference: Reference,
+    ) -> CellResult {
+        let cfg = &self.config;
+        let wo = brdf::direction_from_angles(c.spec.theta_o_deg, 0.0);
+        let est = Estimator {
+            brdf: self.brdfs[c.brdf].raw.as_ref(),
+            light: &self.lights[c.light],
+            sampler,
+            mode: c.spec.mode,
+            wo,
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+            cfg.seed,
+            c.spec.index as u64,
+        ));
+        let mut counter = EvalCounter::default();
+        let ref_value = reference.value;
+        let mut errors = Vec::with_capacity(cfg.n_grid.len());
+        let mut values = Vec::with_capacity(cfg.repetitions);
+        for &n in &cfg.n_grid {
+            values.clear();
+            for _ in 0..cfg.repetitions {
+                let samples = est.draw(n, &mut rng, &mut counter);
+                let sum: f64 = samples.iter().map(|s| est.value(s)).sum();
+                values.push(sum / n as f64);
+            }
+            let rel: Vec<f64> = values
+                .iter()
+                .map(|v| (v - ref_value).abs() / ref_value)
+                .collect();
+            let (mean_rel, var_rel) = mean_var(&rel);
+            let (_, var_est) = mean_var(&values);
+            errors.push(ErrorAtN {
+                n,
+                mean_rel_err: finite(mean_rel),
+                ci95: finite(Z95 * (var_rel / rel.len() as f64).sqrt()),
+                rms_rel_err: finite(
+                    (rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt(),
+                ),
+                variance_per_sample: finite(n as f64 * var_est),
+            });
+        }
+        let variance = match c.spec.mode {
+            Mode::OneSample => {
+                let samples = est.draw(cfg.variance_samples, &mut rng, &mut counter);
+                let ys: Vec<f64> = samples.iter().map(|s| est.value(s)).collect();
+                let (mean, var) = mean_var(&ys);
+                let m4 = ys.iter().map(|y| (y - mean).powi(4)).sum::<f64>() / ys.len() as f64;
+                let var_of_var = ((m4 - var * var) / ys.len() as f64).max(0.0);
+                WithCi {
+                    value: finite(var),
+                    ci95: finite(Z95 * var_of_var.sqrt()),
+                }
+            }
+            Mode::Batch => {
+                let last = errors.last().map_or(0.0, |e| e.variance_per_sample);
+                // Sample variance of R estimates: relative sd ≈ √(2/(R−1)) for near-normal
+                // estimates.
+                WithCi {
+                    value: last,
+                    ci95: finite(Z95 * last * (2.0 / (cfg.repetitions as f64 - 1.0)).sqrt()),
+                }
+            }
+        };
+        let zero_variance = variance.value <= ZERO_VARIANCE * ref_value * ref_value;
+        CellResult {
+            index: c.spec.index,
+            sampler: c.spec.sampler.clone(),
+            mode: c.spec.mode,
+            brdf: c.spec.brdf.clone(),
+            theta_o_deg: c.spec.theta_o_deg,
+            light: c.spec.light.clone(),
+            status: None,
+            reference,
+            bytes: sampler.bytes_used(),
+            evaluations_per_sample: counter.per_sample(),
+            variance,
+            zero_variance,
+            errors,
+            timing: None,
+        }
+    }
+
+    /// The timings of one cell, on the calling thread.
+    fn time_cell(
+        &self,
+        c: &PlanCell,
+        sampler: &dyn DirectionSampler,
+        build_seconds: f64,
+        variance: f64,
+    ) -> Timing {
+        let cfg = &self.config;
+        let est = Estimator {
+            brdf: self.brdfs[c.brdf].raw.as_ref(),
+            light: &self.lights[c.light],
+            sampler,
+            mode: c.spec.mode,
+            wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+            cfg.seed ^ 0x7469_6d65,
+            c.spec.index as u64,
+        ));
+        let mut counter = EvalCounter::default();
+        let n = cfg.timing_samples;
+        let mut sample_ns = Vec::with_capacity(cfg.timing_repeats);
+        let mut estimator_ns = Vec::with_capacity(cfg.timing_repeats);
+        let mut sink = 0.0;
+        for _ in 0..cfg.timing_repeats {
+            let start = Instant::now();
+            let samples = est.draw(n, &mut rng, &mut counter);
+            sample_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+            sink += samples.len() as f64;
+            let start = Instant::now();
+            let samples = est.draw(n, &mut rng, &mut counter);
+            let sum: f64 = samples.iter().map(|s| est.value(s)).sum();
+            estimator_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+            sink += sum;
+        }
+        std::hint::black_box(sink);
+        let estimator = median(&mut estimator_ns);
+        Timing {
+            build_seconds: if self.entries[c.sampler].capabilities.needs_build {
+                build_seconds
+            } else {
+                0.0
+            },
+            sample_ns: median(&mut sample_ns),
+            estimator_ns: estimator,
+            efficiency: (variance > 0.0 && estimator > 0.0)
+                .then(|| 1.0 / (variance * estimator * 1e-9)),
+        }
+    }
+}
+
+/// A cell that could not run.
+fn failed(c: &PlanCell, reference: Reference, why: String) -> CellResult {
+    CellResult {
+        index: c.spec.index,
+        sampler: c.spec.sampler.clone(),
+        mode: c.spec.mode,
+        brdf: c.spec.brdf.clone(),
+        theta_o_deg: c.spec.theta_o_deg,
+        light: c.spec.light.clone(),
+        status: Some(why),
+        reference,
+        bytes: 0,
+        evaluations_per_sample: 0.0,
+        variance: WithCi {
+            value: 0.0,
+            ci95: 0.0,
+        },
+        zero_variance: false,
+        errors: Vec::new(),
+        timing: None,
+    }
+}
+
+/// One cell's estimator.
+struct Estimator<'a> {
+    brdf: &'a dyn Brdf,
+    light: &'a Light,
+    sampler: &'a dyn DirectionSampler,
+    mode: Mode,
+    wo: Vec3,
+}
+
+impl Estimator<'_> {
+    /// `n` samples in the cell's mode, counting the sampler's BRDF evaluations.
+    fn draw(
+        &self,
+        n: usize,
+        rng: &mut Xoshiro256PlusPlus,
+        counter: &mut EvalCounter,
+    ) -> Vec<DirSample> {
+        let before = thread_evaluations();
+        let s = match self.mode {
+            Mode::OneSample => (0..n).map(|_| self.sampler.sample(&self.wo, rng)).collect(),
+            Mode::Batch => self.sampler.sample_batch(&self.wo, n, rng),
+        };
+        counter.evaluations += thread_evaluations() - before;
+        counter.samples += n as u64;
+        s
+    }
+
+    /// `Y(f_r ⊙ L) cos θ / p_σ`, 0 below the horizon or where the pdf is 0.
+    #[inline]
+    fn value(&self, s: &DirSample) -> f64 {
+        if !(s.wi.z > 0.0 && s.pdf > 0.0) {
+            return 0.0;
+        }
+        let f = self.brdf.eval_rgb(&self.wo, &s.wi);
+        let l = self.light.radiance(&s.wi);
+        colour::luminance([f[0] * l[0], f[1] * l[1], f[2] * l[2]]) * s.wi.z / s.pdf
+    }
+}
+
+/// BRDF evaluations and samples of one cell.
+#[derive(Default)]
+struct EvalCounter {
+    evaluations: u64,
+    samples: u64,
+}
+
+impl EvalCounter {
+    fn per_sample(&self) -> f64 {
+        if self.samples == 0 {
+            0.0
+        } else {
+            self.evaluations as f64 / self.samples as f64
+        }
+    }
+}
+
+/// Mean and unbiased sample variance (fixed summation order).
+fn mean_var(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    if x.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mean = x.iter().sum::<f64>() / n;
+    if x.len() < 2 {
+        return (mean, 0.0);
+    }
+    let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
+    (mean, var)
+}
+
+/// The median (sorts `x`); 0 for an empty slice.
+fn median(x: &mut [f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    x.sort_by(f64::total_cmp);
+    let m = x.len() / 2;
+    if x.len() % 2 == 1 {
+        x[m]
+    } else {
+        0.5 * (x[m - 1] + x[m])
+    }
+}
+
+/// Non-finite values (a zero reference) are stored as `f64::MAX` so JSON stays valid.
+fn finite(x: f64) -> f64 {
+    if x.is_finite() { x } else { f64::MAX }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sampler reporting a wrong pdf (the cosine warp with its pdf scaled by 1.25).
+    struct BrokenCosine;
+
+    impl DirectionSampler for BrokenCosine {
+        fn sample(&self, wo: &Vec3, u: &mut dyn partition_sampler::UniformSource) -> DirSample {
+            let s = baselines_cosine().sample(wo, u);
+            DirSample {
+                pdf: 1.25 * s.pdf,
+                ..s
+            }
+        }
+        fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            1.25 * baselines_cosine().pdf(wo, wi)
+        }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+    }
+
+    fn baselines_cosine() -> std::sync::Arc<dyn DirectionSampler> {
+        samplers::build_direction(
+            "cosine",
+            &DirectionRequest::new(
+                Arc::from(brdf::parse_spec("lambert").unwrap()),
+                &SetOptions::default(),
+            ),
+        )
+        .unwrap()
+        .sampler
+    }
+
+    /// z-score of the estimator's mean over `n` samples against the reference.
+    fn z_score(sampler: &dyn DirectionSampler, n: usize) -> f64 {
+        let brdf = brdf::parse_spec("phong:n=10").unwrap();
+        let light = Light::parse("area:theta=20,phi=180,radius=15").unwrap();
+        let wo = brdf::direction_from_angles(20.0, 0.0);
+        let reference = crate::reference(brdf.as_ref(), &wo, &light).value;
+        let est = Estimator {
+            brdf: brdf.as_ref(),
+            light: &light,
+            sampler,
+            mode: Mode::OneSample,
+            wo,
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let samples = est.draw(n, &mut rng, &mut EvalCounter::default());
+        let ys: Vec<f64> = samples.iter().map(|s| est.value(s)).collect();
+        let (mean, var) = mean_var(&ys);
+        (mean - reference) / (var / n as f64).sqrt()
+    }
+
+    #[test]
+    fn the_estimator_is_unbiased_and_a_wrong_pdf_is_caught() {
+        let good = z_score(baselines_cosine().as_ref(), 200_000);
+        assert!(good.abs() < 4.0, "z = {good}");
+        let broken = z_score(&BrokenCosine, 200_000);
+        assert!(broken.abs() > 10.0, "z = {broken}");
+    }
+
+    #[test]
+    fn median_and_variance() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
+        let (m, v) = mean_var(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(m, 2.5);
+        assert!((v - 5.0 / 3.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,334 @@
+//! A study's results: per-cell numbers, the JSON and CSV forms, and merging shards.
+//!
+//! # `results.json` schema (`"schema": "brdf-lab-study/1"`)
+//!
+//! ```text
+//! {
+//!   "schema": "brdf-lab-study/1",
+//!   "config": { preset, samplers[], brdfs[], theta_o_deg[], lights[], n_grid[], repetitions,
+//!               variance_samples, timing_samples, timing_repeats, slices, seed },
+//!   "shard": null | { "index": K, "count": N },      // K from 1
+//!   "total_cells": number of cells of the whole grid,
+//!   "notes": [ "…" ],                                 // e.g. a missing map file
+//!   "lights": [ { "spec", "description" } ],
+//!   "cells": [ {
+//!       "index", "sampler", "mode" ("one-sample" | "batch"), "brdf", "theta_o_deg", "light",
+//!       "status": null | "why the cell could not run",
+//!       "reference": { "value", "abs_err", "method" },   // L_r(ωo), luminance
+//!       "bytes": memory of the sampler's structures,
+//!       "evaluations_per_sample": BRDF evaluations by the sampler per sample,
+//!       "variance": { "value", "ci95" },   // per-sample variance of the estimator
+//!       "zero_variance": bool,             // exact f·cos·L sampler (constant light)
+//!       "errors": [ { "n", "mean_rel_err", "ci95", "rms_rel_err", "variance_per_sample" } ],
+//!       "timing": { "build_seconds", "sample_ns", "estimator_ns", "efficiency" }  // TIMINGS
+//!   } ]
+//! }
+//! ```
+//!
+//! Everything outside `timing` depends only on the config (seed included): equal on rerun, for
+//! any thread count, and between one run and merged shards. `timing` holds the only measured
+//! times: build time, time per sample of the sampler alone and of the whole estimator
+//! (single-threaded, median of the repeats) and the efficiency 1 / (variance × estimator time
+//! per sample in seconds).
+
+use std::collections::BTreeSet;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Mode, Reference, Shard, StudyConfig, StudyError};
+
+/// Version tag of [`StudyResults`]' JSON form.
+pub const SCHEMA: &str = "brdf-lab-study/1";
+
+/// A value with the half-width of its 95 % confidence interval.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WithCi {
+    /// The estimate.
+    pub value: f64,
+    /// Half-width of the 95 % confidence interval.
+    pub ci95: f64,
+}
+
+/// Relative error of the estimator at one sample count.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ErrorAtN {
+    /// Samples per estimate.
+    pub n: usize,
+    /// Mean over the repetitions of `|L̂_N − L_ref| / L_ref`.
+    pub mean_rel_err: f64,
+    /// Half-width of its 95 % confidence interval (1.96 · sd / √R).
+    pub ci95: f64,
+    /// Root mean square of the relative errors.
+    pub rms_rel_err: f64,
+    /// `N · Var(L̂_N)` over the repetitions: the per-sample variance this N achieves (equal
+    /// to the one-sample variance for independent samples, lower for stratified batches).
+    pub variance_per_sample: f64,
+}
+
+/// Measured times of a cell (the only time-dependent numbers of a study).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    /// Time to build the sampler for this BRDF (s); 0 for samplers without a structure.
+    pub build_seconds: f64,
+    /// Time per sample of the sampler alone (ns), single-threaded, median of the repeats.
+    pub sample_ns: f64,
+    /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns).
+    pub estimator_ns: f64,
+    /// `1 / (variance × estimator time per sample in s)`; `None` when the variance is 0.
+    pub efficiency: Option<f64>,
+}
+
+/// The results of one cell.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CellResult {
+    /// Position in the full grid.
+    pub index: usize,
+    /// Sampler name.
+    pub sampler: String,
+    /// How samples were drawn.
+    pub mode: Mode,
+    /// BRDF spec.
+    pub brdf: String,
+    /// Outgoing polar angle (degrees, φo = 0).
+    pub theta_o_deg: f64,
+    /// Light spec.
+    pub light: String,
+    /// Why the cell could not run (e.g. the sampler does not apply to this BRDF).
+    pub status: Option<String>,
+    /// The reference `L_r(ωo)`.
+    pub reference: Reference,
+    /// Memory of the sampler's structures (bytes).
+    pub bytes: usize,
+    /// BRDF evaluations made by the sampler per sample (the estimator's own excluded).
+    pub evaluations_per_sample: f64,
+    /// Per-sample variance of the estimator: the one-sample variance of `f L cos / p` (one-sample
+    /// mode) or `N · Var(L̂_N)` at the largest N (batch mode).
+    pub variance: WithCi,
+    /// The variance is zero to rounding (an exact `f·cos·L` sampler, e.g. under constant light).
+    pub zero_variance: bool,
+    /// Relative errors along the N grid.
+    pub errors: Vec<ErrorAtN>,
+    /// Measured times.
+    pub timing: Option<Timing>,
+}
+
+impl CellResult {
+    /// Whether the cell ran.
+    pub fn ok(&self) -> bool {
+        self.status.is_none()
+    }
+
+    /// The relative error at the largest N.
+    pub fn final_error(&self) -> Option<&ErrorAtN> {
+        self.errors.last()
+    }
+
+    /// `sampler` or `sampler (batch)`.
+    pub fn label(&self) -> String {
+        match self.mode {
+            Mode::OneSample => self.sampler.clone(),
+            Mode::Batch => format!("{} (batch)", self.sampler),
+        }
+    }
+
+    /// A copy without timings (for comparisons that must be exact).
+    pub fn without_timing(&self) -> Self {
+        Self {
+            timing: None,
+            ..self.clone()
+        }
+    }
+}
+
+/// A light of the study and its description.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LightInfo {
+    /// The spec.
+    pub spec: String,
+    /// What it is.
+    pub description: String,
+}
+
+/// The results of a study (or of one shard of it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyResults {
+    /// [`SCHEMA`].
+    pub schema: String,
+    /// The study.
+    pub config: StudyConfig,
+    /// The shard these results cover, `None` for a whole study.
+    pub shard: Option<Shard>,
+    /// Cells of the whole grid.
+    pub total_cells: usize,
+    /// Notes for the report (e.g. a missing map file and what replaced it).
+    pub notes: Vec<String>,
+    /// The lights.
+    pub lights: Vec<LightInfo>,
+    /// The cells run, by index.
+    pub cells: Vec<CellResult>,
+}
+
+impl StudyResults {
+    /// The JSON form (pretty-printed).
+    pub fn to_json(&self) -> String {
+        // Serialising plain data with finite floats cannot fail; non-finite floats are never
+        // stored (they become `None` or are replaced before).
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
+    }
+
+    /// Reads the JSON form back.
+    pub fn from_json(text: &str, path: &str) -> Result<Self, StudyError> {
+        let r: Self = serde_json::from_str(text).map_err(|e| StudyError::ResultsFile {
+            path: path.to_string(),
+            reason: e.to_string(),
+        })?;
+        if r.schema != SCHEMA {
+            return Err(StudyError::ResultsFile {
+                path: path.to_string(),
+                reason: format!("schema `{}`, expected `{SCHEMA}`", r.schema),
+            });
+        }
+        Ok(r)
+    }
+
+    /// The same results without timings (what must agree bit for bit between runs).
+    pub fn without_timing(&self) -> Self {
+        Self {
+            cells: self.cells.iter().map(CellResult::without_timing).collect(),
+            ..self.clone()
+        }
+    }
+
+    /// The CSV form: one row per cell and N; timing columns are marked `[timing]` in the
+    /// header. Fields are quoted where needed (BRDF specs contain commas).
+    pub fn to_csv(&self) -> String {
+        let mut out = String::from(
+            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],efficiency[timing]\n",
+        );
+        for c in &self.cells {
+            let t = c.timing;
+            let timing = [
+                t.map(|t| t.build_seconds),
+                t.map(|t| t.sample_ns),
+                t.map(|t| t.estimator_ns),
+                t.and_then(|t| t.efficiency),
+            ]
+            .map(opt);
+            let rows: Vec<Option<&ErrorAtN>> = if c.errors.is_empty() {
+                vec![None]
+            } else {
+                c.errors.iter().map(Some).collect()
+            };
+            for e in rows {
+                let fields = [
+                    c.index.to_string(),
+                    quote(&c.sampler),
+                    c.mode.as_str().to_string(),
+                    quote(&c.brdf),
+                    num(c.theta_o_deg),
+                    quote(&c.light),
+                    quote(c.status.as_deref().unwrap_or("")),
+                    num(c.reference.value),
+                    num(c.reference.abs_err),
+                    e.map_or(String::new(), |e| e.n.to_string()),
+                    opt(e.map(|e| e.mean_rel_err)),
+                    opt(e.map(|e| e.ci95)),
+                    opt(e.map(|e| e.rms_rel_err)),
+                    opt(e.map(|e| e.variance_per_sample)),
+                    num(c.variance.value),
+                    num(c.variance.ci95),
+                    c.zero_variance.to_string(),
+                    num(c.evaluations_per_sample),
+                    c.bytes.to_string(),
+                ];
+                out.push_str(&fields.join(","));
+                for t in &timing {
+                    out.push(',');
+                    out.push_str(t);
+                }
+                out.push('\n');
+            }
+        }
+        out
+    }
+
+    /// Combines the results of shards into the results of the whole study: the shards must
+    /// share the config, notes and shard count, be distinct, and together cover every cell.
+    ///
+    /// Errors: [`StudyError::Merge`] saying what does not fit.
+    pub fn merge(parts: Vec<StudyResults>) -> Result<Self, StudyError> {
+        let fail = |m: String| Err(StudyError::Merge(m));
+        let Some(first) = parts.first() else {
+            return fail("no results given".into());
+        };
+        let mut seen_shards = BTreeSet::new();
+        for p in &parts {
+            if p.config != first.config {
+                return fail("the results come from different study configurations".into());
+            }
+            if p.total_cells != first.total_cells
+                || p.notes != first.notes
+                || p.lights != first.lights
+            {
+                return fail(
+                    "the results come from different runs (cells, notes or lights differ)".into(),
+                );
+            }
+            match (p.shard, first.shard) {
+                (Some(s), Some(f)) if s.count == f.count => {
+                    if !seen_shards.insert(s.index) {
+                        return fail(format!("shard {}/{} given twice", s.index, s.count));
+                    }
+                }
+                (None, _) if parts.len() == 1 => {}
+                _ => return fail("every input must be a shard K/N of the same N".into()),
+            }
+        }
+        let mut cells: Vec<CellResult> =
+            parts.iter().flat_map(|p| p.cells.iter().cloned()).collect();
+        cells.sort_by_key(|c| c.index);
+        let indices: Vec<usize> = cells.iter().map(|c| c.index).collect();
+        if indices != (0..first.total_cells).collect::<Vec<_>>() {
+            let missing = first
+                .shard
+                .map(|s| {
+                    (1..=s.count)
+                        .filter(|k| !seen_shards.contains(k))
+                        .map(|k| format!("{k}/{}", s.count))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                })
+                .unwrap_or_default();
+            return fail(format!(
+                "the shards do not cover every cell once (missing shards: {missing})"
+            ));
+        }
+        Ok(Self {
+            schema: SCHEMA.to_string(),
+            config: first.config.clone(),
+            shard: None,
+            total_cells: first.total_cells,
+            notes: first.notes.clone(),
+            lights: first.lights.clone(),
+            cells,
+        })
+    }
+}
+
+/// Full round-trip precision.
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or(String::new(), num)
+}
+
+/// Quotes a CSV field when it holds a comma, a quote or a line break.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
