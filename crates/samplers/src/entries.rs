@@ -129,7 +129,6 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             },
         },
     },
-
     // -- factored baseline (Lawrence 2004) --
     SamplerEntry {
         name: "quadtree-disc",

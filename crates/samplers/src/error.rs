@@ -71,6 +71,5 @@ pub enum RegistryError {
     /// A tabulated or cascade CDF could not be built (an option out of range).
     #[error("cdf baseline: {0}")]
     Cdf(#[from] baselines::CdfOptionsError),
-
     // -- factored baseline's error --
 }
