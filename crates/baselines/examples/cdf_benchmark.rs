@@ -6,8 +6,10 @@
 //!
 //! The MERL-layout file is a tabulated Cook–Torrance written to the temporary directory and
 //! read back (MERL data are not redistributable), so the measured path includes the MERL
-//! lookup. Times are wall-clock on whatever cores rayon gets (builds are parallel over slices;
-//! sampling runs on one thread).
+//! lookup. Builds are parallel over slices and report wall-clock and process CPU seconds;
+//! sampling runs on one thread and reports that thread's CPU time per sample (Linux
+//! `/proc/thread-self/schedstat`, wall-clock elsewhere), so that a busy machine does not
+//! inflate it.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -47,13 +49,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         println!("\n## {label}\n");
         println!(
-            "| sampler | build s | memory MiB | CDF points stored / fine | ns per sample | variance of f·cos/p (mean over θo) |"
+            "| sampler | build s (wall / CPU) | memory MiB | CDF points stored / fine | CPU ns per sample | variance of f·cos/p (mean over θo) |"
         );
         println!("|---|---:|---:|---:|---:|---:|");
         compare(brdf, samples)?;
         println!("\n### ε sweep (cascade-cdf, default grid)\n");
         println!(
-            "| ε | build s | memory MiB | compression ratio | ns per sample | variance | tabulated-cdf of the same memory: grid, variance |"
+            "| ε | build s (wall / CPU) | memory MiB | compression ratio | CPU ns per sample | variance | tabulated-cdf of the same memory: grid, variance |"
         );
         println!("|---:|---:|---:|---:|---:|---:|---|");
         sweep(brdf, samples / 4)?;
@@ -61,7 +63,35 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// Mean time per sample (one thread), cycling over [`THETA_O`].
+/// CPU nanoseconds of the calling thread (Linux), if available.
+fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// CPU seconds (user + system) of the whole process (Linux, 100 ticks per second), if available.
+fn process_cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 1..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: u64 = f.get(11)?.parse::<u64>().ok()? + f.get(12)?.parse::<u64>().ok()?;
+    Some(ticks as f64 / 100.0)
+}
+
+/// Runs `build`, returning its result and `"wall / CPU"` seconds.
+fn timed<T>(build: impl FnOnce() -> T) -> (T, String) {
+    let cpu0 = process_cpu_s();
+    let start = Instant::now();
+    let out = build();
+    let wall = start.elapsed().as_secs_f64();
+    let cpu = match (cpu0, process_cpu_s()) {
+        (Some(a), Some(b)) => format!("{:.2}", b - a),
+        _ => "n/a".into(),
+    };
+    (out, format!("{wall:.2} / {cpu}"))
+}
+
+/// Mean time per sample (one thread's CPU time), cycling over [`THETA_O`].
 fn time_per_sample(s: &dyn DirectionSampler, n: usize) -> f64 {
     let wos: Vec<Vec3> = THETA_O
         .iter()
@@ -69,13 +99,18 @@ fn time_per_sample(s: &dyn DirectionSampler, n: usize) -> f64 {
         .collect();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
     let mut guard = 0.0;
+    let cpu0 = thread_cpu_ns();
     let start = Instant::now();
     for i in 0..n {
         guard += s.sample(&wos[i % wos.len()], &mut rng).pdf;
     }
-    let t = start.elapsed().as_secs_f64();
+    let wall = start.elapsed().as_secs_f64() * 1e9;
     assert!(guard.is_finite());
-    t / n as f64 * 1e9
+    let t = match (cpu0, thread_cpu_ns()) {
+        (Some(a), Some(b)) => (b - a) as f64,
+        _ => wall,
+    };
+    t / n as f64
 }
 
 /// Per-sample variance of the albedo estimator `f cos / p`, averaged over [`THETA_O`].
@@ -106,7 +141,7 @@ fn variance(brdf: &dyn Brdf, s: &dyn DirectionSampler, n: usize) -> f64 {
 
 fn row(
     name: &str,
-    build: f64,
+    build: &str,
     bytes: usize,
     points: &str,
     brdf: &dyn Brdf,
@@ -114,7 +149,7 @@ fn row(
     n: usize,
 ) {
     println!(
-        "| {name} | {build:.2} | {:.2} | {points} | {:.0} | {:.4} |",
+        "| {name} | {build} | {:.2} | {points} | {:.0} | {:.4} |",
         bytes as f64 / (1 << 20) as f64,
         time_per_sample(s, n),
         variance(brdf, s, n / 4)
@@ -122,13 +157,14 @@ fn row(
 }
 
 fn compare(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Error>> {
-    row("uniform", 0.0, 0, "—", brdf.as_ref(), &UniformHemisphere, n);
+    row("uniform", "—", 0, "—", brdf.as_ref(), &UniformHemisphere, n);
     let o = CdfOptions::default();
-    let t = TabulatedCdf::build(brdf.as_ref(), &o)?;
+    let (t, build) = timed(|| TabulatedCdf::build(brdf.as_ref(), &o));
+    let t = t?;
     let r = t.report();
     row(
         "tabulated-cdf",
-        r.build_time.as_secs_f64(),
+        &build,
         r.bytes,
         &format!("{} / {}", r.stored_points, r.fine_points),
         brdf.as_ref(),
@@ -136,11 +172,12 @@ fn compare(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Err
         n,
     );
     drop(t);
-    let c = CascadeCdf::build(brdf.as_ref(), &o)?;
+    let (c, build) = timed(|| CascadeCdf::build(brdf.as_ref(), &o));
+    let c = c?;
     let r = c.report();
     row(
         "cascade-cdf (ε = 1e-3)",
-        r.build_time.as_secs_f64(),
+        &build,
         r.bytes,
         &format!(
             "{} / {} ({:.4})",
@@ -157,10 +194,10 @@ fn compare(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Err
         ("adaptive", Variant::Adaptive),
         ("adaptive-paper", Variant::Paper),
     ] {
-        let start = Instant::now();
-        let set = QuadTreeSet::build(Arc::clone(brdf), variant, &SetOptions::default())?;
-        let build = start.elapsed().as_secs_f64();
-        row(name, build, set.bytes_used(), "—", brdf.as_ref(), &set, n);
+        let (set, build) =
+            timed(|| QuadTreeSet::build(Arc::clone(brdf), variant, &SetOptions::default()));
+        let set = set?;
+        row(name, &build, set.bytes_used(), "—", brdf.as_ref(), &set, n);
     }
     Ok(())
 }
@@ -171,7 +208,8 @@ fn sweep(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Error
             epsilon,
             ..CdfOptions::default()
         };
-        let c = CascadeCdf::build(brdf.as_ref(), &o)?;
+        let (c, build) = timed(|| CascadeCdf::build(brdf.as_ref(), &o));
+        let c = c?;
         let r = c.report().clone();
         // The fair baseline: an uncompressed table with (about) the same bytes, n_φ = 2 n_z.
         let cells_per_slice = r.bytes as f64 / 8.0 / r.layout.len() as f64;
@@ -183,8 +221,7 @@ fn sweep(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Error
         };
         let t = TabulatedCdf::build(brdf.as_ref(), &same)?;
         println!(
-            "| {epsilon:e} | {:.2} | {:.2} | {:.4} | {:.0} | {:.4} | {}×{} ({:.2} MiB), {:.4} |",
-            r.build_time.as_secs_f64(),
+            "| {epsilon:e} | {build} | {:.2} | {:.4} | {:.0} | {:.4} | {}×{} ({:.2} MiB), {:.4} |",
             r.bytes as f64 / (1 << 20) as f64,
             r.compression_ratio(),
             time_per_sample(&c, n),
