@@ -1,7 +1,8 @@
 //! Baseline samplers that brdf-lab's adaptive-partition sampler is compared with.
 //!
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
-//! [`UniformHemisphere`] and [`CosineHemisphere`].
+//! [`UniformHemisphere`] and [`CosineHemisphere`]; per-slice tabulated CDFs, uncompressed
+//! ([`TabulatedCdf`]) and Douglas–Peucker-compressed ([`CascadeCdf`], Lawrence 2005), in [`cdf`].
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -18,8 +19,13 @@
 //! assert!((s.pdf - CosineHemisphere.pdf(&wo, &s.wi)).abs() < 1e-12);
 //! ```
 
+// `!(x > 0.0)` is the project's NaN-rejecting check (NaN fails it).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod cdf;
 pub mod hemisphere;
 pub mod options;
 
+pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
-pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};
+pub use options::{BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, LobeOptions};

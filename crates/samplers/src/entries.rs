@@ -97,7 +97,38 @@ pub static SAMPLERS: &[SamplerEntry] = &[
     // -- lobe baselines (lobe-sphere, lobe-hemisphere, analytic) --
 
     // -- CDF baselines (tabulated-cdf, cascade-cdf) --
-
+    SamplerEntry {
+        name: "tabulated-cdf",
+        summary: "uncompressed marginal/conditional piecewise-constant CDF of f·cos over (cosθ, φ) per outgoing slice, nearest slice (seed 000's uncompressed CDF)",
+        capabilities: CDF_TABLE,
+        constructor: Constructor::Direction {
+            support: Support::Hemisphere,
+            build: |request| {
+                let cdf = baselines::TabulatedCdf::build_with_progress(
+                    request.brdf.as_ref(),
+                    &request.baselines.cdf,
+                    request.progress,
+                )?;
+                Ok(BuiltDirection::plain(Arc::new(cdf)))
+            },
+        },
+    },
+    SamplerEntry {
+        name: "cascade-cdf",
+        summary: "Lawrence 2005: the cascade of 1D CDFs per outgoing slice compressed by Douglas–Peucker (vertical tolerance ε), sampled and evaluated on the compressed piecewise-linear CDFs",
+        capabilities: CDF_TABLE,
+        constructor: Constructor::Direction {
+            support: Support::Hemisphere,
+            build: |request| {
+                let cdf = baselines::CascadeCdf::build_with_progress(
+                    request.brdf.as_ref(),
+                    &request.baselines.cdf,
+                    request.progress,
+                )?;
+                Ok(BuiltDirection::plain(Arc::new(cdf)))
+            },
+        },
+    },
     // -- factored baseline (Lawrence 2004) --
     SamplerEntry {
         name: "quadtree-disc",
@@ -143,6 +174,16 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         constructor: Constructor::Grid(grid_cdf),
     },
 ];
+
+/// Capabilities of the per-slice tabulated CDFs of a BRDF (exact: the pdf is the density of
+/// the table that is sampled, compressed or not).
+const CDF_TABLE: Capabilities = Capabilities {
+    exact_pdf: true,
+    batch_mode: false,
+    needs_build: true,
+    anisotropic: true,
+    measured: true,
+};
 
 /// Capabilities of the tabulated CDFs of maps and grids.
 const BLIND_TABLE: Capabilities = Capabilities {

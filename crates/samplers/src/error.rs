@@ -68,6 +68,8 @@ pub enum RegistryError {
     // -- lobe baselines' error --
 
     // -- CDF baselines' error --
-
+    /// A tabulated or cascade CDF could not be built (an option out of range).
+    #[error("cdf baseline: {0}")]
+    Cdf(#[from] baselines::CdfOptionsError),
     // -- factored baseline's error --
 }

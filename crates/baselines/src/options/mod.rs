@@ -5,7 +5,7 @@ mod cdf;
 mod factored;
 mod lobe;
 
-pub use cdf::CdfOptions;
+pub use cdf::{CdfOptions, CdfOptionsError};
 pub use factored::FactoredOptions;
 pub use lobe::LobeOptions;
 

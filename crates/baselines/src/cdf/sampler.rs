@@ -1,0 +1,368 @@
+//! [`CdfSampler`]: one tabulated (or compressed) CDF per outgoing slice of a BRDF, sampled as a
+//! [`DirectionSampler`] with the nearest slice.
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use brdf::{Brdf, Vec3};
+use brdf_sampling::{DirSample, DirectionSampler, Progress, SliceLayout};
+use partition_sampler::UniformSource;
+use rayon::prelude::*;
+
+use super::grid::{GridShape, slice_values};
+use crate::{CdfOptions, CdfOptionsError};
+
+/// A point of one slice's `(z, φ)` domain with its density w.r.t. `dz dφ` (= solid angle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlicePoint {
+    /// `z = cos θi ∈ (0, 1)`.
+    pub z: f64,
+    /// `φi ∈ [0, 2π)` in the slice's frame.
+    pub phi: f64,
+    /// Density w.r.t. `dz dφ`, i.e. w.r.t. solid angle.
+    pub pdf: f64,
+}
+
+/// The per-slice distribution of a [`CdfSampler`]: built from the slice's fine cell values,
+/// sampled from two uniforms, with a pdf w.r.t. `dz dφ` (= solid angle).
+pub trait SliceCdf: Send + Sync + Sized {
+    /// The registry name of the sampler made of these slices.
+    const NAME: &'static str;
+    /// Whether the CDFs are compressed (the report then states `ε`).
+    const COMPRESSED: bool;
+
+    /// The distribution of the cell values `values` (row-major `n_z × n_φ`, all positive).
+    fn build(values: &[f64], shape: GridShape, options: &CdfOptions) -> Self;
+
+    /// Warps `u ∈ [0,1)²` (`u[0]` for `z`, `u[1]` for `φ`) to a point and its density.
+    fn sample(&self, shape: GridShape, u: [f64; 2]) -> SlicePoint;
+
+    /// Density at `(z, φ)`, `z ∈ [0, 1]`, `φ ∈ [0, 2π)`, the value `sample` reports there.
+    fn pdf(&self, shape: GridShape, z: f64, phi: f64) -> f64;
+
+    /// Heap and inline bytes of the slice.
+    fn bytes_used(&self) -> usize;
+
+    /// CDF points stored (the uncompressed slice stores [`GridShape::cdf_points`]).
+    fn stored_points(&self) -> usize;
+}
+
+/// Build report of a [`CdfSampler`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CdfReport {
+    /// The sampler's registry name.
+    pub sampler: &'static str,
+    /// Outgoing slices.
+    pub layout: SliceLayout,
+    /// The fine grid of every slice.
+    pub shape: GridShape,
+    /// Evaluations per cell and axis.
+    pub supersampling: usize,
+    /// The Douglas–Peucker tolerance (compressed samplers only).
+    pub epsilon: Option<f64>,
+    /// Wall-clock build time (evaluation, CDFs and compression).
+    pub build_time: Duration,
+    /// Bytes of all slices.
+    pub bytes: usize,
+    /// CDF points of the uncompressed tables (`slices ·` [`GridShape::cdf_points`]).
+    pub fine_points: usize,
+    /// CDF points stored.
+    pub stored_points: usize,
+    /// BRDF evaluations spent on the fine grids.
+    pub grid_evaluations: u64,
+}
+
+impl CdfReport {
+    /// Stored points over the uncompressed table's points (1 for `tabulated-cdf`).
+    pub fn compression_ratio(&self) -> f64 {
+        self.stored_points as f64 / self.fine_points as f64
+    }
+
+    /// One line for logs and the CLI.
+    pub fn summary(&self) -> String {
+        let eps = self
+            .epsilon
+            .map_or(String::new(), |e| format!(", ε = {e:e}"));
+        format!(
+            "{}: {} slices ({} θ × {} φ{}) of {} × {} cells (z × φ, {}² evaluations each){eps}; built in {:.3} s; {:.1} KiB; {} of {} CDF points stored (ratio {:.4})",
+            self.sampler,
+            self.layout.len(),
+            self.layout.theta,
+            self.layout.phi,
+            if self.layout.half_turn {
+                " over [0°, 180°)"
+            } else {
+                ""
+            },
+            self.shape.n_z,
+            self.shape.n_phi,
+            self.supersampling,
+            self.build_time.as_secs_f64(),
+            self.bytes as f64 / 1024.0,
+            self.stored_points,
+            self.fine_points,
+            self.compression_ratio()
+        )
+    }
+}
+
+/// The slice layout of `brdf` under `options`: `slices` θ slices for an isotropic BRDF (φ
+/// rotation serves every azimuth), else the `[θ, φ]` grid of `anisotropic_slices`, over
+/// `[0, π)` for a half-turn-symmetric BRDF with an even φ count (see [`SliceLayout`]).
+pub fn cdf_layout(brdf: &dyn Brdf, options: &CdfOptions) -> SliceLayout {
+    if brdf.is_isotropic() {
+        SliceLayout {
+            theta: options.slices,
+            phi: 1,
+            half_turn: false,
+        }
+    } else {
+        let [theta, phi] = options.anisotropic_slices;
+        let half_turn = brdf.is_half_turn_symmetric() && phi.is_multiple_of(2);
+        SliceLayout {
+            theta,
+            phi: if half_turn { phi / 2 } else { phi },
+            half_turn,
+        }
+    }
+}
+
+/// A tabulated CDF per outgoing slice of one BRDF, as a [`DirectionSampler`]
+/// (baselines.md §B).
+///
+/// Slice `(θ_j, φ_k)` of [`cdf_layout`] tabulates `g(ωi) = f_r(ωo_jk, ωi) cos θi` (luminance
+/// for RGB BRDFs) on the fine `(z, φ)` grid of [`CdfOptions`] and holds the distribution `S`
+/// of it. For an outgoing direction `ωo` the **nearest** slice `c` is used in both `sample` and
+/// `pdf` ([`SliceLayout::nearest`]), its sample turned about the normal by `Δ = φo − φ_k`, so
+///
+/// `p(ωi | ωo) = p_c(cos θi, φi − Δ)` w.r.t. **solid angle** (`dz dφ = dω`), 0 below the
+/// horizon.
+///
+/// Every cell of every slice has positive mass (the defensive floor), so `p > 0` on the whole
+/// upper hemisphere and `(1/N) Σ f cos / p` is unbiased for any BRDF, however coarse the slices.
+pub struct CdfSampler<S> {
+    layout: SliceLayout,
+    /// `cos θ` of the θ-slice edges `(j + 1)(π/2)/nθ`, `j = 0..nθ−1` (decreasing): the slice
+    /// choice without `acos`.
+    theta_edges_cos: Vec<f64>,
+    shape: GridShape,
+    slices: Vec<S>,
+    report: CdfReport,
+}
+
+impl<S> std::fmt::Debug for CdfSampler<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CdfSampler")
+            .field("report", &self.report)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<S: SliceCdf> CdfSampler<S> {
+    /// Builds the slices of `brdf` (in parallel with rayon; the result does not depend on the
+    /// thread count).
+    ///
+    /// Errors: an invalid option, or a table larger than [`CdfOptions::MAX_TOTAL_CELLS`].
+    pub fn build(brdf: &dyn Brdf, options: &CdfOptions) -> Result<Self, CdfOptionsError> {
+        Self::build_with_progress(brdf, options, None)
+    }
+
+    /// [`CdfSampler::build`] reporting `(slices done, total)` after each slice.
+    pub fn build_with_progress(
+        brdf: &dyn Brdf,
+        options: &CdfOptions,
+        progress: Option<Progress<'_>>,
+    ) -> Result<Self, CdfOptionsError> {
+        options.validate()?;
+        let layout = cdf_layout(brdf, options);
+        options.validate_size(layout.len())?;
+        let start = Instant::now();
+        let shape = GridShape {
+            n_z: options.n_z,
+            n_phi: options.n_phi,
+        };
+        let done = AtomicUsize::new(0);
+        let built: Vec<(S, u64)> = (0..layout.len())
+            .into_par_iter()
+            .map(|i| {
+                let wo = layout.direction_of(i);
+                let (values, evaluations) =
+                    slice_values(brdf, &wo, shape, options.supersampling, options.floor);
+                let slice = S::build(&values, shape, options);
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(p) = progress {
+                    p(d, layout.len());
+                }
+                (slice, evaluations)
+            })
+            .collect();
+        let grid_evaluations = built.iter().map(|b| b.1).sum();
+        let slices: Vec<S> = built.into_iter().map(|b| b.0).collect();
+        let report = CdfReport {
+            sampler: S::NAME,
+            layout,
+            shape,
+            supersampling: options.supersampling,
+            epsilon: S::COMPRESSED.then_some(options.epsilon),
+            build_time: start.elapsed(),
+            bytes: std::mem::size_of::<Self>() + slices.iter().map(S::bytes_used).sum::<usize>(),
+            fine_points: layout.len() * shape.cdf_points(),
+            stored_points: slices.iter().map(S::stored_points).sum(),
+            grid_evaluations,
+        };
+        let theta_edges_cos = (1..layout.theta)
+            .map(|j| (j as f64 * FRAC_PI_2 / layout.theta as f64).cos())
+            .collect();
+        Ok(Self {
+            layout,
+            theta_edges_cos,
+            shape,
+            slices,
+            report,
+        })
+    }
+
+    /// The build report (time, memory, compression).
+    pub fn report(&self) -> &CdfReport {
+        &self.report
+    }
+
+    /// The slice layout.
+    pub fn layout(&self) -> SliceLayout {
+        self.layout
+    }
+
+    /// The fine grid of every slice.
+    pub fn shape(&self) -> GridShape {
+        self.shape
+    }
+
+    /// Slice `index` of the layout.
+    pub fn slice(&self, index: usize) -> Option<&S> {
+        self.slices.get(index)
+    }
+}
+
+/// The slice serving an outgoing direction and the rotation `Δ = φo − φ_k` about the normal
+/// that maps the slice's frame to the world, as `(cos Δ, sin Δ)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SliceFrame {
+    index: usize,
+    cos: f64,
+    sin: f64,
+}
+
+impl<S> CdfSampler<S> {
+    /// The nearest slice of `wo` (the same rule as [`SliceLayout::nearest`]: θ bin, nearest φ
+    /// slice circularly), without trigonometry for isotropic layouts; `None` when `wo` is at or
+    /// below the horizon or not finite. `sample` and `pdf` both use it, so a direction's pdf is
+    /// always evaluated with the slice that sampled it.
+    #[inline]
+    fn frame(&self, wo: &Vec3) -> Option<SliceFrame> {
+        if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
+            return None;
+        }
+        let j = self.theta_edges_cos.partition_point(|&c| wo.z <= c);
+        let r = wo.x.hypot(wo.y);
+        let (cos_o, sin_o) = if r > 0.0 {
+            (wo.x / r, wo.y / r)
+        } else {
+            (1.0, 0.0)
+        };
+        if self.layout.phi == 1 {
+            return Some(SliceFrame {
+                index: j,
+                cos: cos_o,
+                sin: sin_o,
+            });
+        }
+        let phi = sin_o.atan2(cos_o);
+        let period = self.layout.phi_period();
+        let step = period / self.layout.phi as f64;
+        let k = ((phi.rem_euclid(period) / step).round() as usize) % self.layout.phi;
+        let (sin, cos) = (phi - self.layout.phi_of(k)).sin_cos();
+        Some(SliceFrame {
+            index: j * self.layout.phi + k,
+            cos,
+            sin,
+        })
+    }
+}
+
+impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
+    fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
+        let u0 = u.next_uniform();
+        let u1 = u.next_uniform();
+        let Some(f) = self.frame(wo) else {
+            return DirSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 0.0,
+            };
+        };
+        let p = self.slices[f.index].sample(self.shape, [u0, u1]);
+        let r = (1.0 - p.z * p.z).max(0.0).sqrt();
+        let (s, c) = p.phi.sin_cos();
+        let (x, y) = (r * c, r * s);
+        DirSample {
+            wi: Vec3::new(f.cos * x - f.sin * y, f.sin * x + f.cos * y, p.z),
+            pdf: p.pdf,
+        }
+    }
+
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        let Some(f) = self.frame(wo) else {
+            return 0.0;
+        };
+        let x = f.cos * wi.x + f.sin * wi.y;
+        let y = f.cos * wi.y - f.sin * wi.x;
+        let mut phi = y.atan2(x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        self.slices[f.index].pdf(self.shape, wi.z.min(1.0), phi)
+    }
+
+    fn bytes_used(&self) -> usize {
+        self.report.bytes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cdf::TabulatedCdf;
+
+    #[test]
+    fn the_slice_frame_is_the_layouts_nearest_slice() {
+        let o = CdfOptions {
+            slices: 7,
+            anisotropic_slices: [5, 6],
+            n_z: 2,
+            n_phi: 2,
+            supersampling: 1,
+            ..CdfOptions::default()
+        };
+        for spec in [
+            "phong",
+            "ward:alpha_x=0.1,alpha_y=0.3",
+            "lafortune:cx=-1,cy=-0.5",
+        ] {
+            let brdf = brdf::parse_spec(spec).unwrap();
+            let t = TabulatedCdf::build(brdf.as_ref(), &o).unwrap();
+            for i in 0..500 {
+                let theta = (i as f64 * 0.618).fract() * 89.9;
+                let phi = (i as f64 * 0.377).fract() * 720.0 - 360.0;
+                let wo = brdf::direction_from_angles(theta, phi);
+                let (c, f) = (t.layout().nearest(&wo).unwrap(), t.frame(&wo).unwrap());
+                assert_eq!(c.index, f.index, "{spec} θ {theta} φ {phi}");
+                let (s, co) = c.rotation.sin_cos();
+                assert!((s - f.sin).abs() < 1e-12 && (co - f.cos).abs() < 1e-12);
+            }
+            assert!(t.frame(&Vec3::new(1.0, 0.0, 0.0)).is_none());
+        }
+    }
+}
