@@ -1,7 +1,9 @@
 //! Baseline samplers that brdf-lab's adaptive-partition sampler is compared with.
 //!
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
-//! [`UniformHemisphere`] and [`CosineHemisphere`].
+//! [`UniformHemisphere`] and [`CosineHemisphere`]; the cosine lobe about the mirror direction
+//! with a fitted exponent per outgoing slice ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`),
+//! and the models' own analytic samplers ([`AnalyticSampler`]: `analytic`).
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -18,8 +20,13 @@
 //! assert!((s.pdf - CosineHemisphere.pdf(&wo, &s.wi)).abs() < 1e-12);
 //! ```
 
+// `!(x > 0.0)` is the house style for checks that must also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod hemisphere;
+pub mod lobe;
 pub mod options;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
+pub use lobe::{AnalyticSampler, LobeError, LobeFit, LobeSampler, LobeSupport};
 pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};
