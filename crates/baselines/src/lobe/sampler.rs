@@ -1,6 +1,7 @@
 //! `lobe-sphere` and `lobe-hemisphere`: the fitted cosine lobe around the mirror direction,
 //! mixed with cosine hemisphere sampling.
 
+use std::cell::Cell;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::Arc;
 
@@ -176,8 +177,24 @@ impl LobeSampler {
     }
 
     /// Above-horizon mass of the lobe at `wo` with `nodes` nodes per panel.
+    ///
+    /// A pure function of `(θo, n, nodes)`; the last value is remembered per thread, since
+    /// callers evaluate many pdfs at one `ωo` (no shared state: the sampler stays `Sync`).
     fn mass(&self, wo: &Vec3, n: f64, nodes: usize) -> f64 {
-        above_horizon_mass(wo.z.clamp(-1.0, 1.0).acos(), n, nodes)
+        thread_local! {
+            static LAST: Cell<(u64, u64, usize, f64)> = const { Cell::new((u64::MAX, u64::MAX, 0, 0.0)) };
+        }
+        let theta = wo.z.clamp(-1.0, 1.0).acos();
+        let key = (theta.to_bits(), n.to_bits(), nodes);
+        LAST.with(|last| {
+            let (t, e, k, value) = last.get();
+            if (t, e, k) == key {
+                return value;
+            }
+            let value = above_horizon_mass(theta, n, nodes);
+            last.set((key.0, key.1, key.2, value));
+            value
+        })
     }
 }
 
