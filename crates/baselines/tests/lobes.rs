@@ -15,6 +15,11 @@ use proptest::prelude::*;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
+/// A labelled sampler with its BRDF.
+type Case = (String, Arc<dyn Brdf>, Box<dyn DirectionSampler>);
+/// A BRDF with its samplers.
+type Built = (Arc<dyn Brdf>, Vec<Box<dyn DirectionSampler>>);
+
 fn brdf(spec: &str) -> Arc<dyn Brdf> {
     Arc::from(brdf::parse_spec(spec).unwrap())
 }
@@ -126,7 +131,7 @@ fn pdfs_integrate_to_one() {
 #[test]
 fn estimates_of_the_albedo_match_its_quadrature() {
     // E[f cos / p] = ∫_Ω f cos dσ (unbiasedness, every sampler on every kind of model).
-    let mut cases: Vec<(String, Arc<dyn Brdf>, Box<dyn DirectionSampler>)> = Vec::new();
+    let mut cases: Vec<Case> = Vec::new();
     for spec in [
         "phong:n=50",
         "ggx:alpha=0.2,alpha_y=0.5",
@@ -312,7 +317,7 @@ proptest! {
         model in 0usize..4,
     ) {
         use std::sync::OnceLock;
-        static BUILT: OnceLock<Vec<(Arc<dyn Brdf>, Vec<Box<dyn DirectionSampler>>)>> = OnceLock::new();
+        static BUILT: OnceLock<Vec<Built>> = OnceLock::new();
         let built = BUILT.get_or_init(|| {
             ["phong:n=80", "ggx:alpha=0.15,alpha_y=0.4", "beckmann:alpha=0.05", "ward"]
                 .iter()
