@@ -42,6 +42,14 @@ pub mod names {
     pub const BOUND_AUDIT: &str = "bound-audit";
     /// The sampler could be built.
     pub const BUILD: &str = "build";
+    /// The sampler does not apply to this target (e.g. `analytic` for a model without an
+    /// analytic sampler): reported, not failed.
+    pub const SKIPPED: &str = "skipped";
+}
+
+/// A passed deterministic outcome recording that the case was skipped, and why.
+pub(crate) fn skipped_outcome(reason: impl std::fmt::Display) -> TestOutcome {
+    TestOutcome::deterministic(names::SKIPPED, f64::NAN, true, format!("skipped: {reason}"))
 }
 
 /// A failed deterministic outcome describing an error that prevented a test.

@@ -12,9 +12,10 @@ use stats::{TestOutcome, sidak_level};
 
 use crate::adapters::DirectionAtWo;
 use crate::builds::{
-    StandaloneCase, build_direction, build_disc, direction_domain, standalone_cases, uses_brdf,
+    StandaloneCase, build_direction, build_disc, direction_domain, not_applicable,
+    standalone_cases, uses_brdf,
 };
-use crate::case::{error_outcome, names, run_case};
+use crate::case::{error_outcome, names, run_case, skipped_outcome};
 use crate::domain::Domain;
 use crate::error::ValidationError;
 use crate::mutants::mutants;
@@ -211,11 +212,14 @@ fn run_brdf_job(
 ) -> Vec<CaseResult> {
     let (spec, brdf) = &r.brdfs[bi];
     // Direction samplers are built once per BRDF; disc samplers per angle.
-    let built = direction_domain(entry).map(|domain| {
-        build_direction(entry, brdf)
-            .map(|s| (s, domain))
-            .map_err(|e| e.to_string())
-    });
+    let built = match direction_domain(entry)
+        .map(|domain| build_direction(entry, brdf).map(|s| (s, domain)))
+    {
+        Some(Err(e)) if not_applicable(&e) => {
+            return skipped_angles(entry.name, spec, r, &e.to_string(), on_done);
+        }
+        other => other.map(|b| b.map_err(|e| e.to_string())),
+    };
     let subject_at = |wo: Vec3, refs: &BrdfReferences| match &built {
         Some(b) => {
             let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
@@ -229,6 +233,30 @@ fn run_brdf_job(
         ))),
     };
     run_angles(entry.name, spec, r, refs, seed, on_done, &subject_at)
+}
+
+/// The cases of a sampler that does not apply to a BRDF: one skipped outcome per angle.
+fn skipped_angles(
+    sampler: &str,
+    spec: &str,
+    r: &Resolved,
+    reason: &str,
+    on_done: &(dyn Fn(&CaseResult) + Sync),
+) -> Vec<CaseResult> {
+    r.angles
+        .iter()
+        .map(|&theta| {
+            let c = CaseResult {
+                sampler: sampler.to_owned(),
+                target: spec.to_owned(),
+                theta_o: Some(theta),
+                domain: "—".to_owned(),
+                outcomes: vec![skipped_outcome(reason)],
+            };
+            on_done(&c);
+            c
+        })
+        .collect()
 }
 
 /// A direction sampler at `wo` as a subject on `domain`.

@@ -2,7 +2,10 @@
 //!
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
 //! [`UniformHemisphere`] and [`CosineHemisphere`]; per-slice tabulated CDFs, uncompressed
-//! ([`TabulatedCdf`]) and Douglas–Peucker-compressed ([`CascadeCdf`], Lawrence 2005), in [`cdf`].
+//! ([`TabulatedCdf`]) and Douglas–Peucker-compressed ([`CascadeCdf`], Lawrence 2005), in [`cdf`];
+//! the cosine lobe about the mirror direction
+//! with a fitted exponent per outgoing slice ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`),
+//! and the models' own analytic samplers ([`AnalyticSampler`]: `analytic`).
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -17,6 +20,22 @@
 //! let mut u = UniformSequence::new(&[0.25, 0.5]);
 //! let s = CosineHemisphere.sample(&wo, &mut u);
 //! assert!((s.pdf - CosineHemisphere.pdf(&wo, &s.wi)).abs() < 1e-12);
+//!
+//! // The cosine lobe about the mirror direction, exponent fitted per θo slice, and the
+//! // model's own sampler.
+//! use baselines::{AnalyticSampler, LobeOptions, LobeSampler, LobeSupport};
+//! use std::sync::Arc;
+//! let phong: Arc<dyn brdf::Brdf> = Arc::from(brdf::parse_spec("phong:n=50")?);
+//! let options = LobeOptions { slices: 4, ..LobeOptions::default() };
+//! let lobe = LobeSampler::new(&phong, LobeSupport::Hemisphere, &options)?;
+//! assert_eq!(lobe.exponents().len(), 4);
+//! let analytic = AnalyticSampler::new(phong.as_ref())?;
+//! let wo = brdf::direction_from_angles(30.0, 0.0);
+//! for s in [&lobe as &dyn DirectionSampler, &analytic] {
+//!     let d = s.sample(&wo, &mut UniformSequence::new(&[0.5, 0.25, 0.75]));
+//!     assert!((d.pdf - s.pdf(&wo, &d.wi)).abs() <= 1e-12 * d.pdf);
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 // `!(x > 0.0)` is the project's NaN-rejecting check (NaN fails it).
@@ -24,8 +43,10 @@
 
 pub mod cdf;
 pub mod hemisphere;
+pub mod lobe;
 pub mod options;
 
 pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
+pub use lobe::{AnalyticSampler, LobeError, LobeFit, LobeSampler, LobeSupport};
 pub use options::{BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, LobeOptions};

@@ -1,5 +1,6 @@
 //! The [`Brdf`] trait shared by every reflectance model.
 
+use crate::analytic::AnalyticLobes;
 use crate::geometry::Vec3;
 use std::sync::Arc;
 
@@ -83,6 +84,13 @@ pub trait Brdf: Send + Sync {
         true
     }
 
+    /// The model's diffuse and specular parts as a renderer's analytic importance sampler
+    /// needs them (GGX/Beckmann visible normals, Phong and Blinn lobes, Ward), or `None` when
+    /// the model has no standard analytic sampler. Default `None`.
+    fn analytic_lobes(&self) -> Option<AnalyticLobes> {
+        None
+    }
+
     /// Short model name (the registry key, e.g. `"phong"`).
     fn name(&self) -> &str {
         "custom"
@@ -117,6 +125,9 @@ macro_rules! forward_brdf {
             }
             fn bounded_at_horizon(&self) -> bool {
                 (**self).bounded_at_horizon()
+            }
+            fn analytic_lobes(&self) -> Option<AnalyticLobes> {
+                (**self).analytic_lobes()
             }
             fn name(&self) -> &str {
                 (**self).name()

@@ -37,6 +37,7 @@
 // `!(x > 0.0)` is the house style for checks that must also reject NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analytic;
 mod brdf;
 pub mod fresnel;
 mod geometry;
@@ -51,6 +52,7 @@ pub mod special;
 mod test_support;
 
 pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, luminance};
+pub use analytic::{AnalyticLobes, SpecularLobe};
 pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,
     reflect_about, rotate_y, rotate_z,

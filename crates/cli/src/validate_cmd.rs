@@ -115,6 +115,20 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
         failed.len(),
         report.alpha
     );
+    let skipped: Vec<_> = report
+        .tests
+        .iter()
+        .filter(|t| t.test == validation::names::SKIPPED)
+        .collect();
+    if let Some(first) = skipped.first() {
+        println!(
+            "skipped    {} cases where the sampler does not apply, e.g. {} | {}: {}",
+            skipped.len(),
+            first.sampler,
+            first.brdf,
+            first.detail
+        );
+    }
     for t in failed.iter().take(20) {
         println!(
             "  FAILED   {} | {} | θo {} | {}: statistic {:.4e}, p = {}",

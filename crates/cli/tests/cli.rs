@@ -143,6 +143,42 @@ fn bad_inputs_exit_2_with_one_line() {
         "such.binary",
     );
     assert_input_error(&["validate", "--quick", "--sampler", "nope"], "nope");
+    // Lobe options out of range: exit 2 with the range.
+    let lobe = |flag: &'static str, value: &'static str| {
+        [
+            "sample",
+            "--brdf",
+            "phong",
+            "--theta-o",
+            "30",
+            "--sampler",
+            "lobe-sphere",
+            "-n",
+            "5",
+            flag,
+            value,
+        ]
+    };
+    assert_input_error(
+        &lobe("--lobe-exponent=-1", "--lobe-slices=4"),
+        "[0, 1000000]",
+    );
+    assert_input_error(&lobe("--lobe-exponent", "NaN"), "--lobe-exponent");
+    assert_input_error(&lobe("--lobe-slices", "0"), "[1, 1024]");
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "oren-nayar",
+            "--theta-o",
+            "30",
+            "--sampler",
+            "analytic",
+            "-n",
+            "5",
+        ],
+        "has no analytic sampler",
+    );
     // Usage errors carry clap's full (multi-line) message; see usage_errors_show_clap_s_….
     assert_usage_error(&["nosuchcommand"], "nosuchcommand");
 }

@@ -8,8 +8,8 @@ use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, Scheme};
 use partition_sampler::{Domain, QuadTreeBuilder, Rect, SampledGridDensity};
 
 use crate::{
-    BuiltDirection, Capabilities, Constructor, DiscSampler, GridSampler, RegistryError,
-    SamplerEntry, Support,
+    BuiltDirection, Capabilities, Constructor, DirectionRequest, DiscSampler, GridSampler,
+    RegistryError, SamplerEntry, Support,
 };
 
 /// Capabilities of the adaptive quadtree sets: exact pdf (envelope scheme, or the papers'
@@ -95,7 +95,41 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         },
     },
     // -- lobe baselines (lobe-sphere, lobe-hemisphere, analytic) --
-
+    SamplerEntry {
+        name: "lobe-sphere",
+        summary: "cosine lobe (n+1)/(2π)·max(0, ω_r·ω)^n about the mirror direction on S², exponent fitted per θo slice (--lobe-exponent fixes it), mixed with cosine sampling; below-horizon samples contribute zero",
+        capabilities: LOBE,
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |r| lobe(r, baselines::LobeSupport::Sphere),
+        },
+    },
+    SamplerEntry {
+        name: "lobe-hemisphere",
+        summary: "the fitted cosine lobe truncated to the hemisphere, normalised by its exact above-horizon mass (quadrature), mixed with cosine sampling",
+        capabilities: LOBE,
+        constructor: Constructor::Direction {
+            support: Support::Hemisphere,
+            build: |r| lobe(r, baselines::LobeSupport::Hemisphere),
+        },
+    },
+    SamplerEntry {
+        name: "analytic",
+        summary: "the model's own sampler (GGX/Beckmann visible normals, Phong/Blinn lobes, Ward) mixed with cosine sampling by its diffuse weight; models without one are refused",
+        capabilities: Capabilities {
+            needs_build: false,
+            measured: false,
+            ..LOBE
+        },
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |r| {
+                Ok(BuiltDirection::plain(Arc::new(
+                    baselines::AnalyticSampler::new(r.brdf.as_ref())?,
+                )))
+            },
+        },
+    },
     // -- CDF baselines (tabulated-cdf, cascade-cdf) --
     SamplerEntry {
         name: "tabulated-cdf",
@@ -184,6 +218,25 @@ const CDF_TABLE: Capabilities = Capabilities {
     anisotropic: true,
     measured: true,
 };
+
+/// Capabilities of the lobe baselines: exact pdf (the hemisphere lobe's mass by a declared
+/// quadrature), fitted per BRDF, every kind of BRDF.
+const LOBE: Capabilities = Capabilities {
+    exact_pdf: true,
+    batch_mode: false,
+    needs_build: true,
+    anisotropic: true,
+    measured: true,
+};
+
+fn lobe(
+    request: &DirectionRequest<'_>,
+    support: baselines::LobeSupport,
+) -> Result<BuiltDirection, RegistryError> {
+    Ok(BuiltDirection::plain(Arc::new(
+        baselines::LobeSampler::new(&request.brdf, support, &request.baselines.lobe)?,
+    )))
+}
 
 /// Capabilities of the tabulated CDFs of maps and grids.
 const BLIND_TABLE: Capabilities = Capabilities {

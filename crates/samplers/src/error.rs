@@ -66,7 +66,10 @@ pub enum RegistryError {
     #[error(transparent)]
     Grid(#[from] partition_sampler::PiecewiseConstantError),
     // -- lobe baselines' error --
-
+    /// A lobe or analytic baseline could not be built (bad option, or no analytic sampler for
+    /// the model).
+    #[error(transparent)]
+    Lobe(#[from] baselines::LobeError),
     // -- CDF baselines' error --
     /// A tabulated or cascade CDF could not be built (an option out of range).
     #[error("cdf baseline: {0}")]

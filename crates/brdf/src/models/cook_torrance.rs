@@ -131,6 +131,17 @@ impl Brdf for CookTorrance {
     fn conserves_energy(&self) -> bool {
         self.params.kd + self.params.ks <= 1.0
     }
+    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
+        Some(crate::AnalyticLobes {
+            diffuse: self.params.kd,
+            specular: self.params.ks,
+            lobe: Some(crate::SpecularLobe::Microfacet {
+                distribution: super::NormalDistribution::Beckmann,
+                alpha_x: self.params.m,
+                alpha_y: self.params.m,
+            }),
+        })
+    }
     fn name(&self) -> &str {
         NAME
     }

@@ -91,6 +91,13 @@ impl Brdf for Lambert {
     fn conserves_energy(&self) -> bool {
         true
     }
+    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
+        Some(crate::AnalyticLobes {
+            diffuse: 1.0,
+            specular: 0.0,
+            lobe: None,
+        })
+    }
     fn name(&self) -> &str {
         NAME
     }

@@ -106,6 +106,15 @@ impl Brdf for Lewis {
     fn conserves_energy(&self) -> bool {
         self.lobe.conserves_energy()
     }
+    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
+        Some(crate::AnalyticLobes {
+            diffuse: self.params.kd,
+            specular: self.params.ks,
+            lobe: Some(crate::SpecularLobe::HalfVector {
+                exponent: self.params.n,
+            }),
+        })
+    }
     fn name(&self) -> &str {
         NAME
     }

@@ -206,6 +206,17 @@ impl Brdf for Microfacet {
     fn conserves_energy(&self) -> bool {
         true
     }
+    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
+        Some(crate::AnalyticLobes {
+            diffuse: 0.0,
+            specular: 1.0,
+            lobe: Some(crate::SpecularLobe::Microfacet {
+                distribution: self.dist,
+                alpha_x: self.params.alpha_x,
+                alpha_y: self.params.alpha_y,
+            }),
+        })
+    }
     fn name(&self) -> &str {
         match self.dist {
             NormalDistribution::Beckmann => NAME_BECKMANN,

@@ -111,6 +111,15 @@ impl Brdf for Phong {
     fn conserves_energy(&self) -> bool {
         self.params.kd + self.params.ks <= 1.0
     }
+    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
+        Some(crate::AnalyticLobes {
+            diffuse: self.params.kd,
+            specular: self.params.ks,
+            lobe: Some(crate::SpecularLobe::Phong {
+                exponent: self.params.n,
+            }),
+        })
+    }
     fn name(&self) -> &str {
         NAME
     }
