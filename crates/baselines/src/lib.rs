@@ -1,7 +1,8 @@
 //! Baseline samplers that brdf-lab's adaptive-partition sampler is compared with.
 //!
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
-//! [`UniformHemisphere`] and [`CosineHemisphere`].
+//! [`UniformHemisphere`] and [`CosineHemisphere`]; [`FactoredSampler`] (Lawrence et al. 2004,
+//! NMF-factored `f_r cos θ`, options [`FactoredOptions`]).
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -18,8 +19,16 @@
 //! assert!((s.pdf - CosineHemisphere.pdf(&wo, &s.wi)).abs() < 1e-12);
 //! ```
 
+// `!(x > 0.0)`-style checks are deliberate: they reject NaN along with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod factored;
 pub mod hemisphere;
 pub mod options;
 
+pub use factored::{FactoredError, FactoredReport, FactoredSampler};
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
-pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};
+pub use options::{
+    BaselineOptions, CdfOptions, FactoredOptions, FactoredOptionsError, LobeOptions, NmfCost,
+    Reparam,
+};
