@@ -70,4 +70,7 @@ pub enum RegistryError {
     // -- CDF baselines' error --
 
     // -- factored baseline's error --
+    /// The factored baseline could not be built.
+    #[error(transparent)]
+    Factored(#[from] baselines::FactoredError),
 }
