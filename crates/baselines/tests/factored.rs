@@ -257,3 +257,30 @@ fn iteration_cap_keeps_the_result_and_reports_it() {
     let total = sphere_integral(300, |wi| s.pdf(&wo, wi));
     assert!((total - 1.0).abs() < 5e-3, "{total}");
 }
+
+#[test]
+fn anisotropic_and_full_row_tables_are_unbiased() {
+    // θo × φo rows: an anisotropic BRDF, and an isotropic one with the θo-only variant off.
+    for (spec, isotropic_rows) in [
+        ("ward:alpha_x=0.1,alpha_y=0.3", true),
+        ("phong:n=30", false),
+    ] {
+        let b = brdf(spec);
+        let options = FactoredOptions {
+            isotropic_rows,
+            ..small()
+        };
+        let s = FactoredSampler::build(b.as_ref(), &options).unwrap();
+        assert!(!s.report().rows_theta_only);
+        assert_eq!(s.report().rows, 16 * 32);
+        for (theta, phi) in [(25.0, 40.0), (70.0, 200.0)] {
+            let wo = direction_from_angles(theta, phi);
+            let total = sphere_integral(600, |wi| s.pdf(&wo, wi));
+            assert!((total - 1.0).abs() < 5e-3, "{spec} {theta} {phi}: {total}");
+            let reference = albedo(b.as_ref(), &wo);
+            let values = estimates(&s, b.as_ref(), &wo, 100_000, 8, &|wi| s.pdf(&wo, wi));
+            let z = mean_z_test(&values, reference, 1e-3).unwrap();
+            assert!(z.passed, "{spec} {theta} {phi}: {z:?}");
+        }
+    }
+}

@@ -3,7 +3,7 @@
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
-use brdf::{Vec3, rotate_z};
+use brdf::Vec3;
 
 use crate::options::Reparam;
 
@@ -92,17 +92,17 @@ impl OutgoingCells {
         }
     }
 
-    /// The row of `wo` (nearest cell, the same lookup for `sample` and `pdf`) and the angle
-    /// by which the row's frame is turned about the normal (`φo` in the θo-only variant, else 0).
-    pub(crate) fn cell(&self, wo: &Vec3) -> (usize, f64) {
+    /// The row of `wo` (nearest cell, the same lookup for `sample` and `pdf`) and the turn
+    /// about the normal of the row's frame (by `φo` in the θo-only variant, else none).
+    pub(crate) fn cell(&self, wo: &Vec3) -> (usize, Turn) {
         let theta = wo.z.clamp(-1.0, 1.0).acos();
         let t = ((theta / FRAC_PI_2) * self.n_theta as f64) as usize;
         let it = t.min(self.n_theta - 1);
-        let phi = wo.y.atan2(wo.x);
         if self.theta_only {
-            (it, phi)
+            (it, Turn::to_azimuth_of(wo))
         } else {
-            (it * self.phi.n + self.phi.bin_of(phi), 0.0)
+            let phi = wo.y.atan2(wo.x);
+            (it * self.phi.n + self.phi.bin_of(phi), Turn::NONE)
         }
     }
 
@@ -163,18 +163,47 @@ pub(crate) fn reparametrised(reparam: Reparam, wo: &Vec3, wi: &Vec3) -> Option<(
     }
 }
 
-/// `v` in a frame turned by `angle` about the normal (`rotate_z(v, −angle)`).
-pub(crate) fn to_frame(v: &Vec3, angle: f64) -> Vec3 {
-    if angle == 0.0 {
-        *v
-    } else {
-        rotate_z(v, -angle)
-    }
+/// A turn about the normal by the angle with cosine `c` and sine `s`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Turn {
+    c: f64,
+    s: f64,
 }
 
-/// `v` from a frame turned by `angle` back to the local frame.
-pub(crate) fn from_frame(v: &Vec3, angle: f64) -> Vec3 {
-    if angle == 0.0 { *v } else { rotate_z(v, angle) }
+impl Turn {
+    /// No turn.
+    pub(crate) const NONE: Turn = Turn { c: 1.0, s: 0.0 };
+
+    /// The turn by the azimuth of `v` (none when `v` is on the normal).
+    pub(crate) fn to_azimuth_of(v: &Vec3) -> Turn {
+        let r = v.x.hypot(v.y);
+        if r > 0.0 {
+            Turn {
+                c: v.x / r,
+                s: v.y / r,
+            }
+        } else {
+            Turn::NONE
+        }
+    }
+
+    /// `v` in the turned frame (rotated by minus the angle).
+    pub(crate) fn to_frame(&self, v: &Vec3) -> Vec3 {
+        Vec3::new(
+            self.c * v.x + self.s * v.y,
+            -self.s * v.x + self.c * v.y,
+            v.z,
+        )
+    }
+
+    /// `v` from the turned frame back to the local frame.
+    pub(crate) fn from_frame(&self, v: &Vec3) -> Vec3 {
+        Vec3::new(
+            self.c * v.x - self.s * v.y,
+            self.s * v.x + self.c * v.y,
+            v.z,
+        )
+    }
 }
 
 #[cfg(test)]
@@ -218,5 +247,14 @@ mod tests {
         for row in 0..cells.rows() {
             assert_eq!(cells.cell(&cells.centre(row)).0, row);
         }
+        let turned = OutgoingCells {
+            theta_only: true,
+            ..cells
+        };
+        let wo = direction(0.5, 2.0);
+        let (_, turn) = turned.cell(&wo);
+        let local = turn.to_frame(&wo);
+        assert!(local.y.abs() < 1e-15 && local.x > 0.0);
+        assert!((turn.from_frame(&local) - wo).norm() < 1e-15);
     }
 }
