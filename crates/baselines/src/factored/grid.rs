@@ -188,7 +188,7 @@ impl Turn {
     }
 
     /// `v` in the turned frame (rotated by minus the angle).
-    pub(crate) fn to_frame(&self, v: &Vec3) -> Vec3 {
+    pub(crate) fn local_to_row(&self, v: &Vec3) -> Vec3 {
         Vec3::new(
             self.c * v.x + self.s * v.y,
             -self.s * v.x + self.c * v.y,
@@ -197,7 +197,7 @@ impl Turn {
     }
 
     /// `v` from the turned frame back to the local frame.
-    pub(crate) fn from_frame(&self, v: &Vec3) -> Vec3 {
+    pub(crate) fn row_to_local(&self, v: &Vec3) -> Vec3 {
         Vec3::new(
             self.c * v.x - self.s * v.y,
             self.s * v.x + self.c * v.y,
@@ -253,8 +253,8 @@ mod tests {
         };
         let wo = direction(0.5, 2.0);
         let (_, turn) = turned.cell(&wo);
-        let local = turn.to_frame(&wo);
+        let local = turn.local_to_row(&wo);
         assert!(local.y.abs() < 1e-15 && local.x > 0.0);
-        assert!((turn.from_frame(&local) - wo).norm() < 1e-15);
+        assert!((turn.row_to_local(&local) - wo).norm() < 1e-15);
     }
 }

@@ -96,8 +96,8 @@ impl FactoredSampler {
     /// (`None` where the factored density is zero).
     fn locate(&self, wo: &Vec3, wi: &Vec3) -> (usize, Option<(usize, usize, f64)>) {
         let (row, turn) = self.outgoing.cell(wo);
-        let wo_r = turn.to_frame(wo);
-        let wi_r = turn.to_frame(wi);
+        let wo_r = turn.local_to_row(wo);
+        let wi_r = turn.local_to_row(wi);
         let cell = reparametrised(self.reparam, &wo_r, &wi_r).map(|(wp, jacobian)| {
             let a = self.theta_p.band_of(wp.z);
             let b = self.phi_p.bin_of(wp.y.atan2(wp.x));
@@ -144,8 +144,8 @@ impl FactoredSampler {
         let (b, t) = pick(cdf, u2);
         let phi = (b as f64 + t) * self.phi_p.width;
         let wp = direction(z, phi);
-        let wo_r = turn.to_frame(wo);
-        turn.from_frame(&incoming(self.reparam, &wo_r, &wp))
+        let wo_r = turn.local_to_row(wo);
+        turn.row_to_local(&incoming(self.reparam, &wo_r, &wp))
     }
 }
 
