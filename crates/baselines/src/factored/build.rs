@@ -131,6 +131,22 @@ impl FactoredSampler {
     ///
     /// Errors: [`FactoredError`] for invalid options, a negative or non-finite BRDF value, or
     /// a BRDF that is zero on every cell.
+    ///
+    /// ```
+    /// use baselines::{FactoredOptions, FactoredSampler};
+    /// use brdf_sampling::DirectionSampler;
+    /// use partition_sampler::UniformSequence;
+    ///
+    /// let brdf = brdf::parse_spec("phong:n=20")?;
+    /// let options = FactoredOptions { max_iterations: 200, ..FactoredOptions::default() };
+    /// let sampler = FactoredSampler::build(brdf.as_ref(), &options)?;
+    /// println!("{}", sampler.report()); // fit, convergence, build time, bytes
+    ///
+    /// let wo = brdf::direction_from_angles(30.0, 0.0);
+    /// let s = sampler.sample(&wo, &mut UniformSequence::new(&[0.5, 0.3, 0.7]));
+    /// assert!((s.pdf - sampler.pdf(&wo, &s.wi)).abs() <= 1e-12 * s.pdf);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn build(brdf: &dyn Brdf, options: &FactoredOptions) -> Result<Self, FactoredError> {
         options.validate()?;
         let start = Instant::now();
