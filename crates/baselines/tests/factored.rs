@@ -284,3 +284,31 @@ fn anisotropic_and_full_row_tables_are_unbiased() {
         }
     }
 }
+
+#[test]
+fn every_analytic_model_at_the_full_tier_angles_is_unbiased() {
+    // E[g/p] against the albedo for every analytic model at θo ∈ {0, 30, 60, 85, 89}° with the
+    // default options (Šidák-corrected over the cases), plus p > 0 at every sample.
+    let cases: Vec<(&str, f64)> = brdf::models()
+        .iter()
+        .filter(|m| m.name != "merl")
+        .flat_map(|m| [0.0, 30.0, 60.0, 85.0, 89.0].map(|t| (m.name, t)))
+        .collect();
+    let alpha = 1.0 - (1.0 - 1e-3f64).powf(1.0 / cases.len() as f64);
+    let options = FactoredOptions {
+        max_iterations: 300,
+        ..FactoredOptions::default()
+    };
+    let mut built = std::collections::HashMap::new();
+    for (name, theta) in cases {
+        let b = brdf(name);
+        let s = built
+            .entry(name)
+            .or_insert_with(|| FactoredSampler::build(b.as_ref(), &options).unwrap());
+        let wo = direction_from_angles(theta, 0.0);
+        let reference = albedo(b.as_ref(), &wo);
+        let values = estimates(s, b.as_ref(), &wo, 40_000, 21, &|wi| s.pdf(&wo, wi));
+        let z = mean_z_test(&values, reference, alpha).unwrap();
+        assert!(z.passed, "{name} θo {theta}: {z:?}");
+    }
+}
