@@ -3,9 +3,10 @@
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
 //! [`UniformHemisphere`] and [`CosineHemisphere`]; per-slice tabulated CDFs, uncompressed
 //! ([`TabulatedCdf`]) and Douglas–Peucker-compressed ([`CascadeCdf`], Lawrence 2005), in [`cdf`];
-//! the cosine lobe about the mirror direction
-//! with a fitted exponent per outgoing slice ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`),
-//! and the models' own analytic samplers ([`AnalyticSampler`]: `analytic`).
+//! the cosine lobe about the mirror direction with a fitted exponent per outgoing slice
+//! ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`); the models' own analytic samplers
+//! ([`AnalyticSampler`]: `analytic`); [`FactoredSampler`] (Lawrence et al. 2004, NMF-factored
+//! `f_r cos θ`, options [`FactoredOptions`]).
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -42,11 +43,16 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod cdf;
+pub mod factored;
 pub mod hemisphere;
 pub mod lobe;
 pub mod options;
 
 pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
+pub use factored::{FactoredError, FactoredReport, FactoredSampler};
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use lobe::{AnalyticSampler, LobeError, LobeFit, LobeSampler, LobeSupport};
-pub use options::{BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, LobeOptions};
+pub use options::{
+    BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, FactoredOptionsError,
+    LobeOptions, NmfCost, Reparam,
+};

@@ -165,6 +165,27 @@ pub static SAMPLERS: &[SamplerEntry] = &[
     },
     // -- factored baseline (Lawrence 2004) --
     SamplerEntry {
+        name: "factored",
+        summary: "Lawrence et al. 2004: two-level NMF of f_r·cosθ (half-angle, J = 3, K = 2), term by F_l(ωo), mixture pdf over all terms; defensive cosine α = 0.05 (non-paper)",
+        capabilities: Capabilities {
+            exact_pdf: true,
+            batch_mode: false,
+            needs_build: true,
+            anisotropic: true,
+            measured: true,
+        },
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |request| {
+                let sampler = baselines::FactoredSampler::build(
+                    request.brdf.as_ref(),
+                    &request.baselines.factored,
+                )?;
+                Ok(BuiltDirection::plain(Arc::new(sampler)))
+            },
+        },
+    },
+    SamplerEntry {
         name: "quadtree-disc",
         summary: "the generic partition sampler applied naively to f_r(ωo, h⁻¹(x)) on the disc for one ωo (512² image map, safety 1.25; no rim band, no equal-area slices)",
         capabilities: Capabilities {

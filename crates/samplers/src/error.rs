@@ -75,4 +75,7 @@ pub enum RegistryError {
     #[error("cdf baseline: {0}")]
     Cdf(#[from] baselines::CdfOptionsError),
     // -- factored baseline's error --
+    /// The factored baseline could not be built.
+    #[error(transparent)]
+    Factored(#[from] baselines::FactoredError),
 }

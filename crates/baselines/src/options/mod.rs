@@ -6,7 +6,7 @@ mod factored;
 mod lobe;
 
 pub use cdf::{CdfOptions, CdfOptionsError};
-pub use factored::FactoredOptions;
+pub use factored::{FactoredOptions, FactoredOptionsError, NmfCost, Reparam};
 pub use lobe::LobeOptions;
 
 /// Options of every BRDF baseline (each family's defaults are the papers' or measured ones).
