@@ -116,7 +116,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
             Tier::Full => {
                 let mut v: Vec<String> = brdf::models()
                     .iter()
-                    .filter(|m| m.name != "merl")
+                    .filter(|m| !m.needs_argument())
                     .map(|m| m.name.to_owned())
                     .collect();
                 if let Some(dir) = &config.merl_dir {

@@ -40,6 +40,7 @@
 mod brdf;
 pub mod fresnel;
 mod geometry;
+pub mod measured;
 pub mod merl;
 pub mod models;
 mod params;
@@ -55,6 +56,7 @@ pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,
     reflect_about, rotate_y, rotate_z,
 };
+pub use measured::rgl::{RglBrdf, RglError};
 pub use merl::{MerlBrdf, MerlError, write_merl};
 pub use params::{ParamDefault, ParamError, ParamInfo, Range};
 pub use plausibility::energy_warnings;

@@ -1,6 +1,7 @@
 //! Model registry and the `SPEC` parser (`name` or `name:key=value,...`, or `merl:PATH`).
 
 use crate::brdf::Brdf;
+use crate::measured::rgl::{RglBrdf, RglError};
 use crate::merl::{MerlBrdf, MerlError};
 use crate::models::*;
 use crate::params::{ParamDefault, ParamError, ParamInfo, Range};
@@ -102,6 +103,13 @@ impl ModelInfo {
         (self.build)(&resolved).map_err(SpecError::Invalid)
     }
 
+    /// Whether the model is built from a spec argument (a file path such as `merl:PATH` or a
+    /// preset name) rather than from numeric parameters: such models have no defaults to
+    /// build from.
+    pub fn needs_argument(&self) -> bool {
+        ARGUMENT_MODELS.contains(&self.name)
+    }
+
     /// Comma-separated list of the valid keys.
     pub fn valid_keys(&self) -> String {
         if self.params.is_empty() {
@@ -180,12 +188,26 @@ pub enum SpecError {
     /// `merl` without a path.
     #[error("merl: missing file path (expected `merl:PATH`)")]
     MissingPath,
+    /// A file format (`rgl`, …) without a path.
+    #[error("{model}: missing file path (expected `{model}:PATH`)")]
+    MissingFile {
+        /// The format's name.
+        model: &'static str,
+    },
     /// A cross-parameter constraint failed in the model constructor.
     #[error(transparent)]
     Invalid(#[from] ParamError),
     /// The MERL file could not be loaded.
     #[error(transparent)]
     Merl(#[from] MerlError),
+    /// The RGL file could not be loaded.
+    #[error("rgl:{path}: {source}")]
+    Rgl {
+        /// The path given.
+        path: String,
+        /// The cause.
+        source: RglError,
+    },
 }
 
 macro_rules! boxed {
@@ -368,9 +390,26 @@ static MODELS: &[ModelInfo] = &[
             })
         },
     },
+    ModelInfo {
+        name: "rgl",
+        aliases: &[],
+        summary: "measured isotropic RGB material of the RGL database, spec `rgl:PATH` (Dupuy & Jakob 2018 `.bsdf` tensor file)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "rgl",
+                message: "needs a file: use the spec `rgl:PATH`".into(),
+            })
+        },
+    },
 ];
 
-/// All registered models (analytic ones, then `merl`), in listing order.
+/// Models built from a spec argument instead of numeric parameters
+/// ([`ModelInfo::needs_argument`]).
+const ARGUMENT_MODELS: &[&str] = &["merl", "rgl"];
+
+/// All registered models (analytic ones, then the measured formats), in listing order.
 pub fn models() -> &'static [ModelInfo] {
     MODELS
 }
@@ -384,7 +423,7 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 
 /// Parse a BRDF spec and build the model.
 ///
-/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH`. Whitespace around names,
+/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
 /// keys), malformed item, bad number, out-of-range value (stating the range), duplicate key,
@@ -404,6 +443,18 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
             return Err(SpecError::MissingPath);
         }
         return Ok(Box::new(MerlBrdf::load(Path::new(path))?));
+    }
+    if name.eq_ignore_ascii_case("rgl") {
+        let path = rest.map(str::trim).unwrap_or("");
+        if path.is_empty() {
+            return Err(SpecError::MissingFile { model: "rgl" });
+        }
+        return RglBrdf::load(Path::new(path))
+            .map(|b| Box::new(b) as Box<dyn Brdf>)
+            .map_err(|source| SpecError::Rgl {
+                path: path.to_string(),
+                source,
+            });
     }
     let Some(info) = find_model(name) else {
         return Err(SpecError::UnknownModel {
@@ -459,7 +510,7 @@ mod tests {
 
     #[test]
     fn every_model_builds_from_defaults() {
-        for m in models().iter().filter(|m| m.name != "merl") {
+        for m in models().iter().filter(|m| !m.needs_argument()) {
             let b = parse_spec(m.name).unwrap_or_else(|e| panic!("{}: {e}", m.name));
             assert_eq!(b.name(), m.name);
             match m.isotropic {

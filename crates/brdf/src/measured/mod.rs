@@ -1,0 +1,6 @@
+//! Measured reflectance formats beyond MERL: the RGL material database's `.bsdf` tensor files
+//! ([`rgl`]) and the Cornell pbrt-v2 `.brdf` spectral samples.
+
+pub mod rgl;
+pub mod tensor;
+pub mod warp;
