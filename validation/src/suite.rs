@@ -361,8 +361,11 @@ pub fn run(
         .collect();
     let mut jobs: Vec<Job<'_>> = Vec::new();
     for &entry in &brdf_entries {
-        for bi in 0..r.brdfs.len() {
-            jobs.push(Job::Brdf { entry, brdf: bi });
+        for (bi, (_, brdf)) in r.brdfs.iter().enumerate() {
+            // Format-specific samplers (rgl-native) skip the BRDFs they do not apply to.
+            if entry.supports(brdf.as_ref()) {
+                jobs.push(Job::Brdf { entry, brdf: bi });
+            }
         }
     }
     let mut failed_builds: Vec<CaseResult> = Vec::new();
@@ -380,7 +383,11 @@ pub fn run(
     }
     jobs.extend((0..r.sets.len()).map(Job::Set));
     let mutant_list = if config.mutants { mutants() } else { &[] };
-    let total = (brdf_entries.len() * r.brdfs.len() + r.sets.len()) * r.angles.len()
+    let brdf_jobs = jobs
+        .iter()
+        .filter(|j| matches!(j, Job::Brdf { .. }))
+        .count();
+    let total = (brdf_jobs + r.sets.len()) * r.angles.len()
         + jobs
             .iter()
             .filter(|j| matches!(j, Job::Standalone { .. }))

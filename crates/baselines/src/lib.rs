@@ -1,7 +1,7 @@
 //! Baseline samplers that brdf-lab's adaptive-partition sampler is compared with.
 //!
 //! Direction samplers (pdf w.r.t. solid angle, the [`brdf_sampling::DirectionSampler`] shape):
-//! [`UniformHemisphere`] and [`CosineHemisphere`].
+//! [`UniformHemisphere`] and [`CosineHemisphere`]; [`RglNative`], the RGL format's own sampler.
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -20,6 +20,8 @@
 
 pub mod hemisphere;
 pub mod options;
+pub mod rgl_native;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};
+pub use rgl_native::{NotRglError, RglNative};

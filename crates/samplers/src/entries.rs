@@ -142,7 +142,31 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         capabilities: BLIND_TABLE,
         constructor: Constructor::Grid(grid_cdf),
     },
+    SamplerEntry {
+        name: "rgl-native",
+        summary: "RGL .bsdf files only: the format's own sampling (luminance table, then the VNDF warp; Dupuy & Jakob 2018, Mitsuba's measured plugin), exact pdf",
+        capabilities: Capabilities {
+            exact_pdf: true,
+            batch_mode: false,
+            needs_build: false,
+            anisotropic: false,
+            measured: true,
+        },
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |request| {
+                Ok(BuiltDirection::plain(Arc::new(
+                    baselines::RglNative::for_brdf(request.brdf.as_ref())?,
+                )))
+            },
+        },
+    },
 ];
+
+/// Samplers that apply only to some BRDFs (format-specific), with the test of the BRDFs they
+/// accept; every other entry accepts every BRDF of its kind.
+pub(crate) static BRDF_SPECIFIC: &[(&str, fn(&dyn Brdf) -> bool)] =
+    &[("rgl-native", baselines::RglNative::accepts)];
 
 /// Capabilities of the tabulated CDFs of maps and grids.
 const BLIND_TABLE: Capabilities = Capabilities {

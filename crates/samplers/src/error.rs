@@ -70,4 +70,7 @@ pub enum RegistryError {
     // -- CDF baselines' error --
 
     // -- factored baseline's error --
+    /// A format-specific sampler was asked to sample a BRDF of another kind.
+    #[error(transparent)]
+    NotRgl(#[from] baselines::NotRglError),
 }
