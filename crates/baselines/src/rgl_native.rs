@@ -82,7 +82,7 @@ impl DirectionSampler for RglNative {
         let d = wo.dot(&m);
         let wi = (2.0 * d * m - wo).normalize();
         let jac = jacobian(u_m[0], st, d);
-        if !(jac > 0.0) || !wi.iter().all(|v| v.is_finite()) {
+        if jac.is_nan() || jac <= 0.0 || !wi.iter().all(|v| v.is_finite()) {
             return below;
         }
         DirSample {
