@@ -163,9 +163,12 @@ pub static SAMPLERS: &[SamplerEntry] = &[
     },
 ];
 
+/// Whether a format-specific sampler applies to a BRDF.
+pub(crate) type AcceptsBrdf = fn(&dyn Brdf) -> bool;
+
 /// Samplers that apply only to some BRDFs (format-specific), with the test of the BRDFs they
 /// accept; every other entry accepts every BRDF of its kind.
-pub(crate) static BRDF_SPECIFIC: &[(&str, fn(&dyn Brdf) -> bool)] =
+pub(crate) static BRDF_SPECIFIC: &[(&str, AcceptsBrdf)] =
     &[("rgl-native", baselines::RglNative::accepts)];
 
 /// Capabilities of the tabulated CDFs of maps and grids.
