@@ -200,6 +200,24 @@ pub enum SpecError {
     /// The MERL file could not be loaded.
     #[error(transparent)]
     Merl(#[from] MerlError),
+    /// A preset model (`sgd`, `abc`) without `material=NAME`.
+    #[error(
+        "{model}: missing material (expected `{model}:material=NAME`; `brdf-lab list` shows the names)"
+    )]
+    MissingMaterial {
+        /// The model.
+        model: &'static str,
+    },
+    /// No preset of that name.
+    #[error("{model}: unknown material `{name}`{}", if suggestions.is_empty() { "; `brdf-lab list` shows the names".to_string() } else { format!("; close matches: {}", suggestions.join(", ")) })]
+    UnknownMaterial {
+        /// The model.
+        model: &'static str,
+        /// The name given.
+        name: String,
+        /// Close preset names, best first.
+        suggestions: Vec<String>,
+    },
     /// The RGL file could not be loaded.
     #[error("rgl:{path}: {source}")]
     Rgl {
@@ -403,11 +421,80 @@ static MODELS: &[ModelInfo] = &[
             })
         },
     },
+    ModelInfo {
+        name: "sgd",
+        aliases: &[],
+        summary: "Shifted Gamma Distribution model with the published fit of a MERL material, spec `sgd:material=NAME` (Bagher, Soler & Holzschuch 2012)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "sgd",
+                message: "needs a material: use the spec `sgd:material=NAME`".into(),
+            })
+        },
+    },
+    ModelInfo {
+        name: "abc",
+        aliases: &[],
+        summary: "ABC model with the published fit of a MERL material, spec `abc:material=NAME` (Low, Kronander, Ynnerman & Unger 2012)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "abc",
+                message: "needs a material: use the spec `abc:material=NAME`".into(),
+            })
+        },
+    },
 ];
 
 /// Models built from a spec argument instead of numeric parameters
 /// ([`ModelInfo::needs_argument`]).
-const ARGUMENT_MODELS: &[&str] = &["merl", "rgl"];
+const ARGUMENT_MODELS: &[&str] = &["merl", "rgl", "sgd", "abc"];
+
+/// The preset names of a preset model (`sgd`, `abc`), `None` for other models.
+pub fn preset_names(model: &str) -> Option<Vec<&'static str>> {
+    match model {
+        "sgd" => Some(sgd::preset_names()),
+        "abc" => Some(abc::preset_names()),
+        _ => None,
+    }
+}
+
+/// `sgd:material=NAME` / `abc:material=NAME`.
+fn parse_preset(model: &'static str, rest: Option<&str>) -> Result<Box<dyn Brdf>, SpecError> {
+    let rest = rest.map(str::trim).unwrap_or("");
+    if rest.is_empty() {
+        return Err(SpecError::MissingMaterial { model });
+    }
+    let Some((key, name)) = rest.split_once('=') else {
+        return Err(SpecError::Malformed {
+            model: model.to_string(),
+            item: rest.to_string(),
+        });
+    };
+    if key.trim() != "material" {
+        return Err(SpecError::UnknownKey {
+            model: model.to_string(),
+            key: key.trim().to_string(),
+            valid: "material".to_string(),
+        });
+    }
+    let name = name.trim();
+    let built: Option<Box<dyn Brdf>> = match model {
+        "sgd" => Sgd::preset(name).map(|b| Box::new(b) as Box<dyn Brdf>),
+        _ => Abc::preset(name).map(|b| Box::new(b) as Box<dyn Brdf>),
+    };
+    built.ok_or_else(|| SpecError::UnknownMaterial {
+        model,
+        name: name.to_string(),
+        suggestions: match model {
+            "sgd" => sgd::close_matches(name),
+            _ => abc::close_matches(name),
+        },
+    })
+}
 
 /// All registered models (analytic ones, then the measured formats), in listing order.
 pub fn models() -> &'static [ModelInfo] {
@@ -423,7 +510,8 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 
 /// Parse a BRDF spec and build the model.
 ///
-/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH`. Whitespace around names,
+/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` |
+/// `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
 /// keys), malformed item, bad number, out-of-range value (stating the range), duplicate key,
@@ -455,6 +543,12 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
                 path: path.to_string(),
                 source,
             });
+    }
+    if name.eq_ignore_ascii_case("sgd") {
+        return parse_preset("sgd", rest);
+    }
+    if name.eq_ignore_ascii_case("abc") {
+        return parse_preset("abc", rest);
     }
     let Some(info) = find_model(name) else {
         return Err(SpecError::UnknownModel {

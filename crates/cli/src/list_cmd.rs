@@ -4,7 +4,9 @@ use crate::error::CliResult;
 
 /// Runs `brdf-lab list`.
 pub(crate) fn run() -> CliResult<()> {
-    println!("BRDF models (SPEC = name or name:key=value,...; also merl:PATH for MERL files)");
+    println!(
+        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH, rgl:PATH, sgd:material=NAME, abc:material=NAME)"
+    );
     for m in brdf::models() {
         let iso = match m.isotropic {
             brdf::Isotropy::Always => "isotropic",
@@ -18,6 +20,9 @@ pub(crate) fn run() -> CliResult<()> {
         };
         println!("\n  {}{aliases} — {iso}", m.name);
         println!("      {}", m.summary);
+        if let Some(names) = brdf::preset_names(m.name) {
+            println!("      materials ({}): {}", names.len(), names.join(", "));
+        }
         for p in m.params {
             println!(
                 "      {:<10} default {:<10} range {:<16} {}",
