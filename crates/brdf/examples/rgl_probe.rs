@@ -28,6 +28,14 @@ fn main() {
             b.eval(&wi, &wo)
         );
     }
+    let t = std::time::Instant::now();
+    let mut acc = 0.0;
+    let wo = direction_from_angles(30.0, 0.0);
+    for i in 0..1_000_000 {
+        let a = i as f64 * 0.000_001;
+        acc += b.eval(&wo, &direction_from_angles(80.0 * a, 360.0 * a * 37.0));
+    }
+    println!("1e6 evals: {:?} ({acc})", t.elapsed());
     for th in [0.0, 45.0, 80.0] {
         let wo = direction_from_angles(th, 0.0);
         for ti in [85.0, 89.0, 89.9, 89.999] {
