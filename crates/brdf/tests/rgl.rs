@@ -111,6 +111,8 @@ fn white_paper_albedo_is_plausible() {
     for (wo, wi) in random_pairs(3, 2000) {
         let f = b.eval_rgb(&wo, &wi);
         assert!(f.iter().all(|v| v.is_finite() && *v > 0.0), "{f:?}");
+        // The luminance table gives the luminance of the RGB value.
+        approx::assert_relative_eq!(b.eval(&wo, &wi), brdf::luminance(f), max_relative = 1e-12);
     }
 }
 

@@ -198,6 +198,9 @@ struct Tables {
     luminance: Warp2D,
     /// Slices `[θ][channel]`.
     rgb: BilinearTable,
+    /// Luminance `0.2126 R + 0.7152 G + 0.0722 B` of the (clamped) `rgb` table, slices `[θ]`:
+    /// interpolation is linear, so this is the luminance of the interpolated RGB.
+    rgb_luminance: BilinearTable,
     jacobian: bool,
     clamped: Option<NegativeClamp>,
     /// `ndf` and `sigma` do not depend on the azimuth.
@@ -300,6 +303,13 @@ impl RglBrdf {
             c.min = c.min.min(*v);
             *v = 0.0;
         }
+        let cell = lum_shape[2] * lum_shape[3];
+        let mut y = Vec::with_capacity(n_theta * cell);
+        for t in 0..n_theta {
+            let at = |ch: usize, k: usize| rgb[(3 * t + ch) * cell + k];
+            y.extend((0..cell).map(|k| luminance([at(0, k), at(1, k), at(2, k)])));
+        }
+        let rgb_luminance = BilinearTable::new(lum_shape[3], lum_shape[2], y);
         let rgb = BilinearTable::new(lum_shape[3], lum_shape[2], rgb);
 
         let jac_field = tf.field("jacobian")?;
@@ -325,6 +335,7 @@ impl RglBrdf {
                 vndf,
                 luminance: lum,
                 rgb,
+                rgb_luminance,
                 jacobian,
                 clamped,
             }),
@@ -403,6 +414,23 @@ impl RglBrdf {
     /// Linear RGB value of `f_r · cos θi` at given coordinates (the format's definition, see
     /// the module docs).
     pub fn rgb_cos_at(&self, c: &HalfCoords) -> [f64; 3] {
+        let (s, i, w, factor) = self.lookup(c);
+        let t = &self.tables;
+        let mut out = [0.0; 3];
+        for (ch, o) in out.iter_mut().enumerate() {
+            *o = (t.rgb.eval(s, 3 * i + ch, 3, w) * factor).max(0.0);
+        }
+        out
+    }
+
+    /// Luminance of [`rgb_cos_at`](Self::rgb_cos_at) (one table lookup instead of three).
+    pub fn luminance_cos_at(&self, c: &HalfCoords) -> f64 {
+        let (s, i, w, factor) = self.lookup(c);
+        (self.tables.rgb_luminance.eval(s, i, 1, w) * factor).max(0.0)
+    }
+
+    /// The warped-square position, the slice blend and the `D/(4σ)` factor of `c`.
+    fn lookup(&self, c: &HalfCoords) -> ([f64; 2], usize, f64, f64) {
         let t = &self.tables;
         let (s, _) = t.vndf.invert(c.u_m, c.theta_o);
         let (i, w) = t.theta.locate(c.theta_o);
@@ -412,11 +440,7 @@ impl RglBrdf {
         } else {
             1.0
         };
-        let mut out = [0.0; 3];
-        for (ch, o) in out.iter_mut().enumerate() {
-            *o = (t.rgb.eval(s, 3 * i + ch, 3, w) * factor).max(0.0);
-        }
-        out
+        (s, i, w, factor)
     }
 }
 
@@ -490,7 +514,10 @@ fn sampling_table(
 
 impl Brdf for RglBrdf {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        luminance(self.eval_rgb(wo, wi))
+        match Self::half_coords(wo, wi) {
+            Some(c) => self.luminance_cos_at(&c) / wi.z,
+            None => 0.0,
+        }
     }
 
     fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
