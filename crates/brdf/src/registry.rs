@@ -219,7 +219,7 @@ pub enum SpecError {
         suggestions: Vec<String>,
     },
     /// The RGL file could not be loaded.
-    #[error("rgl:{path}: {source}")]
+    #[error("{source}")]
     Rgl {
         /// The path given.
         path: String,
