@@ -44,7 +44,8 @@ pub const QUICK_RGL: &str = concat!(
     "/../data/measured/rgl/paper_white_rgb.bsdf"
 );
 
-/// Directory searched in the full tier for the shared measured materials (`rgl/*.bsdf`), when
+/// Directory searched in the full tier for the shared measured materials (`rgl/*.bsdf`,
+/// `cornell/*.brdf`), when
 /// a MERL directory is searched too (relative to the working directory, like
 /// [`DEFAULT_MERL_DIR`]).
 pub const DEFAULT_MEASURED_DIR: &str = "../shared/data/measured";

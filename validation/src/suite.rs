@@ -69,18 +69,23 @@ impl Resolved {
     }
 }
 
-/// `rgl:` specs of the `rgl/*.bsdf` files under `dir` (none when absent).
+/// `rgl:` specs of the `rgl/*.bsdf` files and `cornell:` specs of the `cornell/*.brdf` files
+/// under `dir` (none when absent).
 fn measured_specs(dir: &Path) -> Vec<String> {
-    let Ok(entries) = std::fs::read_dir(dir.join("rgl")) else {
-        return Vec::new();
-    };
-    let mut files: Vec<String> = entries
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "bsdf"))
-        .map(|p| format!("rgl:{}", p.display()))
-        .collect();
-    files.sort();
+    let mut files: Vec<String> = Vec::new();
+    for (sub, ext, model) in [("rgl", "bsdf", "rgl"), ("cornell", "brdf", "cornell")] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        let mut found: Vec<String> = entries
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == ext))
+            .map(|p| format!("{model}:{}", p.display()))
+            .collect();
+        found.sort();
+        files.extend(found);
+    }
     files
 }
 

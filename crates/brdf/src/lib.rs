@@ -56,6 +56,7 @@ pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,
     reflect_about, rotate_y, rotate_z,
 };
+pub use measured::cornell::{CornellBrdf, CornellError};
 pub use measured::rgl::{RglBrdf, RglError};
 pub use merl::{MerlBrdf, MerlError, write_merl};
 pub use params::{ParamDefault, ParamError, ParamInfo, Range};

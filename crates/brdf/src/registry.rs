@@ -1,6 +1,7 @@
 //! Model registry and the `SPEC` parser (`name` or `name:key=value,...`, or `merl:PATH`).
 
 use crate::brdf::Brdf;
+use crate::measured::cornell::{CornellBrdf, CornellError};
 use crate::measured::rgl::{RglBrdf, RglError};
 use crate::merl::{MerlBrdf, MerlError};
 use crate::models::*;
@@ -218,6 +219,14 @@ pub enum SpecError {
         /// Close preset names, best first.
         suggestions: Vec<String>,
     },
+    /// The Cornell file could not be loaded.
+    #[error("{source}")]
+    Cornell {
+        /// The path given.
+        path: String,
+        /// The cause.
+        source: CornellError,
+    },
     /// The RGL file could not be loaded.
     #[error("{source}")]
     Rgl {
@@ -422,6 +431,19 @@ static MODELS: &[ModelInfo] = &[
         },
     },
     ModelInfo {
+        name: "cornell",
+        aliases: &[],
+        summary: "measured spectral material of Cornell PCG, spec `cornell:PATH` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "cornell",
+                message: "needs a file: use the spec `cornell:PATH`".into(),
+            })
+        },
+    },
+    ModelInfo {
         name: "sgd",
         aliases: &[],
         summary: "Shifted Gamma Distribution model with the published fit of a MERL material, spec `sgd:material=NAME` (Bagher, Soler & Holzschuch 2012)",
@@ -451,7 +473,7 @@ static MODELS: &[ModelInfo] = &[
 
 /// Models built from a spec argument instead of numeric parameters
 /// ([`ModelInfo::needs_argument`]).
-const ARGUMENT_MODELS: &[&str] = &["merl", "rgl", "sgd", "abc"];
+const ARGUMENT_MODELS: &[&str] = &["merl", "rgl", "cornell", "sgd", "abc"];
 
 /// The preset names of a preset model (`sgd`, `abc`), `None` for other models.
 pub fn preset_names(model: &str) -> Option<Vec<&'static str>> {
@@ -510,7 +532,7 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 
 /// Parse a BRDF spec and build the model.
 ///
-/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` |
+/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` | `cornell:PATH` |
 /// `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
@@ -540,6 +562,18 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
         return RglBrdf::load(Path::new(path))
             .map(|b| Box::new(b) as Box<dyn Brdf>)
             .map_err(|source| SpecError::Rgl {
+                path: path.to_string(),
+                source,
+            });
+    }
+    if name.eq_ignore_ascii_case("cornell") {
+        let path = rest.map(str::trim).unwrap_or("");
+        if path.is_empty() {
+            return Err(SpecError::MissingFile { model: "cornell" });
+        }
+        return CornellBrdf::load(Path::new(path))
+            .map(|b| Box::new(b) as Box<dyn Brdf>)
+            .map_err(|source| SpecError::Cornell {
                 path: path.to_string(),
                 source,
             });

@@ -5,7 +5,7 @@ use crate::error::CliResult;
 /// Runs `brdf-lab list`.
 pub(crate) fn run() -> CliResult<()> {
     println!(
-        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH, rgl:PATH, sgd:material=NAME, abc:material=NAME)"
+        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH, rgl:PATH, cornell:PATH, sgd:material=NAME, abc:material=NAME)"
     );
     for m in brdf::models() {
         let iso = match m.isotropic {

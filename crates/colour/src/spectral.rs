@@ -85,8 +85,16 @@ impl SpectrumToRgb {
         let n = wavelengths.len();
         let mut weights: Vec<[f64; 3]> = (0..n)
             .map(|k| {
-                let lo = if k > 0 { wavelengths[k - 1] } else { wavelengths[k] };
-                let hi = if k + 1 < n { wavelengths[k + 1] } else { wavelengths[k] };
+                let lo = if k > 0 {
+                    wavelengths[k - 1]
+                } else {
+                    wavelengths[k]
+                };
+                let hi = if k + 1 < n {
+                    wavelengths[k + 1]
+                } else {
+                    wavelengths[k]
+                };
                 let dl = 0.5 * (hi - lo);
                 cie1931(wavelengths[k]).map(|c| c * dl)
             })
@@ -142,7 +150,9 @@ mod tests {
             assert!((ints[i] - 106.86).abs() < 2.0, "{ints:?}");
         }
         let sum: f64 = ints.iter().sum();
-        assert!((ints[0] / sum - 1.0 / 3.0).abs() < 0.01 && (ints[1] / sum - 1.0 / 3.0).abs() < 0.01);
+        assert!(
+            (ints[0] / sum - 1.0 / 3.0).abs() < 0.01 && (ints[1] / sum - 1.0 / 3.0).abs() < 0.01
+        );
     }
 
     #[test]
@@ -154,7 +164,10 @@ mod tests {
         // A flat spectrum is grey (within the fit's accuracy).
         assert!(rgb.iter().all(|v| (v - 0.5).abs() < 0.02), "{rgb:?}");
         // A spectrum concentrated at long wavelengths is red.
-        let red: Vec<f64> = wl.iter().map(|&l| if l >= 620.0 { 1.0 } else { 0.0 }).collect();
+        let red: Vec<f64> = wl
+            .iter()
+            .map(|&l| if l >= 620.0 { 1.0 } else { 0.0 })
+            .collect();
         let r = c.rgb(&red);
         assert!(r[0] > 5.0 * r[1].abs() && r[0] > 5.0 * r[2].abs(), "{r:?}");
         assert_eq!(SpectrumToRgb::new(&[500.0]), Err(WavelengthError::TooFew));
