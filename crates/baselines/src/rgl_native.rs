@@ -102,7 +102,9 @@ impl DirectionSampler for RglNative {
         if jac > 0.0 { p_lum * p_vndf / jac } else { 0.0 }
     }
 
+    /// 0: the sampler precomputes nothing; the warp tables it reads are the BRDF's own (shared,
+    /// not copied).
     fn bytes_used(&self) -> usize {
-        self.brdf.vndf().bytes_used() + self.brdf.luminance_warp().bytes_used()
+        0
     }
 }
