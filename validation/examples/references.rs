@@ -5,6 +5,8 @@
 //! ```sh
 //! cargo run --release -p validation --example references > validation/references/albedo.json
 //! ```
+//! With arguments `SPEC...`, only the quick-tier entries of those specs are computed and printed
+//! (a JSON array of entries, to merge by hand).
 
 use validation::references::{
     ENVIRONMENT_FORMULA, REFERENCE_RULE, StoredReferences, compute_stored,
@@ -12,13 +14,17 @@ use validation::references::{
 use validation::{QUICK_BRDFS, QUICK_THETA_O, mutants};
 
 fn main() {
+    let only: Vec<String> = std::env::args().skip(1).collect();
     let mut settings: Vec<(String, f64)> = Vec::new();
-    for spec in QUICK_BRDFS {
+    for spec in QUICK_BRDFS
+        .iter()
+        .filter(|s| only.is_empty() || only.iter().any(|o| o == *s))
+    {
         for &t in QUICK_THETA_O {
             settings.push(((*spec).to_owned(), t));
         }
     }
-    for m in mutants() {
+    for m in mutants().iter().filter(|_| only.is_empty()) {
         if !settings.iter().any(|(s, t)| s == m.brdf && *t == m.theta_o) {
             settings.push((m.brdf.to_owned(), m.theta_o));
         }
@@ -32,6 +38,13 @@ fn main() {
                 std::process::exit(1);
             }
         }
+    }
+    if !only.is_empty() {
+        match serde_json::to_string_pretty(&entries) {
+            Ok(s) => println!("{s}"),
+            Err(e) => eprintln!("{e}"),
+        }
+        return;
     }
     let table = StoredReferences {
         rule: REFERENCE_RULE.to_owned(),

@@ -33,7 +33,29 @@ pub const QUICK_BRDFS: &[&str] = &[
     "ward",
     "ggx:alpha=0.2",
     "oren-nayar",
+    QUICK_RGL,
 ];
+
+/// The quick tier's measured material: the RGL fixture in the repository
+/// (`data/measured/rgl/paper_white_rgb.bsdf`, found from this crate's source directory).
+pub const QUICK_RGL: &str = concat!(
+    "rgl:",
+    env!("CARGO_MANIFEST_DIR"),
+    "/../data/measured/rgl/paper_white_rgb.bsdf"
+);
+
+/// Directory searched in the full tier for the shared measured materials (`rgl/*.bsdf`,
+/// `cornell/*.brdf`), when
+/// a MERL directory is searched too (relative to the working directory, like
+/// [`DEFAULT_MERL_DIR`]).
+pub const DEFAULT_MEASURED_DIR: &str = "../shared/data/measured";
+
+/// The full tier's presets of fitted models (every MERL material's SGD fit), run at
+/// [`PRESET_THETA_O`] only (there are 100 of them).
+pub const FULL_PRESET_MODELS: &[&str] = &["sgd"];
+
+/// Outgoing polar angles of the full tier's preset fits.
+pub const PRESET_THETA_O: &[f64] = &[30.0, 75.0];
 
 /// Outgoing polar angles (degrees, `φo = 0`) of the quick tier.
 pub const QUICK_THETA_O: &[f64] = &[0.0, 45.0, 80.0];

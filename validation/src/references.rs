@@ -124,7 +124,7 @@ pub fn compute_stored(spec: &str, theta_o: f64) -> Result<StoredReference, Strin
     let a = albedo_reference(brdf.as_ref(), &wo).map_err(|e| e.to_string())?;
     let l = lit_reference(brdf.as_ref(), &wo).map_err(|e| e.to_string())?;
     Ok(StoredReference {
-        brdf: spec.to_owned(),
+        brdf: portable_spec(spec),
         theta_o,
         albedo: a.value,
         albedo_error: a.abs_error,
@@ -132,6 +132,33 @@ pub fn compute_stored(spec: &str, theta_o: f64) -> Result<StoredReference, Strin
         lit_error: l.abs_error,
         albedo_check: brdf::directional_albedo(brdf.as_ref(), &wo, 256, 1024),
     })
+}
+
+/// The repository root as seen from this crate's sources (measured fixtures live under it).
+const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../");
+
+/// A spec as stored in the table: a measured file under the repository root
+/// (`rgl:/…/validation/../data/…`) becomes repository-relative (`rgl:data/…`), so the table
+/// does not depend on where the repository is checked out. Other specs are unchanged.
+pub fn portable_spec(spec: &str) -> String {
+    match spec.split_once(':') {
+        Some((model, path)) if model == "rgl" => match path.strip_prefix(REPO_ROOT) {
+            Some(rel) => format!("{model}:{rel}"),
+            None => spec.to_owned(),
+        },
+        _ => spec.to_owned(),
+    }
+}
+
+/// The inverse of [`portable_spec`]: a repository-relative measured spec made loadable from
+/// any working directory.
+pub fn local_spec(stored: &str) -> String {
+    match stored.split_once(':') {
+        Some((model, path)) if model == "rgl" && !path.starts_with('/') => {
+            format!("{model}:{REPO_ROOT}{path}")
+        }
+        _ => stored.to_owned(),
+    }
 }
 
 /// The stored table shipped with the crate.

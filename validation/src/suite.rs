@@ -20,7 +20,8 @@ use crate::domain::Domain;
 use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
-    FULL_THETA_O, MIN_SAMPLES, Plan, QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
+    DEFAULT_MEASURED_DIR, FULL_PRESET_MODELS, FULL_THETA_O, MIN_SAMPLES, PRESET_THETA_O, Plan,
+    QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
@@ -57,6 +58,36 @@ struct Resolved {
     angles: Vec<f64>,
     samplers: Vec<&'static SamplerEntry>,
     sets: Vec<LoadedSet>,
+    /// Specs run at [`PRESET_THETA_O`] only (the full tier's default preset fits).
+    few_angles: Vec<String>,
+}
+
+impl Resolved {
+    /// Whether `spec` runs at `theta` (every angle of the run, except for the full tier's
+    /// preset fits, which run at the run's angles that are in [`PRESET_THETA_O`]).
+    fn runs(&self, spec: &str, theta: f64) -> bool {
+        !self.few_angles.iter().any(|s| s == spec) || PRESET_THETA_O.contains(&theta)
+    }
+}
+
+/// `rgl:` specs of the `rgl/*.bsdf` files and `cornell:` specs of the `cornell/*.brdf` files
+/// under `dir` (none when absent).
+fn measured_specs(dir: &Path) -> Vec<String> {
+    let mut files: Vec<String> = Vec::new();
+    for (sub, ext, model) in [("rgl", "bsdf", "rgl"), ("cornell", "brdf", "cornell")] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        let mut found: Vec<String> = entries
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == ext))
+            .map(|p| format!("{model}:{}", p.display()))
+            .collect();
+        found.sort();
+        files.extend(found);
+    }
+    files
 }
 
 fn merl_specs(dir: &Path) -> Vec<String> {
@@ -111,17 +142,28 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
             }
         }
     }
+    let mut few_angles: Vec<String> = Vec::new();
     let specs: Vec<String> = if config.brdfs.is_empty() {
         match tier {
             Tier::Quick => QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect(),
             Tier::Full => {
                 let mut v: Vec<String> = brdf::models()
                     .iter()
-                    .filter(|m| m.name != "merl")
+                    .filter(|m| !m.needs_argument())
                     .map(|m| m.name.to_owned())
                     .collect();
                 if let Some(dir) = &config.merl_dir {
                     v.extend(merl_specs(dir));
+                    v.extend(measured_specs(Path::new(DEFAULT_MEASURED_DIR)));
+                }
+                for model in FULL_PRESET_MODELS {
+                    let presets = brdf::preset_names(model).unwrap_or_default();
+                    let specs: Vec<String> = presets
+                        .iter()
+                        .map(|n| format!("{model}:material={n}"))
+                        .collect();
+                    few_angles.extend(specs.iter().cloned());
+                    v.extend(specs);
                 }
                 v
             }
@@ -155,6 +197,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         angles,
         samplers: entries,
         sets,
+        few_angles,
     })
 }
 
@@ -289,6 +332,9 @@ fn run_angles(
 ) -> Vec<CaseResult> {
     let mut out = Vec::with_capacity(r.angles.len());
     for (ai, &theta) in r.angles.iter().enumerate() {
+        if !r.runs(spec, theta) {
+            continue;
+        }
         let wo = direction_from_angles(theta, 0.0);
         let subject: Result<AnySubject, String> = refs
             .get(ai)
@@ -389,8 +435,11 @@ pub fn run(
         .collect();
     let mut jobs: Vec<Job<'_>> = Vec::new();
     for &entry in &brdf_entries {
-        for bi in 0..r.brdfs.len() {
-            jobs.push(Job::Brdf { entry, brdf: bi });
+        for (bi, (_, brdf)) in r.brdfs.iter().enumerate() {
+            // Format-specific samplers (rgl-native) skip the BRDFs they do not apply to.
+            if entry.supports(brdf.as_ref()) {
+                jobs.push(Job::Brdf { entry, brdf: bi });
+            }
         }
     }
     let mut failed_builds: Vec<CaseResult> = Vec::new();
@@ -408,7 +457,15 @@ pub fn run(
     }
     jobs.extend((0..r.sets.len()).map(Job::Set));
     let mutant_list = if config.mutants { mutants() } else { &[] };
-    let total = (brdf_entries.len() * r.brdfs.len() + r.sets.len()) * r.angles.len()
+    let angles_of = |spec: &str| r.angles.iter().filter(|&&t| r.runs(spec, t)).count();
+    let total = jobs
+        .iter()
+        .map(|j| match j {
+            Job::Brdf { brdf, .. } => angles_of(&r.brdfs[*brdf].0),
+            _ => 0,
+        })
+        .sum::<usize>()
+        + r.sets.len() * r.angles.len()
         + jobs
             .iter()
             .filter(|j| matches!(j, Job::Standalone { .. }))
@@ -433,10 +490,16 @@ pub fn run(
     } else {
         r.brdfs
             .par_iter()
-            .map(|(_, b)| {
+            .map(|(spec, b)| {
                 r.angles
                     .par_iter()
-                    .map(|&t| references_for(b.as_ref(), &direction_from_angles(t, 0.0)))
+                    .map(|&t| {
+                        if r.runs(spec, t) {
+                            references_for(b.as_ref(), &direction_from_angles(t, 0.0))
+                        } else {
+                            Err("not run at this angle".to_owned())
+                        }
+                    })
                     .collect()
             })
             .collect()

@@ -6,7 +6,7 @@
 //! the cosine lobe about the mirror direction with a fitted exponent per outgoing slice
 //! ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`); the models' own analytic samplers
 //! ([`AnalyticSampler`]: `analytic`); [`FactoredSampler`] (Lawrence et al. 2004, NMF-factored
-//! `f_r cos θ`, options [`FactoredOptions`]).
+//! `f_r cos θ`, options [`FactoredOptions`]); [`RglNative`], the RGL format's own sampler.
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -47,6 +47,7 @@ pub mod factored;
 pub mod hemisphere;
 pub mod lobe;
 pub mod options;
+pub mod rgl_native;
 
 pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
 pub use factored::{FactoredError, FactoredReport, FactoredSampler};
@@ -56,3 +57,4 @@ pub use options::{
     BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, FactoredOptionsError,
     LobeOptions, NmfCost, Reparam,
 };
+pub use rgl_native::{NotRglError, RglNative};

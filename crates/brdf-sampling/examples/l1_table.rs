@@ -55,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|{}", "---|".repeat(ANGLES.len()));
     for m in models()
         .iter()
-        .filter(|m| m.name != "merl" && !skip.iter().any(|s| s == m.name))
+        .filter(|m| !m.needs_argument() && !skip.iter().any(|s| s == m.name))
     {
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(m.name)?);
         let set = brdf_sampling::QuadTreeSet::build(

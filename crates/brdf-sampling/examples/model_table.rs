@@ -209,7 +209,7 @@ fn main() {
     let mut rows = Vec::new();
     let mut specs: Vec<String> = models()
         .iter()
-        .filter(|m| m.name != "merl")
+        .filter(|m| !m.needs_argument())
         .map(|m| m.name.to_string())
         .collect();
     specs.push("merl(phong:n=50)".to_string());

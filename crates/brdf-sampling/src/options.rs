@@ -313,9 +313,10 @@ impl SetOptions {
         Ok(())
     }
 
-    /// The dilation used for `brdf`: [`SetOptions::bound_dilation`], at least 1 for `merl`.
+    /// The dilation used for `brdf`: [`SetOptions::bound_dilation`], at least 1 for the
+    /// discontinuous measured data (`merl`'s bins, `cornell`'s nearest-neighbour blend).
     pub fn dilation_for(&self, brdf: &dyn brdf::Brdf) -> u32 {
-        if brdf.name() == "merl" {
+        if matches!(brdf.name(), "merl" | "cornell") {
             self.bound_dilation.max(1)
         } else {
             self.bound_dilation

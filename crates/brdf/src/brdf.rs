@@ -95,6 +95,12 @@ pub trait Brdf: Send + Sync {
     fn name(&self) -> &str {
         "custom"
     }
+
+    /// The implementing type as [`Any`](std::any::Any), for samplers that work only with one
+    /// concrete BRDF type (e.g. the RGL format's own sampler). Default `None`.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }
 
 macro_rules! forward_brdf {
@@ -131,6 +137,9 @@ macro_rules! forward_brdf {
             }
             fn name(&self) -> &str {
                 (**self).name()
+            }
+            fn as_any(&self) -> Option<&dyn std::any::Any> {
+                (**self).as_any()
             }
         }
     )*};

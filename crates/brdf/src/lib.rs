@@ -41,6 +41,7 @@ pub mod analytic;
 mod brdf;
 pub mod fresnel;
 mod geometry;
+pub mod measured;
 pub mod merl;
 pub mod models;
 mod params;
@@ -57,8 +58,10 @@ pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,
     reflect_about, rotate_y, rotate_z,
 };
+pub use measured::cornell::{CornellBrdf, CornellError};
+pub use measured::rgl::{RglBrdf, RglError};
 pub use merl::{MerlBrdf, MerlError, write_merl};
 pub use params::{ParamDefault, ParamError, ParamInfo, Range};
 pub use plausibility::energy_warnings;
 pub use quadrature::{directional_albedo, projected_hemisphere_integral};
-pub use registry::{Isotropy, ModelInfo, SpecError, find_model, models, parse_spec};
+pub use registry::{Isotropy, ModelInfo, SpecError, find_model, models, parse_spec, preset_names};

@@ -1,6 +1,8 @@
 //! Model registry and the `SPEC` parser (`name` or `name:key=value,...`, or `merl:PATH`).
 
 use crate::brdf::Brdf;
+use crate::measured::cornell::{CornellBrdf, CornellError};
+use crate::measured::rgl::{RglBrdf, RglError};
 use crate::merl::{MerlBrdf, MerlError};
 use crate::models::*;
 use crate::params::{ParamDefault, ParamError, ParamInfo, Range};
@@ -102,6 +104,13 @@ impl ModelInfo {
         (self.build)(&resolved).map_err(SpecError::Invalid)
     }
 
+    /// Whether the model is built from a spec argument (a file path such as `merl:PATH` or a
+    /// preset name) rather than from numeric parameters: such models have no defaults to
+    /// build from.
+    pub fn needs_argument(&self) -> bool {
+        ARGUMENT_MODELS.contains(&self.name)
+    }
+
     /// Comma-separated list of the valid keys.
     pub fn valid_keys(&self) -> String {
         if self.params.is_empty() {
@@ -180,12 +189,52 @@ pub enum SpecError {
     /// `merl` without a path.
     #[error("merl: missing file path (expected `merl:PATH`)")]
     MissingPath,
+    /// A file format (`rgl`, …) without a path.
+    #[error("{model}: missing file path (expected `{model}:PATH`)")]
+    MissingFile {
+        /// The format's name.
+        model: &'static str,
+    },
     /// A cross-parameter constraint failed in the model constructor.
     #[error(transparent)]
     Invalid(#[from] ParamError),
     /// The MERL file could not be loaded.
     #[error(transparent)]
     Merl(#[from] MerlError),
+    /// A preset model (`sgd`, `abc`) without `material=NAME`.
+    #[error(
+        "{model}: missing material (expected `{model}:material=NAME`; `brdf-lab list` shows the names)"
+    )]
+    MissingMaterial {
+        /// The model.
+        model: &'static str,
+    },
+    /// No preset of that name.
+    #[error("{model}: unknown material `{name}`{}", if suggestions.is_empty() { "; `brdf-lab list` shows the names".to_string() } else { format!("; close matches: {}", suggestions.join(", ")) })]
+    UnknownMaterial {
+        /// The model.
+        model: &'static str,
+        /// The name given.
+        name: String,
+        /// Close preset names, best first.
+        suggestions: Vec<String>,
+    },
+    /// The Cornell file could not be loaded.
+    #[error("{source}")]
+    Cornell {
+        /// The path given.
+        path: String,
+        /// The cause.
+        source: CornellError,
+    },
+    /// The RGL file could not be loaded.
+    #[error("{source}")]
+    Rgl {
+        /// The path given.
+        path: String,
+        /// The cause.
+        source: RglError,
+    },
 }
 
 macro_rules! boxed {
@@ -368,9 +417,108 @@ static MODELS: &[ModelInfo] = &[
             })
         },
     },
+    ModelInfo {
+        name: "rgl",
+        aliases: &[],
+        summary: "measured isotropic RGB material of the RGL database, spec `rgl:PATH` (Dupuy & Jakob 2018 `.bsdf` tensor file)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "rgl",
+                message: "needs a file: use the spec `rgl:PATH`".into(),
+            })
+        },
+    },
+    ModelInfo {
+        name: "cornell",
+        aliases: &[],
+        summary: "measured spectral material of Cornell PCG, spec `cornell:PATH` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "cornell",
+                message: "needs a file: use the spec `cornell:PATH`".into(),
+            })
+        },
+    },
+    ModelInfo {
+        name: "sgd",
+        aliases: &[],
+        summary: "Shifted Gamma Distribution model with the published fit of a MERL material, spec `sgd:material=NAME` (Bagher, Soler & Holzschuch 2012)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "sgd",
+                message: "needs a material: use the spec `sgd:material=NAME`".into(),
+            })
+        },
+    },
+    ModelInfo {
+        name: "abc",
+        aliases: &[],
+        summary: "ABC model with the published fit of a MERL material, spec `abc:material=NAME` (Low, Kronander, Ynnerman & Unger 2012)",
+        params: &[],
+        isotropic: Isotropy::Always,
+        build: |_| {
+            Err(ParamError::Constraint {
+                model: "abc",
+                message: "needs a material: use the spec `abc:material=NAME`".into(),
+            })
+        },
+    },
 ];
 
-/// All registered models (analytic ones, then `merl`), in listing order.
+/// Models built from a spec argument instead of numeric parameters
+/// ([`ModelInfo::needs_argument`]).
+const ARGUMENT_MODELS: &[&str] = &["merl", "rgl", "cornell", "sgd", "abc"];
+
+/// The preset names of a preset model (`sgd`, `abc`), `None` for other models.
+pub fn preset_names(model: &str) -> Option<Vec<&'static str>> {
+    match model {
+        "sgd" => Some(sgd::preset_names()),
+        "abc" => Some(abc::preset_names()),
+        _ => None,
+    }
+}
+
+/// `sgd:material=NAME` / `abc:material=NAME`.
+fn parse_preset(model: &'static str, rest: Option<&str>) -> Result<Box<dyn Brdf>, SpecError> {
+    let rest = rest.map(str::trim).unwrap_or("");
+    if rest.is_empty() {
+        return Err(SpecError::MissingMaterial { model });
+    }
+    let Some((key, name)) = rest.split_once('=') else {
+        return Err(SpecError::Malformed {
+            model: model.to_string(),
+            item: rest.to_string(),
+        });
+    };
+    if key.trim() != "material" {
+        return Err(SpecError::UnknownKey {
+            model: model.to_string(),
+            key: key.trim().to_string(),
+            valid: "material".to_string(),
+        });
+    }
+    let name = name.trim();
+    let built: Option<Box<dyn Brdf>> = match model {
+        "sgd" => Sgd::preset(name).map(|b| Box::new(b) as Box<dyn Brdf>),
+        _ => Abc::preset(name).map(|b| Box::new(b) as Box<dyn Brdf>),
+    };
+    built.ok_or_else(|| SpecError::UnknownMaterial {
+        model,
+        name: name.to_string(),
+        suggestions: match model {
+            "sgd" => sgd::close_matches(name),
+            _ => abc::close_matches(name),
+        },
+    })
+}
+
+/// All registered models (analytic ones, then the measured formats), in listing order.
 pub fn models() -> &'static [ModelInfo] {
     MODELS
 }
@@ -384,7 +532,8 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 
 /// Parse a BRDF spec and build the model.
 ///
-/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH`. Whitespace around names,
+/// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` | `cornell:PATH` |
+/// `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
 /// keys), malformed item, bad number, out-of-range value (stating the range), duplicate key,
@@ -404,6 +553,36 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
             return Err(SpecError::MissingPath);
         }
         return Ok(Box::new(MerlBrdf::load(Path::new(path))?));
+    }
+    if name.eq_ignore_ascii_case("rgl") {
+        let path = rest.map(str::trim).unwrap_or("");
+        if path.is_empty() {
+            return Err(SpecError::MissingFile { model: "rgl" });
+        }
+        return RglBrdf::load(Path::new(path))
+            .map(|b| Box::new(b) as Box<dyn Brdf>)
+            .map_err(|source| SpecError::Rgl {
+                path: path.to_string(),
+                source,
+            });
+    }
+    if name.eq_ignore_ascii_case("cornell") {
+        let path = rest.map(str::trim).unwrap_or("");
+        if path.is_empty() {
+            return Err(SpecError::MissingFile { model: "cornell" });
+        }
+        return CornellBrdf::load(Path::new(path))
+            .map(|b| Box::new(b) as Box<dyn Brdf>)
+            .map_err(|source| SpecError::Cornell {
+                path: path.to_string(),
+                source,
+            });
+    }
+    if name.eq_ignore_ascii_case("sgd") {
+        return parse_preset("sgd", rest);
+    }
+    if name.eq_ignore_ascii_case("abc") {
+        return parse_preset("abc", rest);
     }
     let Some(info) = find_model(name) else {
         return Err(SpecError::UnknownModel {
@@ -459,7 +638,7 @@ mod tests {
 
     #[test]
     fn every_model_builds_from_defaults() {
-        for m in models().iter().filter(|m| m.name != "merl") {
+        for m in models().iter().filter(|m| !m.needs_argument()) {
             let b = parse_spec(m.name).unwrap_or_else(|e| panic!("{}: {e}", m.name));
             assert_eq!(b.name(), m.name);
             match m.isotropic {

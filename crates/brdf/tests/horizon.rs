@@ -30,7 +30,7 @@ fn growth(b: &dyn Brdf) -> f64 {
 fn declarations_match_the_probe() {
     let mut report = Vec::new();
     for info in models() {
-        if info.name == "merl" {
+        if info.needs_argument() {
             continue; // needs a file; tabulated data are bounded by construction
         }
         let b = parse_spec(info.name).unwrap();

@@ -12,7 +12,7 @@ pub(crate) fn run() -> CliResult<()> {
 fn write_listing(out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(
         out,
-        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH for MERL files)"
+        "BRDF models (SPEC = name or name:key=value,...; also merl:PATH, rgl:PATH, cornell:PATH, sgd:material=NAME, abc:material=NAME)"
     )?;
     for m in brdf::models() {
         let iso = match m.isotropic {
@@ -27,6 +27,14 @@ fn write_listing(out: &mut dyn Write) -> std::io::Result<()> {
         };
         writeln!(out, "\n  {}{aliases} — {iso}", m.name)?;
         writeln!(out, "      {}", m.summary)?;
+        if let Some(names) = brdf::preset_names(m.name) {
+            writeln!(
+                out,
+                "      materials ({}): {}",
+                names.len(),
+                names.join(", ")
+            )?;
+        }
         for p in m.params {
             writeln!(
                 out,

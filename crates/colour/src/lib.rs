@@ -4,8 +4,14 @@
 //! MERL reflectances and HDR/EXR/PFM radiances are linear already). RGB quantities are sampled
 //! proportionally to their luminance `Y` ([`luminance`]).
 //!
-//! This crate will later also hold the CIE 1931 spectral-to-RGB conversion for measured
-//! spectral BRDFs, so that every crate converts colour the same way. It depends on nothing.
+//! It also holds the CIE 1931 spectral-to-RGB conversion of measured spectral BRDFs
+//! ([`spectral`]), so that every crate converts colour the same way. It depends on nothing.
+
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod spectral;
+
+pub use spectral::{SpectrumToRgb, WavelengthError, cie1931};
 
 /// Rec. 709 / sRGB luminance weights of linear R, G and B: `Y = 0.2126 R + 0.7152 G + 0.0722 B`
 /// (the `Y` row of the linear-sRGB-to-CIE-XYZ matrix; the weights sum to 1).

@@ -228,6 +228,25 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         capabilities: BLIND_TABLE,
         constructor: Constructor::Grid(grid_cdf),
     },
+    SamplerEntry {
+        name: "rgl-native",
+        summary: "RGL .bsdf files only: the format's own sampling (luminance table, then the VNDF warp; Dupuy & Jakob 2018, Mitsuba's measured plugin), exact pdf",
+        capabilities: Capabilities {
+            exact_pdf: true,
+            batch_mode: false,
+            needs_build: false,
+            anisotropic: false,
+            measured: true,
+        },
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |request| {
+                Ok(BuiltDirection::plain(Arc::new(
+                    baselines::RglNative::for_brdf(request.brdf.as_ref())?,
+                )))
+            },
+        },
+    },
 ];
 
 /// Capabilities of the per-slice tabulated CDFs of a BRDF (exact: the pdf is the density of
@@ -258,6 +277,14 @@ fn lobe(
         baselines::LobeSampler::new(&request.brdf, support, &request.baselines.lobe)?,
     )))
 }
+
+/// Whether a format-specific sampler applies to a BRDF.
+pub(crate) type AcceptsBrdf = fn(&dyn Brdf) -> bool;
+
+/// Samplers that apply only to some BRDFs (format-specific), with the test of the BRDFs they
+/// accept; every other entry accepts every BRDF of its kind.
+pub(crate) static BRDF_SPECIFIC: &[(&str, AcceptsBrdf)] =
+    &[("rgl-native", baselines::RglNative::accepts)];
 
 /// Capabilities of the tabulated CDFs of maps and grids.
 const BLIND_TABLE: Capabilities = Capabilities {

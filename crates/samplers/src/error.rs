@@ -78,4 +78,7 @@ pub enum RegistryError {
     /// The factored baseline could not be built.
     #[error(transparent)]
     Factored(#[from] baselines::FactoredError),
+    /// A format-specific sampler was asked to sample a BRDF of another kind.
+    #[error(transparent)]
+    NotRgl(#[from] baselines::NotRglError),
 }

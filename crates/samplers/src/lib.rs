@@ -213,6 +213,16 @@ impl SamplerEntry {
         }
     }
 
+    /// Whether this entry's sampler can be built for `brdf`: `false` only for a
+    /// format-specific sampler (e.g. `rgl-native`) given a BRDF of another kind. Suites skip
+    /// such pairs instead of reporting a failed build.
+    pub fn supports(&self, brdf: &dyn Brdf) -> bool {
+        entries::BRDF_SPECIFIC
+            .iter()
+            .find(|(name, _)| *name == self.name)
+            .is_none_or(|(_, accepts)| accepts(brdf))
+    }
+
     /// Builds this entry's disc sampler of `f_r(ωo, h⁻¹(x))`.
     pub fn build_disc(
         &self,

@@ -45,11 +45,20 @@ fn names_are_unique_and_every_kind_is_present() {
 fn every_direction_sampler_builds_and_reports_consistent_pdfs() {
     let options = small();
     let wo = brdf::direction_from_angles(40.0, 10.0);
+    let rgl = format!(
+        "rgl:{}/../../data/measured/rgl/paper_white_rgb.bsdf",
+        env!("CARGO_MANIFEST_DIR")
+    );
     for e in SAMPLERS.iter().filter(|e| e.is_direction()) {
+        // Format-specific samplers (rgl-native) get a BRDF of their format.
+        let spec = if e.supports(brdf("phong:n=20").as_ref()) {
+            "phong:n=20"
+        } else {
+            rgl.as_str()
+        };
+        assert!(e.supports(brdf(spec).as_ref()), "{}", e.name);
         let built = e
-            .build_direction(
-                &DirectionRequest::new(brdf("phong:n=20"), &options).with_spec("phong:n=20"),
-            )
+            .build_direction(&DirectionRequest::new(brdf(spec), &options).with_spec(spec))
             .unwrap_or_else(|err| panic!("{}: {err}", e.name));
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
         for _ in 0..200 {
@@ -167,4 +176,24 @@ fn a_saved_set_comes_back_as_the_entry_that_built_it() {
         samplers::load_set(b"nonsense", None),
         Err(RegistryError::SetFile(_))
     ));
+}
+
+#[test]
+fn rgl_native_refuses_other_brdfs_and_the_suite_can_skip_them() {
+    let e = samplers::find("rgl-native").expect("registered");
+    let phong = brdf("phong:n=20");
+    assert!(!e.supports(phong.as_ref()));
+    let options = small();
+    let err = e
+        .build_direction(&DirectionRequest::new(phong, &options))
+        .expect_err("not an RGL file");
+    assert!(matches!(err, samplers::RegistryError::NotRgl(_)), "{err}");
+    // Every other direction sampler accepts every BRDF.
+    for other in SAMPLERS.iter().filter(|x| x.name != "rgl-native") {
+        assert!(
+            other.supports(brdf("phong:n=20").as_ref()),
+            "{}",
+            other.name
+        );
+    }
 }

@@ -1,6 +1,7 @@
 //! Analytic reflectance models (one module per model; each documents its formula, parameters,
 //! defaults and reference).
 
+pub mod abc;
 pub mod ashikhmin_shirley;
 pub mod beard_maxwell;
 pub mod blinn;
@@ -11,15 +12,18 @@ pub mod htsg;
 pub mod lafortune;
 pub mod lambert;
 pub mod lewis;
+mod merl_fits;
 pub mod microfacet;
 pub mod minnaert;
 pub mod oren_nayar;
 pub mod phong;
 pub mod poulin_fournier;
 pub mod schlick;
+pub mod sgd;
 pub mod strauss;
 pub mod ward;
 
+pub use abc::{Abc, AbcParams};
 pub use ashikhmin_shirley::{AshikhminShirley, AshikhminShirleyParams};
 pub use beard_maxwell::{BeardMaxwell, BeardMaxwellParams};
 pub use blinn::{Blinn, BlinnParams, blinn_defaults};
@@ -35,6 +39,7 @@ pub use oren_nayar::{OrenNayar, OrenNayarParams};
 pub use phong::{Phong, PhongParams};
 pub use poulin_fournier::{PoulinFournier, PoulinFournierParams};
 pub use schlick::{Schlick, SchlickParams};
+pub use sgd::{Sgd, SgdChannel};
 pub use strauss::{Strauss, StraussParams};
 pub use ward::{Ward, WardNormalisation, WardParams};
 

@@ -1,0 +1,7 @@
+//! Measured reflectance formats beyond MERL: the RGL material database's `.bsdf` tensor files
+//! ([`rgl`]) and the Cornell pbrt-v2 `.brdf` spectral samples ([`cornell`]).
+
+pub mod cornell;
+pub mod rgl;
+pub mod tensor;
+pub mod warp;

@@ -1,0 +1,559 @@
+//! Isotropic RGB materials of the RGL database (Dupuy & Jakob 2018, "An Adaptive
+//! Parameterization for Efficient Material Acquisition and Rendering", ACM TOG 37(6)), the
+//! `.bsdf` tensor files read by Mitsuba's `measured` plugin.
+//!
+//! **Fields** (see [`tensor`](super::tensor) for the container): `theta_i[T]` and `phi_i[1]`
+//! (the incident angles of the slices, radians; one `φ` value = isotropic), `ndf[Py, Px]` and
+//! `sigma[Py, Px]` (the microfacet distribution `D` and the projected area `σ`, on the
+//! `u`-square of a direction), `vndf[1, T, Ny, Nx]` (the visible-normal distribution, a
+//! sampling density of the half vector on the `u`-square), `luminance[1, T, M, M]` and
+//! `rgb[1, T, 3, M, M]` (reflectance tables over the **warped** square, the VNDF warp's
+//! uniform domain), `jacobian[1]` (`u8`, whether the `D/(4σ)` factor is to be applied) and
+//! `description`. Every table must be finite, `ndf`, `vndf`, `luminance` non-negative, `sigma`
+//! positive, `theta_i` increasing in `[0, π/2]`, and the shapes consistent.
+//!
+//! **Coordinates.** A direction of elevation `θ` and azimuth `φ` has `u = (√(2θ/π),
+//! (φ + π)/(2π))`. For `ωo` (the format's "incident" direction: the one the tables are sliced
+//! by) and `ωi`, the half vector `m = (ωo + ωi)/|ωo + ωi|` has `u_m = (√(2θm/π),
+//! frac((φm − φo + π)/(2π)))` (isotropy: the azimuth is taken relative to `ωo`).
+//!
+//! **Value.** With `s = vndf⁻¹(u_m; θo)` (the inverse of the VNDF warp at the slice of `θo`,
+//! [`Warp2D::invert`]), the file defines each channel of `f_r · cos θi` (the quantity Mitsuba's
+//! `BSDF::eval` returns: the BRDF times the foreshortening of the sampled direction) as
+//! `rgb_c(s; θo) · D(u_m) / (4 σ(u_o))` (the factor only when `jacobian = 1`; `D/(4σ)` is the
+//! VNDF's density of `ωi`, so the table holds `f·cos / p_vndf`). `rgb_c`, `D`, `σ` are bilinear
+//! in their squares and linear in `θo` between slices. The BRDF is that value divided by
+//! `cos θi`; [`Brdf::eval`] is its luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B`.
+//!
+//! **Negative entries.** Real files hold slightly negative `rgb` entries (fitting noise, down
+//! to about −0.01 in `cc_ibiza_sunset`, −0.1 reported elsewhere). They are clamped to 0 when
+//! read; [`RglBrdf::clamped`] reports how many and the most negative one.
+//!
+//! **Reciprocity** is not guaranteed by the format (the tables are sliced by `ωo` only), so
+//! [`Brdf::is_reciprocal`] is `false`.
+
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use thiserror::Error;
+
+use super::tensor::TensorFile;
+use super::warp::{BilinearTable, ParamAxis, Warp2D};
+use crate::brdf::{Brdf, luminance};
+use crate::geometry::Vec3;
+
+/// Why an RGL `.bsdf` file could not be read.
+#[derive(Debug, Error)]
+pub enum RglError {
+    /// Filesystem error.
+    #[error("RGL file {path}: {source}")]
+    Io {
+        /// File involved.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The file does not start with `tensor_file\0`.
+    #[error("not an RGL tensor file (the magic `tensor_file\\0` is missing)")]
+    BadMagic,
+    /// A container version other than 1.0.
+    #[error("unsupported tensor file version {major}.{minor} (expected 1.0)")]
+    UnsupportedVersion {
+        /// Major version.
+        major: u8,
+        /// Minor version.
+        minor: u8,
+    },
+    /// The file ends inside the header or a field's data.
+    #[error("truncated tensor file: {what} needs {needed} bytes, the file has {len}")]
+    Truncated {
+        /// What was being read.
+        what: String,
+        /// Bytes needed.
+        needed: usize,
+        /// Bytes present.
+        len: usize,
+    },
+    /// Two fields have the same name.
+    #[error("field `{name}` appears twice")]
+    DuplicateField {
+        /// The name.
+        name: String,
+    },
+    /// An element type code outside the format's list.
+    #[error("field `{field}` has unknown element type {dtype}")]
+    UnknownType {
+        /// The field.
+        field: String,
+        /// Its code.
+        dtype: u8,
+    },
+    /// A field the format requires is absent.
+    #[error("field `{name}` is missing")]
+    MissingField {
+        /// The name.
+        name: String,
+    },
+    /// A field has the wrong element type.
+    #[error("field `{field}` has element type {dtype}, expected {expected}")]
+    WrongType {
+        /// The field.
+        field: String,
+        /// Its code.
+        dtype: u8,
+        /// The expected type.
+        expected: &'static str,
+    },
+    /// A field's shape is inconsistent with the format or with the other fields.
+    #[error("field `{field}` has shape {shape:?}, expected {expected}")]
+    WrongShape {
+        /// The field.
+        field: String,
+        /// Its shape.
+        shape: Vec<usize>,
+        /// What was expected.
+        expected: String,
+    },
+    /// A NaN or infinite value.
+    #[error("field `{field}` holds a non-finite value at index {index}")]
+    NonFinite {
+        /// The field.
+        field: String,
+        /// Flat index.
+        index: usize,
+    },
+    /// A value out of its range (negative density, non-positive `sigma`, angle out of range).
+    #[error("field `{field}`: value {value} at index {index} is out of range ({rule})")]
+    OutOfRange {
+        /// The field.
+        field: String,
+        /// Flat index.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The rule it breaks.
+        rule: &'static str,
+    },
+    /// More than one `phi_i` value: anisotropic files are not supported.
+    #[error("anisotropic RGL files ({n_phi} values of phi_i) are not supported; expected 1")]
+    Anisotropic {
+        /// Number of `phi_i` values.
+        n_phi: usize,
+    },
+    /// A sampling table slice integrates to zero.
+    #[error("field `{field}`: slice {slice} integrates to zero")]
+    ZeroSlice {
+        /// The field.
+        field: String,
+        /// The slice.
+        slice: usize,
+    },
+}
+
+/// How many negative `rgb` entries were clamped to zero when reading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NegativeClamp {
+    /// Number of clamped entries.
+    pub count: usize,
+    /// The most negative value.
+    pub min: f64,
+}
+
+/// Elevation of a unit vector, `acos z`, computed as `2 asin(|d − n|/2)` (accurate near the
+/// normal).
+pub fn elevation(d: &Vec3) -> f64 {
+    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
+    2.0 * (0.5 * dist).clamp(-1.0, 1.0).asin()
+}
+
+/// `θ ↦ u = √(2θ/π)`.
+pub fn theta_to_u(theta: f64) -> f64 {
+    (theta.max(0.0) / FRAC_PI_2).sqrt()
+}
+
+/// `u ↦ θ = u² π/2`.
+pub fn u_to_theta(u: f64) -> f64 {
+    u * u * FRAC_PI_2
+}
+
+/// `φ ↦ u = (φ + π)/(2π)`.
+pub fn phi_to_u(phi: f64) -> f64 {
+    (phi + PI) / TAU
+}
+
+/// `u ↦ φ = (2u − 1)π`.
+pub fn u_to_phi(u: f64) -> f64 {
+    (2.0 * u - 1.0) * PI
+}
+
+/// The tables of one material (shared by clones).
+#[derive(Debug)]
+struct Tables {
+    description: String,
+    theta: ParamAxis,
+    ndf: BilinearTable,
+    sigma: BilinearTable,
+    vndf: Warp2D,
+    luminance: Warp2D,
+    /// Slices `[θ][channel]`.
+    rgb: BilinearTable,
+    /// Luminance `0.2126 R + 0.7152 G + 0.0722 B` of the (clamped) `rgb` table, slices `[θ]`:
+    /// interpolation is linear, so this is the luminance of the interpolated RGB.
+    rgb_luminance: BilinearTable,
+    jacobian: bool,
+    clamped: Option<NegativeClamp>,
+    /// `ndf` and `sigma` do not depend on the azimuth.
+    isotropic: bool,
+    /// Every table is even in the relative azimuth (`u.y ↦ 1 − u.y`).
+    mirror_symmetric: bool,
+}
+
+/// Relative tolerance of the symmetry checks made when a file is read.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-6;
+
+/// An isotropic RGL material (see the [module docs](self)). Cheap to clone.
+#[derive(Debug, Clone)]
+pub struct RglBrdf {
+    tables: Arc<Tables>,
+}
+
+/// The half-vector coordinates of a pair `(ωo, ωi)` in the format's parametrisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfCoords {
+    /// Elevation of `ωo` (the slice parameter).
+    pub theta_o: f64,
+    /// `u` of `ωo`.
+    pub u_o: [f64; 2],
+    /// `u_m` of the half vector (azimuth relative to `ωo`).
+    pub u_m: [f64; 2],
+    /// The unit half vector.
+    pub m: Vec3,
+}
+
+impl RglBrdf {
+    /// Reads and validates an RGL `.bsdf` file.
+    pub fn load(path: &Path) -> Result<Self, RglError> {
+        let bytes = std::fs::read(path).map_err(|source| RglError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_bytes(&bytes)
+    }
+
+    /// Reads and validates an RGL `.bsdf` file's bytes.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, RglError> {
+        let tf = TensorFile::parse(bytes)?;
+        let description = String::from_utf8_lossy(tf.u8_data("description")?).into_owned();
+        let phi = tf.f32_data("phi_i")?;
+        let phi_shape = &tf.field("phi_i")?.shape;
+        if phi_shape.len() != 1 {
+            return Err(shape_error("phi_i", phi_shape, "rank 1"));
+        }
+        if phi.len() != 1 {
+            return Err(RglError::Anisotropic { n_phi: phi.len() });
+        }
+        let theta = tf.f32_data("theta_i")?;
+        let theta_shape = &tf.field("theta_i")?.shape;
+        if theta_shape.len() != 1 || theta.is_empty() {
+            return Err(shape_error("theta_i", theta_shape, "[T] with T ≥ 1"));
+        }
+        for (index, &t) in theta.iter().enumerate() {
+            if !(0.0..=FRAC_PI_2 + 1e-6).contains(&t) {
+                return Err(RglError::OutOfRange {
+                    field: "theta_i".into(),
+                    index,
+                    value: t,
+                    rule: "must lie in [0, π/2]",
+                });
+            }
+            if index > 0 && !(t > theta[index - 1]) {
+                return Err(RglError::OutOfRange {
+                    field: "theta_i".into(),
+                    index,
+                    value: t,
+                    rule: "must be strictly increasing",
+                });
+            }
+        }
+        let n_theta = theta.len();
+        let axis = ParamAxis::new(theta);
+
+        let (ndf, _) = plain_table(&tf, "ndf", 0.0, false)?;
+        let (sigma, _) = plain_table(&tf, "sigma", 0.0, true)?;
+
+        let vndf = sampling_table(&tf, "vndf", n_theta, &axis)?;
+        let lum = sampling_table(&tf, "luminance", n_theta, &axis)?;
+
+        let rgb_field = tf.field("rgb")?;
+        let lum_shape = &tf.field("luminance")?.shape;
+        let expected_rgb = [1, n_theta, 3, lum_shape[2], lum_shape[3]];
+        if rgb_field.shape != expected_rgb {
+            return Err(shape_error(
+                "rgb",
+                &rgb_field.shape,
+                &format!("{expected_rgb:?} (phi_i, theta_i, channel, luminance's grid)"),
+            ));
+        }
+        let mut rgb = tf.f32_data("rgb")?;
+        let mut clamped: Option<NegativeClamp> = None;
+        for v in rgb.iter_mut().filter(|v| **v < 0.0) {
+            let c = clamped.get_or_insert(NegativeClamp { count: 0, min: 0.0 });
+            c.count += 1;
+            c.min = c.min.min(*v);
+            *v = 0.0;
+        }
+        let cell = lum_shape[2] * lum_shape[3];
+        let mut y = Vec::with_capacity(n_theta * cell);
+        for t in 0..n_theta {
+            let at = |ch: usize, k: usize| rgb[(3 * t + ch) * cell + k];
+            y.extend((0..cell).map(|k| luminance([at(0, k), at(1, k), at(2, k)])));
+        }
+        let rgb_luminance = BilinearTable::new(lum_shape[3], lum_shape[2], y);
+        let rgb = BilinearTable::new(lum_shape[3], lum_shape[2], rgb);
+
+        let jac_field = tf.field("jacobian")?;
+        if jac_field.shape != [1] {
+            return Err(shape_error("jacobian", &jac_field.shape, "[1]"));
+        }
+        let jacobian = tf.u8_data("jacobian")?[0] != 0;
+
+        let tol = SYMMETRY_TOLERANCE;
+        let isotropic = ndf.is_y_constant(tol) && sigma.is_y_constant(tol);
+        let mirror_symmetric = isotropic
+            && vndf.table().is_y_symmetric(tol)
+            && lum.table().is_y_symmetric(tol)
+            && rgb.is_y_symmetric(tol);
+        Ok(Self {
+            tables: Arc::new(Tables {
+                isotropic,
+                mirror_symmetric,
+                description,
+                theta: axis,
+                ndf,
+                sigma,
+                vndf,
+                luminance: lum,
+                rgb,
+                rgb_luminance,
+                jacobian,
+                clamped,
+            }),
+        })
+    }
+
+    /// The file's description string.
+    pub fn description(&self) -> &str {
+        &self.tables.description
+    }
+
+    /// The negative `rgb` entries clamped to zero, if there were any.
+    pub fn clamped(&self) -> Option<NegativeClamp> {
+        self.tables.clamped
+    }
+
+    /// The slice angles `theta_i` (radians).
+    pub fn theta_slices(&self) -> &[f64] {
+        self.tables.theta.values()
+    }
+
+    /// The VNDF warp (half-vector `u_m` from the warped square, conditioned on `θo`).
+    pub fn vndf(&self) -> &Warp2D {
+        &self.tables.vndf
+    }
+
+    /// The luminance sampling density on the warped square, conditioned on `θo`.
+    pub fn luminance_warp(&self) -> &Warp2D {
+        &self.tables.luminance
+    }
+
+    /// Heap bytes of the tables.
+    pub fn bytes_used(&self) -> usize {
+        let t = &self.tables;
+        t.vndf.bytes_used()
+            + t.luminance.bytes_used()
+            + 8 * (t.rgb.slices() * t.rgb.size().0 * t.rgb.size().1)
+            + 8 * 2 * (t.ndf.size().0 * t.ndf.size().1)
+    }
+
+    /// The format's coordinates of `(ωo, ωi)`; `None` when either is at or below the horizon,
+    /// not finite, or `ωi = −ωo`.
+    pub fn half_coords(wo: &Vec3, wi: &Vec3) -> Option<HalfCoords> {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return None;
+        }
+        Self::half_coords_any(wo, wi)
+    }
+
+    /// [`half_coords`](Self::half_coords) for any `ωi` (the native sampler's pdf on the whole
+    /// sphere): the half vector is flipped into the upper hemisphere when needed.
+    pub fn half_coords_any(wo: &Vec3, wi: &Vec3) -> Option<HalfCoords> {
+        let sum = wo + wi;
+        let norm = sum.norm();
+        if !(norm > 1e-12) || !(wo.z > 0.0) {
+            return None;
+        }
+        let mut m = sum / norm;
+        if m.z < 0.0 {
+            m = -m;
+        }
+        let theta_o = elevation(wo);
+        let phi_o = wo.y.atan2(wo.x);
+        let theta_m = elevation(&m);
+        let phi_m = m.y.atan2(m.x);
+        let mut um_y = phi_to_u(phi_m - phi_o);
+        um_y -= um_y.floor();
+        Some(HalfCoords {
+            theta_o,
+            u_o: [theta_to_u(theta_o), phi_to_u(phi_o)],
+            u_m: [theta_to_u(theta_m), um_y],
+            m,
+        })
+    }
+
+    /// Linear RGB value of `f_r · cos θi` at given coordinates (the format's definition, see
+    /// the module docs).
+    pub fn rgb_cos_at(&self, c: &HalfCoords) -> [f64; 3] {
+        let (s, i, w, factor) = self.lookup(c);
+        let t = &self.tables;
+        let mut out = [0.0; 3];
+        for (ch, o) in out.iter_mut().enumerate() {
+            *o = (t.rgb.eval(s, 3 * i + ch, 3, w) * factor).max(0.0);
+        }
+        out
+    }
+
+    /// Luminance of [`rgb_cos_at`](Self::rgb_cos_at) (one table lookup instead of three).
+    pub fn luminance_cos_at(&self, c: &HalfCoords) -> f64 {
+        let (s, i, w, factor) = self.lookup(c);
+        (self.tables.rgb_luminance.eval(s, i, 1, w) * factor).max(0.0)
+    }
+
+    /// The warped-square position, the slice blend and the `D/(4σ)` factor of `c`.
+    fn lookup(&self, c: &HalfCoords) -> ([f64; 2], usize, f64, f64) {
+        let t = &self.tables;
+        let (s, _) = t.vndf.invert(c.u_m, c.theta_o);
+        let (i, w) = t.theta.locate(c.theta_o);
+        let factor = if t.jacobian {
+            let sigma = t.sigma.eval(c.u_o, 0, 0, 0.0);
+            t.ndf.eval(c.u_m, 0, 0, 0.0) / (4.0 * sigma)
+        } else {
+            1.0
+        };
+        (s, i, w, factor)
+    }
+}
+
+fn shape_error(field: &str, shape: &[usize], expected: &str) -> RglError {
+    RglError::WrongShape {
+        field: field.to_string(),
+        shape: shape.to_vec(),
+        expected: expected.to_string(),
+    }
+}
+
+/// A rank-2 table `[Py, Px]` (both ≥ 2) with values `≥ min` (`> min` when `strict`).
+fn plain_table(
+    tf: &TensorFile<'_>,
+    name: &str,
+    min: f64,
+    strict: bool,
+) -> Result<(BilinearTable, ()), RglError> {
+    let shape = tf.field(name)?.shape.clone();
+    if shape.len() != 2 || shape[0] < 2 || shape[1] < 2 {
+        return Err(shape_error(name, &shape, "[Py, Px] with Py, Px ≥ 2"));
+    }
+    let data = tf.f32_data(name)?;
+    check_min(name, &data, min, strict)?;
+    Ok((BilinearTable::new(shape[1], shape[0], data), ()))
+}
+
+fn check_min(name: &str, data: &[f64], min: f64, strict: bool) -> Result<(), RglError> {
+    for (index, &value) in data.iter().enumerate() {
+        let ok = if strict { value > min } else { value >= min };
+        if !ok {
+            return Err(RglError::OutOfRange {
+                field: name.to_string(),
+                index,
+                value,
+                rule: if strict {
+                    "must be positive"
+                } else {
+                    "must be non-negative"
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A rank-4 sampling table `[1, T, Ny, Nx]` (non-negative, every slice positive).
+fn sampling_table(
+    tf: &TensorFile<'_>,
+    name: &str,
+    n_theta: usize,
+    axis: &ParamAxis,
+) -> Result<Warp2D, RglError> {
+    let shape = tf.field(name)?.shape.clone();
+    if shape.len() != 4 || shape[0] != 1 || shape[1] != n_theta || shape[2] < 2 || shape[3] < 2 {
+        return Err(shape_error(
+            name,
+            &shape,
+            &format!("[1, {n_theta}, Ny, Nx] with Ny, Nx ≥ 2"),
+        ));
+    }
+    let data = tf.f32_data(name)?;
+    check_min(name, &data, 0.0, false)?;
+    Warp2D::new(axis.clone(), BilinearTable::new(shape[3], shape[2], data)).map_err(|z| {
+        RglError::ZeroSlice {
+            field: name.to_string(),
+            slice: z.0,
+        }
+    })
+}
+
+impl Brdf for RglBrdf {
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        match Self::half_coords(wo, wi) {
+            Some(c) => self.luminance_cos_at(&c) / wi.z,
+            None => 0.0,
+        }
+    }
+
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        match Self::half_coords(wo, wi) {
+            Some(c) => self.rgb_cos_at(&c).map(|v| v / wi.z),
+            None => [0.0; 3],
+        }
+    }
+
+    /// True when the file's `ndf` and `sigma` do not depend on the azimuth (checked when read):
+    /// the rest of the format depends on azimuths only through `φm − φo`.
+    fn is_isotropic(&self) -> bool {
+        self.tables.isotropic
+    }
+
+    /// Isotropic and every table even in the relative azimuth (checked when read, relative
+    /// tolerance [`SYMMETRY_TOLERANCE`]): then `φm − φo ↦ φo − φm` leaves `f` unchanged.
+    fn is_mirror_symmetric(&self) -> bool {
+        self.tables.mirror_symmetric
+    }
+
+    fn is_half_turn_symmetric(&self) -> bool {
+        self.tables.isotropic
+    }
+
+    /// `false`: tabulated `f·cos θi` does not vanish at grazing `ωi` (bilinear interpolation
+    /// of measured data), so `f = (f·cos)/cos θi` grows like `1/cos θi` there.
+    fn bounded_at_horizon(&self) -> bool {
+        false
+    }
+
+    fn name(&self) -> &str {
+        "rgl"
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+}

@@ -1,0 +1,154 @@
+//! ABC model (Low, Kronander, Ynnerman & Unger 2012, "BRDF models for accurate and efficient
+//! rendering of glossy surfaces", ACM TOG 31(1)) with the published fits of the 100 MERL
+//! materials as presets (`abc:material=NAME`).
+//!
+//! Per RGB channel, with `h = (ωi + ωo)/|ωi + ωo|`:
+//!
+//! `f_r = kd/π + F(ωi·h) D(θh) G / (π cos θi cos θo)`,
+//! * `D(θh) = A / (1 + B (1 − cos θh))^C` (`A` per channel, `B`, `C` shared),
+//! * `F` the unpolarised dielectric Fresnel reflectance of index `ior`
+//!   ([`fresnel_dielectric`]),
+//! * `G = min(1, 2 cos θh cos θi / (ωi·h), 2 cos θh cos θo / (ωo·h))` (V-cavity),
+//!
+//! as evaluated by `djb::abc` in jdupuy/dj_brdf (public domain), whose table is embedded
+//! (`crates/brdf/data/merl100_abc_low2012.tsv`). Isotropic, mirror- and half-turn symmetric,
+//! reciprocal; bounded at the horizon (`G ≤ 2 cos θh cos θi/(ωi·h)` cancels `1/cos θi`); not
+//! energy-conserving by construction.
+
+use crate::brdf::{Brdf, luminance};
+use crate::fresnel::fresnel_dielectric;
+use crate::geometry::{Vec3, both_above};
+use crate::models::merl_fits::{self, FitRow};
+use std::f64::consts::FRAC_1_PI;
+use std::sync::OnceLock;
+
+pub(crate) const NAME: &str = "abc";
+
+/// The embedded table (tab-separated, provenance in its header comments).
+pub const TABLE: &str = include_str!("../../data/merl100_abc_low2012.tsv");
+
+/// Fitted parameters of one material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AbcParams {
+    /// Diffuse albedos (R, G, B).
+    pub kd: [f64; 3],
+    /// NDF scales `A` (R, G, B).
+    pub a: [f64; 3],
+    /// NDF `B`.
+    pub b: f64,
+    /// NDF exponent `C`.
+    pub c: f64,
+    /// Index of refraction of the Fresnel term.
+    pub ior: f64,
+}
+
+/// The ABC model of one MERL material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Abc {
+    material: String,
+    params: AbcParams,
+}
+
+fn rows() -> &'static [FitRow] {
+    static ROWS: OnceLock<Vec<FitRow>> = OnceLock::new();
+    ROWS.get_or_init(|| merl_fits::parse_table(TABLE, 1))
+}
+
+/// The preset names (MERL names), in table order.
+pub fn preset_names() -> Vec<&'static str> {
+    rows().iter().map(|r| r.name.as_str()).collect()
+}
+
+/// Up to five preset names close to `name`.
+pub fn close_matches(name: &str) -> Vec<String> {
+    merl_fits::close_matches(name, rows().iter().map(|r| r.name.as_str()))
+}
+
+impl Abc {
+    /// The preset of a MERL material, or `None`.
+    pub fn preset(material: &str) -> Option<Self> {
+        let row = rows().iter().find(|r| r.name == material)?;
+        let v = &row.values;
+        if v.len() < 9 {
+            return None;
+        }
+        Some(Self {
+            material: row.name.clone(),
+            params: AbcParams {
+                kd: [v[0], v[1], v[2]],
+                a: [v[3], v[4], v[5]],
+                b: v[6],
+                c: v[7],
+                ior: v[8],
+            },
+        })
+    }
+
+    /// The material's MERL name.
+    pub fn material(&self) -> &str {
+        &self.material
+    }
+
+    /// The fitted parameters.
+    pub fn params(&self) -> &AbcParams {
+        &self.params
+    }
+}
+
+impl Brdf for Abc {
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        luminance(self.eval_rgb(wo, wi))
+    }
+
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        if !both_above(wo, wi) {
+            return [0.0; 3];
+        }
+        let p = &self.params;
+        let h = (wo + wi).normalize();
+        let (hi, ho) = (wi.dot(&h), wo.dot(&h));
+        let g = (2.0 * h.z * wi.z / hi).min(2.0 * h.z * wo.z / ho).min(1.0);
+        let f = fresnel_dielectric(hi, p.ior);
+        let base = (1.0 + p.b * (1.0 - h.z)).powf(p.c);
+        let mut out = [0.0; 3];
+        for (ch, o) in out.iter_mut().enumerate() {
+            let d = p.a[ch] / base;
+            let v = p.kd[ch] * FRAC_1_PI + f * d * g * FRAC_1_PI / (wi.z * wo.z);
+            *o = if v.is_finite() { v.max(0.0) } else { 0.0 };
+        }
+        out
+    }
+
+    fn is_isotropic(&self) -> bool {
+        true
+    }
+    fn is_mirror_symmetric(&self) -> bool {
+        true
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        true
+    }
+    fn is_reciprocal(&self) -> bool {
+        true
+    }
+    fn name(&self) -> &str {
+        NAME
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The column mapping of [`Abc::preset`] is the table's header.
+    #[test]
+    fn columns_follow_the_header() {
+        let h = merl_fits::header(TABLE);
+        assert_eq!(
+            h,
+            [
+                "name", "kD_r", "kD_g", "kD_b", "A_r", "A_g", "A_b", "B", "C", "ior"
+            ]
+        );
+    }
+}

@@ -1,0 +1,114 @@
+//! The published fits of the 100 MERL materials, embedded as tab-separated tables with their
+//! provenance (`crates/brdf/data/*.tsv`, see `crates/brdf/data/README.md`): one row per
+//! material, a `name` column then numeric columns; `#` lines are comments; the first
+//! non-comment line is the header.
+
+/// One fitted material: its names and the numeric columns in header order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FitRow {
+    /// The MERL name (e.g. `gold-metallic-paint`).
+    pub name: String,
+    /// Another name of the same material (SGD table's `otherName`), possibly empty.
+    pub other_name: String,
+    /// The numeric columns.
+    pub values: Vec<f64>,
+}
+
+/// Parses an embedded table: `text_columns` leading text columns (1 or 2), then numbers.
+/// The embedded tables are checked by the tests; a malformed row is skipped.
+pub(crate) fn parse_table(text: &str, text_columns: usize) -> Vec<FitRow> {
+    let mut rows = Vec::new();
+    let mut header_seen = false;
+    for line in text.lines() {
+        if line.starts_with('#') || line.trim().is_empty() {
+            continue;
+        }
+        if !header_seen {
+            header_seen = true;
+            continue;
+        }
+        let cols: Vec<&str> = line.split('\t').collect();
+        if cols.len() <= text_columns {
+            continue;
+        }
+        let values: Option<Vec<f64>> = cols[text_columns..]
+            .iter()
+            .map(|c| c.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        let Some(values) = values else { continue };
+        rows.push(FitRow {
+            name: cols[0].trim().to_string(),
+            other_name: if text_columns > 1 {
+                cols[1].trim().to_string()
+            } else {
+                String::new()
+            },
+            values,
+        });
+    }
+    rows
+}
+
+/// The column names of an embedded table (its header line).
+#[cfg(test)]
+pub(crate) fn header(text: &str) -> Vec<&str> {
+    text.lines()
+        .find(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| l.split('\t').map(str::trim).collect())
+        .unwrap_or_default()
+}
+
+/// Up to five names closest to `name` (edit distance ≤ 4, or containing it / contained in it),
+/// best first.
+pub(crate) fn close_matches<'a>(name: &str, names: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let lower = name.to_ascii_lowercase();
+    let mut scored: Vec<(usize, &str)> = names
+        .filter_map(|n| {
+            let d = edit_distance(&lower, n);
+            let contains = !lower.is_empty() && (n.contains(&lower) || lower.contains(n));
+            (d <= 4 || contains).then_some((if contains { d.min(2) } else { d }, n))
+        })
+        .collect();
+    scored.sort();
+    scored.dedup_by(|a, b| a.1 == b.1);
+    scored
+        .into_iter()
+        .take(5)
+        .map(|(_, n)| n.to_string())
+        .collect()
+}
+
+/// Levenshtein distance (for suggestions only).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn close_matches_rank_typos_first() {
+        let names = [
+            "gold-metallic-paint",
+            "gold-metallic-paint2",
+            "gold-paint",
+            "nickel",
+        ];
+        let m = close_matches("gold-metalic-paint", names.iter().copied());
+        assert_eq!(m.first().map(String::as_str), Some("gold-metallic-paint"));
+        assert!(!m.contains(&"nickel".to_string()));
+        assert!(close_matches("zzzzzzzzzz", names.iter().copied()).is_empty());
+    }
+}
