@@ -20,6 +20,8 @@
 
 pub mod hemisphere;
 pub mod options;
+pub mod srbf;
 
 pub use hemisphere::{CosineHemisphere, UniformHemisphere};
-pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions};
+pub use options::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions, SrbfOptions};
+pub use srbf::{SrbfError, SrbfSampler};

@@ -70,4 +70,7 @@ pub enum RegistryError {
     // -- CDF baselines' error --
 
     // -- factored baseline's error --
+    /// The SRBF fits (Tsai 2008) could not be set up.
+    #[error(transparent)]
+    Srbf(#[from] baselines::SrbfError),
 }
