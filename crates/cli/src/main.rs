@@ -10,6 +10,7 @@ mod error;
 mod eval_cmd;
 mod list_cmd;
 mod output;
+mod product_cmd;
 mod progress;
 mod sample_cmd;
 mod validate_cmd;
@@ -39,6 +40,8 @@ enum Command {
     Validate(validate_cmd::ValidateArgs),
     /// Sample an environment map (directions ∝ luminance per solid angle) and print a summary.
     Envmap(envmap_cmd::EnvmapArgs),
+    /// Reflected radiance under an environment map: SRBF product, BRDF, light and MIS estimators.
+    Product(product_cmd::ProductArgs),
 }
 
 fn main() {
@@ -53,6 +56,7 @@ fn main() {
         Command::Build(args) => build_cmd::run(&args),
         Command::Validate(args) => validate_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
+        Command::Product(args) => product_cmd::run(&args),
     };
     if let Err(e) = result {
         report_and_exit(&e);
