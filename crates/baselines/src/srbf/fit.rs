@@ -5,7 +5,8 @@
 //! objective the solid-angle-weighted least squares `E = Σ_i A_i (Σ_k c_k G_ik − f_i)²` over the
 //! target's sample directions (its quadrature weights `A_i` w.r.t. solid angle).
 //!
-//! 1. Greedy initial guess: a lobe at the residual's peak, `λ = ln 2 / (1 − cos α½)` from the
+//! 1. Initial guess: one broad lobe from the target's first moment (mean direction and
+//!    concentration), then greedily a lobe at the residual's peak, `λ = ln 2 / (1 − cos α½)` from the
 //!    nearest sample below half the peak, `c` by 1D non-negative least squares, subtract, repeat;
 //!    then all `c_k` jointly by NNLS (projected coordinate descent on the normal equations).
 //! 2. Joint refinement with L-BFGS ([`super::lbfgs`]) in bound-free parameters: `c = e^a`,
@@ -234,11 +235,27 @@ pub fn fit(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfEr
     })
 }
 
-/// Greedy residual peaks (baselines.md §C.2 steps 1–5).
+/// A broad moment-fitted lobe, then greedy residual peaks (baselines.md §C.2 steps 1–5).
 fn greedy_guess(target: &FitTarget, settings: &FitSettings) -> Vec<SgLobe> {
     let mut residual = target.values.clone();
     let mut lobes = Vec::with_capacity(settings.lobes);
-    for _ in 0..settings.lobes {
+    // Lobe 1 (with K ≥ 2): the floor. Peaks alone leave a wide, low part of the target (a
+    // diffuse term, a sky behind a sun) to the lobes' e^{−2λ} tails, which no sampler built on
+    // them can recover. The floor is the moment fit of the target clipped at its solid-angle-
+    // weighted 90th percentile (so a sun or a specular peak does not dominate it): mean
+    // direction and the concentration of the mean resultant length R̄ (Banerjee et al. 2005:
+    // κ ≈ R̄(3 − R̄²)/(1 − R̄²)), amplitude by least squares on the clipped target.
+    if settings.lobes >= 2
+        && let Some(lobe) = floor_lobe(target, settings)
+    {
+        for (d, r) in target.directions.iter().zip(residual.iter_mut()) {
+            *r -= lobe.eval(d);
+        }
+        lobes.push(lobe);
+    }
+    let mut attempts = 0;
+    while lobes.len() < settings.lobes && attempts < 4 * settings.lobes {
+        attempts += 1;
         let Some((peak, &peak_value)) = residual
             .iter()
             .enumerate()
@@ -250,6 +267,12 @@ fn greedy_guess(target: &FitTarget, settings: &FitSettings) -> Vec<SgLobe> {
             break;
         }
         let axis = target.directions[peak];
+        if lobes.iter().any(|l| l.axis.dot(&axis) > 1.0 - 1e-12) {
+            // A peak narrower than the bandwidth cap: another lobe here only duplicates the
+            // first; move on to the next peak.
+            residual[peak] = 0.0;
+            continue;
+        }
         // Half-maximum radius: the closest sample (largest cosine) below half the peak.
         let cos_half = residual
             .iter()
@@ -280,6 +303,54 @@ fn greedy_guess(target: &FitTarget, settings: &FitSettings) -> Vec<SgLobe> {
         lobes.push(lobe);
     }
     lobes
+}
+
+/// The broad floor lobe of the greedy guess (see there), if the target has one.
+fn floor_lobe(target: &FitTarget, settings: &FitSettings) -> Option<SgLobe> {
+    let mut order: Vec<usize> = (0..target.len()).collect();
+    order.sort_by(|&i, &j| target.values[i].total_cmp(&target.values[j]));
+    let total: f64 = target.weights.iter().sum();
+    let mut acc = 0.0;
+    let mut clip = 0.0;
+    for &i in &order {
+        acc += target.weights[i];
+        clip = target.values[i];
+        if acc >= 0.9 * total {
+            break;
+        }
+    }
+    if !(clip > 0.0) {
+        return None;
+    }
+    let clipped = |i: usize| target.values[i].min(clip);
+    let mut resultant = Vec3::zeros();
+    let mut mass = 0.0;
+    for (i, (d, &a)) in target.directions.iter().zip(&target.weights).enumerate() {
+        resultant += d * (a * clipped(i));
+        mass += a * clipped(i);
+    }
+    let r = (resultant.norm() / mass).min(1.0 - 1e-9);
+    if !(r > 0.0) {
+        return None;
+    }
+    let lambda =
+        (r * (3.0 - r * r) / (1.0 - r * r)).clamp(settings.lambda_min, settings.lambda_max);
+    let mut lobe = SgLobe {
+        axis: resultant / resultant.norm(),
+        lambda,
+        amplitude: 1.0,
+    };
+    let (mut num, mut den) = (0.0, 0.0);
+    for (i, (d, &a)) in target.directions.iter().zip(&target.weights).enumerate() {
+        let g = lobe.eval(d);
+        num += a * clipped(i) * g;
+        den += a * g * g;
+    }
+    if !(num > 0.0 && den > 0.0) {
+        return None;
+    }
+    lobe.amplitude = num / den;
+    Some(lobe)
 }
 
 /// Refits every amplitude jointly with `c ≥ 0` (projected coordinate descent on the normal
