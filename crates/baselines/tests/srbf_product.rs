@@ -1,10 +1,11 @@
 //! Unbiasedness of the reflected-radiance estimators (SRBF product, BRDF, light, MIS): each
 //! agrees with an independent converged reference within 4 standard errors.
 //!
-//! `reduced_*` runs in CI (small maps and fits); `full_tier_*` (ignored; run with
+//! `reduced_*` runs in CI (small maps and fits, every estimator tested); `full_tier_*` (ignored; run with
 //! `cargo test -p baselines --release --test srbf_product -- --ignored`) covers the three maps of
 //! `../shared/data/envmaps`, the procedural sky, four BRDFs (diffuse, glossy, sharp,
-//! MERL-layout) and three normals each.
+//! MERL-layout) and three normals each; there the BRDF-only estimators are reported, not tested
+//! (see [`check`]).
 
 use baselines::srbf::{
     Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
@@ -19,7 +20,10 @@ fn z(a: &Estimate, b: &Estimate) -> f64 {
     (a.estimate - b.estimate) / (a.std_err.powi(2) + b.std_err.powi(2)).sqrt()
 }
 
-/// Runs every estimator on one (map, BRDF) pair at `normals`, returns the failures.
+/// Runs every estimator on one (map, BRDF) pair at `normals`, returns the failures. With
+/// `test_brdf_only == false` the BRDF-only estimators are printed, not tested: on a map with a
+/// sun they are rare-event estimators (the sun is hit a handful of times in 10⁵ samples, or not
+/// at all), so their sample standard error is not a valid yardstick.
 fn check(
     map: &EnvMap,
     brdf: &dyn Brdf,
@@ -27,6 +31,7 @@ fn check(
     normals: &[[f64; 3]],
     n: usize,
     n_ref: usize,
+    test_brdf_only: bool,
 ) -> Vec<String> {
     let brdf_fit = SrbfSampler::build(brdf, options).unwrap();
     let map_fit = fit_envmap(map, options).unwrap();
@@ -84,6 +89,14 @@ fn check(
         }
         for e in &estimates {
             let zz = z(e, &reference);
+            if !test_brdf_only && e.estimator.starts_with("brdf:") {
+                eprintln!(
+                    "{} normal {normal:?}: {} z = {zz:.2} (not tested)",
+                    brdf.name(),
+                    e.estimator
+                );
+                continue;
+            }
             if zz.is_nan() || zz.abs() >= 4.0 {
                 failures.push(format!(
                     "{} normal {normal:?}: {} = {:.6e} ± {:.2e} vs reference {:.6e} ± {:.2e} (z = {zz:.2})",
@@ -121,6 +134,7 @@ fn reduced_estimators_agree_with_the_reference() {
             &normals,
             20_000,
             200_000,
+            true,
         ));
     }
     assert!(failures.is_empty(), "{failures:#?}");
@@ -200,7 +214,15 @@ fn full_tier_estimators_agree_with_the_reference() {
     let mut failures = Vec::new();
     for (map_name, map) in &maps {
         for (label, brdf) in &brdfs {
-            let f = check(map, brdf.as_ref(), &options, &normals, 100_000, 2_000_000);
+            let f = check(
+                map,
+                brdf.as_ref(),
+                &options,
+                &normals,
+                100_000,
+                2_000_000,
+                false,
+            );
             failures.extend(f.into_iter().map(|s| format!("{map_name} / {label}: {s}")));
         }
     }
