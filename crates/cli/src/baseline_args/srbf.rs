@@ -18,7 +18,7 @@ pub(crate) struct SrbfArgs {
     #[arg(long = "srbf-lobes", default_value_t = SrbfOptions::default().brdf_lobes)]
     pub(crate) srbf_lobes: usize,
     /// srbf: bandwidth bounds of the BRDF lobes, `MIN,MAX` (0 < MIN < MAX).
-    #[arg(long = "srbf-lambda", default_value = "0.5,20000", value_parser = parse_bounds)]
+    #[arg(long = "srbf-lambda", default_value = "0.5,20000", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub(crate) srbf_lambda: (f64, f64),
     /// srbf: polar rows of each slice's hemisphere fit grid (4× as many azimuths).
     #[arg(long = "srbf-fit-rows", default_value_t = SrbfOptions::default().fit_rows)]
@@ -34,7 +34,7 @@ pub(crate) struct SrbfArgs {
     #[arg(long = "srbf-map-lobes", default_value_t = SrbfOptions::default().map_lobes)]
     pub(crate) srbf_map_lobes: usize,
     /// product: bandwidth bounds of the map's lobes, `MIN,MAX`.
-    #[arg(long = "srbf-map-lambda", default_value = "0.5,5000", value_parser = parse_bounds)]
+    #[arg(long = "srbf-map-lambda", default_value = "0.5,5000", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub(crate) srbf_map_lambda: (f64, f64),
     /// product: width of the box-filtered map that is fitted (height = width/2).
     #[arg(long = "srbf-map-fit-width", default_value_t = SrbfOptions::default().map_fit_width)]
