@@ -6,7 +6,8 @@
 //! the cosine lobe about the mirror direction with a fitted exponent per outgoing slice
 //! ([`LobeSampler`]: `lobe-sphere`, `lobe-hemisphere`); the models' own analytic samplers
 //! ([`AnalyticSampler`]: `analytic`); [`FactoredSampler`] (Lawrence et al. 2004, NMF-factored
-//! `f_r cos θ`, options [`FactoredOptions`]); [`RglNative`], the RGL format's own sampler.
+//! `f_r cos θ`, options [`FactoredOptions`]); [`RglNative`], the RGL format's own sampler;
+//! [`SrbfSampler`] (Tsai et al. 2008 SRBF mixtures) and the product estimators in [`srbf`].
 //!
 //! The planar baseline, the classic piecewise-constant CDF sampler, lives in `partition_sampler`
 //! (`partition_sampler::PiecewiseConstant2D`) next to the adaptive sampler it is compared with.
@@ -48,6 +49,7 @@ pub mod hemisphere;
 pub mod lobe;
 pub mod options;
 pub mod rgl_native;
+pub mod srbf;
 
 pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
 pub use factored::{FactoredError, FactoredReport, FactoredSampler};
@@ -55,6 +57,7 @@ pub use hemisphere::{CosineHemisphere, UniformHemisphere};
 pub use lobe::{AnalyticSampler, LobeError, LobeFit, LobeSampler, LobeSupport};
 pub use options::{
     BaselineOptions, CdfOptions, CdfOptionsError, FactoredOptions, FactoredOptionsError,
-    LobeOptions, NmfCost, Reparam,
+    LobeOptions, NmfCost, Reparam, SrbfOptions,
 };
 pub use rgl_native::{NotRglError, RglNative};
+pub use srbf::{SrbfError, SrbfSampler};

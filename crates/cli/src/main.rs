@@ -10,6 +10,7 @@ mod error;
 mod eval_cmd;
 mod list_cmd;
 mod output;
+mod product_cmd;
 mod progress;
 mod sample_cmd;
 mod study_cmd;
@@ -42,6 +43,8 @@ enum Command {
     Envmap(envmap_cmd::EnvmapArgs),
     /// Variance-versus-cost study of the direction samplers (report, CSV, JSON, plots); `study merge` combines shards.
     Study(study_cmd::StudyArgs),
+    /// Reflected radiance under an environment map: SRBF product, BRDF, light and MIS estimators.
+    Product(product_cmd::ProductArgs),
 }
 
 fn main() {
@@ -57,6 +60,7 @@ fn main() {
         Command::Validate(args) => validate_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
         Command::Study(args) => study_cmd::run(&args),
+        Command::Product(args) => product_cmd::run(&args),
     };
     if let Err(e) = result {
         report_and_exit(&e);

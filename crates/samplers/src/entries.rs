@@ -247,6 +247,25 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             },
         },
     },
+    SamplerEntry {
+        name: "srbf",
+        summary: "Tsai 2008: per-θo-slice mixture of non-negative Gaussian SRBFs fitted to f_r·cos (greedy + L-BFGS), vMF lobes, exact mixture pdf on the sphere",
+        capabilities: Capabilities {
+            exact_pdf: true,
+            batch_mode: false,
+            needs_build: true,
+            anisotropic: true,
+            measured: true,
+        },
+        constructor: Constructor::Direction {
+            support: Support::Sphere,
+            build: |request| {
+                let sampler =
+                    baselines::SrbfSampler::build(request.brdf.as_ref(), &request.baselines.srbf)?;
+                Ok(BuiltDirection::plain(Arc::new(sampler)))
+            },
+        },
+    },
 ];
 
 /// Capabilities of the per-slice tabulated CDFs of a BRDF (exact: the pdf is the density of

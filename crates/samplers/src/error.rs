@@ -81,4 +81,7 @@ pub enum RegistryError {
     /// A format-specific sampler was asked to sample a BRDF of another kind.
     #[error(transparent)]
     NotRgl(#[from] baselines::NotRglError),
+    /// The SRBF fits (Tsai 2008) could not be set up.
+    #[error(transparent)]
+    Srbf(#[from] baselines::SrbfError),
 }

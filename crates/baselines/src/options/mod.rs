@@ -4,10 +4,12 @@
 mod cdf;
 mod factored;
 mod lobe;
+mod srbf;
 
 pub use cdf::{CdfOptions, CdfOptionsError};
 pub use factored::{FactoredOptions, FactoredOptionsError, NmfCost, Reparam};
 pub use lobe::LobeOptions;
+pub use srbf::SrbfOptions;
 
 /// Options of every BRDF baseline (each family's defaults are the papers' or measured ones).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -18,4 +20,6 @@ pub struct BaselineOptions {
     pub cdf: CdfOptions,
     /// Lawrence 2004 NMF factorisation.
     pub factored: FactoredOptions,
+    /// Tsai 2008 SRBF fits and product sampling.
+    pub srbf: SrbfOptions,
 }

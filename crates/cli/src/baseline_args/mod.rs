@@ -5,6 +5,7 @@
 mod cdf;
 mod factored;
 mod lobe;
+pub(crate) mod srbf;
 
 use baselines::BaselineOptions;
 use clap::Args;
@@ -20,6 +21,8 @@ pub(crate) struct BaselineArgs {
     pub(crate) cdf: cdf::CdfArgs,
     #[command(flatten)]
     pub(crate) factored: factored::FactoredArgs,
+    #[command(flatten)]
+    pub(crate) srbf: srbf::SrbfArgs,
 }
 
 impl BaselineArgs {
@@ -29,6 +32,7 @@ impl BaselineArgs {
             lobe: self.lobe.options()?,
             cdf: self.cdf.options()?,
             factored: self.factored.options()?,
+            srbf: self.srbf.options()?,
         })
     }
 }

@@ -1,0 +1,89 @@
+//! The SRBF baselines' typed error.
+
+/// SRBF fitting, sampling or product estimation could not be set up.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SrbfError {
+    /// A lobe count of zero (per slice or for the map).
+    #[error("the {what} lobe count must be at least 1 (got 0)")]
+    ZeroLobes {
+        /// Which count (`per-slice`, `map`, `kept product`).
+        what: &'static str,
+    },
+    /// Bandwidth bounds that are not `0 < min < max < ∞`.
+    #[error("{what} bandwidth bounds must satisfy 0 < min < max < ∞ (got min {min}, max {max})")]
+    BadBandwidth {
+        /// Which bounds (`BRDF`, `map`).
+        what: &'static str,
+        /// The lower bound given.
+        min: f64,
+        /// The upper bound given.
+        max: f64,
+    },
+    /// A resolution (slices, fit grid) of zero or too large.
+    #[error("{what} must be between 1 and {max} (got {got})")]
+    BadResolution {
+        /// Which resolution.
+        what: &'static str,
+        /// The largest accepted value.
+        max: usize,
+        /// The value given.
+        got: usize,
+    },
+    /// Target samples, weights and directions of different lengths, or no samples at all.
+    #[error(
+        "fit target: {directions} directions, {weights} weights, {values} values (need equal, non-zero counts)"
+    )]
+    TargetShape {
+        /// Number of directions.
+        directions: usize,
+        /// Number of weights.
+        weights: usize,
+        /// Number of values.
+        values: usize,
+    },
+    /// A target value or weight that is NaN, infinite or negative.
+    #[error("fit target sample {index}: value {value} and weight {weight} must be finite and ≥ 0")]
+    BadTarget {
+        /// Index of the sample.
+        index: usize,
+        /// Its value.
+        value: f64,
+        /// Its weight.
+        weight: f64,
+    },
+    /// The target is zero everywhere (e.g. an all-black map): nothing to fit.
+    #[error("the fit target is zero everywhere (e.g. an all-black map)")]
+    BlackTarget,
+    /// A surface normal of zero length or with a non-finite component.
+    #[error("the normal ({x}, {y}, {z}) must be finite with non-zero length")]
+    BadNormal {
+        /// x component.
+        x: f64,
+        /// y component.
+        y: f64,
+        /// z component.
+        z: f64,
+    },
+    /// An outgoing direction below or on the horizon of the local frame.
+    #[error("the outgoing direction must be above the horizon (cos θo = {cos_theta})")]
+    BelowHorizon {
+        /// Its cosine with the normal.
+        cos_theta: f64,
+    },
+    /// A sample count too small for the estimator.
+    #[error("{estimator} needs at least {min} samples (got {got})")]
+    TooFewSamples {
+        /// The estimator.
+        estimator: &'static str,
+        /// The minimum.
+        min: usize,
+        /// The count given.
+        got: usize,
+    },
+    /// A defensive sample share outside `[0, 1)`.
+    #[error("the defensive share must be in [0, 1) (got {value})")]
+    BadDefensive {
+        /// The value given.
+        value: f64,
+    },
+}

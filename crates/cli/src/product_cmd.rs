@@ -1,0 +1,432 @@
+//! `brdf-lab product`: reflected radiance `L_r(ωo) = ∫ L(ωi) f_r(ωo, ωi) cos θi dωi` under an
+//! environment map, estimated side by side by SRBF product sampling (Tsai 2008), BRDF sampling,
+//! light sampling and MIS, against a converged reference (design.md §5).
+//!
+//! The shading frame is explicit: `--normal` (world space, the map's frame) and `--rotation`
+//! about it; `--theta-o/--phi-o` are in that local frame. Samplers come from the registry.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use baselines::srbf::{
+    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    estimate_srbf_product, fit_envmap,
+};
+use baselines::{SrbfOptions, SrbfSampler};
+use brdf_sampling::DirectionSampler;
+use clap::Args;
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use serde::Serialize;
+
+use crate::brdf_args::{SetArgs, parse_brdf};
+use crate::error::{CliError, CliResult};
+use crate::output::{check_all, num, write_atomically};
+
+/// Width and height of the built-in procedural sky.
+const SKY_SIZE: (usize, usize) = (1024, 512);
+
+/// Arguments of `brdf-lab product`.
+#[derive(Debug, Args)]
+pub(crate) struct ProductArgs {
+    /// BRDF: `name` or `name:key=value,...` or `merl:PATH`.
+    #[arg(long = "brdf")]
+    spec: String,
+    /// Lat-long map (.hdr, .exr or .pfm) in world space; without it the built-in procedural sky.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// World-space surface normal `X,Y,Z` (normalised here; the zero vector is refused).
+    #[arg(long, default_value = "0,0,1", value_parser = parse_vec3, allow_hyphen_values = true)]
+    normal: [f64; 3],
+    /// Rotation of the tangent frame about the normal, in degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    rotation: f64,
+    /// Outgoing polar angle θo in the local frame, degrees in [0, 90).
+    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    theta_o: f64,
+    /// Outgoing azimuth φo in the local frame, degrees.
+    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    phi_o: f64,
+    /// Samples per estimator.
+    #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(16..))]
+    n: u64,
+    /// Seed (each estimator gets its own stream derived from it).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// BRDF direction samplers for the `brdf` and `mis` estimators (repeatable; registry names).
+    #[arg(long = "brdf-sampler", default_values_t = ["srbf".to_string(), "cosine".to_string()])]
+    brdf_samplers: Vec<String>,
+    /// Environment-map samplers for the `light` and `mis` estimators (repeatable).
+    #[arg(long = "light-sampler", default_values_t = ["envmap-adaptive".to_string(), "envmap-cdf".to_string()])]
+    light_samplers: Vec<String>,
+    /// Samples of the reference (MIS, balance heuristic, of the first BRDF and light samplers).
+    #[arg(long = "reference-samples", default_value_t = 4_000_000, value_parser = clap::value_parser!(u64).range(16..))]
+    reference_samples: u64,
+    /// Write the results as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the results as CSV (`estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z`).
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Options of the samplers (the srbf fits: --srbf-*).
+    #[command(flatten)]
+    set: SetArgs,
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("`{s}`: expected X,Y,Z"));
+    }
+    let mut v = [0.0; 3];
+    for (x, p) in v.iter_mut().zip(parts) {
+        *x = p.trim().parse().map_err(|e| format!("`{p}`: {e}"))?;
+    }
+    Ok(v)
+}
+
+/// One estimator's row of the output.
+#[derive(Debug, Serialize)]
+struct Row {
+    estimator: String,
+    estimate: f64,
+    std_err: f64,
+    samples: usize,
+    seconds: f64,
+    seconds_per_sample: f64,
+    variance_time: f64,
+    /// `(estimate − reference) / √(σ² + σ_ref²)`.
+    z: f64,
+    reference: f64,
+    reference_std_err: f64,
+}
+
+/// The fits' quality and cost.
+#[derive(Debug, Serialize)]
+struct FitSummary {
+    brdf_slices: usize,
+    brdf_lobes: usize,
+    brdf_mean_rel_l2: f64,
+    brdf_max_rel_l2: f64,
+    brdf_mean_rel_l1: f64,
+    brdf_not_converged: usize,
+    brdf_seconds: f64,
+    brdf_bytes: usize,
+    map_lobes: usize,
+    map_rel_l2: f64,
+    map_rel_l1: f64,
+    map_converged: bool,
+    map_seconds: f64,
+    map_bytes: usize,
+    product_lobes: usize,
+    kept_lobes: usize,
+    kept_mass_fraction: f64,
+}
+
+/// The JSON document.
+#[derive(Debug, Serialize)]
+struct Report {
+    brdf: String,
+    map: String,
+    normal: [f64; 3],
+    rotation_deg: f64,
+    theta_o: f64,
+    phi_o: f64,
+    reference: Estimate2,
+    fits: FitSummary,
+    estimators: Vec<Row>,
+}
+
+/// The reference estimate.
+#[derive(Debug, Serialize)]
+struct Estimate2 {
+    estimator: String,
+    estimate: f64,
+    std_err: f64,
+    samples: usize,
+    seconds: f64,
+}
+
+fn load_map(path: Option<&PathBuf>) -> CliResult<(EnvMap, String)> {
+    match path {
+        Some(path) => {
+            let map = EnvMap::load(path)
+                .map_err(|e| CliError::input(format!("--map {}: {e}", path.display())))?;
+            Ok((map, path.display().to_string()))
+        }
+        None => Ok((
+            envmap::procedural_sky(SKY_SIZE.0, SKY_SIZE.1).map_err(CliError::input)?,
+            "procedural-sky".to_string(),
+        )),
+    }
+}
+
+/// Distinct seeds per estimator.
+fn stream(seed: u64, k: u64) -> u64 {
+    partition_sampler::chunk_seed(seed, k)
+}
+
+/// Runs `brdf-lab product`.
+pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
+    check_all([
+        ("--json", args.json.as_deref()),
+        ("--csv", args.csv.as_deref()),
+    ])?;
+    if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
+        return Err(CliError::input(format!(
+            "--theta-o must be in [0, 90) degrees, got {}",
+            args.theta_o
+        )));
+    }
+    if !(args.phi_o.is_finite() && args.rotation.is_finite()) {
+        return Err(CliError::input("--phi-o and --rotation must be finite"));
+    }
+    let frame = LocalFrame::new(args.normal, args.rotation.to_radians())
+        .map_err(|e| CliError::input(format!("--normal: {e}")))?;
+    let baselines = args.set.baselines.options()?;
+    let srbf_options: SrbfOptions = baselines.srbf.clone();
+    let brdf = parse_brdf(&args.spec)?;
+    let (map, map_name) = load_map(args.map.as_ref())?;
+    let n = args.n as usize;
+    let wo = brdf::direction_from_angles(args.theta_o, args.phi_o);
+    let scene = ProductScene::new(brdf.as_ref(), &map, frame, wo).map_err(CliError::input)?;
+
+    // Samplers from the registry (built once; their build time is not in the estimators').
+    let options = args.set.options();
+    let mut brdf_samplers: Vec<(String, Arc<dyn DirectionSampler>)> = Vec::new();
+    for name in &args.brdf_samplers {
+        let request = samplers::DirectionRequest::new(Arc::clone(&brdf), &options)
+            .with_baselines(baselines.clone())
+            .with_spec(&args.spec);
+        let built = samplers::build_direction(name, &request).map_err(CliError::input)?;
+        brdf_samplers.push((name.clone(), built.sampler));
+    }
+    let mut light_samplers: Vec<(String, EnvMapSampler)> = Vec::new();
+    for name in &args.light_samplers {
+        let entry = samplers::find(name).map_err(CliError::input)?;
+        let sampler = entry
+            .build_envmap(&map, &AdaptiveOptions::default())
+            .map_err(CliError::input)?;
+        light_samplers.push((name.clone(), sampler));
+    }
+
+    // SRBF fits (preprocessing, timed separately).
+    let brdf_fit = SrbfSampler::build(brdf.as_ref(), &srbf_options).map_err(CliError::input)?;
+    let map_fit = fit_envmap(&map, &srbf_options).map_err(CliError::input)?;
+    let br = brdf_fit.report();
+    if br.not_converged > 0 {
+        eprintln!(
+            "brdf-lab: warning: {} of {} BRDF slice fits hit the L-BFGS cap (--srbf-max-iter); largest residual (rel. L2) {:.3e}",
+            br.not_converged, br.slices, br.max_rel_l2
+        );
+    }
+    if !map_fit.report.converged {
+        eprintln!(
+            "brdf-lab: warning: the map fit hit the L-BFGS cap; residual (rel. L2) {:.3e}",
+            map_fit.report.rel_l2
+        );
+    }
+
+    // The reference.
+    let reference = estimate_mis(
+        &scene,
+        brdf_samplers[0].1.as_ref(),
+        &light_samplers[0].1,
+        MisHeuristic::Balance,
+        &format!(
+            "reference mis-balance:{}+{}",
+            brdf_samplers[0].0, light_samplers[0].0
+        ),
+        args.reference_samples as usize,
+        stream(args.seed, 0),
+    )
+    .map_err(CliError::input)?;
+
+    let mut estimates: Vec<Estimate> = Vec::new();
+    let (product, stats) = estimate_srbf_product(
+        &scene,
+        &brdf_fit,
+        &map_fit,
+        &srbf_options.product_settings(),
+        n,
+        stream(args.seed, 1),
+    )
+    .map_err(CliError::input)?;
+    estimates.push(product);
+    let mut k = 2;
+    for (name, s) in &brdf_samplers {
+        estimates.push(
+            estimate_brdf(
+                &scene,
+                s.as_ref(),
+                &format!("brdf:{name}"),
+                n,
+                stream(args.seed, k),
+            )
+            .map_err(CliError::input)?,
+        );
+        k += 1;
+    }
+    for (name, s) in &light_samplers {
+        estimates.push(
+            estimate_light(&scene, s, &format!("light:{name}"), n, stream(args.seed, k))
+                .map_err(CliError::input)?,
+        );
+        k += 1;
+    }
+    for (bname, b) in &brdf_samplers {
+        for (lname, l) in &light_samplers {
+            for (h, hname) in [
+                (MisHeuristic::Balance, "balance"),
+                (MisHeuristic::Power, "power"),
+            ] {
+                estimates.push(
+                    estimate_mis(
+                        &scene,
+                        b.as_ref(),
+                        l,
+                        h,
+                        &format!("mis-{hname}:{bname}+{lname}"),
+                        n,
+                        stream(args.seed, k),
+                    )
+                    .map_err(CliError::input)?,
+                );
+                k += 1;
+            }
+        }
+    }
+
+    let rows: Vec<Row> = estimates
+        .iter()
+        .map(|e| Row {
+            estimator: e.estimator.clone(),
+            estimate: e.estimate,
+            std_err: e.std_err,
+            samples: e.samples,
+            seconds: e.seconds,
+            seconds_per_sample: e.seconds_per_sample(),
+            variance_time: e.variance_time(),
+            z: (e.estimate - reference.estimate)
+                / (e.std_err.powi(2) + reference.std_err.powi(2)).sqrt(),
+            reference: reference.estimate,
+            reference_std_err: reference.std_err,
+        })
+        .collect();
+
+    println!("brdf       {}", args.spec);
+    println!(
+        "map        {map_name} ({} x {} pixels)",
+        map.width(),
+        map.height()
+    );
+    println!(
+        "frame      normal ({}, {}, {}), rotation {}°, θo {}°, φo {}°",
+        args.normal[0], args.normal[1], args.normal[2], args.rotation, args.theta_o, args.phi_o
+    );
+    println!(
+        "srbf fit   BRDF: {} slices, {} lobes, rel. L2 mean {:.3} max {:.3}, rel. L1 mean {:.3}, {:.2} s, {} bytes",
+        br.slices, br.lobes, br.mean_rel_l2, br.max_rel_l2, br.mean_rel_l1, br.seconds, br.bytes
+    );
+    println!(
+        "           map: {} lobes, rel. L2 {:.3}, rel. L1 {:.3}, {:.2} s, {} bytes; product: {} lobes, kept {} ({:.1} % of the mass)",
+        map_fit.lobes.len(),
+        map_fit.report.rel_l2,
+        map_fit.report.rel_l1,
+        map_fit.report.seconds,
+        map_fit.bytes_used(),
+        stats.product_lobes,
+        stats.kept,
+        100.0 * stats.kept_mass_fraction
+    );
+    println!(
+        "reference  {:.6e} ± {:.2e} ({}, {} samples, {:.2} s)",
+        reference.estimate,
+        reference.std_err,
+        reference.estimator,
+        reference.samples,
+        reference.seconds
+    );
+    println!(
+        "{:<44} {:>13} {:>10} {:>8} {:>10} {:>10}",
+        "estimator", "estimate", "std err", "z", "ns/sample", "var×time"
+    );
+    for r in &rows {
+        println!(
+            "{:<44} {:>13.6e} {:>10.3e} {:>8.2} {:>10.1} {:>10.3e}",
+            r.estimator,
+            r.estimate,
+            r.std_err,
+            r.z,
+            1e9 * r.seconds_per_sample,
+            r.variance_time
+        );
+    }
+
+    if let Some(path) = &args.csv {
+        write_atomically(path, |w| {
+            writeln!(
+                w,
+                "estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z,reference,reference_std_err"
+            )?;
+            for r in &rows {
+                writeln!(
+                    w,
+                    "{},{},{},{},{},{},{},{},{},{}",
+                    r.estimator,
+                    num(r.estimate),
+                    num(r.std_err),
+                    r.samples,
+                    num(r.seconds),
+                    num(r.seconds_per_sample),
+                    num(r.variance_time),
+                    num(r.z),
+                    num(r.reference),
+                    num(r.reference_std_err)
+                )?;
+            }
+            Ok(())
+        })?;
+    }
+    if let Some(path) = &args.json {
+        let report = Report {
+            brdf: args.spec.clone(),
+            map: map_name,
+            normal: args.normal,
+            rotation_deg: args.rotation,
+            theta_o: args.theta_o,
+            phi_o: args.phi_o,
+            reference: Estimate2 {
+                estimator: reference.estimator.clone(),
+                estimate: reference.estimate,
+                std_err: reference.std_err,
+                samples: reference.samples,
+                seconds: reference.seconds,
+            },
+            fits: FitSummary {
+                brdf_slices: br.slices,
+                brdf_lobes: br.lobes,
+                brdf_mean_rel_l2: br.mean_rel_l2,
+                brdf_max_rel_l2: br.max_rel_l2,
+                brdf_mean_rel_l1: br.mean_rel_l1,
+                brdf_not_converged: br.not_converged,
+                brdf_seconds: br.seconds,
+                brdf_bytes: br.bytes,
+                map_lobes: map_fit.lobes.len(),
+                map_rel_l2: map_fit.report.rel_l2,
+                map_rel_l1: map_fit.report.rel_l1,
+                map_converged: map_fit.report.converged,
+                map_seconds: map_fit.report.seconds,
+                map_bytes: map_fit.bytes_used(),
+                product_lobes: stats.product_lobes,
+                kept_lobes: stats.kept,
+                kept_mass_fraction: stats.kept_mass_fraction,
+            },
+            estimators: rows,
+        };
+        write_atomically(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &report).map_err(std::io::Error::other)?;
+            writeln!(w)
+        })?;
+    }
+    Ok(())
+}

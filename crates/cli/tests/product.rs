@@ -1,0 +1,120 @@
+//! End-to-end tests of `brdf-lab product`: bad input exits 2 with the reason before any work;
+//! a small run writes the JSON and CSV of design.md §5.
+
+use std::process::{Command, Output};
+
+fn brdf_lab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .args(args)
+        .output()
+        .expect("run brdf-lab")
+}
+
+/// Exit code 2, one line on stderr containing `needle`, no panic.
+fn assert_input_error(args: &[&str], needle: &str) {
+    let o = brdf_lab(args);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: `{needle}` not in {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+const BASE: [&str; 6] = ["product", "--brdf", "lambert", "--theta-o", "30", "-n=1000"];
+
+fn with(extra: &[&str]) -> Vec<String> {
+    BASE.iter().chain(extra).map(|s| s.to_string()).collect()
+}
+
+fn run_input_error(extra: &[&str], needle: &str) {
+    let args = with(extra);
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_input_error(&refs, needle);
+}
+
+#[test]
+fn bad_input_is_exit_2_with_the_reason() {
+    run_input_error(&["--normal", "0,0,0"], "normal");
+    run_input_error(&["--srbf-lobes", "0"], "lobe count must be at least 1");
+    run_input_error(&["--srbf-map-lobes", "0"], "map lobe count");
+    run_input_error(&["--srbf-lambda", "0,100"], "bandwidth bounds");
+    run_input_error(&["--srbf-map-lambda", "-1,100"], "bandwidth bounds");
+    run_input_error(&["--srbf-defensive", "1"], "defensive share");
+    let dir = tempfile::tempdir().unwrap();
+    let black = dir.path().join("black.pfm");
+    let mut bytes = b"PF\n2 1\n-1.0\n".to_vec();
+    bytes.extend(std::iter::repeat_n(0u8, 2 * 3 * 4));
+    std::fs::write(&black, bytes).unwrap();
+    run_input_error(&["--map", black.to_str().unwrap()], "black");
+}
+
+#[test]
+fn small_run_writes_json_and_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("p.json");
+    let csv = dir.path().join("p.csv");
+    let args = with(&[
+        "--normal",
+        "0.2,-0.1,1",
+        "--srbf-slices",
+        "2",
+        "--srbf-fit-rows",
+        "8",
+        "--srbf-lobes",
+        "2",
+        "--srbf-map-lobes",
+        "4",
+        "--srbf-map-fit-width",
+        "16",
+        "--reference-samples",
+        "20000",
+        "--brdf-sampler",
+        "cosine",
+        "--light-sampler",
+        "envmap-cdf",
+        "--json",
+        json.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    let o = brdf_lab(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(doc["reference"]["estimate"].as_f64().unwrap() > 0.0);
+    assert!(doc["reference"]["std_err"].as_f64().unwrap() > 0.0);
+    let estimators = doc["estimators"].as_array().unwrap();
+    let names: Vec<&str> = estimators
+        .iter()
+        .map(|e| e["estimator"].as_str().unwrap())
+        .collect();
+    for expected in [
+        "srbf-product",
+        "brdf:cosine",
+        "light:envmap-cdf",
+        "mis-balance:cosine+envmap-cdf",
+        "mis-power:cosine+envmap-cdf",
+    ] {
+        assert!(names.contains(&expected), "{names:?}");
+    }
+    for e in estimators {
+        for key in [
+            "estimate",
+            "std_err",
+            "seconds",
+            "reference",
+            "reference_std_err",
+            "variance_time",
+        ] {
+            assert!(e[key].as_f64().is_some_and(f64::is_finite), "{key} in {e}");
+        }
+    }
+    let table = std::fs::read_to_string(&csv).unwrap();
+    assert!(table.starts_with("estimator,estimate,std_err,"));
+    assert_eq!(table.lines().count(), 1 + estimators.len());
+}
