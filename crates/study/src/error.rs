@@ -5,7 +5,7 @@
 pub enum StudyError {
     /// A sampler name that is not a registered direction sampler.
     #[error(transparent)]
-    Sampler(#[from] samplers::RegistryError),
+    Sampler(Box<samplers::RegistryError>),
     /// A BRDF spec that does not parse.
     #[error("--brdf {spec}: {source}")]
     Brdf {
@@ -63,4 +63,12 @@ pub enum StudyError {
         /// The backend's message.
         reason: String,
     },
+}
+
+impl From<samplers::RegistryError> for StudyError {
+    /// Boxed: the registry's error carries every sampler's error and would make every
+    /// `Result<_, StudyError>` large.
+    fn from(e: samplers::RegistryError) -> Self {
+        StudyError::Sampler(Box::new(e))
+    }
 }

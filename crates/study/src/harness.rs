@@ -94,7 +94,7 @@ impl StudyPlan {
             .map(|name| {
                 let e = samplers::find(name)?;
                 if !e.is_direction() {
-                    return Err(StudyError::Sampler(samplers::RegistryError::WrongKind {
+                    return Err(StudyError::from(samplers::RegistryError::WrongKind {
                         name: e.name,
                         expected: "direction",
                         found: e.constructor.kind(),
