@@ -48,14 +48,35 @@ impl Brdf for CountingBrdf {
     fn bounded_at_horizon(&self) -> bool {
         self.0.bounded_at_horizon()
     }
+    fn analytic_lobes(&self) -> Option<brdf::AnalyticLobes> {
+        self.0.analytic_lobes()
+    }
     fn name(&self) -> &str {
         self.0.name()
+    }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        self.0.as_any()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn forwards_what_samplers_ask_of_the_brdf() {
+        // The `analytic` sampler reads the model's lobes and format-specific samplers downcast
+        // the BRDF: a wrapper that dropped either made those samplers refuse counted BRDFs.
+        let phong = CountingBrdf(Arc::from(brdf::parse_spec("phong:n=50").unwrap()));
+        assert!(phong.analytic_lobes().is_some());
+        assert_eq!(
+            phong.analytic_lobes(),
+            brdf::parse_spec("phong:n=50").unwrap().analytic_lobes()
+        );
+        let inner = brdf::parse_spec("lambert").unwrap();
+        let lambert = CountingBrdf(Arc::from(brdf::parse_spec("lambert").unwrap()));
+        assert_eq!(lambert.as_any().is_some(), inner.as_any().is_some());
+    }
 
     #[test]
     fn counts_each_evaluation_on_this_thread() {

@@ -184,10 +184,15 @@ impl StudyPlan {
         let request =
             DirectionRequest::new(Arc::clone(&brdf.counted), &options).with_spec(&brdf.spec);
         let start = Instant::now();
-        let r = self.entries[s]
-            .build_direction(&request)
-            .map(|d| (d, start.elapsed().as_secs_f64()))
-            .map_err(|e| format!("cannot build: {e}"));
+        let entry = &self.entries[s];
+        let r = if !entry.supports(brdf.counted.as_ref()) {
+            Err("does not apply to this BRDF (a format-specific sampler)".to_owned())
+        } else {
+            entry
+                .build_direction(&request)
+                .map(|d| (d, start.elapsed().as_secs_f64()))
+                .map_err(|e| format!("cannot build: {e}"))
+        };
         if let Ok(mut v) = self.built.lock() {
             v.push(((s, b), r.clone()));
         }
