@@ -137,14 +137,7 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         capabilities: CDF_TABLE,
         constructor: Constructor::Direction {
             support: Support::Hemisphere,
-            build: |request| {
-                let cdf = baselines::TabulatedCdf::build_with_progress(
-                    request.brdf.as_ref(),
-                    &request.baselines.cdf,
-                    request.progress,
-                )?;
-                Ok(BuiltDirection::plain(Arc::new(cdf)))
-            },
+            build: cdf_baseline::<baselines::cdf::TabulatedSlice>,
         },
     },
     SamplerEntry {
@@ -153,14 +146,7 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         capabilities: CDF_TABLE,
         constructor: Constructor::Direction {
             support: Support::Hemisphere,
-            build: |request| {
-                let cdf = baselines::CascadeCdf::build_with_progress(
-                    request.brdf.as_ref(),
-                    &request.baselines.cdf,
-                    request.progress,
-                )?;
-                Ok(BuiltDirection::plain(Arc::new(cdf)))
-            },
+            build: cdf_baseline::<baselines::cdf::CascadeSlice>,
         },
     },
     // -- factored baseline (Lawrence 2004) --
@@ -287,6 +273,18 @@ const LOBE: Capabilities = Capabilities {
     anisotropic: true,
     measured: true,
 };
+
+/// Builds a per-slice CDF baseline (`tabulated-cdf`, `cascade-cdf`) for the request.
+fn cdf_baseline<S: baselines::cdf::SliceCdf + 'static>(
+    request: &DirectionRequest<'_>,
+) -> Result<BuiltDirection, RegistryError> {
+    let cdf = baselines::cdf::CdfSampler::<S>::build_with_progress(
+        request.brdf.as_ref(),
+        &request.baselines.cdf,
+        request.progress,
+    )?;
+    Ok(BuiltDirection::plain(Arc::new(cdf)))
+}
 
 fn lobe(
     request: &DirectionRequest<'_>,
