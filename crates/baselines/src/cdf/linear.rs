@@ -19,43 +19,13 @@ pub(crate) fn clamp_unit(u: f64) -> f64 {
     }
 }
 
-/// Writes the normalised running sum of `values` into `cdf` (length `values.len() + 1`) and
-/// returns the plain sum: `cdf[0] = 0`, `cdf[n] = 1`, non-decreasing. A zero (or non-finite)
-/// sum gives the CDF of the uniform distribution (a zero-mass row gets a uniform
-/// conditional, baselines.md §B.5).
-pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
-    let n = values.len();
-    debug_assert_eq!(cdf.len(), n + 1);
-    let mut acc = 0.0;
-    cdf[0] = 0.0;
-    for (c, &v) in cdf[1..].iter_mut().zip(values) {
-        acc += v;
-        *c = acc;
-    }
-    if acc.is_finite() && acc > 0.0 {
-        let inv = 1.0 / acc;
-        for c in &mut cdf[1..n] {
-            *c = (*c * inv).min(1.0);
-        }
-    } else {
-        let inv_n = 1.0 / n as f64;
-        for (i, c) in cdf[1..n].iter_mut().enumerate() {
-            *c = (i + 1) as f64 * inv_n;
-        }
-    }
-    cdf[n] = 1.0;
-    acc
-}
+/// The normalised running sum of cell masses (a zero-mass row gets the uniform CDF,
+/// baselines.md §B.5): the planar CDFs' own routine.
+pub(crate) use partition_sampler::fill_cdf;
 
-/// The segment `m` with `C_m ≤ u < C_{m+1}` for `u ∈ [0, 1)` (an upper bound on `C`, so the
-/// segment found always has positive mass) and the position `du ∈ [0, 1)` of `u` inside it.
-#[inline]
-pub(crate) fn find_segment(cs: &[f64], u: f64) -> (usize, f64) {
-    let k = cs.len() - 1;
-    let m = cs[1..k].partition_point(|&c| c <= u);
-    let (lo, hi) = (cs[m], cs[m + 1]);
-    (m, ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON))
-}
+/// The segment `m` with `C_m ≤ u < C_{m+1}` for `u ∈ [0, 1)` and the position `du ∈ [0, 1)` of
+/// `u` inside it (the planar CDFs' cell search; the segment found always has positive mass).
+pub(crate) use partition_sampler::find_cell as find_segment;
 
 /// The segment `m` with `x_m ≤ t < x_{m+1}` (clamped to the first and last segment).
 #[inline]

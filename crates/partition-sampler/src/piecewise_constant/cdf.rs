@@ -29,10 +29,11 @@ pub(crate) fn validate_values(values: &[f64], width: usize) -> Result<(), Piecew
     Ok(())
 }
 
-/// Writes the normalised CDF of `values` into `cdf` (length `values.len() + 1`) and returns
-/// the plain sum. `cdf[0] = 0`, `cdf[n] = 1`, non-decreasing. With a zero sum the CDF is
-/// that of the uniform distribution (such a row is never selected by a 2D sampler).
-pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
+/// Writes the normalised CDF of `values` (non-negative masses of `n` cells) into `cdf`
+/// (length `n + 1`) and returns the plain sum. `cdf[0] = 0`, `cdf[n] = 1`, non-decreasing.
+/// With a zero (or non-finite) sum the CDF is that of the uniform distribution (such a row is
+/// never selected by a 2D sampler; a baseline's zero-mass row gets a defined conditional).
+pub fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
     let n = values.len();
     debug_assert_eq!(cdf.len(), n + 1);
     let mut acc = 0.0;
@@ -41,7 +42,7 @@ pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
         acc += v;
         *c = acc;
     }
-    if acc > 0.0 {
+    if acc.is_finite() && acc > 0.0 {
         let inv = 1.0 / acc;
         for c in &mut cdf[1..n] {
             // Division keeps the order (rounding is monotone); clamp guards inv-rounding.
@@ -60,7 +61,7 @@ pub(crate) fn fill_cdf(values: &[f64], cdf: &mut [f64]) -> f64 {
 /// Finds the cell `i` with `cdf[i] ≤ u < cdf[i+1]` for `u ∈ [0,1)`, and the position
 /// `du ∈ [0,1)` of `u` inside it. The interval found always has positive width.
 #[inline]
-pub(crate) fn find_cell(cdf: &[f64], u: f64) -> (usize, f64) {
+pub fn find_cell(cdf: &[f64], u: f64) -> (usize, f64) {
     find_cell_by(cdf, |&c| c, u)
 }
 

@@ -14,6 +14,7 @@ mod error;
 mod one_d;
 mod two_d;
 
+pub use cdf::{fill_cdf, find_cell};
 pub use error::PiecewiseConstantError;
 pub use one_d::{PiecewiseConstant1D, Sample1};
 pub use two_d::PiecewiseConstant2D;
