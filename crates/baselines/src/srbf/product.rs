@@ -214,24 +214,10 @@ pub fn estimate_brdf(
     seed: u64,
 ) -> Result<Estimate, SrbfError> {
     check_samples("brdf", n, 2)?;
-    let start = Instant::now();
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut m = Moments::default();
-    for _ in 0..n {
-        let s = sampler.sample(&scene.wo, &mut rng);
-        m.push(if s.pdf > 0.0 {
-            scene.integrand(&s.wi) / s.pdf
-        } else {
-            0.0
-        });
-    }
-    Ok(Estimate {
-        estimator: name.to_string(),
-        estimate: m.mean(),
-        std_err: (m.variance() / n as f64).sqrt(),
-        samples: n,
-        seconds: start.elapsed().as_secs_f64(),
-    })
+    Ok(one_sample_estimate(scene, name, n, seed, |rng| {
+        let s = sampler.sample(&scene.wo, rng);
+        (s.wi, s.pdf)
+    }))
 }
 
 /// `(1/N) Σ g/p` with an environment-map sampler (world directions turned into the frame).
@@ -243,25 +229,39 @@ pub fn estimate_light(
     seed: u64,
 ) -> Result<Estimate, SrbfError> {
     check_samples("light", n, 2)?;
+    Ok(one_sample_estimate(scene, name, n, seed, |rng| {
+        let s = sampler.sample(rng);
+        (scene.frame.to_local(&Vec3::from(s.direction)), s.pdf_sa)
+    }))
+}
+
+/// `(1/N) Σ g(ωi)/p(ωi)` over `n` draws `(ωi, p)` (local frame, solid-angle pdf) from one
+/// generator seeded with `seed`; a draw with `p = 0` contributes 0.
+fn one_sample_estimate(
+    scene: &ProductScene<'_>,
+    name: &str,
+    n: usize,
+    seed: u64,
+    mut draw: impl FnMut(&mut Xoshiro256PlusPlus) -> (Vec3, f64),
+) -> Estimate {
     let start = Instant::now();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut m = Moments::default();
     for _ in 0..n {
-        let s = sampler.sample(&mut rng);
-        let wi = scene.frame.to_local(&Vec3::from(s.direction));
-        m.push(if s.pdf_sa > 0.0 {
-            scene.integrand(&wi) / s.pdf_sa
+        let (wi, pdf) = draw(&mut rng);
+        m.push(if pdf > 0.0 {
+            scene.integrand(&wi) / pdf
         } else {
             0.0
         });
     }
-    Ok(Estimate {
+    Estimate {
         estimator: name.to_string(),
         estimate: m.mean(),
         std_err: (m.variance() / n as f64).sqrt(),
         samples: n,
         seconds: start.elapsed().as_secs_f64(),
-    })
+    }
 }
 
 /// The multiple-importance-sampling weight of a technique.
