@@ -64,4 +64,6 @@ pub use merl::{MerlBrdf, MerlError, write_merl};
 pub use params::{ParamDefault, ParamError, ParamInfo, Range};
 pub use plausibility::energy_warnings;
 pub use quadrature::{directional_albedo, projected_hemisphere_integral};
-pub use registry::{Isotropy, ModelInfo, SpecError, find_model, models, parse_spec, preset_names};
+pub use registry::{
+    Isotropy, ModelInfo, SEED_003_MODELS, SpecError, find_model, models, parse_spec, preset_names,
+};

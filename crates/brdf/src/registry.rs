@@ -518,6 +518,26 @@ fn parse_preset(model: &'static str, rest: Option<&str>) -> Result<Box<dyn Brdf>
     })
 }
 
+/// The 16 analytic models of the seed papers (seed 003 §1 and Table 2), by registry name.
+pub const SEED_003_MODELS: [&str; 16] = [
+    "ashikhmin-shirley",
+    "beard-maxwell",
+    "blinn",
+    "coupled",
+    "htsg",
+    "lafortune",
+    "lewis",
+    "minnaert",
+    "oren-nayar",
+    "phong",
+    "poulin-fournier",
+    "schlick-diffuse",
+    "schlick-specular",
+    "strauss",
+    "cook-torrance",
+    "ward",
+];
+
 /// All registered models (analytic ones, then the measured formats), in listing order.
 pub fn models() -> &'static [ModelInfo] {
     MODELS

@@ -109,24 +109,7 @@ fn registry_lists_required_keys() {
     assert_eq!(keys("lambert"), ["rho"]);
     assert!(find_model("lafortune").is_some());
     // The seed papers' sixteen models are all present.
-    for name in [
-        "ashikhmin-shirley",
-        "beard-maxwell",
-        "blinn",
-        "coupled",
-        "htsg",
-        "lafortune",
-        "lewis",
-        "minnaert",
-        "oren-nayar",
-        "phong",
-        "poulin-fournier",
-        "schlick-diffuse",
-        "schlick-specular",
-        "strauss",
-        "cook-torrance",
-        "ward",
-    ] {
+    for name in brdf::SEED_003_MODELS {
         assert!(find_model(name).is_some(), "{name}");
     }
     assert!(models().len() >= 21);

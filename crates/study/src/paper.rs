@@ -26,24 +26,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 use crate::{RenderConfig, StudyConfig, StudyError, StudyPlan};
 
 /// The 16 models of seed 003 (registry names).
-pub const SEED_003_MODELS: [&str; 16] = [
-    "ashikhmin-shirley",
-    "beard-maxwell",
-    "blinn",
-    "coupled",
-    "htsg",
-    "lafortune",
-    "lewis",
-    "minnaert",
-    "oren-nayar",
-    "phong",
-    "poulin-fournier",
-    "schlick-diffuse",
-    "schlick-specular",
-    "strauss",
-    "cook-torrance",
-    "ward",
-];
+pub const SEED_003_MODELS: [&str; 16] = brdf::SEED_003_MODELS;
 
 /// Pixels per side of the Table 1 sphere (reduced size).
 pub const PAPER_SPHERE_PX: usize = 24;
