@@ -30,7 +30,8 @@ impl Group<'_> {
         )
     }
 
-    /// Cells that ran and have a finite efficiency, best first.
+    /// Cells that ran and have a finite efficiency (1 / (MSE per sample at the budget N ×
+    /// time)), best first.
     pub fn by_efficiency(&self) -> Vec<(&CellResult, f64)> {
         let mut v: Vec<(&CellResult, f64)> = self
             .cells

@@ -6,8 +6,11 @@
 //! * the estimator of `L_r(ωo)` is `(1/N) Σ Y(f_r(ωo, ωk) ⊙ L(ωk)) cos θk / p_σ(ωk)` with the
 //!   sampler's solid-angle pdf; samples below the horizon (or with pdf 0) contribute 0;
 //! * relative errors: `repetitions` independent estimates at every N of the grid;
-//! * per-sample variance: `variance_samples` one-sample values (one-sample mode), or
-//!   `N · Var(L̂_N)` at the largest N (batch mode, whose samples are not independent);
+//! * per-sample variance: over every one-sample value the cell drew (the repetitions plus
+//!   `variance_samples` more; one-sample mode), or `N · Var(L̂_N)` at the largest N (batch
+//!   mode, whose samples are not independent);
+//! * per-sample MSE at the budget (largest) N against the reference, its tail share and
+//!   warnings ([`crate::dispersion`]): efficiency divides by it;
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
 //! * timings: after the statistics, cell by cell on the calling thread with nothing else
 //!   running, median of `timing_repeats` runs of `timing_samples` samples.
@@ -27,11 +30,9 @@ use rayon::prelude::*;
 use samplers::{DirectionRequest, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
+use crate::dispersion::{self, BudgetMse, Z95};
 use crate::results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
 use crate::{CellSpec, Light, Mode, Reference, Shard, StudyConfig, StudyError, reference};
-
-/// z-value of a two-sided 95 % normal confidence interval.
-const Z95: f64 = 1.959_963_984_540_054;
 
 /// Relative size (to the reference squared) below which a variance counts as zero.
 const ZERO_VARIANCE: f64 = 1e-20;
@@ -297,8 +298,10 @@ impl StudyPlan {
         // Timings: one cell at a time on this thread.
         for (c, r) in cells.iter().zip(results.iter_mut()) {
             if let (Some(Ok((built, seconds))), true) = (find_build(c), r.ok()) {
-                r.timing =
-                    Some(self.time_cell(c, built.sampler.as_ref(), *seconds, r.variance.value));
+                // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
+                // sampler's rounding-level value counts as 0 (no efficiency).
+                let mse = if r.zero_variance { 0.0 } else { r.mse.value };
+                r.timing = Some(self.time_cell(c, built.sampler.as_ref(), *seconds, mse));
             }
             progress(1);
         }
@@ -346,11 +349,21 @@ impl StudyPlan {
         let ref_value = reference.value;
         let mut errors = Vec::with_capacity(cfg.n_grid.len());
         let mut values = Vec::with_capacity(cfg.repetitions);
+        // Every one-sample value of the cell (independent draws): the variance and the MSE
+        // at the budget are measured on all of them.
+        let mut all_values: Vec<f64> = Vec::new();
         for &n in &cfg.n_grid {
             values.clear();
             for _ in 0..cfg.repetitions {
                 let samples = est.draw(n, &mut rng, &mut counter);
-                let sum: f64 = samples.iter().map(|s| est.value(s)).sum();
+                let ys = samples.iter().map(|s| est.value(s));
+                let sum: f64 = if c.spec.mode == Mode::OneSample {
+                    let start = all_values.len();
+                    all_values.extend(ys);
+                    all_values[start..].iter().sum()
+                } else {
+                    ys.sum()
+                };
                 values.push(sum / n as f64);
             }
             let rel: Vec<f64> = values
@@ -369,27 +382,55 @@ impl StudyPlan {
                 variance_per_sample: finite(n as f64 * var_est),
             });
         }
-        let variance = match c.spec.mode {
+        let budget = cfg.n_grid.last().copied().unwrap_or(1);
+        let (variance, mse, tail_share, warnings) = match c.spec.mode {
             Mode::OneSample => {
                 let samples = est.draw(cfg.variance_samples, &mut rng, &mut counter);
-                let ys: Vec<f64> = samples.iter().map(|s| est.value(s)).collect();
-                let (mean, var) = mean_var(&ys);
-                let m4 = ys.iter().map(|y| (y - mean).powi(4)).sum::<f64>() / ys.len() as f64;
-                let var_of_var = ((m4 - var * var) / ys.len() as f64).max(0.0);
-                WithCi {
-                    value: finite(var),
-                    ci95: finite(Z95 * var_of_var.sqrt()),
-                }
+                all_values.extend(samples.iter().map(|s| est.value(s)));
+                let st = dispersion::one_sample_stats(&all_values);
+                let mse = dispersion::one_sample_mse(&st, ref_value, reference.abs_err, budget);
+                let warnings = dispersion::warnings(
+                    st.tail_share,
+                    st.n,
+                    st.variance,
+                    st.variance_ci95,
+                    Some((st.mean, st.variance.sqrt())),
+                    ref_value,
+                    reference.abs_err,
+                );
+                let variance = WithCi {
+                    value: finite(st.variance),
+                    ci95: finite(st.variance_ci95),
+                };
+                (variance, mse, st.tail_share, warnings)
             }
             Mode::Batch => {
                 let last = errors.last().map_or(0.0, |e| e.variance_per_sample);
                 // Sample variance of R estimates: relative sd ≈ √(2/(R−1)) for near-normal
                 // estimates.
-                WithCi {
+                let variance = WithCi {
                     value: last,
                     ci95: finite(Z95 * last * (2.0 / (cfg.repetitions as f64 - 1.0)).sqrt()),
-                }
+                };
+                let (mse, tail_share) =
+                    dispersion::batch_mse(&values, ref_value, reference.abs_err, budget);
+                let warnings = dispersion::warnings(
+                    tail_share,
+                    values.len(),
+                    variance.value,
+                    variance.ci95,
+                    None,
+                    ref_value,
+                    reference.abs_err,
+                );
+                (variance, mse, tail_share, warnings)
             }
+        };
+        let mse = BudgetMse {
+            value: finite(mse.value),
+            ci95: finite(mse.ci95),
+            reference_err: finite(mse.reference_err),
+            ..mse
         };
         let zero_variance = variance.value <= ZERO_VARIANCE * ref_value * ref_value;
         CellResult {
@@ -405,6 +446,9 @@ impl StudyPlan {
             evaluations_per_sample: counter.per_sample(),
             variance,
             zero_variance,
+            mse,
+            tail_share,
+            warnings,
             errors,
             timing: None,
         }
@@ -416,7 +460,7 @@ impl StudyPlan {
         c: &PlanCell,
         sampler: &dyn DirectionSampler,
         build_seconds: f64,
-        variance: f64,
+        mse: f64,
     ) -> Timing {
         let cfg = &self.config;
         let est = Estimator {
@@ -456,8 +500,7 @@ impl StudyPlan {
             },
             sample_ns: median(&mut sample_ns),
             estimator_ns: estimator,
-            efficiency: (variance > 0.0 && estimator > 0.0)
-                .then(|| 1.0 / (variance * estimator * 1e-9)),
+            efficiency: (mse > 0.0 && estimator > 0.0).then(|| 1.0 / (mse * estimator * 1e-9)),
         }
     }
 }
@@ -480,6 +523,14 @@ fn failed(c: &PlanCell, reference: Reference, why: String) -> CellResult {
             ci95: 0.0,
         },
         zero_variance: false,
+        mse: BudgetMse {
+            n: 0,
+            value: 0.0,
+            ci95: 0.0,
+            reference_err: 0.0,
+        },
+        tail_share: 0.0,
+        warnings: Vec::new(),
         errors: Vec::new(),
         timing: None,
     }

@@ -4,8 +4,10 @@
 //! batch-mode samplers) × BRDF × outgoing angle θo × light — each seeded from
 //! `(seed, cell index)`. For each cell it measures the estimator of reflected radiance
 //! `L_r(ωo) = ∫_Ω f_r(ωo, ωi) L(ωi) cos θi dσ(ωi)` built on the sampler (pdf w.r.t. solid
-//! angle): the per-sample variance, time per sample, BRDF evaluations per sample, efficiency
-//! `1 / (variance × time)`, and relative error against a deterministic-quadrature reference at
+//! angle): the per-sample variance, the per-sample mean squared error at the budget N against
+//! the reference (module [`dispersion`]: heavy tails and bias are not mistaken for low
+//! variance), time per sample, BRDF evaluations per sample, efficiency `1 / (MSE × time)`,
+//! and relative error against a deterministic-quadrature reference at
 //! every N of a grid, with 95 % confidence intervals. Samplers come from the `samplers`
 //! registry and BRDFs from `brdf::parse_spec`, so new ones join without code changes.
 //!
@@ -37,6 +39,7 @@
 
 mod config;
 mod counting;
+pub mod dispersion;
 mod error;
 mod groups;
 mod harness;
@@ -53,6 +56,7 @@ pub use config::{
     QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
+pub use dispersion::BudgetMse;
 pub use error::StudyError;
 pub use groups::{Group, groups, is_adaptive, short_light};
 pub use harness::{ProgressFn, StudyPlan};

@@ -349,10 +349,10 @@ pub fn group_figures(g: &Group<'_>) -> Vec<(String, String, Figure)> {
         ),
         (
             format!("{}-efficiency", g.slug),
-            format!("Efficiency 1/(variance × time) (timing) — {}", g.title()),
+            format!("Efficiency 1/(MSE × time) (timing) — {}", g.title()),
             Figure::Bars {
                 title,
-                y_label: "efficiency (1/(variance·s))".into(),
+                y_label: "efficiency (1/(MSE·s))".into(),
                 bars,
             },
         ),

@@ -1,10 +1,10 @@
 //! A study's results: per-cell numbers, the JSON and CSV forms, and merging shards.
 //!
-//! # `results.json` schema (`"schema": "brdf-lab-study/1"`)
+//! # `results.json` schema (`"schema": "brdf-lab-study/2"`)
 //!
 //! ```text
 //! {
-//!   "schema": "brdf-lab-study/1",
+//!   "schema": "brdf-lab-study/2",
 //!   "config": { preset, samplers[], brdfs[], theta_o_deg[], lights[], n_grid[], repetitions,
 //!               variance_samples, timing_samples, timing_repeats, slices, seed },
 //!   "shard": null | { "index": K, "count": N },      // K from 1
@@ -19,6 +19,9 @@
 //!       "evaluations_per_sample": BRDF evaluations by the sampler per sample,
 //!       "variance": { "value", "ci95" },   // per-sample variance of the estimator
 //!       "zero_variance": bool,             // exact f·cos·L sampler (constant light)
+//!       "mse": { "n", "value", "ci95", "reference_err" },  // N·E[(L̂_N − L)²] at the budget N
+//!       "tail_share": largest share of Σ(y − ȳ)² held by one value,
+//!       "warnings": [ "…" ],               // why the spread estimate is unreliable
 //!       "errors": [ { "n", "mean_rel_err", "ci95", "rms_rel_err", "variance_per_sample" } ],
 //!       "timing": { "build_seconds", "sample_ns", "estimator_ns", "efficiency" }  // TIMINGS
 //!   } ]
@@ -29,16 +32,26 @@
 //! any thread count, and between one run and merged shards. `timing` holds the only measured
 //! times: build time, time per sample of the sampler alone and of the whole estimator
 //! (single-threaded, median of the repeats) and the efficiency 1 / (variance × estimator time
-//! per sample in seconds).
+//! per sample in seconds), the MSE at the budget N standing in for the variance.
+//!
+//! ## Changes from `brdf-lab-study/1`
+//!
+//! * new `mse`, `tail_share`, `warnings` per cell (crate docs of `dispersion`);
+//! * `variance` (one-sample mode) is now over every one-sample value the cell drew (the
+//!   error-curve repetitions plus `variance_samples` more), not over `variance_samples` alone;
+//! * `timing.efficiency` is `1 / (mse.value × estimator time)`, no longer `1 / (variance × …)`:
+//!   a heavy-tailed sampler whose sample variance misses its rare large values, or a biased
+//!   one, no longer ranks first. Version 1 files are refused by `study merge`.
 
 use std::collections::BTreeSet;
 
 use serde::{Deserialize, Serialize};
 
+use crate::dispersion::BudgetMse;
 use crate::{Mode, Reference, Shard, StudyConfig, StudyError};
 
 /// Version tag of [`StudyResults`]' JSON form.
-pub const SCHEMA: &str = "brdf-lab-study/1";
+pub const SCHEMA: &str = "brdf-lab-study/2";
 
 /// A value with the half-width of its 95 % confidence interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -74,7 +87,8 @@ pub struct Timing {
     pub sample_ns: f64,
     /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns).
     pub estimator_ns: f64,
-    /// `1 / (variance × estimator time per sample in s)`; `None` when the variance is 0.
+    /// `1 / (MSE per sample at the budget N × estimator time per sample in s)` (the cell's
+    /// [`CellResult::mse`]); `None` when it is 0.
     pub efficiency: Option<f64>,
 }
 
@@ -101,11 +115,21 @@ pub struct CellResult {
     pub bytes: usize,
     /// BRDF evaluations made by the sampler per sample (the estimator's own excluded).
     pub evaluations_per_sample: f64,
-    /// Per-sample variance of the estimator: the one-sample variance of `f L cos / p` (one-sample
-    /// mode) or `N · Var(L̂_N)` at the largest N (batch mode).
+    /// Per-sample variance of the estimator: the sample variance of `f L cos / p` over every
+    /// one-sample value the cell drew (one-sample mode) or `N · Var(L̂_N)` at the largest N
+    /// (batch mode).
     pub variance: WithCi,
     /// The variance is zero to rounding (an exact `f·cos·L` sampler, e.g. under constant light).
     pub zero_variance: bool,
+    /// Per-sample mean squared error against the reference at the budget (largest) N,
+    /// `N · E[(L̂_N − L)²] = σ² + N b²`: what efficiency divides by (module `dispersion`).
+    pub mse: BudgetMse,
+    /// Largest share of `Σ (y − ȳ)²` held by one value (one-sample values, or the batch
+    /// estimates at the budget N).
+    pub tail_share: f64,
+    /// Why the cell's spread estimate is unreliable (a heavy tail, an uncertain variance, a
+    /// mean off the reference); empty when none applies.
+    pub warnings: Vec<String>,
     /// Relative errors along the N grid.
     pub errors: Vec<ErrorAtN>,
     /// Measured times.
@@ -203,7 +227,7 @@ impl StudyResults {
     /// header. Fields are quoted where needed (BRDF specs contain commas).
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
-            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],efficiency[timing]\n",
+            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],efficiency[timing]\n",
         );
         for c in &self.cells {
             let t = c.timing;
@@ -238,6 +262,11 @@ impl StudyResults {
                     num(c.variance.value),
                     num(c.variance.ci95),
                     c.zero_variance.to_string(),
+                    num(c.mse.value),
+                    num(c.mse.ci95),
+                    num(c.mse.reference_err),
+                    num(c.tail_share),
+                    quote(&c.warnings.join("; ")),
                     num(c.evaluations_per_sample),
                     c.bytes.to_string(),
                 ];
