@@ -45,16 +45,6 @@ pub fn direction_domain(entry: &SamplerEntry) -> Option<Domain> {
     })
 }
 
-/// Whether a build error means the sampler does not apply to this BRDF (the `analytic`
-/// sampler of a model without one): the suite skips and reports such cases instead of
-/// failing them.
-pub fn not_applicable(error: &RegistryError) -> bool {
-    matches!(
-        error,
-        RegistryError::Lobe(baselines::LobeError::NoAnalyticSampler { .. })
-    )
-}
-
 /// The entry's direction sampler for `brdf`, with the default [`SetOptions`].
 pub fn build_direction(
     entry: &SamplerEntry,

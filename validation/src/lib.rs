@@ -55,8 +55,8 @@ mod suite;
 pub mod targets;
 
 pub use builds::{
-    StandaloneCase, build_direction, build_disc, direction_domain, not_applicable,
-    quadtree_disc_sampler, standalone_cases, test_maps, uses_brdf,
+    StandaloneCase, build_direction, build_disc, direction_domain, quadtree_disc_sampler,
+    standalone_cases, test_maps, uses_brdf,
 };
 pub use case::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use domain::{Domain, Resolution};

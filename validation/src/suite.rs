@@ -12,8 +12,7 @@ use stats::{TestOutcome, sidak_level};
 
 use crate::adapters::DirectionAtWo;
 use crate::builds::{
-    StandaloneCase, build_direction, build_disc, direction_domain, not_applicable,
-    standalone_cases, uses_brdf,
+    StandaloneCase, build_direction, build_disc, direction_domain, standalone_cases, uses_brdf,
 };
 use crate::case::{error_outcome, names, run_case, skipped_outcome};
 use crate::domain::Domain;
@@ -266,15 +265,17 @@ fn run_brdf_job(
     on_done: &(dyn Fn(&CaseResult) + Sync),
 ) -> Vec<CaseResult> {
     let (spec, brdf) = &r.brdfs[bi];
+    // A sampler that does not apply to this BRDF (the registry says why) is skipped and
+    // reported, never built.
+    if let Err(na) = entry.applicability(brdf.as_ref()) {
+        return skipped_angles(entry.name, spec, r, &na.reason, on_done);
+    }
     // Direction samplers are built once per BRDF; disc samplers per angle.
-    let built = match direction_domain(entry)
-        .map(|domain| build_direction(entry, brdf).map(|s| (s, domain)))
-    {
-        Some(Err(e)) if not_applicable(&e) => {
-            return skipped_angles(entry.name, spec, r, &e.to_string(), on_done);
-        }
-        other => other.map(|b| b.map_err(|e| e.to_string())),
-    };
+    let built = direction_domain(entry).map(|domain| {
+        build_direction(entry, brdf)
+            .map(|s| (s, domain))
+            .map_err(|e| e.to_string())
+    });
     let subject_at = |wo: Vec3, refs: &BrdfReferences| match &built {
         Some(b) => {
             let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
@@ -290,7 +291,8 @@ fn run_brdf_job(
     run_angles(entry.name, spec, r, refs, seed, on_done, &subject_at)
 }
 
-/// The cases of a sampler that does not apply to a BRDF: one skipped outcome per angle.
+/// The cases of a sampler that does not apply to a BRDF: one skipped outcome per angle the
+/// BRDF runs at.
 fn skipped_angles(
     sampler: &str,
     spec: &str,
@@ -300,6 +302,7 @@ fn skipped_angles(
 ) -> Vec<CaseResult> {
     r.angles
         .iter()
+        .filter(|&&theta| r.runs(spec, theta))
         .map(|&theta| {
             let c = CaseResult {
                 sampler: sampler.to_owned(),
@@ -447,11 +450,9 @@ pub fn run(
         .collect();
     let mut jobs: Vec<Job<'_>> = Vec::new();
     for &entry in &brdf_entries {
-        for (bi, (_, brdf)) in r.brdfs.iter().enumerate() {
-            // Format-specific samplers (rgl-native) skip the BRDFs they do not apply to.
-            if entry.supports(brdf.as_ref()) {
-                jobs.push(Job::Brdf { entry, brdf: bi });
-            }
+        // Pairs where the sampler does not apply are jobs too: reported as skipped cases.
+        for bi in 0..r.brdfs.len() {
+            jobs.push(Job::Brdf { entry, brdf: bi });
         }
     }
     let mut failed_builds: Vec<CaseResult> = Vec::new();

@@ -1,7 +1,8 @@
-//! A sampler that does not apply to a BRDF (`analytic` for a model without an analytic
-//! sampler) is skipped and reported, not failed; a real build failure still fails.
+//! A sampler that does not apply to a BRDF (`samplers::SamplerEntry::applicability`: `analytic`
+//! for a model without an analytic sampler, `rgl-native` for a non-RGL BRDF) is skipped and
+//! reported, not failed; a real build failure still fails.
 
-use validation::{ValidateConfig, names, not_applicable, run};
+use validation::{ValidateConfig, names, run};
 
 #[test]
 fn analytic_on_a_model_without_one_is_skipped_and_reported() {
@@ -32,20 +33,43 @@ fn analytic_on_a_model_without_one_is_skipped_and_reported() {
 }
 
 #[test]
-fn only_the_missing_analytic_sampler_counts_as_not_applicable() {
-    let oren: std::sync::Arc<dyn brdf::Brdf> =
-        std::sync::Arc::from(brdf::parse_spec("oren-nayar").unwrap());
+fn rgl_native_on_an_analytic_model_is_skipped_and_reported() {
+    let config = ValidateConfig {
+        brdfs: vec!["lambert".into()],
+        samplers: vec!["rgl-native".into()],
+        theta_o: vec![30.0],
+        samples: Some(validation::MIN_SAMPLES),
+        ..ValidateConfig::quick()
+    };
+    let report = run(&config, &|_| {}).expect("valid configuration");
+    let tests: Vec<_> = report
+        .tests
+        .iter()
+        .filter(|t| t.sampler == "rgl-native")
+        .collect();
+    assert_eq!(tests.len(), 1, "one skipped case, nothing run");
+    assert_eq!(tests[0].test, names::SKIPPED);
+    assert!(tests[0].detail.contains("needs an RGL material"));
+    assert!(report.passed());
+}
+
+#[test]
+fn a_bad_option_is_a_failed_build_not_a_skip() {
+    let lambert: std::sync::Arc<dyn brdf::Brdf> =
+        std::sync::Arc::from(brdf::parse_spec("lambert").unwrap());
     let options = brdf_sampling::SetOptions::default();
-    let request = samplers::DirectionRequest::new(oren, &options);
-    let err = samplers::build_direction("analytic", &request).unwrap_err();
-    assert!(not_applicable(&err), "{err}");
-    let bad = request.with_baselines(baselines::BaselineOptions {
-        lobe: baselines::LobeOptions {
-            slices: 0,
-            ..baselines::LobeOptions::default()
+    let bad = samplers::DirectionRequest::new(lambert, &options).with_baselines(
+        baselines::BaselineOptions {
+            lobe: baselines::LobeOptions {
+                slices: 0,
+                ..baselines::LobeOptions::default()
+            },
+            ..baselines::BaselineOptions::default()
         },
-        ..baselines::BaselineOptions::default()
-    });
+    );
     let err = samplers::build_direction("lobe-sphere", &bad).unwrap_err();
-    assert!(!not_applicable(&err), "{err}");
+    assert!(
+        !matches!(err, samplers::RegistryError::NotApplicable(_)),
+        "{err}"
+    );
 }

@@ -179,6 +179,22 @@ fn bad_inputs_exit_2_with_one_line() {
         ],
         "has no analytic sampler",
     );
+    // Every not-applicable pair is refused with the registry's one reason (sample, eval,
+    // build and product all build through `SamplerEntry::build_direction`).
+    assert_input_error(
+        &[
+            "sample",
+            "--brdf",
+            "phong",
+            "--theta-o",
+            "30",
+            "--sampler",
+            "rgl-native",
+            "-n",
+            "5",
+        ],
+        "does not apply to this BRDF: the rgl-native sampler needs an RGL material",
+    );
     // Usage errors carry clap's full (multi-line) message; see usage_errors_show_clap_s_….
     assert_usage_error(&["nosuchcommand"], "nosuchcommand");
 }

@@ -295,13 +295,39 @@ fn lobe(
     )))
 }
 
-/// Whether a format-specific sampler applies to a BRDF.
-pub(crate) type AcceptsBrdf = fn(&dyn Brdf) -> bool;
+/// Whether a sampler applies to a BRDF: `Err(reason)` when it does not.
+pub(crate) type AppliesTo = fn(&dyn Brdf) -> Result<(), String>;
 
-/// Samplers that apply only to some BRDFs (format-specific), with the test of the BRDFs they
-/// accept; every other entry accepts every BRDF of its kind.
-pub(crate) static BRDF_SPECIFIC: &[(&str, AcceptsBrdf)] =
-    &[("rgl-native", baselines::RglNative::accepts)];
+/// Samplers that apply only to some BRDFs, with the test of the BRDFs they accept; every other
+/// entry applies to every BRDF of its kind. The one source of "does not apply" for the
+/// command line, the validation suite and the studies ([`crate::SamplerEntry::applicability`]).
+pub(crate) static APPLIES_TO: &[(&str, AppliesTo)] = &[
+    ("rgl-native", rgl_material),
+    ("analytic", has_analytic_lobes),
+];
+
+/// `rgl-native` samples RGL materials only (a format-specific sampler).
+fn rgl_material(brdf: &dyn Brdf) -> Result<(), String> {
+    if baselines::RglNative::accepts(brdf) {
+        Ok(())
+    } else {
+        Err(baselines::NotRglError {
+            brdf: brdf.name().to_string(),
+        }
+        .to_string())
+    }
+}
+
+/// `analytic` needs the model's analytic lobe description ([`Brdf::analytic_lobes`]).
+fn has_analytic_lobes(brdf: &dyn Brdf) -> Result<(), String> {
+    match brdf.analytic_lobes() {
+        Some(_) => Ok(()),
+        None => Err(baselines::LobeError::NoAnalyticSampler {
+            model: brdf.name().to_owned(),
+        }
+        .to_string()),
+    }
+}
 
 /// Capabilities of the tabulated CDFs of maps and grids.
 const BLIND_TABLE: Capabilities = Capabilities {

@@ -2,6 +2,18 @@
 
 use brdf_sampling::Variant;
 
+/// Why a registered sampler does not apply to a BRDF (e.g. `analytic` for a model without an
+/// analytic sampler, `rgl-native` for a BRDF that is not an RGL material): not a failure of
+/// the sampler or of its build, so suites and studies skip the pair and report `reason`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("sampler `{sampler}` does not apply to this BRDF: {reason}")]
+pub struct NotApplicable {
+    /// The sampler's registered name.
+    pub sampler: &'static str,
+    /// Why, in one line.
+    pub reason: String,
+}
+
 /// A sampler could not be found or built.
 #[derive(Debug, thiserror::Error)]
 pub enum RegistryError {
@@ -39,6 +51,9 @@ pub enum RegistryError {
         /// Its mixture flag.
         mixture: bool,
     },
+    /// The sampler does not apply to the BRDF ([`crate::SamplerEntry::applicability`]).
+    #[error(transparent)]
+    NotApplicable(#[from] NotApplicable),
     /// A BRDF spec (e.g. the one stored in a set file) does not parse.
     #[error("BRDF spec `{spec}`: {source}")]
     Brdf {

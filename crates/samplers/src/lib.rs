@@ -40,7 +40,7 @@ mod error;
 mod request;
 
 pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, quadtree_disc_density};
-pub use error::RegistryError;
+pub use error::{NotApplicable, RegistryError};
 pub use request::{BuiltDirection, DirectionRequest};
 
 use std::sync::Arc;
@@ -187,12 +187,16 @@ impl SamplerEntry {
 
     /// Builds this entry's direction sampler for `request`.
     ///
-    /// Errors: [`RegistryError::WrongKind`] if the entry is not a direction sampler, or the
-    /// sampler's own build error.
+    /// Errors: [`RegistryError::WrongKind`] if the entry is not a direction sampler,
+    /// [`RegistryError::NotApplicable`] if it does not apply to the BRDF
+    /// ([`Self::applicability`]), or the sampler's own build error.
     pub fn build_direction(
         &self,
         request: &DirectionRequest<'_>,
     ) -> Result<BuiltDirection, RegistryError> {
+        if self.is_direction() {
+            self.applicability(request.brdf.as_ref())?;
+        }
         match self.constructor {
             Constructor::AdaptiveSet { variant, mixture } => {
                 let options = brdf_sampling::SetOptions {
@@ -213,14 +217,22 @@ impl SamplerEntry {
         }
     }
 
-    /// Whether this entry's sampler can be built for `brdf`: `false` only for a
-    /// format-specific sampler (e.g. `rgl-native`) given a BRDF of another kind. Suites skip
-    /// such pairs instead of reporting a failed build.
-    pub fn supports(&self, brdf: &dyn Brdf) -> bool {
-        entries::BRDF_SPECIFIC
+    /// Whether this entry's sampler applies to `brdf`: `Err` with the reason for a
+    /// format-specific sampler given a BRDF of another kind (`rgl-native`) or a model-specific
+    /// one given a model it has nothing for (`analytic`); `Ok` for every other pair. Builds
+    /// check it first ([`RegistryError::NotApplicable`]); the validation suite and the studies
+    /// call it to skip such pairs and report the reason instead of a failed build.
+    pub fn applicability(&self, brdf: &dyn Brdf) -> Result<(), NotApplicable> {
+        match entries::APPLIES_TO
             .iter()
             .find(|(name, _)| *name == self.name)
-            .is_none_or(|(_, accepts)| accepts(brdf))
+        {
+            Some((_, applies)) => applies(brdf).map_err(|reason| NotApplicable {
+                sampler: self.name,
+                reason,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Builds this entry's disc sampler of `f_r(ωo, h⁻¹(x))`.

@@ -51,12 +51,12 @@ fn every_direction_sampler_builds_and_reports_consistent_pdfs() {
     );
     for e in SAMPLERS.iter().filter(|e| e.is_direction()) {
         // Format-specific samplers (rgl-native) get a BRDF of their format.
-        let spec = if e.supports(brdf("phong:n=20").as_ref()) {
+        let spec = if e.applicability(brdf("phong:n=20").as_ref()).is_ok() {
             "phong:n=20"
         } else {
             rgl.as_str()
         };
-        assert!(e.supports(brdf(spec).as_ref()), "{}", e.name);
+        assert_eq!(e.applicability(brdf(spec).as_ref()), Ok(()), "{}", e.name);
         let built = e
             .build_direction(&DirectionRequest::new(brdf(spec), &options).with_spec(spec))
             .unwrap_or_else(|err| panic!("{}: {err}", e.name));
@@ -179,19 +179,35 @@ fn a_saved_set_comes_back_as_the_entry_that_built_it() {
 }
 
 #[test]
-fn rgl_native_refuses_other_brdfs_and_the_suite_can_skip_them() {
-    let e = samplers::find("rgl-native").expect("registered");
-    let phong = brdf("phong:n=20");
-    assert!(!e.supports(phong.as_ref()));
+fn not_applicable_pairs_have_one_reason_and_builds_refuse_them_with_it() {
     let options = small();
-    let err = e
-        .build_direction(&DirectionRequest::new(phong, &options))
-        .expect_err("not an RGL file");
-    assert!(matches!(err, samplers::RegistryError::NotRgl(_)), "{err}");
-    // Every other direction sampler accepts every BRDF.
-    for other in SAMPLERS.iter().filter(|x| x.name != "rgl-native") {
+    let not_applicable = |name: &str, spec: &str| {
+        let e = samplers::find(name).expect("registered");
+        let b = brdf(spec);
+        let na = e.applicability(b.as_ref()).expect_err(name);
+        assert_eq!(na.sampler, e.name);
+        let err = e
+            .build_direction(&DirectionRequest::new(b, &options))
+            .expect_err("the build checks applicability first");
         assert!(
-            other.supports(brdf("phong:n=20").as_ref()),
+            matches!(&err, RegistryError::NotApplicable(x) if *x == na),
+            "{err}"
+        );
+        na.reason
+    };
+    // A format-specific sampler given another kind of BRDF.
+    assert!(not_applicable("rgl-native", "phong:n=20").contains("needs an RGL material"));
+    // A model-specific sampler given a model it has nothing for.
+    assert!(not_applicable("analytic", "oren-nayar").contains("has no analytic sampler"));
+    // Every other pair applies: every direction sampler but rgl-native to phong, every one but
+    // rgl-native and analytic to oren-nayar.
+    for other in SAMPLERS.iter().filter(|x| x.is_direction()) {
+        let phong = other.applicability(brdf("phong:n=20").as_ref());
+        assert_eq!(phong.is_ok(), other.name != "rgl-native", "{}", other.name);
+        let oren = other.applicability(brdf("oren-nayar").as_ref());
+        assert_eq!(
+            oren.is_ok(),
+            !["rgl-native", "analytic"].contains(&other.name),
             "{}",
             other.name
         );

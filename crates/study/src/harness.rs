@@ -186,8 +186,8 @@ impl StudyPlan {
             DirectionRequest::new(Arc::clone(&brdf.counted), &options).with_spec(&brdf.spec);
         let start = Instant::now();
         let entry = &self.entries[s];
-        let r = if !entry.supports(brdf.counted.as_ref()) {
-            Err("does not apply to this BRDF (a format-specific sampler)".to_owned())
+        let r = if let Err(na) = entry.applicability(brdf.counted.as_ref()) {
+            Err(format!("does not apply to this BRDF: {}", na.reason))
         } else {
             entry
                 .build_direction(&request)
