@@ -433,6 +433,8 @@ impl StudyPlan {
             ..mse
         };
         let zero_variance = variance.value <= ZERO_VARIANCE * ref_value * ref_value;
+        // The spread of rounding errors says nothing about a sampler.
+        let warnings = if zero_variance { Vec::new() } else { warnings };
         CellResult {
             index: c.spec.index,
             sampler: c.spec.sampler.clone(),

@@ -29,6 +29,7 @@
 //! // Under constant light, cosine sampling of a Lambertian BRDF is exact: zero variance.
 //! let cosine = results.cells.iter().find(|c| c.sampler == "cosine").unwrap();
 //! assert!(cosine.zero_variance);
+//! assert!(cosine.warnings.is_empty() && cosine.timing.unwrap().efficiency.is_none());
 //! let uniform = results.cells.iter().find(|c| c.sampler == "uniform").unwrap();
 //! assert!(!uniform.zero_variance);
 //! # Ok::<(), study::StudyError>(())
