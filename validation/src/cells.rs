@@ -518,6 +518,31 @@ mod tests {
         );
     }
 
+    #[test]
+    fn declarations_hold_for_turned_slices_and_rows() {
+        // An anisotropic BRDF (φ slices: the serving slice is turned by Δ ≠ 0) and an isotropic
+        // factored sampler at φo ≠ 0 (its row frame is turned by φo).
+        let brdf = brdf::parse_spec("ward:alpha_x=0.1,alpha_y=0.3").unwrap();
+        let o = CdfOptions {
+            anisotropic_slices: [4, 6],
+            n_z: 8,
+            n_phi: 16,
+            ..CdfOptions::default()
+        };
+        let aniso: Arc<dyn DirectionSampler> =
+            Arc::new(TabulatedCdf::build(brdf.as_ref(), &o).unwrap());
+        for (s, wo) in [
+            (aniso, direction_from_angles(40.0, 37.0)),
+            (small_factored(), direction_from_angles(60.0, 37.0)),
+        ] {
+            let at = DirectionAtWo::new(Arc::clone(&s), wo);
+            let model = CellModel::new(&at, s.pdf_cells(&wo).unwrap(), &plan()).unwrap();
+            assert!(model.check.passed, "{}", model.check.detail);
+            let norm = model.normalisation_tests(&plan());
+            assert!(norm[0].passed, "{}", norm[0].detail);
+        }
+    }
+
     /// Cosine sampling that claims its pdf is constant on 4 × 4 cells.
     struct FalseCells;
 
