@@ -54,6 +54,10 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
     fn normaliser_rel_err(&self) -> Option<f64> {
         self.sampler.normaliser_rel_err(&self.wo)
     }
+
+    fn pdf_cells(&self) -> Option<brdf_sampling::PdfCells> {
+        self.sampler.pdf_cells(&self.wo)
+    }
 }
 
 /// Any [`Sampler2D`] (pdf w.r.t. area on its domain); batches are independent draws.

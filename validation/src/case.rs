@@ -8,6 +8,7 @@ use stats::{
     histogram, ks_projection_test, normalisation, pdf_consistency, support_coverage,
 };
 
+use crate::cells::{CellModel, ExactTests};
 use crate::plan::Plan;
 use crate::seeding::{chunk_seed, stream_seed};
 use crate::subject::{AnySubject, Reference, SamplerUnderTest, Subject};
@@ -69,7 +70,13 @@ fn renamed(mut o: TestOutcome, name: &str) -> TestOutcome {
 pub fn run_case(subject: &AnySubject, plan: &Plan, seed: u64) -> Vec<TestOutcome> {
     match subject {
         AnySubject::Direction(s) => match plan.resolution.sphere_binning(s.domain) {
-            Ok(Some(b)) => run_subject(s, &b, plan, seed),
+            Ok(Some(b)) => match s.sampler.pdf_cells() {
+                None => run_subject(s, &b, plan, seed, None),
+                Some(cells) => match CellModel::new(s.sampler.as_ref(), cells, plan) {
+                    Ok(model) => run_subject(s, &b, plan, seed, Some(&model)),
+                    Err(e) => vec![error_outcome(names::BUILD, e)],
+                },
+            },
             Ok(None) => vec![error_outcome(
                 names::BUILD,
                 "direction subject on a planar domain",
@@ -77,7 +84,7 @@ pub fn run_case(subject: &AnySubject, plan: &Plan, seed: u64) -> Vec<TestOutcome
             Err(e) => vec![error_outcome(names::BUILD, e)],
         },
         AnySubject::Planar(s) => match plan.resolution.planar_binning(s.domain) {
-            Ok(Some(b)) => run_subject(s, b.as_ref(), plan, seed),
+            Ok(Some(b)) => run_subject(s, b.as_ref(), plan, seed, None),
             Ok(None) => vec![error_outcome(
                 names::BUILD,
                 "planar subject on a direction domain",
@@ -184,7 +191,7 @@ pub fn z_test(
     TestOutcome::with_p_value(name, z, p, alpha, detail)
 }
 
-fn chi_square<P: Copy + Send + Sync>(
+pub(crate) fn chi_square<P: Copy + Send + Sync>(
     name: &str,
     binning: &dyn Binning<Point = P>,
     masses: &[f64],
@@ -208,11 +215,16 @@ fn chi_square<P: Copy + Send + Sync>(
 
 /// Every test of the suite on `s` (binned by `binning`), in report order. p-values are judged
 /// at a placeholder level here; the run re-judges them with the Šidák level.
+///
+/// With `exact` (a sampler that declares where its pdf is piecewise constant), the χ², KS and
+/// normalisation tests are its exact versions, followed by the check of the declaration
+/// ([`crate::cells`]); otherwise they integrate the pdf by adaptive quadrature.
 pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     s: &Subject<P>,
     binning: &dyn Binning<Point = P>,
     plan: &Plan,
     seed: u64,
+    exact: Option<&dyn ExactTests<P>>,
 ) -> Vec<TestOutcome> {
     let alpha = 0.01;
     let sampler = s.sampler.as_ref();
@@ -227,37 +239,41 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     let opts = &plan.quadrature;
     let mut out = Vec::with_capacity(11);
 
-    let n_max = points.len().max(batch_points.len()) as u64;
-    match expected_masses_with(&pdf, binning, n_max, opts) {
-        Ok(table) => {
-            out.push(chi_square(
-                names::CHI_SQUARE,
-                binning,
-                &table.masses,
-                &points,
-                alpha,
-            ));
-            out.push(chi_square(
-                names::BATCH_CHI_SQUARE,
-                binning,
-                &table.masses,
-                &batch_points,
-                alpha,
-            ));
-        }
-        Err(e) => {
-            out.push(error_outcome(names::CHI_SQUARE, &e));
-            out.push(error_outcome(names::BATCH_CHI_SQUARE, &e));
-        }
-    }
     let axis_names = s.domain.axis_names();
-    for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
-        out.push(
-            match ks_projection_test(binning, &pdf, &points, axis, alpha, opts) {
-                Ok(o) => renamed(o, name),
-                Err(e) => error_outcome(name, e),
-            },
-        );
+    if let Some(exact) = exact {
+        out.extend(exact.distribution_tests(&points, &batch_points, axis_names, plan, alpha));
+    } else {
+        let n_max = points.len().max(batch_points.len()) as u64;
+        match expected_masses_with(&pdf, binning, n_max, opts) {
+            Ok(table) => {
+                out.push(chi_square(
+                    names::CHI_SQUARE,
+                    binning,
+                    &table.masses,
+                    &points,
+                    alpha,
+                ));
+                out.push(chi_square(
+                    names::BATCH_CHI_SQUARE,
+                    binning,
+                    &table.masses,
+                    &batch_points,
+                    alpha,
+                ));
+            }
+            Err(e) => {
+                out.push(error_outcome(names::CHI_SQUARE, &e));
+                out.push(error_outcome(names::BATCH_CHI_SQUARE, &e));
+            }
+        }
+        for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
+            out.push(
+                match ks_projection_test(binning, &pdf, &points, axis, alpha, opts) {
+                    Ok(o) => renamed(o, name),
+                    Err(e) => error_outcome(name, e),
+                },
+            );
+        }
     }
     let all: Vec<(P, f64)> = singles
         .iter()
@@ -268,12 +284,15 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         Ok(o) => renamed(o, names::PDF_CONSISTENCY),
         Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
     });
-    out.push(
-        match normalisation(binning, &pdf, 1.0, plan.normalisation_tolerance, opts) {
-            Ok(o) => renamed(o, names::NORMALISATION),
-            Err(e) => error_outcome(names::NORMALISATION, e),
-        },
-    );
+    match exact {
+        Some(exact) => out.extend(exact.normalisation_tests(plan)),
+        None => out.push(
+            match normalisation(binning, &pdf, 1.0, plan.normalisation_tolerance, opts) {
+                Ok(o) => renamed(o, names::NORMALISATION),
+                Err(e) => error_outcome(names::NORMALISATION, e),
+            },
+        ),
+    }
     let target = s.target.as_ref();
     out.push(
         match support_coverage(binning, target, &pdf, plan.support_resolution, opts) {

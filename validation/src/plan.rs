@@ -59,24 +59,6 @@ pub const FULL_PRESET_MODELS: &[&str] = &["sgd"];
 /// Outgoing polar angles of the full tier's preset fits.
 pub const PRESET_THETA_O: &[f64] = &[30.0, 75.0];
 
-/// Registered samplers that the quick tier leaves out when no `--sampler` is given, with the
-/// reason; each is reported as skipped cases (never silently dropped) and still runs when named
-/// with `--sampler`. Keep this list short and every reason measured.
-pub const QUICK_DEFERRED: &[(&str, &str)] = &[
-    (
-        "factored",
-        "its pdf is piecewise constant in the half vector, discontinuous along ~48 curves in ωi that no bin follows, and the suite's adaptive quadrature of expected counts and KS CDFs did not finish one 200 000-sample case in 40 min on 2 cores (issue 10); its own tests check normalisation, χ² and unbiasedness on every analytic model",
-    ),
-    (
-        "tabulated-cdf",
-        "its pdf jumps at every edge of its 256 × 512 cells and the KS projection test's adaptive 1D quadrature refines to depth 20 at each jump: one quick case takes ~96 CPU-s and the tier ~1 h (issue 10); its own tests check normalisation, χ², pdf consistency and unbiasedness",
-    ),
-    (
-        "cascade-cdf",
-        "the same as tabulated-cdf: a piecewise-linear CDF per fine row, so a pdf with thousands of jumps that the KS projection quadrature resolves one by one (issue 10); its own tests check the compression bound, normalisation, χ² (with a broken-pdf control) and unbiasedness",
-    ),
-];
-
 /// Outgoing polar angles (degrees, `φo = 0`) of the quick tier.
 pub const QUICK_THETA_O: &[f64] = &[0.0, 45.0, 80.0];
 

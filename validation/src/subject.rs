@@ -47,6 +47,13 @@ pub trait SamplerUnderTest<P>: Send + Sync {
     fn normaliser_rel_err(&self) -> Option<f64> {
         None
     }
+
+    /// Where the pdf is piecewise constant, for direction samplers that declare it
+    /// ([`brdf_sampling::DirectionSampler::pdf_cells`]): the suite then integrates it exactly
+    /// (see [`crate::cells`]). `None` by default.
+    fn pdf_cells(&self) -> Option<brdf_sampling::PdfCells> {
+        None
+    }
 }
 
 /// An integral with an accurately known value, and how the value was obtained.

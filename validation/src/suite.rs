@@ -20,7 +20,7 @@ use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
     DEFAULT_MEASURED_DIR, FULL_PRESET_MODELS, FULL_THETA_O, MIN_SAMPLES, PRESET_THETA_O, Plan,
-    QUICK_BRDFS, QUICK_DEFERRED, QUICK_THETA_O, Tier, ValidateConfig,
+    QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
@@ -56,9 +56,6 @@ struct Resolved {
     brdfs: Vec<(String, Arc<dyn Brdf>)>,
     angles: Vec<f64>,
     samplers: Vec<&'static SamplerEntry>,
-    /// Registered samplers the quick tier leaves out by default, with the reason
-    /// ([`QUICK_DEFERRED`]); reported as skipped cases.
-    deferred: Vec<(&'static SamplerEntry, &'static str)>,
     sets: Vec<LoadedSet>,
     /// Specs run at [`PRESET_THETA_O`] only (the full tier's default preset fits).
     few_angles: Vec<String>,
@@ -134,16 +131,8 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
     }
     let sets = load_sets(&config.sets)?;
     let mut entries: Vec<&'static SamplerEntry> = Vec::new();
-    let mut deferred = Vec::new();
     if config.samplers.is_empty() && sets.is_empty() {
         entries.extend(samplers::samplers().iter());
-        if tier == Tier::Quick {
-            for &(name, reason) in QUICK_DEFERRED {
-                if let Some(i) = entries.iter().position(|e| e.name == name) {
-                    deferred.push((entries.remove(i), reason));
-                }
-            }
-        }
     } else {
         for name in &config.samplers {
             let e = samplers::find(name)?;
@@ -206,7 +195,6 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         brdfs,
         angles,
         samplers: entries,
-        deferred,
         sets,
         few_angles,
     })
@@ -567,24 +555,6 @@ pub fn run(
             }
         })
         .collect();
-    let mut deferred: Vec<CaseResult> = Vec::new();
-    for &(entry, reason) in &r.deferred {
-        for (spec, _) in &r.brdfs {
-            for &theta in &r.angles {
-                deferred.push(CaseResult {
-                    sampler: entry.name.to_owned(),
-                    target: spec.clone(),
-                    theta_o: Some(theta),
-                    domain: "—".to_owned(),
-                    outcomes: vec![skipped_outcome(format!(
-                        "deferred from the quick tier by default: {reason}; run it with --sampler {}",
-                        entry.name
-                    ))],
-                });
-            }
-        }
-    }
-
     let mutant_results: Vec<(CaseResult, CaseResult)> = mutant_list
         .par_iter()
         .map(|m| {
@@ -631,7 +601,6 @@ pub fn run(
         failed_builds
             .into_iter()
             .chain(results.into_iter().flatten())
-            .chain(deferred)
             .collect(),
         mutant_results,
     ))

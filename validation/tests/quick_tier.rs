@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use samplers::samplers;
-use validation::{ProgressEvent, QUICK_DEFERRED, ValidateConfig, mutants, run};
+use validation::{ProgressEvent, ValidateConfig, mutants, run};
 
 #[test]
 #[cfg_attr(
@@ -46,19 +46,16 @@ fn quick_tier_passes_for_every_sampler_and_catches_every_mutant() {
         .iter()
         .filter(|e| !e.is_direction() || quick.iter().any(|b| e.applicability(b.as_ref()).is_ok()))
     {
-        let deferred = QUICK_DEFERRED.iter().any(|(name, _)| *name == e.name);
         let ran = |t: &&validation::TestRecord| t.sampler == e.name && t.test != "skipped";
         assert!(
             report.tests.iter().any(|t| t.sampler == e.name),
             "sampler {} is missing from the report",
             e.name
         );
-        // Every registered sampler runs real tests, except the few the quick tier defers
-        // (each reported as skipped with its reason, and none of them runs).
-        assert_eq!(
+        // Every registered sampler runs real tests.
+        assert!(
             report.tests.iter().any(|t| ran(&t)),
-            !deferred,
-            "sampler {}: deferred {deferred}",
+            "sampler {} ran no test",
             e.name
         );
     }

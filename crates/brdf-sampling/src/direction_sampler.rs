@@ -1,6 +1,8 @@
 //! The common shape of every direction sampler: `sample(wo, u) -> (wi, pdf)`, `pdf(wo, wi)`.
 
 use brdf::Vec3;
+
+use crate::PdfCells;
 use partition_sampler::UniformSource;
 
 /// One sampled incident direction.
@@ -47,6 +49,13 @@ pub trait DirectionSampler: Send + Sync {
     /// Declared relative error of the pdf's normalising constant at `wo` (samplers whose pdf
     /// is `f·cos / Î` with a numerical `Î`); `None` when the pdf is exact by construction.
     fn normaliser_rel_err(&self, _wo: &Vec3) -> Option<f64> {
+        None
+    }
+
+    /// Where the pdf at `wo` is piecewise constant (see [`PdfCells`]), for samplers that know:
+    /// a validation then integrates the pdf cell by cell, exactly, instead of refining its
+    /// quadrature at every jump. `None` (the default) means "no declared structure".
+    fn pdf_cells(&self, _wo: &Vec3) -> Option<PdfCells> {
         None
     }
 

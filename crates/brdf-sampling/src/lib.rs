@@ -94,6 +94,7 @@ mod image_map;
 mod layout;
 mod normalisation;
 mod options;
+mod pdf_cells;
 mod persist;
 mod reference;
 mod report;
@@ -107,6 +108,7 @@ pub use disc::{
 pub use error::{SetError, SetFileError};
 pub use layout::{SliceChoice, SliceLayout};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
+pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};
 pub use persist::SET_FORMAT_VERSION;
 pub use reference::{
     AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,

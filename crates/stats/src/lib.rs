@@ -12,6 +12,8 @@
 //! - [`ks_onesample`], [`ks_twosample`], [`projection_cdf`], [`ks_projection_test`]:
 //!   Kolmogorov–Smirnov tests (exact p-values for small samples, Stephens-corrected
 //!   asymptotics for large ones) on 1D projections whose CDF is tabulated by quadrature.
+//! - [`PiecewiseConstant`]: densities constant on known cells, whose bin masses and
+//!   projection CDFs are exact overlap sums (no quadrature; for pdfs with thousands of jumps).
 //! - [`pdf_consistency`], [`normalisation`], [`support_coverage`], [`mean_z_test`]: the
 //!   deterministic checks and the estimator z-test.
 //! - [`Suite`] applies the Šidák correction ([`sidak_level`]) over its tests;
@@ -55,6 +57,7 @@
 mod binning;
 mod calibration;
 mod cdf;
+mod cells;
 mod checks;
 mod chi_square;
 mod error;
@@ -68,6 +71,7 @@ pub use binning::{
 };
 pub use calibration::{Calibration, calibrate};
 pub use cdf::{Projection, TabulatedCdf, project, projection_cdf};
+pub use cells::{CellRow, PiecewiseConstant};
 pub use checks::{
     COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test, mean_z_test, normalisation,
     pdf_consistency, support_coverage,

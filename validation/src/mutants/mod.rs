@@ -12,8 +12,12 @@
 //! | `mixture-not-renormalised` | mixture pdf with weights summing to 1.2 |
 //! | `pdf-on-neighbour-slice` | samples from slice `θ_j`, pdf evaluated with slice `θ_{j+1}` |
 //! | `support-hole` | cosine sampling truncated at 80°, renormalised: no samples near the horizon |
+//! | `tabulated-cdf-row-pdf-off` | `tabulated-cdf`'s pdf 2 × on its heaviest `cos θ` row, renormalised |
+//! | `cascade-cdf-row-pdf-off` | the same for `cascade-cdf` |
+//! | `factored-band-pdf-off` | the same for `factored`, on its heaviest half-vector `θh` band |
 
 mod bases;
+mod cells;
 mod direction;
 mod planar;
 
@@ -24,11 +28,12 @@ use brdf_sampling::DirectionSampler;
 use partition_sampler::QuadTreeBuilder;
 
 pub use bases::{CosineHemisphere, LobeMixture, cosine_direction, cosine_pdf};
+pub use cells::RowScaledPdf;
 pub use direction::{CosineReportedUniform, RegionScaledPdf, TruncatedCosine};
 pub use planar::{FloorSplit, Remainder, ScaledBounds};
 
 use crate::adapters::{DirectionAtWo, QuadTreePlanar};
-use crate::builds::quadtree_disc_sampler;
+use crate::builds::{build_direction, direction_domain, quadtree_disc_sampler};
 use crate::domain::Domain;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
@@ -104,6 +109,34 @@ fn direction_pair(
         mutant: wrap(Arc::new(mutant)),
         control: wrap(Arc::new(control)),
     }
+}
+
+/// The registered cell-declaring sampler `name` for `brdf` (control) and its
+/// [`RowScaledPdf`] with factor 2 at `wo` (mutant), on the sampler's own domain.
+fn row_scaled_pair(
+    name: &str,
+    brdf: &Arc<dyn Brdf>,
+    wo: &Vec3,
+    refs: &BrdfReferences,
+) -> Result<MutantCase, String> {
+    let entry = samplers::find(name).map_err(|e| e.to_string())?;
+    let domain = direction_domain(entry).ok_or("not a direction sampler")?;
+    let base = build_direction(entry, brdf).map_err(|e| e.to_string())?;
+    let broken: Arc<dyn DirectionSampler> =
+        Arc::new(RowScaledPdf::new(Arc::clone(&base), wo, 2.0)?);
+    let wrap = |s: Arc<dyn DirectionSampler>| {
+        AnySubject::Direction(brdf_direction_subject(
+            Arc::new(DirectionAtWo::new(s, *wo)),
+            domain,
+            Arc::clone(brdf),
+            *wo,
+            refs,
+        ))
+    };
+    Ok(MutantCase {
+        mutant: wrap(broken),
+        control: wrap(base),
+    })
 }
 
 /// Phong-like mixture used by the lobe mutants: cosine weight 0.3, exponent 50.
@@ -282,6 +315,27 @@ pub static MUTANTS: &[Mutant] = &[
                 r,
             ))
         },
+    },
+    Mutant {
+        name: "tabulated-cdf-row-pdf-off",
+        description: "tabulated-cdf whose reported pdf is 2 x too high on its heaviest cos(theta) row and lower on the others (still normalised, self-consistent, cells still constant)",
+        brdf: "phong:n=50",
+        theta_o: 45.0,
+        build: |b, wo, r| row_scaled_pair("tabulated-cdf", b, wo, r),
+    },
+    Mutant {
+        name: "cascade-cdf-row-pdf-off",
+        description: "cascade-cdf whose reported pdf is 2 x too high on its heaviest fine cos(theta) row and lower on the others (still normalised, self-consistent, cells still constant)",
+        brdf: "phong:n=50",
+        theta_o: 45.0,
+        build: |b, wo, r| row_scaled_pair("cascade-cdf", b, wo, r),
+    },
+    Mutant {
+        name: "factored-band-pdf-off",
+        description: "factored whose reported pdf (above its defensive cosine part) is 2 x too high on its heaviest half-vector theta band and lower on the others (still normalised, self-consistent, cells still constant)",
+        brdf: "ggx:alpha=0.2",
+        theta_o: 45.0,
+        build: |b, wo, r| row_scaled_pair("factored", b, wo, r),
     },
 ];
 

@@ -120,6 +120,13 @@ impl SliceCdf for CascadeSlice {
             * density_scale(shape)
     }
 
+    /// The marginal's kept points are row edges, so the `z` density is constant on each fine
+    /// row; the row's conditional is linear between its kept points.
+    fn phi_edges(&self, shape: GridShape, row: usize) -> Vec<f64> {
+        let (xs, _) = self.conditional(row);
+        xs.iter().map(|&x| shape.phi_of(f64::from(x))).collect()
+    }
+
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + 12 * (self.marginal_xs.len() + self.xs.len())

@@ -6,7 +6,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirSample, DirectionSampler, Progress, SliceLayout};
+use brdf_sampling::{
+    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SliceLayout,
+};
 use partition_sampler::UniformSource;
 use rayon::prelude::*;
 
@@ -40,6 +42,10 @@ pub trait SliceCdf: Send + Sync + Sized {
 
     /// Density at `(z, φ)`, `z ∈ [0, 1]`, `φ ∈ [0, 2π)`, the value `sample` reports there.
     fn pdf(&self, shape: GridShape, z: f64, phi: f64) -> f64;
+
+    /// The azimuth edges (increasing, from 0 to 2π) between which the density of fine row `row`
+    /// (`z ∈ [row/n_z, (row+1)/n_z)`) is constant.
+    fn phi_edges(&self, shape: GridShape, row: usize) -> Vec<f64>;
 
     /// Heap and inline bytes of the slice.
     fn bytes_used(&self) -> usize;
@@ -324,6 +330,34 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
             phi += TAU;
         }
         self.slices[f.index].pdf(self.shape, wi.z.min(1.0), phi)
+    }
+
+    /// The pdf at `wo` is constant on the cells of the serving slice's fine rows
+    /// (`z ∈ [a/n_z, (a+1)/n_z)`), cut at [`SliceCdf::phi_edges`] and turned by the slice's
+    /// rotation `Δ`; zero below the horizon (the rows tile the upper hemisphere).
+    fn pdf_cells(&self, wo: &Vec3) -> Option<PdfCells> {
+        let f = self.frame(wo)?;
+        let slice = &self.slices[f.index];
+        let turn = f.sin.atan2(f.cos);
+        let n_z = self.shape.n_z;
+        let rows = (0..n_z)
+            .map(|a| {
+                let z = [
+                    a as f64 / n_z as f64,
+                    if a + 1 == n_z {
+                        1.0
+                    } else {
+                        (a + 1) as f64 / n_z as f64
+                    },
+                ];
+                PdfCellRow::turned(z, &slice.phi_edges(self.shape, a), turn)
+            })
+            .collect();
+        Some(PdfCells {
+            coords: CellCoords::Incident,
+            rows,
+            cosine_weight: 0.0,
+        })
     }
 
     fn bytes_used(&self) -> usize {

@@ -93,6 +93,10 @@ impl SliceCdf for TabulatedSlice {
         (self.marginal[a + 1] - self.marginal[a]) * (cond[b + 1] - cond[b]) * density_scale(shape)
     }
 
+    fn phi_edges(&self, shape: GridShape, _row: usize) -> Vec<f64> {
+        (0..=shape.n_phi).map(|b| shape.phi_of(b as f64)).collect()
+    }
+
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>() + 8 * (self.marginal.len() + self.conditional.len())
     }

@@ -187,6 +187,11 @@ impl Turn {
         }
     }
 
+    /// The angle of the turn, in `(−π, π]`.
+    pub(crate) fn angle(&self) -> f64 {
+        self.s.atan2(self.c)
+    }
+
     /// `v` in the turned frame (rotated by minus the angle).
     pub(crate) fn local_to_row(&self, v: &Vec3) -> Vec3 {
         Vec3::new(

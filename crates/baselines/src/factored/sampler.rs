@@ -4,7 +4,7 @@
 use std::f64::consts::FRAC_1_PI;
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells};
 use partition_sampler::UniformSource;
 
 use crate::CosineHemisphere;
@@ -181,6 +181,32 @@ impl DirectionSampler for FactoredSampler {
             0.0
         };
         factored + defensive
+    }
+
+    /// The factored part is constant on each `(θp band, φp bin)` cell of the reparametrised
+    /// direction `ωp` (the half vector, or `ωi` in spherical mode), turned by the row's frame;
+    /// the defensive part is the cosine component of weight `α`.
+    fn pdf_cells(&self, wo: &Vec3) -> Option<PdfCells> {
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let (_, turn) = self.outgoing.cell(wo);
+        let edges: Vec<f64> = (0..=self.phi_p.n)
+            .map(|b| b as f64 * self.phi_p.width)
+            .collect();
+        let c = &self.theta_p.cos_edges;
+        let rows = (0..self.theta_p.len())
+            .rev()
+            .map(|a| PdfCellRow::turned([c[a + 1], c[a]], &edges, turn.angle()))
+            .collect();
+        Some(PdfCells {
+            coords: match self.reparam {
+                Reparam::HalfAngle => CellCoords::HalfVector { wo: *wo },
+                Reparam::Spherical => CellCoords::Incident,
+            },
+            rows,
+            cosine_weight: self.alpha,
+        })
     }
 
     fn bytes_used(&self) -> usize {
