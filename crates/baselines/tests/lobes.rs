@@ -353,7 +353,12 @@ proptest! {
 /// suite's quadrature refine forever at θo = 85°–89°).
 #[test]
 fn half_vector_densities_stay_exact_next_to_the_fold_at_minus_wo() {
-    for spec in ["blinn:n=100", "lewis:n=50", "ward", "ward-original:alpha_x=0.2"] {
+    for spec in [
+        "blinn:n=100",
+        "lewis:n=50",
+        "ward",
+        "ward-original:alpha_x=0.2",
+    ] {
         let b = brdf(spec);
         let s = AnalyticSampler::new(b.as_ref()).unwrap();
         for theta in [60.0, 85.0, 89.0] {
