@@ -344,3 +344,42 @@ proptest! {
         }
     }
 }
+
+/// The half-vector samplers' density has an integrable `1/|ωo + ωi|` peak at `ωi = −ωo` (the
+/// fold of the reflection map). Approaching it along a fixed tangent `t`, `|ωo + ωi|·pdf`
+/// tends to `(1 − p_d)·p_h(t)/2`, a finite limit: the density must follow that law down to
+/// `|ωo + ωi| ≈ 10⁻¹¹` instead of dissolving into round-off (`1 + ωo·ωi` is `O(|s|²)`, so
+/// computing `ωo·h` by a dot product leaves no correct digit there, which made the validation
+/// suite's quadrature refine forever at θo = 85°–89°).
+#[test]
+fn half_vector_densities_stay_exact_next_to_the_fold_at_minus_wo() {
+    for spec in [
+        "blinn:n=100",
+        "lewis:n=50",
+        "ward",
+        "ward-original:alpha_x=0.2",
+    ] {
+        let b = brdf(spec);
+        let s = AnalyticSampler::new(b.as_ref()).unwrap();
+        for theta in [60.0, 85.0, 89.0] {
+            let wo = direction_from_angles(theta, 0.0);
+            // The unit tangent at −ωo closest to the normal: the half vector of the limit.
+            let t = (Vec3::z() - wo * wo.z).normalize();
+            let scaled = |d: f64| {
+                let wi = (-wo + t * d).normalize();
+                (wo + wi).norm() * s.pdf(&wo, &wi)
+            };
+            // At |s| = 1e-7 the half vector is within ~1e-7 of t: p_h(h) is within ~n·1e-7
+            // of its limit.
+            let limit = scaled(1e-7);
+            assert!(limit > 0.0, "{spec} at {theta}°: {limit}");
+            for d in [1e-8, 1e-9, 1e-10, 1e-11] {
+                let v = scaled(d);
+                assert!(
+                    (v / limit - 1.0).abs() < 1e-3,
+                    "{spec} at {theta}°, |s| = {d:e}: |s|·pdf = {v:e}, at 1e-7: {limit:e}"
+                );
+            }
+        }
+    }
+}

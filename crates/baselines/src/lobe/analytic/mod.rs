@@ -154,6 +154,12 @@ impl AnalyticSampler {
 /// Density of `ωi = reflect(ωo, h)` for `h` drawn from `p_h` on the upper hemisphere:
 /// `p_h(h)/(4|ωo·h|)` with `h = ±(ωo+ωi)/|ωo+ωi|`, the sign making `h_z > 0` (the one `h` that
 /// maps to `ωi`).
+///
+/// For unit `ωo`, `ωi` and `s = ωo + ωi`, `ωo·s = 1 + ωo·ωi = |s|²/2`, so `|ωo·h| = |s|/2` and
+/// the density is `p_h(h)/(2|s|)`. That form is used because it is stable: the density has an
+/// integrable `1/|s|` peak at `ωi = −ωo` (below the horizon; a fold of the reflection map),
+/// where `ωo·h` computed as a dot product loses every digit to cancellation (`1 + ωo·ωi` is
+/// `O(|s|²)`), while `|s|` keeps its relative accuracy down to `|s| ≈ 10⁻¹⁵`.
 fn reflected(wo: &Vec3, wi: &Vec3, p_h: impl Fn(&Vec3) -> f64) -> f64 {
     let s = wo + wi;
     let len = s.norm();
@@ -161,11 +167,7 @@ fn reflected(wo: &Vec3, wi: &Vec3, p_h: impl Fn(&Vec3) -> f64) -> f64 {
         return 0.0;
     }
     let h = if s.z >= 0.0 { s / len } else { -s / len };
-    let cos = wo.dot(&h).abs();
-    if !(cos > 0.0) {
-        return 0.0;
-    }
-    p_h(&h) / (4.0 * cos)
+    p_h(&h) / (2.0 * len)
 }
 
 /// Ward's half-vector density (w.r.t. solid angle of `h`): the Gaussian of the slopes
