@@ -93,6 +93,6 @@ pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,
 };
-pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
+pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows, sin_pi_unit};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;
