@@ -30,7 +30,7 @@ run_one() {
     h2d=$("$PY" "$PEERS/mitsuba_warp_bench.py" --density "$TMP/d.npy" --warp hierarchical -n "$N" --repeat 5 --fair --threads "$THREADS")
     d2d=$("$PY" "$PEERS/mitsuba_warp_bench.py" --density "$TMP/d.npy" --warp discrete -n "$N" --repeat 5 --fair --threads "$THREADS")
     if [ $# -gt 0 ]; then set -- --map "$1"; fi
-    ours=$(RAYON_NUM_THREADS=$THREADS "$BIN" envmap -n "$N" --compare "$@")
+    ours=$(RAYON_NUM_THREADS=$THREADS "$BIN" envmap -n "$N" --compare "$@" 2>/dev/null)
     h_rate=$(echo "$h2d" | sed -n 's/^sampling: median .* = \([0-9.]*\) M samples.*/\1/p')
     d_rate=$(echo "$d2d" | sed -n 's/^sampling: median .* = \([0-9.]*\) M samples.*/\1/p')
     h_build=$(echo "$h2d" | sed -n 's/^build: \([0-9.]*\) ms/\1/p')
