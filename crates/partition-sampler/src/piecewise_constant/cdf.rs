@@ -92,6 +92,21 @@ pub(crate) fn fill_guide_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [
     }
 }
 
+/// The guide table of the normalised CDF `cdf` (as [`fill_cdf`] writes it), `guide.len() ≥ 1`
+/// entries: `guide[g]` is the cell [`find_cell`] returns for `u = g / guide.len()`. O(n + G).
+pub fn fill_guide(cdf: &[f64], guide: &mut [u32]) {
+    fill_guide_by(cdf, |&c| c, guide)
+}
+
+/// [`find_cell`] from a guide table ([`fill_guide`] of the same CDF): the same cell and
+/// position for every `u ∈ [0, 1)`, found by a short scan from `guide[⌊u·G⌋]` instead of a
+/// binary search (O(1) expected for `G` near the cell count; coarser guides trade a longer
+/// scan, within one cache line for `G = n/8`, for less memory).
+#[inline]
+pub fn find_cell_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f64) {
+    find_cell_guided_by(cdf, |&c| c, guide, u)
+}
+
 /// [`find_cell_by`] started from a guide table ([`fill_guide_by`]) instead of a binary
 /// search: the same cell and position for every `u ∈ [0,1)` (the scan from the guide's entry
 /// first steps down while the CDF exceeds `u` — only possible through rounding of `u·G` — then
