@@ -15,7 +15,7 @@ use crate::CdfOptions;
 /// which is a solid-angle density since `dz dφ = dω`.
 ///
 /// Sampling starts each CDF search from a guide table ([`partition_sampler::fill_guide`], one
-/// `u32` per `GUIDE_CELLS` = 8 cells, ≈ 1.5 % of the table's memory) instead of a binary search
+/// `u32` per `GUIDE_CELLS` = 8 cells, +6 % of the table's memory) instead of a binary search
 /// over the row: the same cell for every `u`, one or two cache lines read instead of ~9
 /// dependent probes of a 4 KiB row.
 #[derive(Debug, Clone, PartialEq)]
