@@ -3,15 +3,15 @@
 #
 #   sh crates/envmap/benches/mitsuba_side_by_side.sh [MAP.hdr ...]
 #
-# Environment: PEERS = directory of the peer scripts (mitsuba_warp_bench.py and its .venv;
-# default ../shared/peers), N = samples (default 4000000), THREADS = threads for both sides
+# Environment: PEERS = directory of the peer scripts (mitsuba_warp_bench.py and its .venv,
+# required), N = samples (default 4000000), THREADS = threads for both sides
 # (default 2). Without maps: the built-in procedural sky only. For each map it exports the
 # density Mitsuba's envmap emitter warps (luminance x sin(pi v_centre), float32 .npy), times
 # Mitsuba's Hierarchical2D and DiscreteDistribution2D (--fair: uniforms drawn in the kernel,
 # pdf kept; median of 5), then `brdf-lab envmap --compare` (same N, same threads), and prints
 # one table row per map. Mitsuba is a peer, never a dependency.
 set -eu
-PEERS=${PEERS:-../shared/peers}
+PEERS=${PEERS:?set PEERS to the directory holding mitsuba_warp_bench.py and its .venv}
 N=${N:-4000000}
 THREADS=${THREADS:-2}
 PY="$PEERS/.venv/bin/python"
