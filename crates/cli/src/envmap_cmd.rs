@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice};
-use partition_sampler::{PAR_CHUNK, Sample2, TreeParams, chunk_seed};
+use partition_sampler::{PAR_CHUNK, Sample2, Sampler2D, TreeParams, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -248,9 +248,36 @@ fn write_samples(path: &std::path::Path, blocks: &[Vec<Sample2>]) -> CliResult<(
     result
 }
 
+/// Samples per buffer when a consumer draws with [`Sampler2D::sample_into`] (a renderer's
+/// batch of directions); the buffer is reused, never stored.
+const CONSUMER_BATCH: usize = 256;
+
+/// Draws `len` samples from `rng` and consumes them (sums their pdfs): one `sample_uv` call per
+/// sample, or (`block`) [`Sampler2D::sample_into`] on a reused buffer of [`CONSUMER_BATCH`].
+/// Both give the same samples.
+fn consume(sampler: &EnvMapSampler, len: usize, rng: &mut Xoshiro256PlusPlus, block: bool) -> f64 {
+    if !block {
+        return (0..len).map(|_| sampler.sample_uv(rng).pdf).sum();
+    }
+    let mut buf = [Sample2 {
+        point: [0.0; 2],
+        pdf: 0.0,
+    }; CONSUMER_BATCH];
+    let mut sum = 0.0;
+    let mut left = len;
+    while left > 0 {
+        let k = left.min(CONSUMER_BATCH);
+        sampler.sample_into(rng, &mut buf[..k]);
+        sum += buf[..k].iter().map(|s| s.pdf).sum::<f64>();
+        left -= k;
+    }
+    sum
+}
+
 /// Draws `n` samples on all threads and consumes them (sums their pdfs) without storing them,
-/// as a renderer would: fixed chunks of [`PAR_CHUNK`] with generators seeded from (seed, chunk).
-fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64) -> f64 {
+/// as a renderer would: fixed chunks of [`PAR_CHUNK`] with generators seeded from (seed, chunk),
+/// so the samples are a function of the seed only.
+fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64, block: bool) -> f64 {
     use rayon::prelude::*;
     let chunks = n.div_ceil(PAR_CHUNK);
     let sums: Vec<f64> = (0..chunks)
@@ -258,9 +285,7 @@ fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64) -> f64 {
         .map(|c| {
             let len = PAR_CHUNK.min(n - c * PAR_CHUNK);
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
-            (0..len)
-                .map(|_| sampler.sample_uv(&mut rng).pdf)
-                .sum::<f64>()
+            consume(sampler, len, &mut rng, block)
         })
         .collect();
     sums.iter().sum()
@@ -286,17 +311,19 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
     let threads = rayon::current_num_threads();
     println!();
     println!(
-        "compare    {n} samples per variant, median of 5 builds, {threads} threads for the parallel column (samples consumed, not stored)"
+        "compare    {n} samples per variant, median of 5 builds; M/s on 1 and {threads} threads, 'one' = one sample_uv call per sample, 'blk' = sample_into on buffers of {CONSUMER_BATCH} (same samples; consumed, not stored)"
     );
     println!(
-        "{:<24} {:<8} {:>10} {:>12} {:>8} {:>14} {:>14}",
+        "{:<24} {:<8} {:>10} {:>12} {:>10} {:>11} {:>11} {:>11} {:>11}",
         "sampler",
         "leaves",
         "build ms",
         "memory KiB",
         "trials",
-        "M/s 1 thread",
-        format!("M/s {threads} thr")
+        "M/s 1 one",
+        "M/s 1 blk",
+        format!("M/s {threads} one"),
+        format!("M/s {threads} blk"),
     );
     let pb = progress::bar(variants.len() as u64, "comparing");
     let mut rows = Vec::new();
@@ -311,17 +338,22 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
         }
         let Some(sampler) = sampler else { continue };
         builds.sort_by(f64::total_cmp);
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(args.seed);
-        let t = Instant::now();
-        let mut sink = 0.0;
-        for _ in 0..n {
-            sink += sampler.sample_uv(&mut rng).pdf;
+        let mut rates = [0.0; 4];
+        let mut sinks = [0.0; 4];
+        for (k, (parallel, block)) in [(false, false), (false, true), (true, false), (true, true)]
+            .into_iter()
+            .enumerate()
+        {
+            let t = Instant::now();
+            sinks[k] = if parallel {
+                consume_par(&sampler, n, args.seed, block)
+            } else {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(args.seed);
+                consume(&sampler, n, &mut rng, block)
+            };
+            rates[k] = n as f64 / t.elapsed().as_secs_f64() / 1e6;
         }
-        let single = n as f64 / t.elapsed().as_secs_f64() / 1e6;
-        let t = Instant::now();
-        let par_sink = consume_par(&sampler, n, args.seed);
-        let multi = n as f64 / t.elapsed().as_secs_f64() / 1e6;
-        std::hint::black_box((sink, par_sink));
+        std::hint::black_box(sinks);
         let trials = sampler
             .stats()
             .and_then(|s| s.measured_mean_trials)
@@ -332,14 +364,16 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
             (true, LeafChoiceName::Descent) => "descent",
         };
         rows.push(format!(
-            "{:<24} {:<8} {:>10.3} {:>12.1} {:>8} {:>14.2} {:>14.2}",
+            "{:<24} {:<8} {:>10.3} {:>12.1} {:>10} {:>11.2} {:>11.2} {:>11.2} {:>11.2}",
             entry.name,
             leaf_name,
             builds[builds.len() / 2],
             sampler.bytes_used() as f64 / 1024.0,
             trials,
-            single,
-            multi
+            rates[0],
+            rates[1],
+            rates[2],
+            rates[3],
         ));
         pb.inc(1);
     }

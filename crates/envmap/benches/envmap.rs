@@ -5,6 +5,8 @@
 //! / descent leaf choice, default `n_max`) and the piecewise-constant CDF baseline:
 //! * `build/…`: constructing the sampler from the loaded map (luminance table included);
 //! * `uv_1t/…`: a single-thread loop of `sample_uv` (planar samples, no trigonometry);
+//! * `uv_block_1t/…`: the same samples drawn with `sample_into` on a reused buffer of 250
+//!   (the block path: candidates and density lookups per block);
 //! * `dir_1t/…`: a single-thread loop of `sample` (with direction and solid-angle pdf);
 //! * `uv_par/…`: `sample_uv_par` (rayon, all threads) of 1 M samples.
 //!
@@ -17,6 +19,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
+use partition_sampler::{Sample2, Sampler2D};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -69,6 +72,8 @@ fn kinds() -> Vec<(&'static str, SamplerKind)> {
 }
 
 const LOOP: usize = 100_000;
+/// Buffer of the `uv_block_1t` group (`LOOP` is a multiple of it).
+const BLOCK: usize = 250;
 const PAR: usize = 1_000_000;
 
 fn benches(c: &mut Criterion) {
@@ -107,6 +112,30 @@ fn benches(c: &mut Criterion) {
                     let mut acc = 0.0;
                     for _ in 0..LOOP {
                         acc += s.sample_uv(&mut rng).pdf;
+                    }
+                    acc
+                })
+            });
+        }
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("uv_block_1t/{map_name}"));
+        g.throughput(Throughput::Elements(LOOP as u64));
+        for (name, s) in &samplers {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+            let mut buf = vec![
+                Sample2 {
+                    point: [0.0; 2],
+                    pdf: 0.0
+                };
+                BLOCK
+            ];
+            g.bench_function(*name, |b| {
+                b.iter(|| {
+                    let mut acc = 0.0;
+                    for _ in 0..LOOP / BLOCK {
+                        s.sample_into(&mut rng, &mut buf);
+                        acc += buf.iter().map(|x| x.pdf).sum::<f64>();
                     }
                     acc
                 })

@@ -1,13 +1,28 @@
 //! A bare sampling loop for profilers (`perf stat` / `perf record`): builds one sampler for one
-//! map and draws N planar samples on one thread.
+//! map and draws N planar samples on one thread, one `sample_uv` call per sample (`one`,
+//! default) or with `sample_into` on a reused buffer of 256 (`block`; the same samples).
+//! Prints wall time and the thread's CPU time per sample (from `/proc/thread-self/stat`,
+//! Linux; the figure to quote on a loaded machine).
 //!
-//! `cargo run --release -p envmap --example profile_loop -- [MAP|sky] [adaptive|adaptive-descent|adaptive-paper|pwc] [N] [N_MAX]`
+//! `cargo run --release -p envmap --example profile_loop -- [MAP|sky] [adaptive|adaptive-descent|adaptive-paper|pwc] [N] [N_MAX] [one|block]`
 
 use std::time::Instant;
 
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
+use partition_sampler::{Sample2, Sampler2D};
+
+/// CPU seconds (user + system) of the calling thread, from `/proc/thread-self/stat` (clock
+/// ticks of 1/100 s); `None` where that file does not exist.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -39,19 +54,45 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(20_000_000);
+    let block = match args.get(4).map(String::as_str).unwrap_or("one") {
+        "one" => false,
+        "block" => true,
+        other => return Err(format!("unknown mode {other} (one|block)").into()),
+    };
     let s = EnvMapSampler::new(&map, kind)?;
     let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(1);
+    let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
     let mut acc = 0.0;
-    for _ in 0..n {
-        acc += s.sample_uv(&mut rng).pdf;
+    if block {
+        let mut buf = [Sample2 {
+            point: [0.0; 2],
+            pdf: 0.0,
+        }; 256];
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(buf.len());
+            s.sample_into(&mut rng, &mut buf[..k]);
+            acc += buf[..k].iter().map(|x| x.pdf).sum::<f64>();
+            left -= k;
+        }
+    } else {
+        for _ in 0..n {
+            acc += s.sample_uv(&mut rng).pdf;
+        }
     }
     let secs = t.elapsed().as_secs_f64();
+    let cpu = cpu0.zip(thread_cpu_seconds()).map(|(a, b)| b - a);
     std::hint::black_box(acc);
     println!(
-        "{} samples in {secs:.3} s: {:.2} M samples/s",
+        "{} samples ({}) in {secs:.3} s: {:.2} M samples/s wall; thread CPU {}",
         n,
-        n as f64 / secs / 1e6
+        if block { "block" } else { "one" },
+        n as f64 / secs / 1e6,
+        cpu.map_or("n/a".to_string(), |c| format!(
+            "{c:.2} s = {:.1} ns/sample",
+            c / n as f64 * 1e9
+        ))
     );
     Ok(())
 }

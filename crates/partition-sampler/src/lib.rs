@@ -83,7 +83,8 @@ pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistE
 pub use parallel::{PAR_CHUNK, chunk_rng, chunk_seed, sample_par};
 pub use persist::FORMAT_VERSION;
 pub use piecewise_constant::{
-    PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1, fill_cdf, find_cell,
+    PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1, fill_cdf,
+    fill_guide, find_cell, find_cell_guided,
 };
 pub use quadtree_sampler::{
     Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats,
@@ -93,6 +94,6 @@ pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,
 };
-pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows};
+pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows, sin_pi_unit};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;

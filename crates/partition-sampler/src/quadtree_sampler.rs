@@ -15,6 +15,9 @@ use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
 /// rejection trials. Only reachable when the bounds or integrals badly contradict `f`.
 pub const MAX_TRIALS_PER_SAMPLE: u64 = 1 << 20;
 
+/// Trials generated ahead per block by the batch path of [`Sampler2D::sample_into`].
+const TRIAL_BLOCK: usize = 64;
+
 /// The adaptive-partition sampler of a density `D` (seed 003 §3, seed 000 §3).
 ///
 /// **pdf.** Both [`Sampler2D::sample`] and [`Sampler2D::pdf`] report
@@ -396,6 +399,94 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         }
     }
 
+    /// The batch path of [`Sampler2D::sample_into`] (envelope scheme, alias leaf choice,
+    /// rectangular domain). The one-sample loop is a sequence of trials, each consuming the
+    /// same uniforms (leaf pick, then `x`, `y`, `z` when a leaf is found) whatever the
+    /// outcome, and a sample is the first accepted trial after the previous one (or the
+    /// exhausted one after [`MAX_TRIALS_PER_SAMPLE`]). So the trials can be generated ahead in
+    /// blocks, their densities evaluated together, and the accept pass run after, with the
+    /// same result. A block never holds more trials than samples still missing, so no uniform
+    /// is consumed that the one-sample loop would not consume.
+    #[inline(always)]
+    fn fill_blocks<const MAP: bool, U: UniformSource + ?Sized>(
+        &self,
+        u: &mut U,
+        out: &mut [Sample2],
+        a: &mut Audit,
+    ) {
+        let leaves = &self.tree.leaves;
+        let n = leaves.len();
+        let nf = n as f64;
+        let centre = self.tree.root.center();
+        let mut points = [centre; TRIAL_BLOCK];
+        let mut zs = [0.0f64; TRIAL_BLOCK];
+        let mut bounds = [0.0f64; TRIAL_BLOCK];
+        let mut fs = [0.0f64; TRIAL_BLOCK];
+        let mut picked = [false; TRIAL_BLOCK];
+        let mut filled = 0;
+        let mut since = 0u64;
+        let mut last = centre;
+        while filled < out.len() {
+            let k = (out.len() - filled).min(TRIAL_BLOCK);
+            for j in 0..k {
+                // pick_leaf's alias branch, then trial's point and height.
+                let s = u.next_uniform() * nf;
+                let i = (s as usize).min(n - 1);
+                let first = &leaves[i];
+                let leaf = if s - (i as f64) < first.prob {
+                    Some(first)
+                } else {
+                    leaves.get(first.alias as usize)
+                };
+                let Some(leaf) = leaf else {
+                    picked[j] = false;
+                    points[j] = centre;
+                    continue;
+                };
+                let s = f64::from(leaf.u0) + u.next_uniform() * f64::from(leaf.du);
+                let t = f64::from(leaf.v0) + u.next_uniform() * f64::from(leaf.dv);
+                points[j] = if MAP {
+                    [self.frame.domain_coord(0, s), self.frame.domain_coord(1, t)]
+                } else {
+                    [s, t]
+                };
+                let m = leaf.bound(self.bound_scale);
+                bounds[j] = m;
+                zs[j] = u.next_uniform() * m;
+                picked[j] = true;
+            }
+            self.density.eval_block(&points[..k], &mut fs[..k]);
+            for j in 0..k {
+                a.trials += 1;
+                since += 1;
+                if picked[j] {
+                    let f = fs[j];
+                    if f > bounds[j] {
+                        a.violations += 1;
+                    }
+                    if zs[j] < f {
+                        a.samples += 1;
+                        out[filled] = Sample2 {
+                            point: points[j],
+                            pdf: f * self.inv_integral,
+                        };
+                        filled += 1;
+                        since = 0;
+                        last = centre;
+                        continue;
+                    }
+                    last = points[j];
+                }
+                if since >= MAX_TRIALS_PER_SAMPLE {
+                    out[filled] = self.exhausted(last, a);
+                    filled += 1;
+                    since = 0;
+                    last = centre;
+                }
+            }
+        }
+    }
+
     /// One sample of the configured scheme (counts the sample in `a`).
     #[inline]
     fn draw<U: UniformSource + ?Sized>(&self, u: &mut U, a: &mut Audit) -> Sample2 {
@@ -467,11 +558,25 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
         s
     }
 
-    /// The draws of [`Sampler2D::sample`], counted locally and added to the shared counters once.
+    /// The draws of [`Sampler2D::sample`] — the same samples and the same uniforms consumed,
+    /// bit for bit — counted locally and added to the shared counters once. With
+    /// [`Scheme::Envelope`] and [`LeafChoice::Alias`] on a rectangle the trials are run in
+    /// blocks ([`Self::fill_blocks`]): candidates first, then their densities in one
+    /// [`Density::eval_block`](crate::Density::eval_block) call, then the accept pass.
     fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
         let mut a = Audit::default();
-        for s in out.iter_mut() {
-            *s = self.draw(u, &mut a);
+        let blocked = !self.disc
+            && !self.tree.leaves.is_empty()
+            && self.tree.params.scheme == Scheme::Envelope
+            && self.tree.params.leaf_choice == LeafChoice::Alias;
+        if blocked && self.identity {
+            self.fill_blocks::<false, U>(u, out, &mut a);
+        } else if blocked {
+            self.fill_blocks::<true, U>(u, out, &mut a);
+        } else {
+            for s in out.iter_mut() {
+                *s = self.draw(u, &mut a);
+            }
         }
         self.counters.add(&a);
     }

@@ -64,10 +64,12 @@ pub(crate) fn draw(xs: &[u32], cs: &[f64], u: f64) -> Draw {
     }
 }
 
-/// [`draw`] on the uncompressed axis `x_m = m` (every cell edge kept, `xs` implicit).
+/// [`draw`] on the uncompressed axis `x_m = m` (every cell edge kept, `xs` implicit); the
+/// segment is found from `guide` ([`partition_sampler::fill_guide`] of `cs`), which gives the
+/// binary search's segment exactly.
 #[inline]
-pub(crate) fn draw_uniform(cs: &[f64], u: f64) -> Draw {
-    let (m, du) = find_segment(cs, clamp_unit(u));
+pub(crate) fn draw_uniform(cs: &[f64], guide: &[u32], u: f64) -> Draw {
+    let (m, du) = partition_sampler::find_cell_guided(cs, guide, clamp_unit(u));
     let x0 = m as f64;
     let mut t = x0 + du;
     if !(t > 0.0 && t >= x0 && t < x0 + 1.0) {

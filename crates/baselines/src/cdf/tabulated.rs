@@ -13,10 +13,26 @@ use crate::CdfOptions;
 /// `C(z_a) = Σ_{a'<a} M_a' / Σ M`, `C_a(φ_b) = Σ_{b'<b} g_ab' / M_a`. The density is
 /// piecewise constant, `p(z, φ) = (M_a / Σ M) / Δz · (g_ab / M_a) / Δφ = g_ab / (Σ g Δz Δφ)`,
 /// which is a solid-angle density since `dz dφ = dω`.
+///
+/// Sampling starts each CDF search from a guide table ([`partition_sampler::fill_guide`], one
+/// `u32` per `GUIDE_CELLS` = 8 cells, +6 % of the table's memory) instead of a binary search
+/// over the row: the same cell for every `u`, one or two cache lines read instead of ~9
+/// dependent probes of a 4 KiB row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TabulatedSlice {
     marginal: Vec<f64>,
     conditional: Vec<f64>,
+    marginal_guide: Vec<u32>,
+    /// `guide_len(n_φ)` entries per row, concatenated.
+    conditional_guide: Vec<u32>,
+}
+
+/// Cells per guide entry: a bucket of the guide spans about one cache line of CDF values.
+const GUIDE_CELLS: usize = 8;
+
+/// Guide entries for a CDF over `n` cells.
+fn guide_len(n: usize) -> usize {
+    n.div_ceil(GUIDE_CELLS).max(1)
 }
 
 impl TabulatedSlice {
@@ -31,9 +47,21 @@ impl TabulatedSlice {
             .collect();
         let mut marginal = vec![0.0; shape.n_z + 1];
         fill_cdf(&row_sums, &mut marginal);
+        let mut marginal_guide = vec![0; guide_len(shape.n_z)];
+        partition_sampler::fill_guide(&marginal, &mut marginal_guide);
+        let g = guide_len(n_phi);
+        let mut conditional_guide = vec![0; shape.n_z * g];
+        for (cdf, guide) in conditional
+            .chunks_exact(n_phi + 1)
+            .zip(conditional_guide.chunks_exact_mut(g))
+        {
+            partition_sampler::fill_guide(cdf, guide);
+        }
         Self {
             marginal,
             conditional,
+            marginal_guide,
+            conditional_guide,
         }
     }
 
@@ -59,7 +87,7 @@ impl SliceCdf for TabulatedSlice {
 
     #[inline]
     fn sample(&self, shape: GridShape, u: [f64; 2]) -> SlicePoint {
-        let dz = draw_uniform(&self.marginal, u[0]);
+        let dz = draw_uniform(&self.marginal, &self.marginal_guide, u[0]);
         let a = dz.segment;
         let z = settle(
             dz.t,
@@ -69,7 +97,8 @@ impl SliceCdf for TabulatedSlice {
             |z| shape.row_of(z),
         );
         let cond = self.conditional(a);
-        let dp = draw_uniform(cond, u[1]);
+        let g = guide_len(shape.n_phi);
+        let dp = draw_uniform(cond, &self.conditional_guide[a * g..(a + 1) * g], u[1]);
         let b = dp.segment;
         let phi = settle(
             dp.t,
@@ -98,7 +127,9 @@ impl SliceCdf for TabulatedSlice {
     }
 
     fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * (self.marginal.len() + self.conditional.len())
+        std::mem::size_of::<Self>()
+            + 8 * (self.marginal.len() + self.conditional.len())
+            + 4 * (self.marginal_guide.len() + self.conditional_guide.len())
     }
 
     fn stored_points(&self) -> usize {

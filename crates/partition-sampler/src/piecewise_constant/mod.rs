@@ -14,7 +14,7 @@ mod error;
 mod one_d;
 mod two_d;
 
-pub use cdf::{fill_cdf, find_cell};
+pub use cdf::{fill_cdf, fill_guide, find_cell, find_cell_guided};
 pub use error::PiecewiseConstantError;
 pub use one_d::{PiecewiseConstant1D, Sample1};
 pub use two_d::PiecewiseConstant2D;

@@ -1,0 +1,47 @@
+#!/bin/sh
+# Environment-map sampling throughput, brdf-lab beside Mitsuba 3 (issue 15), in one run.
+#
+#   sh crates/envmap/benches/mitsuba_side_by_side.sh [MAP.hdr ...]
+#
+# Environment: PEERS = directory of the peer scripts (mitsuba_warp_bench.py and its .venv,
+# required), N = samples (default 4000000), THREADS = threads for both sides
+# (default 2). Without maps: the built-in procedural sky only. For each map it exports the
+# density Mitsuba's envmap emitter warps (luminance x sin(pi v_centre), float32 .npy), times
+# Mitsuba's Hierarchical2D and DiscreteDistribution2D (--fair: uniforms drawn in the kernel,
+# pdf kept; median of 5), then `brdf-lab envmap --compare` (same N, same threads), and prints
+# one table row per map. Mitsuba is a peer, never a dependency.
+set -eu
+PEERS=${PEERS:?set PEERS to the directory holding mitsuba_warp_bench.py and its .venv}
+N=${N:-4000000}
+THREADS=${THREADS:-2}
+PY="$PEERS/.venv/bin/python"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+cargo build --release -q -p brdf-lab-cli -p envmap --example export_density
+BIN=target/release/brdf-lab
+EXPORT=target/release/examples/export_density
+echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+printf '| map | Mitsuba H2D M/s | Mitsuba D2D M/s | adaptive M/s (1 thr one / blk, %s thr one / blk) | envmap-cdf M/s (same) | adaptive / H2D | cdf / D2D | adaptive build ms | Mitsuba H2D build ms | adaptive 1->%s scaling (blk) |\n' "$THREADS" "$THREADS"
+printf '|---|---|---|---|---|---|---|---|---|---|\n'
+run_one() {
+    name=$1
+    shift
+    "$EXPORT" "$TMP/d.npy" "$@" > /dev/null
+    h2d=$("$PY" "$PEERS/mitsuba_warp_bench.py" --density "$TMP/d.npy" --warp hierarchical -n "$N" --repeat 5 --fair --threads "$THREADS")
+    d2d=$("$PY" "$PEERS/mitsuba_warp_bench.py" --density "$TMP/d.npy" --warp discrete -n "$N" --repeat 5 --fair --threads "$THREADS")
+    if [ $# -gt 0 ]; then set -- --map "$1"; fi
+    ours=$(RAYON_NUM_THREADS=$THREADS "$BIN" envmap -n "$N" --compare "$@" 2>/dev/null)
+    h_rate=$(echo "$h2d" | sed -n 's/^sampling: median .* = \([0-9.]*\) M samples.*/\1/p')
+    d_rate=$(echo "$d2d" | sed -n 's/^sampling: median .* = \([0-9.]*\) M samples.*/\1/p')
+    h_build=$(echo "$h2d" | sed -n 's/^build: \([0-9.]*\) ms/\1/p')
+    a=$(echo "$ours" | awk '$1 == "envmap-adaptive" && $2 == "alias" { print $3, $(NF-3), $(NF-2), $(NF-1), $NF }')
+    c=$(echo "$ours" | awk '$1 == "envmap-cdf" { print $(NF-3), $(NF-2), $(NF-1), $NF }')
+    echo "$name $h_rate $d_rate $h_build $a $c" | awk '{
+        printf "| %s | %s | %s | %s / %s / %s / %s | %s / %s / %s / %s | %.2f | %.2f | %s | %s | %.2f |\n",
+            $1, $2, $3, $6, $7, $8, $9, $10, $11, $12, $13, $9 / $2, $13 / $3, $5, $4, $9 / $7 }'
+}
+run_one "procedural-sky"
+for map in "$@"; do
+    run_one "$(basename "$map" .hdr)" "$map"
+done
+echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)"
