@@ -28,7 +28,7 @@ use crate::report::{MutantRecord, TestRecord, ValidationReport};
 use crate::seeding::case_seed;
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
-use samplers::SamplerEntry;
+use samplers::{Constructor, SamplerEntry};
 
 /// Progress of a run, reported once at the start and once per finished case.
 #[derive(Debug, Clone, PartialEq)]
@@ -272,6 +272,12 @@ fn run_brdf_job(
     {
         Some(Err(e)) if not_applicable(&e) => {
             return skipped_angles(entry.name, spec, r, &e.to_string(), on_done);
+        }
+        None if matches!(entry.constructor, Constructor::Disc(_)) => {
+            if let Some(e) = samplers::disc_refusal(brdf.as_ref()) {
+                return skipped_angles(entry.name, spec, r, &e.to_string(), on_done);
+            }
+            None
         }
         other => other.map(|b| b.map_err(|e| e.to_string())),
     };

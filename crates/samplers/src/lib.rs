@@ -39,7 +39,7 @@ mod entries;
 mod error;
 mod request;
 
-pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, quadtree_disc_density};
+pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, disc_refusal, quadtree_disc_density};
 pub use error::RegistryError;
 pub use request::{BuiltDirection, DirectionRequest};
 
