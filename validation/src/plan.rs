@@ -26,25 +26,39 @@ impl Tier {
     }
 }
 
-/// BRDF specs of the quick tier.
+/// BRDF specs of the quick tier: five analytic models and the RGL fixture ([`QUICK_RGL`]).
+/// The Cornell material ([`QUICK_CORNELL`]) is added when its shared file is present.
 pub const QUICK_BRDFS: &[&str] = &[
     "lambert",
     "phong:n=50",
     "ward",
     "ggx:alpha=0.2",
     "oren-nayar",
+    QUICK_RGL,
 ];
 
 /// The RGL fixture in the repository (`data/measured/rgl/paper_white_rgb.bsdf`, found from this
-/// crate's source directory). Not in [`QUICK_BRDFS`] yet: with it the quick tier fails for
-/// `adaptive`/`adaptive-paper` at 80° (support coverage, 1.6e-6 of the mass uncovered) and for
-/// `quadtree-disc` (bound audit); `rgl-native` passes on it
-/// (`brdf-lab validate --quick --sampler rgl-native --brdf rgl:data/measured/rgl/paper_white_rgb.bsdf`).
+/// crate's source directory; provenance in `data/measured/README.md`).
 pub const QUICK_RGL: &str = concat!(
     "rgl:",
     env!("CARGO_MANIFEST_DIR"),
     "/../data/measured/rgl/paper_white_rgb.bsdf"
 );
+
+/// The quick tier's Cornell material: `acryl_blue.brdf` of the project's shared measured data
+/// (`../shared/data/measured/cornell/`, beside the repository; found from this crate's source
+/// directory). Its data carry no licence statement, so no copy is in the repository: when the
+/// file is absent (users' clones) the quick tier reports its cases as skipped with the path.
+pub const QUICK_CORNELL: &str = concat!(
+    "cornell:",
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../shared/data/measured/cornell/acryl_blue.brdf"
+);
+
+/// The quick tier runs [`QUICK_CORNELL`] at this outgoing angle only: its reference quadrature
+/// is the tier's most expensive (see
+/// [`SCATTERED_REFERENCE_TOLERANCE`](crate::references::SCATTERED_REFERENCE_TOLERANCE)).
+pub const QUICK_CORNELL_THETA_O: &[f64] = &[45.0];
 
 /// Directory searched in the full tier for the shared measured materials (`rgl/*.bsdf`,
 /// `cornell/*.brdf`), when
