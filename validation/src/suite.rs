@@ -21,8 +21,7 @@ use crate::error::ValidationError;
 use crate::mutants::mutants;
 use crate::plan::{
     DEFAULT_MEASURED_DIR, FULL_PRESET_MODELS, FULL_THETA_O, MIN_SAMPLES, PRESET_THETA_O, Plan,
-    QUICK_BRDFS, QUICK_CORNELL, QUICK_CORNELL_THETA_O, QUICK_DEFERRED, QUICK_THETA_O, Tier,
-    ValidateConfig,
+    QUICK_BRDFS, QUICK_DEFERRED, QUICK_THETA_O, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
 use crate::report::{MutantRecord, TestRecord, ValidationReport};
@@ -63,12 +62,8 @@ struct Resolved {
     deferred: Vec<(&'static SamplerEntry, &'static str)>,
     sets: Vec<LoadedSet>,
     /// Specs run at a few of the run's angles only, with those angles (the full tier's default
-    /// preset fits at [`PRESET_THETA_O`], the quick tier's Cornell material at
-    /// [`QUICK_CORNELL_THETA_O`]).
+    /// preset fits at [`PRESET_THETA_O`]).
     few_angles: Vec<(String, &'static [f64])>,
-    /// Default specs whose data file is absent (the quick tier's shared Cornell material), with
-    /// the reason; reported as skipped cases.
-    absent: Vec<(String, String)>,
 }
 
 impl Resolved {
@@ -163,25 +158,9 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         }
     }
     let mut few_angles: Vec<(String, &'static [f64])> = Vec::new();
-    let mut absent: Vec<(String, String)> = Vec::new();
     let specs: Vec<String> = if config.brdfs.is_empty() {
         match tier {
-            Tier::Quick => {
-                let mut v: Vec<String> = QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect();
-                let path = QUICK_CORNELL.trim_start_matches("cornell:");
-                if Path::new(path).is_file() {
-                    v.push(QUICK_CORNELL.to_owned());
-                    few_angles.push((QUICK_CORNELL.to_owned(), QUICK_CORNELL_THETA_O));
-                } else {
-                    absent.push((
-                        QUICK_CORNELL.to_owned(),
-                        format!(
-                            "the shared Cornell file {path} is absent (the project's shared data set beside the repository; its data carry no licence statement, so it is not copied into the repository): the quick tier runs without it"
-                        ),
-                    ));
-                }
-                v
-            }
+            Tier::Quick => QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect(),
             Tier::Full => {
                 let mut v: Vec<String> = brdf::models()
                     .iter()
@@ -235,7 +214,6 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         deferred,
         sets,
         few_angles,
-        absent,
     })
 }
 
@@ -599,24 +577,6 @@ pub fn run(
         })
         .collect();
     let mut deferred: Vec<CaseResult> = Vec::new();
-    if !brdf_entries.is_empty() {
-        for (spec, reason) in &r.absent {
-            // The only absent default today is the Cornell material, run at a few angles.
-            for &theta in r
-                .angles
-                .iter()
-                .filter(|t| QUICK_CORNELL_THETA_O.contains(t))
-            {
-                deferred.push(CaseResult {
-                    sampler: "every BRDF sampler".to_owned(),
-                    target: spec.clone(),
-                    theta_o: Some(theta),
-                    domain: "—".to_owned(),
-                    outcomes: vec![skipped_outcome(reason.as_str())],
-                });
-            }
-        }
-    }
     for &(entry, reason) in &r.deferred {
         for (spec, _) in &r.brdfs {
             for &theta in &r.angles {
