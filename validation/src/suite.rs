@@ -61,19 +61,15 @@ struct Resolved {
     /// ([`QUICK_DEFERRED`]); reported as skipped cases.
     deferred: Vec<(&'static SamplerEntry, &'static str)>,
     sets: Vec<LoadedSet>,
-    /// Specs run at a few of the run's angles only, with those angles (the full tier's default
-    /// preset fits at [`PRESET_THETA_O`]).
-    few_angles: Vec<(String, &'static [f64])>,
+    /// Specs run at [`PRESET_THETA_O`] only (the full tier's default preset fits).
+    few_angles: Vec<String>,
 }
 
 impl Resolved {
-    /// Whether `spec` runs at `theta`: at every angle of the run, except the specs of
-    /// `few_angles`, which run at the run's angles that are in their list.
+    /// Whether `spec` runs at `theta` (every angle of the run, except for the full tier's
+    /// preset fits, which run at the run's angles that are in [`PRESET_THETA_O`]).
     fn runs(&self, spec: &str, theta: f64) -> bool {
-        self.few_angles
-            .iter()
-            .find(|(s, _)| s == spec)
-            .is_none_or(|(_, angles)| angles.contains(&theta))
+        !self.few_angles.iter().any(|s| s == spec) || PRESET_THETA_O.contains(&theta)
     }
 }
 
@@ -157,7 +153,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
             }
         }
     }
-    let mut few_angles: Vec<(String, &'static [f64])> = Vec::new();
+    let mut few_angles: Vec<String> = Vec::new();
     let specs: Vec<String> = if config.brdfs.is_empty() {
         match tier {
             Tier::Quick => QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect(),
@@ -177,7 +173,7 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
                         .iter()
                         .map(|n| format!("{model}:material={n}"))
                         .collect();
-                    few_angles.extend(specs.iter().map(|s| (s.clone(), PRESET_THETA_O)));
+                    few_angles.extend(specs.iter().cloned());
                     v.extend(specs);
                 }
                 v
