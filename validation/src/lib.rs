@@ -65,8 +65,8 @@ pub use error::ValidationError;
 pub use mutants::{Mutant, mutants};
 pub use plan::{
     DEFAULT_MEASURED_DIR, DEFAULT_MERL_DIR, FULL_PRESET_MODELS, FULL_SAMPLES, FULL_THETA_O,
-    MIN_SAMPLES, PRESET_THETA_O, Plan, QUICK_BRDFS, QUICK_RGL, QUICK_SAMPLES, QUICK_THETA_O, Tier,
-    ValidateConfig,
+    MIN_SAMPLES, PRESET_THETA_O, Plan, QUICK_BRDFS, QUICK_CORNELL, QUICK_RGL, QUICK_SAMPLES,
+    QUICK_THETA_O, Tier, ValidateConfig,
 };
 pub use report::{MutantRecord, TestRecord, ValidationReport};
 pub use subject::{

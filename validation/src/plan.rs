@@ -26,24 +26,35 @@ impl Tier {
     }
 }
 
-/// BRDF specs of the quick tier.
+/// BRDF specs of the quick tier: five analytic models and the RGL fixture ([`QUICK_RGL`]).
 pub const QUICK_BRDFS: &[&str] = &[
     "lambert",
     "phong:n=50",
     "ward",
     "ggx:alpha=0.2",
     "oren-nayar",
+    QUICK_RGL,
 ];
 
 /// The RGL fixture in the repository (`data/measured/rgl/paper_white_rgb.bsdf`, found from this
-/// crate's source directory). Not in [`QUICK_BRDFS`] yet: with it the quick tier fails for
-/// `adaptive`/`adaptive-paper` at 80° (support coverage, 1.6e-6 of the mass uncovered) and for
-/// `quadtree-disc` (bound audit); `rgl-native` passes on it
-/// (`brdf-lab validate --quick --sampler rgl-native --brdf rgl:data/measured/rgl/paper_white_rgb.bsdf`).
+/// crate's source directory; provenance in `data/measured/README.md`).
 pub const QUICK_RGL: &str = concat!(
     "rgl:",
     env!("CARGO_MANIFEST_DIR"),
     "/../data/measured/rgl/paper_white_rgb.bsdf"
+);
+
+/// The Cornell material meant for the quick tier: `acryl_blue.brdf` of the project's shared
+/// measured data (`../shared/data/measured/cornell/`, beside the repository; found from this
+/// crate's source directory; its data carry no licence statement, so no copy is in the
+/// repository). **Not in [`QUICK_BRDFS`] yet:** with it at 45° the tier failed 4 of its tests
+/// (`adaptive`, `adaptive-paper`, `adaptive-mixture`: normalisation `|∫ pdf − 1|` = 1.1–2.0·10⁻³
+/// against 10⁻³; `quadtree-disc`: 2 bound violations), every other test passed
+/// (`brdf-lab validate --quick --theta-o 45 --brdf cornell:../shared/data/measured/cornell/acryl_blue.brdf`).
+pub const QUICK_CORNELL: &str = concat!(
+    "cornell:",
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../shared/data/measured/cornell/acryl_blue.brdf"
 );
 
 /// Directory searched in the full tier for the shared measured materials (`rgl/*.bsdf`,

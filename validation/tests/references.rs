@@ -10,7 +10,9 @@ use validation::{QUICK_BRDFS, QUICK_THETA_O, mutants};
 fn stored_albedos_match_the_run_time_rule() {
     let table = stored_references().expect("the stored table parses");
     assert_eq!(table.rule, REFERENCE_RULE);
-    for spec in QUICK_BRDFS {
+    // Measured specs (the RGL fixture) are not stored: their references are computed at run
+    // time (the RGL fixture's took over 95 CPU-s for three angles, which this test would repeat).
+    for spec in QUICK_BRDFS.iter().filter(|s| !s.starts_with("rgl:")) {
         for &t in QUICK_THETA_O {
             assert!(
                 table

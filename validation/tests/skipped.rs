@@ -73,3 +73,41 @@ fn a_bad_option_is_a_failed_build_not_a_skip() {
         "{err}"
     );
 }
+
+#[test]
+fn quadtree_disc_skips_brdfs_unbounded_at_the_horizon() {
+    let config = ValidateConfig {
+        brdfs: vec!["ward-original".into(), "lambert".into()],
+        samplers: vec!["quadtree-disc".into()],
+        theta_o: vec![45.0],
+        samples: Some(20_000),
+        ..ValidateConfig::quick()
+    };
+    let report = run(&config, &|_| {}).expect("valid configuration");
+    let skipped: Vec<_> = report
+        .tests
+        .iter()
+        .filter(|t| t.test == names::SKIPPED)
+        .collect();
+    assert_eq!(skipped.len(), 1, "ward-original at 45°");
+    assert!(skipped[0].brdf == "ward-original" && skipped[0].passed);
+    assert!(
+        skipped[0].detail.contains("grows without bound"),
+        "{}",
+        skipped[0].detail
+    );
+    // lambert is bounded: it is really tested.
+    assert!(
+        report
+            .tests
+            .iter()
+            .any(|t| t.brdf == "lambert" && t.test == names::CHI_SQUARE)
+    );
+    for t in report.failures() {
+        eprintln!(
+            "FAILED {} {} {:?} {} {}",
+            t.sampler, t.brdf, t.theta_o, t.test, t.detail
+        );
+    }
+    assert!(report.passed());
+}

@@ -138,11 +138,17 @@ pub fn thread_evaluations() -> u64 {
 ///
 /// Either way its integral over the disc is the directional albedo `∫ f_r cos θi dσ`. Every
 /// call inside the disc increments the calling thread's [`thread_evaluations`] counter.
+///
+/// A **zero floor** `c ≥ 0` ([`DiscBrdf::with_zero_floor`], 0 by default) replaces the value
+/// wherever it is exactly 0 inside the disc: the density is then `g(x) = f(x)` where `f(x) ≠ 0`
+/// and `g(x) = c` where `f(x) = 0`, so a sampler proportional to `g` is positive on the whole
+/// open disc (see [`crate::SUPPORT_FLOOR`] for why the sets use it).
 #[derive(Clone)]
 pub struct DiscBrdf {
     brdf: Arc<dyn Brdf>,
     wo: Vec3,
     map: DiscMap,
+    zero_floor: f64,
 }
 
 impl std::fmt::Debug for DiscBrdf {
@@ -151,6 +157,7 @@ impl std::fmt::Debug for DiscBrdf {
             .field("brdf", &self.brdf.name())
             .field("wo", &self.wo)
             .field("map", &self.map)
+            .field("zero_floor", &self.zero_floor)
             .finish()
     }
 }
@@ -163,7 +170,28 @@ impl DiscBrdf {
 
     /// The density of `brdf` for `wo` under `map`.
     pub fn with_map(brdf: Arc<dyn Brdf>, wo: Vec3, map: DiscMap) -> Self {
-        Self { brdf, wo, map }
+        Self {
+            brdf,
+            wo,
+            map,
+            zero_floor: 0.0,
+        }
+    }
+
+    /// The same density with the value `floor` wherever it is exactly 0 inside the disc (see the
+    /// type's docs). A negative or non-finite `floor` is taken as 0.
+    pub fn with_zero_floor(mut self, floor: f64) -> Self {
+        self.zero_floor = if floor.is_finite() && floor > 0.0 {
+            floor
+        } else {
+            0.0
+        };
+        self
+    }
+
+    /// The zero floor `c` (0 when none).
+    pub fn zero_floor(&self) -> f64 {
+        self.zero_floor
     }
 
     /// The hemisphere-to-disc map.
@@ -190,7 +218,7 @@ impl Density for DiscBrdf {
             return 0.0;
         }
         EVALUATIONS.with(|c| c.set(c.get() + 1));
-        match self.map {
+        let v = match self.map {
             DiscMap::Projected => {
                 let wi = Vec3::new(p[0], p[1], (1.0 - r2).sqrt());
                 self.brdf.eval(&self.wo, &wi)
@@ -201,7 +229,8 @@ impl Density for DiscBrdf {
                 let wi = Vec3::new(p[0] * s, p[1] * s, z);
                 2.0 * z * self.brdf.eval(&self.wo, &wi)
             }
-        }
+        };
+        if v == 0.0 { self.zero_floor } else { v }
     }
 }
 

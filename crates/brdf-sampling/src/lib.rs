@@ -115,4 +115,4 @@ pub use reference::{
     reference_albedo_with_budget,
 };
 pub use report::{CostMeasurement, SetReport};
-pub use set::{Progress, QuadTreeSet, Variant, layout_for};
+pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, Variant, layout_for};

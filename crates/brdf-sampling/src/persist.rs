@@ -2,7 +2,7 @@
 //!
 //! Layout: `b"BRQS"`, [`SET_FORMAT_VERSION`] as little-endian `u32`, then the postcard encoding
 //! of the set: BRDF spec and name, 32 probe values of the BRDF, variant, options, layout, build
-//! evaluation count, each slice's [`DiscMap`] and normalisation factor, and every tree in partition-sampler's own versioned format
+//! evaluation count, each slice's [`DiscMap`], normalisation factor and zero floor, and every tree in partition-sampler's own versioned format
 //! ([`partition_sampler::FORMAT_VERSION`]). The BRDF itself is not stored: it is re-attached on
 //! load, which checks that the spec string matches and that the BRDF reproduces the probes
 //! (relative 1e-9).
@@ -22,7 +22,7 @@ use crate::options::SetOptions;
 use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for};
 
 /// Version of the stored set format; bumped on any incompatible change.
-pub const SET_FORMAT_VERSION: u32 = 4;
+pub const SET_FORMAT_VERSION: u32 = 5;
 
 const MAGIC: &[u8; 4] = b"BRQS";
 
@@ -40,6 +40,8 @@ struct Stored {
     grid_evaluations: u64,
     maps: Vec<DiscMap>,
     norms: Vec<SliceNorm>,
+    /// Zero floor of each slice's density ([`crate::SUPPORT_FLOOR`]).
+    floors: Vec<f64>,
     trees: Vec<Vec<u8>>,
 }
 
@@ -93,6 +95,11 @@ impl QuadTreeSet {
             grid_evaluations: self.grid_evaluations,
             maps: self.trees.iter().map(|t| t.density().map()).collect(),
             norms: self.norms.clone(),
+            floors: self
+                .trees
+                .iter()
+                .map(|t| t.density().disc_brdf().zero_floor())
+                .collect(),
             trees: self.trees.iter().map(|t| t.tree().to_bytes()).collect(),
         };
         let mut out = Vec::new();
@@ -153,6 +160,7 @@ impl QuadTreeSet {
             || s.layout.len() != s.trees.len()
             || s.maps.len() != s.trees.len()
             || s.norms.len() != s.trees.len()
+            || s.floors.len() != s.trees.len()
         {
             return Err(SetFileError::Corrupt(format!(
                 "layout {} × {} with {} trees and {} maps does not fit the options and the BRDF's isotropy",
@@ -182,7 +190,14 @@ impl QuadTreeSet {
             }
             let shape = *tree.shape();
             let map = s.maps.get(slice).copied().unwrap_or_default();
-            let f = DiscBrdf::with_map(Arc::clone(&brdf), s.layout.direction_of(slice), map);
+            let floor = s.floors[slice];
+            if !(floor.is_finite() && floor >= 0.0) {
+                return Err(SetFileError::Corrupt(format!(
+                    "slice {slice}: invalid zero floor"
+                )));
+            }
+            let f = DiscBrdf::with_map(Arc::clone(&brdf), s.layout.direction_of(slice), map)
+                .with_zero_floor(floor);
             let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
                 .map_err(|source| SetFileError::Attach { slice, source })?;
             trees.push(sampler);

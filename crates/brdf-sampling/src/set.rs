@@ -147,6 +147,43 @@ fn mirror_asymmetry(f: &DiscBrdf) -> Option<(f64, f64, f64, f64)> {
     })
 }
 
+/// Relative zero floor of every slice's density: a slice built at `ωo_j` samples
+/// `g = f_r(ωo_j, ·)` where that is non-zero and `SUPPORT_FLOOR · f̄_j` where it is exactly 0
+/// (`f̄_j`: the mean of the slice's disc density over [`FLOOR_PROBES`] fixed points; see
+/// [`DiscBrdf::with_zero_floor`]).
+///
+/// Why. A slice serves every `ωo` of its θ bin, and its pdf is `g / ∫ g`. Without the floor the
+/// pdf vanishes wherever `f_r(ωo_j, ·) = 0`, but the support of `f_r(ωo, ·)` can move with θo:
+/// the RGL fixture (`paper_white`) is exactly 0 at `θo = 80.5°` for `θi ≳ 88°` near
+/// `φi ≈ ±164°` (the tables' zero region beyond the measured range, reached by the warp
+/// interpolated between the file's slices at 78.5° and 90°) but positive there at
+/// `θo = 80°`, so the slice at 80.5° left `1.6·10⁻⁶` of the target mass at 80° uncovered
+/// (a biased estimator; found by the validation suite's support test). With the floor the
+/// pdf is positive on the whole open disc for every BRDF. It costs nothing where `f_r > 0`
+/// (there `g = f_r` exactly; only `∫ g` grows, by at most `SUPPORT_FLOOR` of `∫ f_r` times
+/// the zero region's share of the disc), and BRDFs positive everywhere are unchanged.
+pub const SUPPORT_FLOOR: f64 = 1e-3;
+
+/// Fixed points (a Fibonacci spiral over the disc) whose mean density scales the zero floor.
+pub const FLOOR_PROBES: usize = 256;
+
+/// The zero floor of `f` ([`SUPPORT_FLOOR`] × the mean of `f` over [`FLOOR_PROBES`] points of a
+/// Fibonacci spiral covering the disc, radii up to `√(1 − ½/FLOOR_PROBES)`). 0 when every
+/// probe is 0 (then the slice keeps its plain support).
+fn zero_floor(f: &Counted<'_>) -> f64 {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let n = FLOOR_PROBES as f64;
+    let sum: f64 = (0..FLOOR_PROBES)
+        .map(|i| {
+            let r = ((i as f64 + 0.5) / n).sqrt();
+            let t = i as f64 * golden;
+            let v = f.eval([r * t.cos(), r * t.sin()]);
+            if v.is_finite() { v.max(0.0) } else { 0.0 }
+        })
+        .sum();
+    SUPPORT_FLOOR * sum / n
+}
+
 /// A built slice: its tree, the BRDF evaluations spent and its normalisation.
 type BuiltSlice = (QuadTreeSampler<SliceDensity>, u64, SliceNorm);
 
@@ -166,6 +203,11 @@ fn build_slice(
         .map_for(brdf.as_ref(), theta_deg, options.equal_area_from_deg);
     let f = DiscBrdf::with_map(Arc::clone(brdf), layout.direction_of(index), disc_map);
     let counter = EvalCounter::new();
+    let floor = zero_floor(&Counted {
+        f: &f,
+        counter: &counter,
+    });
+    let f = f.with_zero_floor(floor);
     let mirror_y = options.symmetries && brdf.is_mirror_symmetric() && layout.phi == 1 && p == 0.0;
     if mirror_y && let Some((x, y, a, b)) = mirror_asymmetry(&f) {
         return Err(SetError::MirrorAsymmetry {

@@ -93,6 +93,16 @@ pub enum RegistryError {
     /// The factored baseline could not be built.
     #[error(transparent)]
     Factored(#[from] baselines::FactoredError),
+    /// The projected-disc sampler (`quadtree-disc`) was asked to sample a BRDF that grows
+    /// without bound at the horizon ([`brdf::Brdf::bounded_at_horizon`] `= false`): its disc
+    /// density `f_r(ωo, h⁻¹(x))` is unbounded near the rim, so no finite leaf bound holds there.
+    #[error(
+        "sampler `quadtree-disc` samples f_r on the projected disc with finite leaf bounds, but `{brdf}` grows without bound at the horizon (f_r ~ 1/cos θi), so the leaves at the rim cannot be bounded; use `adaptive` (equal-area slices) instead"
+    )]
+    UnboundedOnDisc {
+        /// The BRDF's name.
+        brdf: String,
+    },
     /// A format-specific sampler was asked to sample a BRDF of another kind.
     #[error(transparent)]
     NotRgl(#[from] baselines::NotRglError),
