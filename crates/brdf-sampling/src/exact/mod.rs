@@ -24,13 +24,16 @@
 //! **pdf** (w.r.t. solid angle): `p(ωi | ωo) = f_r(ωo, ωi) cos θi / A(θo, δ)`, with
 //! `A = ∫_Ω f_r(ωo, ·) cos θi dσ` (the disc integral of `g`), tabulated per interval at
 //! Chebyshev–Lobatto nodes ([`ExactOptions::normaliser_nodes`] × [`ExactOptions::phi_normaliser_nodes`]),
-//! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`),
-//! and interpolated ([`chebyshev`]). The reported normaliser error is the quadrature's estimate
+//! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`);
+//! the δ nodes are doubled (Lobatto-nested, up to 17) while the δ tail exceeds the same floor;
+//! `A · cos θo` is interpolated ([`chebyshev`]): it stays smooth up to grazing angles for models
+//! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The reported normaliser error is the quadrature's estimate
 //! plus the interpolation's (the Chebyshev tail).
 //!
 //! **Adaptive intervals.** An interval is halved while its tree would need more than
 //! [`ExactOptions::max_trials`] mean trials at one of its normaliser nodes (`Σ V_i / A`) or its
-//! interpolation tail exceeds [`ExactOptions::normaliser_tol`], down to
+//! θ interpolation tail exceeds [`ExactOptions::normaliser_tol`] (or the quadrature's own error
+//! estimate, if larger: below it the tail is quadrature noise), down to
 //! [`ExactOptions::min_width_deg`]: sharp lobes and grazing angles get narrow intervals, smooth
 //! models keep the initial ones. The layout is reported by [`ExactSet::report`].
 
@@ -202,7 +205,21 @@ struct Interval {
     worst_trials: f64,
     /// Quadrature + interpolation relative error estimate of `A`.
     norm_err: f64,
+    /// The quadrature's part of it.
+    quad_err: f64,
     evaluations: u64,
+}
+
+impl Interval {
+    /// `A(θo, δ)`: the table holds `A · cos θo` (smooth at grazing angles also for BRDFs with
+    /// a `1/cos θo` factor), θo clamped to the table's nodes.
+    #[inline]
+    fn normaliser(&self, q: &Query) -> f64 {
+        let t = &self.table.theta;
+        let theta = q.theta.clamp(t[t.len() - 1], t[0]);
+        let cos = if theta == q.theta { q.cos } else { theta.cos() };
+        self.table.eval(theta, q.delta) / cos
+    }
 }
 
 /// One azimuth cell: its centre and its intervals, ordered by θ.
@@ -315,6 +332,8 @@ struct Query {
     cell: usize,
     interval: usize,
     theta: f64,
+    /// `cos θo`.
+    cos: f64,
     delta: f64,
     rot: f64,
 }
@@ -367,7 +386,7 @@ impl ExactSet {
                 built += 1;
                 let width = job.theta[1] - job.theta[0];
                 let wants = iv.worst_trials > options.max_trials
-                    || iv.table.rel_tail_theta() > options.normaliser_tol;
+                    || iv.table.rel_tail_theta() > options.normaliser_tol.max(iv.quad_err);
                 if wants && 0.5 * width >= min_width {
                     let mid = 0.5 * (job.theta[0] + job.theta[1]);
                     next.push(Job {
@@ -439,7 +458,7 @@ impl ExactSet {
     /// (`None` below the horizon).
     pub fn normaliser(&self, wo: &Vec3) -> Option<f64> {
         let q = self.locate(wo)?;
-        Some(self.interval(&q).table.eval(q.theta, q.delta))
+        Some(self.interval(&q).normaliser(&q))
     }
 
     /// The θ edges (degrees) of every cell's intervals.
@@ -520,6 +539,7 @@ impl ExactSet {
             cell,
             interval,
             theta,
+            cos: wo.z.min(1.0),
             delta,
             rot,
         })
@@ -540,7 +560,7 @@ impl ExactSet {
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
         let s = match drawn {
             Some((x, gx)) => {
-                let a = iv.table.eval(q.theta, q.delta);
+                let a = iv.normaliser(&q);
                 let v = iv.map.to_direction(x);
                 DirSample {
                     wi: rotate_z(&v, q.rot),
@@ -703,7 +723,7 @@ fn build_interval(
                     });
                 }
                 quad_err = quad_err.max(r.rel_err);
-                values.push(r.total);
+                values.push(r.total * t.cos());
             }
         }
         let table = ChebyshevTable {
@@ -711,14 +731,22 @@ fn build_interval(
             delta: delta_nodes,
             values,
         };
-        if half == 0.0 || table.rel_tail_delta() <= options.normaliser_tol || 2 * nd - 1 > 32 {
+        // Interpolation below the quadrature's own error is noise: no refinement past it.
+        let floor = options.normaliser_tol.max(quad_err);
+        if half == 0.0 || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
             break (table, quad_err);
         }
         nd = 2 * nd - 1;
     };
     let quad_evals = crate::disc::thread_evaluations() - before;
     let volume = tree.volume();
-    let worst_trials = table.values.iter().map(|a| volume / a).fold(0.0, f64::max);
+    // The table holds A · cos θ.
+    let worst_trials = table
+        .values
+        .iter()
+        .enumerate()
+        .map(|(k, ac)| volume * table.theta[k / table.delta.len()].cos() / ac)
+        .fold(0.0, f64::max);
     let norm_err = quad_err + table.rel_tail();
     let tree = tree.clone();
     let shape = *tree.shape();
@@ -730,6 +758,7 @@ fn build_interval(
         table,
         worst_trials,
         norm_err,
+        quad_err,
         evaluations: build_evals + quad_evals,
     })
 }
@@ -757,7 +786,7 @@ impl DirectionSampler for ExactSet {
         let Some(q) = self.locate(wo) else {
             return 0.0;
         };
-        let a = self.interval(&q).table.eval(q.theta, q.delta);
+        let a = self.interval(&q).normaliser(&q);
         self.brdf.eval(wo, wi) * wi.z / a
     }
 
