@@ -30,9 +30,9 @@ pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
     args.set.check()?;
     let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
     let is_set = matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. });
-    if !(is_set || entry.is_direction() && entry.capabilities.needs_build)
-        || !is_set && args.out.is_some()
-    {
+    let buildable = is_set || entry.is_direction() && entry.capabilities.needs_build;
+    let saveable = is_set || args.out.is_none();
+    if !(buildable && saveable) {
         let sets: Vec<&str> = samplers::samplers()
             .iter()
             .filter(|e| matches!(e.constructor, samplers::Constructor::AdaptiveSet { .. }))

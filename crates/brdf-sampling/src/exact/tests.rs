@@ -11,8 +11,10 @@ fn small(spec: &str) -> (Arc<dyn Brdf>, ExactOptions) {
     let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
     // Anisotropic BRDFs: 8 × 8 cells (4 over [0, π) by half-turn symmetry) and a looser trial
     // cap keep the test's build small (the default anisotropic build takes ~30 s of CPU).
-    let mut set = SetOptions::default();
-    set.anisotropic_slices = [8, 8];
+    let set = SetOptions {
+        anisotropic_slices: [8, 8],
+        ..SetOptions::default()
+    };
     let mut opts = ExactOptions::with_set(set);
     if !brdf.is_isotropic() {
         opts.max_trials = 4.0;
