@@ -13,7 +13,7 @@
 //! | `pdf-on-neighbour-slice` | samples from slice `θ_j`, pdf evaluated with slice `θ_{j+1}` |
 //! | `support-hole` | cosine sampling truncated at 80°, renormalised: no samples near the horizon |
 //! | `exact-normaliser-1pct` | `adaptive-exact` with `A(θo)` 1 % too large (pdf × 1/1.01) |
-//! | `exact-envelope-too-low` | `adaptive-exact` with one θ interval per half, two bound nodes, safety 1 |
+//! | `exact-envelope-too-low` | `adaptive-exact` with three 30° θ intervals, two bound nodes, safety 1 |
 
 mod bases;
 mod direction;
@@ -322,9 +322,9 @@ pub static MUTANTS: &[Mutant] = &[
     },
     Mutant {
         name: "exact-normaliser-1pct",
-        description: "adaptive-exact whose tabulated normaliser A(theta_o) is 1 % too large (pdf x 1/1.01), at an angle between its Chebyshev nodes",
+        description: "adaptive-exact whose tabulated normaliser A(theta_o) is 1 % too large (pdf x 1/1.01)",
         brdf: "phong:n=50",
-        theta_o: 37.3,
+        theta_o: 45.0,
         build: |b, wo, r| {
             let control = exact_set(b, |_| {})?;
             let broken = Arc::new(ScaledPdf {
@@ -336,12 +336,12 @@ pub static MUTANTS: &[Mutant] = &[
     },
     Mutant {
         name: "exact-envelope-too-low",
-        description: "adaptive-exact whose bounds come from two theta intervals, two bound nodes each (the ends), safety factor 1 and no splitting: too low between the nodes",
+        description: "adaptive-exact whose bounds come from three theta intervals of 30 degrees, two bound nodes each (the ends), safety factor 1 and no splitting: too low midway between the nodes",
         brdf: "phong:n=50",
-        theta_o: 37.3,
+        theta_o: 45.0,
         build: |b, wo, r| {
             let broken = exact_set(b, |o| {
-                o.initial_intervals = 2;
+                o.initial_intervals = 3;
                 o.bound_nodes = 2;
                 o.max_trials = 1e9;
                 o.normaliser_tol = 1.0;
