@@ -59,6 +59,12 @@ pub trait DirectionSampler: Send + Sync {
         None
     }
 
+    /// A human-readable report of the built structure (layout, cost, audit), one item per
+    /// line, for samplers that have one beyond [`crate::SetReport`]; `None` by default.
+    fn build_report(&self) -> Option<String> {
+        None
+    }
+
     /// Bytes of the precomputed structures this sampler needs.
     fn bytes_used(&self) -> usize;
 }

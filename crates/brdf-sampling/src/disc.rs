@@ -132,6 +132,13 @@ pub fn thread_evaluations() -> u64 {
     EVALUATIONS.with(Cell::get)
 }
 
+/// Adds `n` to the calling thread's [`thread_evaluations`] (for densities evaluated outside
+/// [`DiscBrdf`], e.g. the exact sampler's query density).
+#[inline]
+pub(crate) fn count_evaluations(n: u64) {
+    EVALUATIONS.with(|c| c.set(c.get() + n));
+}
+
 /// The density of `f_r(ωo, ·) cos θi` on the unit disc for one fixed outgoing direction,
 /// under a [`DiscMap`]: `x ↦ f_r(ωo, h⁻¹(x))` (projected) or `x ↦ 2 f_r(ωo, h_e⁻¹(x)) cos θi`
 /// (equal-area); 0 outside the disc and on its boundary circle (the horizon).

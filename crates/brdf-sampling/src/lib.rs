@@ -90,6 +90,7 @@
 mod direction_sampler;
 pub mod disc;
 mod error;
+pub mod exact;
 mod image_map;
 mod layout;
 mod normalisation;
@@ -106,6 +107,7 @@ pub use disc::{
     solid_angle_pdf_to_area,
 };
 pub use error::{SetError, SetFileError};
+pub use exact::{ExactError, ExactOptions, ExactReport, ExactSet};
 pub use layout::{SliceChoice, SliceLayout};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};

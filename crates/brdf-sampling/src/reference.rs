@@ -105,7 +105,7 @@ pub fn reference_albedo_rgb(
     Ok([channel(0)?, channel(1)?, channel(2)?])
 }
 
-fn albedo_of(
+pub(crate) fn albedo_of(
     f: impl Fn(&Vec3, &Vec3) -> f64 + Sync,
     brdf: &dyn Brdf,
     wo: &Vec3,

@@ -13,7 +13,8 @@ pub(crate) struct BuildArgs {
     /// BRDF: `name` or `name:key=value,...` or `merl:PATH`.
     #[arg(long = "brdf")]
     spec: String,
-    /// `adaptive` (default) or `adaptive-paper`.
+    /// `adaptive` (default), `adaptive-paper`, … or another built direction sampler such as
+    /// `adaptive-exact` (reported, not saved).
     #[arg(long, default_value = "adaptive")]
     sampler: String,
     /// Save the set here (postcard with a format-version header; written atomically).
@@ -28,14 +29,17 @@ pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
-    if !matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. }) {
+    let is_set = matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. });
+    let buildable = is_set || entry.is_direction() && entry.capabilities.needs_build;
+    let saveable = is_set || args.out.is_none();
+    if !(buildable && saveable) {
         let sets: Vec<&str> = samplers::samplers()
             .iter()
             .filter(|e| matches!(e.constructor, samplers::Constructor::AdaptiveSet { .. }))
             .map(|e| e.name)
             .collect();
         return Err(CliError::input(format!(
-            "--sampler {}: `build` makes adaptive quadtree sets; use one of {}",
+            "--sampler {}: `build` makes (and `--out` saves) adaptive quadtree sets ({}); other built direction samplers are built and reported without --out",
             args.sampler,
             sets.join(", ")
         )));
@@ -44,6 +48,9 @@ pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
     let built = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set)?;
     println!("brdf       {}", args.spec);
     brdf_args::print_set_report(&built);
+    if let Some(report) = built.sampler().build_report() {
+        println!("{report}");
+    }
     if let (Some(path), Built::Set(set)) = (&args.out, &built) {
         let bytes = set.to_bytes();
         crate::output::write_atomically(path, |w| w.write_all(&bytes))?;

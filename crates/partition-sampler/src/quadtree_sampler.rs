@@ -11,6 +11,9 @@ use crate::leaf::{Frame, Leaf};
 use crate::rect::Domain;
 use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
 
+/// `sample_envelope_of`: rejection against another density under this tree's bounds.
+mod envelope_of;
+
 /// A sample is abandoned (returned with pdf 0 and counted as exhausted) after this many
 /// rejection trials. Only reachable when the bounds or integrals badly contradict `f`.
 pub const MAX_TRIALS_PER_SAMPLE: u64 = 1 << 20;

@@ -73,6 +73,22 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         },
     },
     SamplerEntry {
+        name: "adaptive-exact",
+        summary: "adaptive partition per θo interval (and φo cell) with bounds valid over the interval, acceptance against f at the query ωo: exactly ∝ f·cos at every angle, pdf f·cos/A(θo) with A tabulated (Chebyshev)",
+        capabilities: ADAPTIVE,
+        constructor: Constructor::Direction {
+            support: Support::Hemisphere,
+            build: |r| {
+                let set = brdf_sampling::ExactSet::build(
+                    Arc::clone(&r.brdf),
+                    &brdf_sampling::ExactOptions::with_set(*r.options),
+                    r.progress,
+                )?;
+                Ok(BuiltDirection::plain(Arc::new(set)))
+            },
+        },
+    },
+    SamplerEntry {
         name: "uniform",
         summary: "uniform directions on the hemisphere, p = 1/(2π)",
         capabilities: BLIND,

@@ -65,6 +65,9 @@ pub enum RegistryError {
     /// Building an adaptive quadtree set failed.
     #[error(transparent)]
     Set(#[from] brdf_sampling::SetError),
+    /// Building the exact interval-bounded set failed.
+    #[error(transparent)]
+    Exact(#[from] brdf_sampling::ExactError),
     /// A set file could not be read back.
     #[error(transparent)]
     SetFile(#[from] brdf_sampling::SetFileError),

@@ -14,7 +14,7 @@ pub const PAPER_N_GRID: [usize; 8] = [1, 25, 100, 225, 400, 900, 1600, 2500];
 /// registered direction sampler of this list that exists** in the registry, so baselines
 /// registered later join the presets without a code change, and names not (yet) registered
 /// are skipped.
-pub const PREFERRED_SAMPLERS: [&str; 14] = [
+pub const PREFERRED_SAMPLERS: [&str; 15] = [
     "uniform",
     "cosine",
     "lobe-sphere",
@@ -27,6 +27,7 @@ pub const PREFERRED_SAMPLERS: [&str; 14] = [
     "rgl-native",
     "adaptive",
     "adaptive-mixture",
+    "adaptive-exact",
     "adaptive-paper",
     "adaptive-paper-mixture",
 ];

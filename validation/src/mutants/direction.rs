@@ -108,3 +108,35 @@ impl DirectionSampler for RegionScaledPdf {
         0
     }
 }
+
+/// Any direction sampler whose reported pdf (from `sample` and `pdf` alike) is multiplied by
+/// `factor`: a normaliser off by `1/factor − 1` (e.g. `adaptive-exact` with `A(θo)` 1 % too
+/// large). Self-consistent; its pdf integrates to `factor`.
+pub struct ScaledPdf {
+    /// The honest sampler.
+    pub inner: std::sync::Arc<dyn DirectionSampler>,
+    /// The factor.
+    pub factor: f64,
+}
+
+impl DirectionSampler for ScaledPdf {
+    fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
+        let s = self.inner.sample(wo, u);
+        DirSample {
+            pdf: s.pdf * self.factor,
+            ..s
+        }
+    }
+
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        self.inner.pdf(wo, wi) * self.factor
+    }
+
+    fn bound_violations(&self) -> Option<u64> {
+        self.inner.bound_violations()
+    }
+
+    fn bytes_used(&self) -> usize {
+        self.inner.bytes_used()
+    }
+}

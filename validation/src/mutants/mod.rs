@@ -15,6 +15,8 @@
 //! | `tabulated-cdf-row-pdf-off` | `tabulated-cdf`'s pdf 2 × on its heaviest `cos θ` row, renormalised |
 //! | `cascade-cdf-row-pdf-off` | the same for `cascade-cdf` |
 //! | `factored-band-pdf-off` | the same for `factored`, on its heaviest half-vector `θh` band |
+//! | `exact-normaliser-1pct` | `adaptive-exact` with `A(θo)` 1 % too large (pdf × 1/1.01) |
+//! | `exact-envelope-too-low` | `adaptive-exact` with three 30° θ intervals, two bound nodes, safety 1 |
 
 mod bases;
 mod cells;
@@ -29,7 +31,7 @@ use partition_sampler::QuadTreeBuilder;
 
 pub use bases::{CosineHemisphere, LobeMixture, cosine_direction, cosine_pdf};
 pub use cells::RowScaledPdf;
-pub use direction::{CosineReportedUniform, RegionScaledPdf, TruncatedCosine};
+pub use direction::{CosineReportedUniform, RegionScaledPdf, ScaledPdf, TruncatedCosine};
 pub use planar::{FloorSplit, Remainder, ScaledBounds};
 
 use crate::adapters::{DirectionAtWo, QuadTreePlanar};
@@ -178,6 +180,41 @@ fn floor_split(
         )),
         control: control_disc(brdf, wo, refs)?,
     })
+}
+
+/// `adaptive-exact` with default options, or with `broken` applied to them.
+fn exact_set(
+    brdf: &Arc<dyn Brdf>,
+    broken: impl FnOnce(&mut brdf_sampling::ExactOptions),
+) -> Result<Arc<dyn DirectionSampler>, String> {
+    let mut opts = brdf_sampling::ExactOptions::default();
+    broken(&mut opts);
+    brdf_sampling::ExactSet::build(Arc::clone(brdf), &opts, None)
+        .map(|s| Arc::new(s) as Arc<dyn DirectionSampler>)
+        .map_err(|e| e.to_string())
+}
+
+/// A mutant/control pair of direction samplers on the hemisphere.
+fn hemisphere_pair(
+    mutant: Arc<dyn DirectionSampler>,
+    control: Arc<dyn DirectionSampler>,
+    brdf: &Arc<dyn Brdf>,
+    wo: &Vec3,
+    refs: &BrdfReferences,
+) -> MutantCase {
+    let wrap = |s: Arc<dyn DirectionSampler>| {
+        AnySubject::Direction(brdf_direction_subject(
+            Arc::new(DirectionAtWo::new(s, *wo)),
+            Domain::Hemisphere,
+            Arc::clone(brdf),
+            *wo,
+            refs,
+        ))
+    };
+    MutantCase {
+        mutant: wrap(mutant),
+        control: wrap(control),
+    }
 }
 
 /// Every mutant.
@@ -336,6 +373,36 @@ pub static MUTANTS: &[Mutant] = &[
         brdf: "ggx:alpha=0.2",
         theta_o: 45.0,
         build: |b, wo, r| row_scaled_pair("factored", b, wo, r),
+    },
+    Mutant {
+        name: "exact-normaliser-1pct",
+        description: "adaptive-exact whose tabulated normaliser A(theta_o) is 1 % too large (pdf x 1/1.01)",
+        brdf: "phong:n=50",
+        theta_o: 45.0,
+        build: |b, wo, r| {
+            let control = exact_set(b, |_| {})?;
+            let broken = Arc::new(ScaledPdf {
+                inner: Arc::clone(&control),
+                factor: 1.0 / 1.01,
+            });
+            Ok(hemisphere_pair(broken, control, b, wo, r))
+        },
+    },
+    Mutant {
+        name: "exact-envelope-too-low",
+        description: "adaptive-exact whose bounds come from three theta intervals of 30 degrees, two bound nodes each (the ends), safety factor 1 and no splitting: too low midway between the nodes",
+        brdf: "phong:n=50",
+        theta_o: 45.0,
+        build: |b, wo, r| {
+            let broken = exact_set(b, |o| {
+                o.initial_intervals = 3;
+                o.bound_nodes = 2;
+                o.max_trials = 1e9;
+                o.normaliser_tol = 1.0;
+                o.set.safety_factor = 1.0;
+            })?;
+            Ok(hemisphere_pair(broken, exact_set(b, |_| {})?, b, wo, r))
+        },
     },
 ];
 

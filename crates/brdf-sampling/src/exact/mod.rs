@@ -1,0 +1,836 @@
+//! `adaptive-exact`: samples exactly ∝ `f_r(ωo, ·) cos θi` at **every** outgoing direction,
+//! with interval-bounded trees (issue 14).
+//!
+//! # Math
+//! The outgoing angles are partitioned into θ intervals `[θ_a, θ_b]` (and, for anisotropic
+//! BRDFs, the azimuth cells of [`SetOptions::anisotropic_slices`] with centres `φ_k` and
+//! half-width `h`; half-turn-symmetric BRDFs store `[0, π)`). Each interval holds one quadtree
+//! on the unit disc of its [`DiscMap`] (equal-area when `θ_b` reaches
+//! [`SetOptions::equal_area_from_deg`] or the BRDF is unbounded at the horizon), built with the
+//! set's image map, rim band, safety factor and tree parameters from the **envelope**
+//! `F(x) = max_n g_n(x)` of the query densities at the interval's bound nodes (a uniform grid
+//! of [`ExactOptions::bound_nodes`] θ values × [`ExactOptions::phi_bound_nodes`] δ values).
+//! The leaf bounds `M_i` thus hold for every outgoing direction of the interval (between the
+//! nodes, the safety factor covers the envelope's dips; every trial above its bound is counted
+//! by the audit, [`crate::DirectionSampler::bound_violations`]).
+//!
+//! For a query `ωo = (θo, φo)`: the cell `k` with the nearest `φ_k`, the rotation
+//! `r = φo − φ_k` (`δ = r` reduced to `[−h, h]`; 0 cells and `r = φo` for isotropic BRDFs),
+//! the interval containing `θo`, and the query density `g(x) = f_r(ωo, R_r h⁻¹(x))`
+//! (projected) or `2 f_r(ωo, R_r h_e⁻¹(x)) cos θi` (equal-area). A leaf is chosen ∝
+//! `V_i = area_i · M_i`, a point `x` uniformly in it and accepted when `z · M_i < g(x)`; the
+//! accepted `x` has density `g / ∫ g` exactly, and `ωi = R_r h⁻¹(x)`.
+//!
+//! **pdf** (w.r.t. solid angle): `p(ωi | ωo) = f_r(ωo, ωi) cos θi / A(θo, δ)`, with
+//! `A = ∫_Ω f_r(ωo, ·) cos θi dσ` (the disc integral of `g`), tabulated per interval at
+//! Chebyshev–Lobatto nodes ([`ExactOptions::normaliser_nodes`] × [`ExactOptions::phi_normaliser_nodes`]),
+//! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`);
+//! the δ nodes are doubled (Lobatto-nested, up to 17) while the δ tail exceeds the same floor;
+//! `A · cos θo` is interpolated ([`chebyshev`]): it stays smooth up to grazing angles for models
+//! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The reported normaliser error is the quadrature's estimate
+//! plus the interpolation's (the Chebyshev tail).
+//!
+//! **Adaptive intervals.** An interval is halved while its tree would need more than
+//! [`ExactOptions::max_trials`] mean trials at one of its normaliser nodes (`Σ V_i / A`) or its
+//! θ interpolation tail exceeds [`ExactOptions::normaliser_tol`] (or the quadrature's own error
+//! estimate, if larger: below it the tail is quadrature noise), down to
+//! [`ExactOptions::min_width_deg`]: sharp lobes and grazing angles get narrow intervals, smooth
+//! models keep the initial ones. The layout is reported by [`ExactSet::report`].
+
+mod chebyshev;
+mod density;
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use brdf::{Brdf, Vec3, direction_from_radians, rotate_z};
+use partition_sampler::{
+    Audit, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sampler2D, Scheme,
+    TreeParams, UniformSource,
+};
+use rayon::prelude::*;
+
+use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
+use crate::error::SetError;
+use crate::image_map::{Counted, EvalCounter, SliceImageMap};
+use crate::normalisation::per_leaf_quadrature;
+use crate::options::{OptionsError, SetOptions};
+use crate::set::layout_for;
+
+use chebyshev::{ChebyshevTable, lobatto_nodes};
+use density::{IntervalEnvelope, QueryDensity};
+
+/// The largest outgoing polar angle the nodes use (degrees): `f_r` at exactly 90° is 0 or
+/// undefined. Queries above it are served by the last interval with `A` clamped to this angle.
+pub const THETA_TOP_DEG: f64 = 89.99;
+
+/// Settings of [`ExactSet`]. `set` supplies the tree parameters, image map, safety factor,
+/// disc-map policy, symmetries and the anisotropic azimuth cells (its θ slice count is unused).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactOptions {
+    /// The quadtree settings shared with the other adaptive sets.
+    pub set: SetOptions,
+    /// θ intervals before splitting (equal widths over `[0°, 90°]`).
+    pub initial_intervals: usize,
+    /// θ nodes of the bound envelope per interval (uniform, ends included; ≥ 2).
+    pub bound_nodes: usize,
+    /// δ nodes of the bound envelope per azimuth cell (anisotropic BRDFs; ≥ 2).
+    pub phi_bound_nodes: usize,
+    /// Chebyshev–Lobatto θ nodes of the normaliser table (3 ..= 32).
+    pub normaliser_nodes: usize,
+    /// Chebyshev–Lobatto δ nodes of the normaliser table (anisotropic BRDFs; 3 ..= 32).
+    pub phi_normaliser_nodes: usize,
+    /// Split an interval whose mean trials `Σ V_i / A` exceed this at a normaliser node (> 1).
+    pub max_trials: f64,
+    /// Split an interval whose relative interpolation tail exceeds this (> 0).
+    pub normaliser_tol: f64,
+    /// Narrowest interval (degrees, > 0).
+    pub min_width_deg: f64,
+}
+
+impl ExactOptions {
+    /// Default initial interval count.
+    pub const DEFAULT_INITIAL_INTERVALS: usize = 6;
+    /// Default θ bound nodes.
+    pub const DEFAULT_BOUND_NODES: usize = 5;
+    /// Default δ bound nodes.
+    pub const DEFAULT_PHI_BOUND_NODES: usize = 3;
+    /// Default θ normaliser nodes.
+    pub const DEFAULT_NORMALISER_NODES: usize = 9;
+    /// Default δ normaliser nodes.
+    pub const DEFAULT_PHI_NORMALISER_NODES: usize = 5;
+    /// Default trial cap.
+    pub const DEFAULT_MAX_TRIALS: f64 = 2.0;
+    /// Default interpolation tolerance.
+    pub const DEFAULT_NORMALISER_TOL: f64 = 1e-6;
+    /// Default narrowest interval (degrees).
+    pub const DEFAULT_MIN_WIDTH_DEG: f64 = 0.25;
+
+    /// The defaults around `set`.
+    pub fn with_set(set: SetOptions) -> Self {
+        Self {
+            set,
+            initial_intervals: Self::DEFAULT_INITIAL_INTERVALS,
+            bound_nodes: Self::DEFAULT_BOUND_NODES,
+            phi_bound_nodes: Self::DEFAULT_PHI_BOUND_NODES,
+            normaliser_nodes: Self::DEFAULT_NORMALISER_NODES,
+            phi_normaliser_nodes: Self::DEFAULT_PHI_NORMALISER_NODES,
+            max_trials: Self::DEFAULT_MAX_TRIALS,
+            normaliser_tol: Self::DEFAULT_NORMALISER_TOL,
+            min_width_deg: Self::DEFAULT_MIN_WIDTH_DEG,
+        }
+    }
+
+    /// Checks every field (and `set`).
+    pub fn validate(&self) -> Result<(), ExactError> {
+        self.set.validate()?;
+        let bad = |what: &'static str, value: f64| Err(ExactError::Invalid { what, value });
+        if !(1..=90).contains(&self.initial_intervals) {
+            return bad(
+                "initial_intervals (1 ..= 90)",
+                self.initial_intervals as f64,
+            );
+        }
+        if !(2..=64).contains(&self.bound_nodes) {
+            return bad("bound_nodes (2 ..= 64)", self.bound_nodes as f64);
+        }
+        if !(2..=64).contains(&self.phi_bound_nodes) {
+            return bad("phi_bound_nodes (2 ..= 64)", self.phi_bound_nodes as f64);
+        }
+        if !(3..=32).contains(&self.normaliser_nodes) {
+            return bad("normaliser_nodes (3 ..= 32)", self.normaliser_nodes as f64);
+        }
+        if !(3..=32).contains(&self.phi_normaliser_nodes) {
+            return bad(
+                "phi_normaliser_nodes (3 ..= 32)",
+                self.phi_normaliser_nodes as f64,
+            );
+        }
+        if !(self.max_trials > 1.0 && self.max_trials.is_finite()) {
+            return bad("max_trials (> 1)", self.max_trials);
+        }
+        if !(self.normaliser_tol > 0.0 && self.normaliser_tol.is_finite()) {
+            return bad("normaliser_tol (> 0)", self.normaliser_tol);
+        }
+        if !(self.min_width_deg > 0.0 && self.min_width_deg <= 90.0) {
+            return bad("min_width_deg (0, 90]", self.min_width_deg);
+        }
+        Ok(())
+    }
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        Self::with_set(SetOptions::default())
+    }
+}
+
+/// Why an [`ExactSet`] could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ExactError {
+    /// Invalid quadtree settings.
+    #[error(transparent)]
+    Options(#[from] OptionsError),
+    /// An exact-sampler setting out of range.
+    #[error("adaptive-exact: {what} = {value} is out of range")]
+    Invalid {
+        /// The setting and its range.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// An interval's image map or tree failed (the slice number is the interval's).
+    #[error(transparent)]
+    Set(#[from] SetError),
+    /// An interval's normaliser is not positive and finite (the BRDF is zero or not finite
+    /// there).
+    #[error("adaptive-exact: ∫ f cos = {value} at θo = {theta_deg:.3}°, φo = {phi_deg:.3}°")]
+    Normaliser {
+        /// The integral found.
+        value: f64,
+        /// Where.
+        theta_deg: f64,
+        /// Where.
+        phi_deg: f64,
+    },
+}
+
+/// One built interval.
+struct Interval {
+    tree: QuadTreeSampler<SliceDensity>,
+    map: DiscMap,
+    table: ChebyshevTable,
+    /// Largest `Σ V_i / A` over the normaliser nodes.
+    worst_trials: f64,
+    /// Quadrature + interpolation relative error estimate of `A`.
+    norm_err: f64,
+    /// The quadrature's part of it.
+    quad_err: f64,
+    evaluations: u64,
+}
+
+impl Interval {
+    /// `A(θo, δ)`: the table holds `A · cos θo` (smooth at grazing angles also for BRDFs with
+    /// a `1/cos θo` factor), θo clamped to the table's nodes.
+    #[inline]
+    fn normaliser(&self, q: &Query) -> f64 {
+        let t = &self.table.theta;
+        let theta = q.theta.clamp(t[t.len() - 1], t[0]);
+        let cos = if theta == q.theta { q.cos } else { theta.cos() };
+        self.table.eval(theta, q.delta) / cos
+    }
+}
+
+/// One azimuth cell: its centre and its intervals, ordered by θ.
+struct Cell {
+    phi: f64,
+    /// Upper θ edges of the intervals (radians), increasing; the last is π/2.
+    upper: Vec<f64>,
+    intervals: Vec<Interval>,
+}
+
+/// The layout and statistics of an [`ExactSet`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactReport {
+    /// BRDF name.
+    pub brdf: String,
+    /// Azimuth cells (1 for isotropic BRDFs).
+    pub cells: usize,
+    /// Per cell: its centre φ (degrees) and the interval edges in θ (degrees, from 0 to 90).
+    pub layout: Vec<(f64, Vec<f64>)>,
+    /// Trees (= intervals over all cells).
+    pub trees: usize,
+    /// Trees on the equal-area disc.
+    pub equal_area_trees: usize,
+    /// Sampleable leaves over all trees.
+    pub leaves: usize,
+    /// Mean over trees of the worst `Σ V_i / A` at their normaliser nodes.
+    pub mean_worst_trials: f64,
+    /// Largest `Σ V_i / A` at any normaliser node.
+    pub worst_trials: f64,
+    /// Largest estimated relative error of the tabulated normaliser `A`.
+    pub max_normaliser_rel_err: f64,
+    /// Bound violations counted so far by sampling.
+    pub bound_violations: u64,
+    /// Samples drawn so far (flushed counts).
+    pub samples: u64,
+    /// Trials so far (flushed counts).
+    pub trials: u64,
+    /// BRDF evaluations of the build (envelopes count one per node).
+    pub build_evaluations: u64,
+    /// Wall-clock build time.
+    pub build_time: Duration,
+    /// Bytes of the set.
+    pub memory_bytes: usize,
+}
+
+impl std::fmt::Display for ExactReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "intervals  {} in {} azimuth cell(s) ({} equal-area)",
+            self.trees, self.cells, self.equal_area_trees
+        )?;
+        for (phi, edges) in &self.layout {
+            let e: Vec<String> = edges.iter().map(|t| format!("{t:.2}")).collect();
+            writeln!(f, "  φ {phi:7.2}°  θ edges [{}]", e.join(", "))?;
+        }
+        writeln!(f, "leaves     {}", self.leaves)?;
+        writeln!(
+            f,
+            "trials     mean worst ΣV/A {:.3}, largest {:.3}",
+            self.mean_worst_trials, self.worst_trials
+        )?;
+        writeln!(
+            f,
+            "A error    {:.2e} (relative, estimated)",
+            self.max_normaliser_rel_err
+        )?;
+        writeln!(
+            f,
+            "audit      {} violations in {} trials, {} samples",
+            self.bound_violations, self.trials, self.samples
+        )?;
+        writeln!(f, "evals      {} (build)", self.build_evaluations)?;
+        writeln!(f, "build      {:.3} s", self.build_time.as_secs_f64())?;
+        write!(f, "memory     {:.1} KiB", self.memory_bytes as f64 / 1024.0)
+    }
+}
+
+/// The exact sampler (see the module docs).
+pub struct ExactSet {
+    brdf: Arc<dyn Brdf>,
+    options: ExactOptions,
+    isotropic: bool,
+    /// Azimuth period of the cells (2π, or π for half-turn-symmetric BRDFs).
+    period: f64,
+    cells: Vec<Cell>,
+    build_time: Duration,
+}
+
+impl std::fmt::Debug for ExactSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ExactSet")
+            .field("brdf", &self.brdf.name())
+            .field("options", &self.options)
+            .field("trees", &self.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// A request to build one interval.
+#[derive(Debug, Clone, Copy)]
+struct Job {
+    cell: usize,
+    theta: [f64; 2],
+}
+
+/// Where a query lands.
+#[derive(Debug, Clone, Copy)]
+struct Query {
+    cell: usize,
+    interval: usize,
+    theta: f64,
+    /// `cos θo`.
+    cos: f64,
+    delta: f64,
+    rot: f64,
+}
+
+impl ExactSet {
+    /// Builds the set of `brdf` (intervals in parallel with rayon; the result does not depend
+    /// on the thread count). `progress` is called with `(intervals built, intervals queued)`.
+    pub fn build(
+        brdf: Arc<dyn Brdf>,
+        options: &ExactOptions,
+        progress: Option<crate::Progress<'_>>,
+    ) -> Result<Self, ExactError> {
+        options.validate()?;
+        let start = Instant::now();
+        let layout = layout_for(brdf.as_ref(), &options.set);
+        let isotropic = brdf.is_isotropic();
+        let period = layout.phi_period();
+        let n_cells = layout.phi;
+        let half = if isotropic {
+            0.0
+        } else {
+            0.5 * period / n_cells as f64
+        };
+        let min_width = options.min_width_deg.to_radians();
+        let n0 = options.initial_intervals;
+        let mut jobs: Vec<Job> = (0..n_cells)
+            .flat_map(|cell| {
+                (0..n0).map(move |i| Job {
+                    cell,
+                    theta: [
+                        std::f64::consts::FRAC_PI_2 * i as f64 / n0 as f64,
+                        std::f64::consts::FRAC_PI_2 * (i + 1) as f64 / n0 as f64,
+                    ],
+                })
+            })
+            .collect();
+        let mut done: Vec<(Job, Interval)> = Vec::new();
+        let (mut built, mut queued) = (0usize, jobs.len());
+        while !jobs.is_empty() {
+            let results: Vec<Result<(Job, Interval), ExactError>> = jobs
+                .par_iter()
+                .map(|job| {
+                    build_interval(&brdf, options, *job, layout.phi_of(job.cell), half)
+                        .map(|iv| (*job, iv))
+                })
+                .collect();
+            let mut next = Vec::new();
+            for r in results {
+                let (job, iv) = r?;
+                built += 1;
+                let width = job.theta[1] - job.theta[0];
+                let wants = iv.worst_trials > options.max_trials
+                    || iv.table.rel_tail_theta() > options.normaliser_tol.max(iv.quad_err);
+                if wants && 0.5 * width >= min_width {
+                    let mid = 0.5 * (job.theta[0] + job.theta[1]);
+                    next.push(Job {
+                        cell: job.cell,
+                        theta: [job.theta[0], mid],
+                    });
+                    next.push(Job {
+                        cell: job.cell,
+                        theta: [mid, job.theta[1]],
+                    });
+                    queued += 2;
+                } else {
+                    done.push((job, iv));
+                }
+                if let Some(p) = progress {
+                    p(built, queued);
+                }
+            }
+            jobs = next;
+        }
+        done.sort_by(|a, b| {
+            (a.0.cell, a.0.theta[0])
+                .partial_cmp(&(b.0.cell, b.0.theta[0]))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let mut cells: Vec<Cell> = (0..n_cells)
+            .map(|k| Cell {
+                phi: layout.phi_of(k),
+                upper: Vec::new(),
+                intervals: Vec::new(),
+            })
+            .collect();
+        for (job, iv) in done {
+            let c = &mut cells[job.cell];
+            c.upper.push(job.theta[1]);
+            c.intervals.push(iv);
+        }
+        Ok(Self {
+            brdf,
+            options: *options,
+            isotropic,
+            period,
+            cells,
+            build_time: start.elapsed(),
+        })
+    }
+
+    /// Number of trees (intervals over all cells).
+    pub fn len(&self) -> usize {
+        self.cells.iter().map(|c| c.intervals.len()).sum()
+    }
+
+    /// `true` when the set has no trees (never for a built set).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The BRDF.
+    pub fn brdf(&self) -> &Arc<dyn Brdf> {
+        &self.brdf
+    }
+
+    /// The options the set was built with.
+    pub fn options(&self) -> &ExactOptions {
+        &self.options
+    }
+
+    /// The tabulated normaliser `A(θo, δ) = ∫ f_r(ωo, ·) cos θi dσ` used by the pdf at `wo`
+    /// (`None` below the horizon).
+    pub fn normaliser(&self, wo: &Vec3) -> Option<f64> {
+        let q = self.locate(wo)?;
+        Some(self.interval(&q).normaliser(&q))
+    }
+
+    /// The θ edges (degrees) of every cell's intervals.
+    pub fn layout(&self) -> Vec<(f64, Vec<f64>)> {
+        self.cells
+            .iter()
+            .map(|c| {
+                let mut e = vec![0.0];
+                e.extend(c.upper.iter().map(|t| t.to_degrees()));
+                (c.phi.to_degrees(), e)
+            })
+            .collect()
+    }
+
+    /// Layout, cost and audit figures.
+    pub fn report(&self) -> ExactReport {
+        let all = || self.cells.iter().flat_map(|c| c.intervals.iter());
+        let (mut violations, mut samples, mut trials) = (0, 0, 0u64);
+        for iv in all() {
+            let s = iv.tree.stats();
+            violations += s.bound_violations;
+            samples += s.samples;
+            trials += s
+                .measured_mean_trials
+                .map_or(0, |m| (m * s.samples as f64).round() as u64);
+        }
+        let n = self.len().max(1) as f64;
+        ExactReport {
+            brdf: self.brdf.name().to_string(),
+            cells: self.cells.len(),
+            layout: self.layout(),
+            trees: self.len(),
+            equal_area_trees: all().filter(|iv| iv.map == DiscMap::EqualArea).count(),
+            leaves: all().map(|iv| iv.tree.tree().counts().active_leaves).sum(),
+            mean_worst_trials: all().map(|iv| iv.worst_trials).sum::<f64>() / n,
+            worst_trials: all().map(|iv| iv.worst_trials).fold(0.0, f64::max),
+            max_normaliser_rel_err: all().map(|iv| iv.norm_err).fold(0.0, f64::max),
+            bound_violations: violations,
+            samples,
+            trials,
+            build_evaluations: all().map(|iv| iv.evaluations).sum(),
+            build_time: self.build_time,
+            memory_bytes: self.bytes_used(),
+        }
+    }
+
+    fn interval(&self, q: &Query) -> &Interval {
+        &self.cells[q.cell].intervals[q.interval]
+    }
+
+    /// Cell, interval, θo, δ and rotation of `wo`; `None` at or below the horizon.
+    #[inline]
+    fn locate(&self, wo: &Vec3) -> Option<Query> {
+        if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
+            return None;
+        }
+        let theta = wo.z.min(1.0).acos();
+        let phi = wo.y.atan2(wo.x);
+        let (cell, rot, delta) = if self.isotropic {
+            (0, phi, 0.0)
+        } else {
+            let n = self.cells.len();
+            let step = self.period / n as f64;
+            let k = ((phi.rem_euclid(self.period) / step).round() as usize) % n;
+            let rot = phi - self.cells[k].phi;
+            let mut delta = rot.rem_euclid(self.period);
+            if delta > 0.5 * self.period {
+                delta -= self.period;
+            }
+            (k, rot, delta)
+        };
+        let c = &self.cells[cell];
+        let interval = c
+            .upper
+            .partition_point(|&u| u < theta)
+            .min(c.intervals.len() - 1);
+        Some(Query {
+            cell,
+            interval,
+            theta,
+            cos: wo.z.min(1.0),
+            delta,
+            rot,
+        })
+    }
+
+    /// One direction; `audit` receives the trials. Also returns the interval's tree (to record
+    /// the audit in).
+    #[inline]
+    fn draw(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> Option<(DirSample, &QuadTreeSampler<SliceDensity>)> {
+        let q = self.locate(wo)?;
+        let iv = self.interval(&q);
+        let g = QueryDensity::new(self.brdf.as_ref(), *wo, q.rot, iv.map);
+        let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
+        let s = match drawn {
+            Some((x, gx)) => {
+                let a = iv.normaliser(&q);
+                let v = iv.map.to_direction(x);
+                DirSample {
+                    wi: rotate_z(&v, q.rot),
+                    pdf: iv.map.area_to_solid_angle(gx / a, &v),
+                }
+            }
+            None => DirSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 0.0,
+            },
+        };
+        Some((s, &iv.tree))
+    }
+
+    /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
+    /// uniform in the interval, φ uniform in the cell) on the calling thread, and counts trials,
+    /// BRDF evaluations, violations and exhausted samples (also added to the trees' counts).
+    pub fn measure_cost(&self, per_interval: usize, seed: u64) -> crate::CostMeasurement {
+        use rand::SeedableRng;
+        let before = crate::disc::thread_evaluations();
+        let mut total = Audit::default();
+        let mut index = 0u64;
+        let step = self.period / self.cells.len() as f64;
+        for c in &self.cells {
+            let mut lo = 0.0;
+            for (iv, &hi) in c.intervals.iter().zip(&c.upper) {
+                let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(
+                    partition_sampler::chunk_seed(seed, index),
+                );
+                index += 1;
+                let mut a = Audit::default();
+                for _ in 0..per_interval {
+                    let theta = lo + rng.next_uniform() * (hi - lo);
+                    let phi = if self.isotropic {
+                        0.0
+                    } else {
+                        c.phi + (rng.next_uniform() - 0.5) * step
+                    };
+                    let wo = direction_from_radians(theta, phi);
+                    let _ = self.draw(&wo, &mut rng, &mut a);
+                }
+                iv.tree.record_audit(&a);
+                total.merge(&a);
+                lo = hi;
+            }
+        }
+        crate::CostMeasurement {
+            samples: total.samples,
+            trials: total.trials,
+            evaluations: crate::disc::thread_evaluations() - before,
+            violations: total.violations,
+            exhausted: total.exhausted,
+        }
+    }
+}
+
+/// Builds the tree and normaliser table of one interval.
+fn build_interval(
+    brdf: &Arc<dyn Brdf>,
+    options: &ExactOptions,
+    job: Job,
+    phi_k: f64,
+    half: f64,
+) -> Result<Interval, ExactError> {
+    let top = THETA_TOP_DEG.to_radians();
+    let (ta, tb) = (job.theta[0].min(top), job.theta[1].min(top));
+    let set = &options.set;
+    let map = set.disc_map.map_for(
+        brdf.as_ref(),
+        job.theta[1].to_degrees(),
+        set.equal_area_from_deg,
+    );
+    let deltas = |n: usize| -> Vec<f64> {
+        if half == 0.0 {
+            vec![0.0]
+        } else {
+            (0..n)
+                .map(|m| -half + 2.0 * half * m as f64 / (n - 1) as f64)
+                .collect()
+        }
+    };
+    let nb = options.bound_nodes;
+    let mut nodes = Vec::new();
+    for n in 0..nb {
+        let t = ta + (tb - ta) * n as f64 / (nb - 1) as f64;
+        for d in deltas(options.phi_bound_nodes) {
+            nodes.push((direction_from_radians(t, phi_k + d), d));
+        }
+    }
+    let n_nodes = nodes.len() as u64;
+    let mirror_y = set.symmetries && brdf.is_mirror_symmetric() && half == 0.0;
+    let envelope: Arc<dyn Brdf> = Arc::new(IntervalEnvelope {
+        brdf: Arc::clone(brdf),
+        nodes,
+    });
+    let centre = direction_from_radians(0.5 * (ta + tb), phi_k);
+    let f = DiscBrdf::with_map(envelope, centre, map);
+    let counter = EvalCounter::new();
+    let (theta_deg, phi_deg) = (0.5 * (ta + tb).to_degrees(), phi_k.to_degrees());
+    let slice = (job.theta[0].to_degrees() * 1000.0) as usize;
+    let grid_options = GridOptions {
+        refinement: set.grid_refinement,
+        mirror_y,
+        ..GridOptions::default()
+    };
+    let image = SliceImageMap::new(
+        Counted {
+            f: &f,
+            counter: &counter,
+        },
+        set.grid,
+        set.safety_factor,
+        set.dilation_for(brdf.as_ref()),
+        &grid_options,
+    )
+    .map_err(|source| SetError::Density {
+        slice,
+        theta_deg,
+        phi_deg,
+        source,
+    })?;
+    let params = TreeParams {
+        scheme: Scheme::Envelope,
+        leaf_choice: LeafChoice::Alias,
+        ..set.tree
+    };
+    let tree = QuadTreeBuilder::from_params(params)
+        .build_tree(&image)
+        .map_err(|source| SetError::Tree {
+            slice,
+            theta_deg,
+            phi_deg,
+            source,
+        })?;
+    drop(image);
+    let build_evals = counter.total() * n_nodes;
+    // The normaliser at the Chebyshev nodes, by the leaf quadrature of this tree; the δ nodes
+    // double (Lobatto-nested) while their tail exceeds the tolerance.
+    let theta_nodes = lobatto_nodes(ta, tb, options.normaliser_nodes);
+    let before = crate::disc::thread_evaluations();
+    let mut nd = options.phi_normaliser_nodes;
+    let (table, quad_err) = loop {
+        let delta_nodes = if half == 0.0 {
+            vec![0.0]
+        } else {
+            lobatto_nodes(-half, half, nd)
+        };
+        let mut values = Vec::with_capacity(theta_nodes.len() * delta_nodes.len());
+        let mut quad_err = 0.0f64;
+        for &t in &theta_nodes {
+            for &d in &delta_nodes {
+                let q =
+                    QueryDensity::new(brdf.as_ref(), direction_from_radians(t, phi_k + d), d, map);
+                let r = per_leaf_quadrature(&q, tree.leaves(), tree.integral(), mirror_y);
+                if !(r.total.is_finite() && r.total > 0.0) {
+                    return Err(ExactError::Normaliser {
+                        value: r.total,
+                        theta_deg: t.to_degrees(),
+                        phi_deg: (phi_k + d).to_degrees(),
+                    });
+                }
+                quad_err = quad_err.max(r.rel_err);
+                values.push(r.total * t.cos());
+            }
+        }
+        let table = ChebyshevTable {
+            theta: theta_nodes.clone(),
+            delta: delta_nodes,
+            values,
+        };
+        // Interpolation below the quadrature's own error is noise: no refinement past it.
+        let floor = options.normaliser_tol.max(quad_err);
+        if half == 0.0 || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
+            break (table, quad_err);
+        }
+        nd = 2 * nd - 1;
+    };
+    let quad_evals = crate::disc::thread_evaluations() - before;
+    let volume = tree.volume();
+    // The table holds A · cos θ.
+    let worst_trials = table
+        .values
+        .iter()
+        .enumerate()
+        .map(|(k, ac)| volume * table.theta[k / table.delta.len()].cos() / ac)
+        .fold(0.0, f64::max);
+    let norm_err = quad_err + table.rel_tail();
+    let tree = tree.clone();
+    let shape = *tree.shape();
+    let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
+        .map_err(|source| SetError::Attach { slice, source })?;
+    Ok(Interval {
+        tree: sampler,
+        map,
+        table,
+        worst_trials,
+        norm_err,
+        quad_err,
+        evaluations: build_evals + quad_evals,
+    })
+}
+
+impl DirectionSampler for ExactSet {
+    fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
+        let mut a = Audit::default();
+        match self.draw(wo, u, &mut a) {
+            Some((s, tree)) => {
+                tree.record_one_sample(&a);
+                s
+            }
+            None => DirSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 0.0,
+            },
+        }
+    }
+
+    /// `f_r(ωo, ωi) cos θi / A(θo, δ)` above the horizon, 0 below.
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        if !(wi.z > 0.0) {
+            return 0.0;
+        }
+        let Some(q) = self.locate(wo) else {
+            return 0.0;
+        };
+        let a = self.interval(&q).normaliser(&q);
+        self.brdf.eval(wo, wi) * wi.z / a
+    }
+
+    fn bound_violations(&self) -> Option<u64> {
+        Some(
+            self.cells
+                .iter()
+                .flat_map(|c| c.intervals.iter())
+                .map(|iv| iv.tree.stats().bound_violations)
+                .sum(),
+        )
+    }
+
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        let q = self.locate(wo)?;
+        Some(self.interval(&q).norm_err)
+    }
+
+    /// The [`ExactReport`]: the interval layout per azimuth cell, trials, normaliser error,
+    /// audit, build cost and memory.
+    fn build_report(&self) -> Option<String> {
+        Some(self.report().to_string())
+    }
+
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self
+                .cells
+                .iter()
+                .map(|c| {
+                    std::mem::size_of::<Cell>()
+                        + c.upper.capacity() * 8
+                        + c.intervals
+                            .iter()
+                            .map(|iv| {
+                                std::mem::size_of::<Interval>()
+                                    + iv.tree.bytes_used()
+                                    + iv.table.bytes_used()
+                            })
+                            .sum::<usize>()
+                })
+                .sum::<usize>()
+    }
+}
+
+#[cfg(test)]
+mod tests;
