@@ -58,6 +58,14 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
     fn pdf_cells(&self) -> Option<brdf_sampling::PdfCells> {
         self.sampler.pdf_cells(&self.wo)
     }
+
+    fn singular_points(&self) -> Vec<Dir3> {
+        self.sampler
+            .singular_directions(&self.wo)
+            .iter()
+            .map(dir_of)
+            .collect()
+    }
 }
 
 /// Any [`Sampler2D`] (pdf w.r.t. area on its domain); batches are independent draws.

@@ -5,7 +5,8 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use stats::{
     Axis, Binning, DEFAULT_MIN_EXPECTED, TestOutcome, chi_square_gof, expected_masses_with,
-    histogram, ks_projection_test, normalisation, pdf_consistency, support_coverage,
+    histogram, ks_projection_test_with_singularities, normalisation, pdf_consistency,
+    support_coverage,
 };
 
 use crate::cells::{CellModel, ExactTests};
@@ -213,6 +214,22 @@ pub(crate) fn chi_square<P: Copy + Send + Sync>(
     }
 }
 
+/// Parameter coordinates of the declared singular points inside the domain, each with copies
+/// shifted by `±` the `v` range (so a point near the seam of a periodic `φ` is graded towards
+/// from both sides; copies beyond one piece of the range are ignored by the grading).
+fn singular_params<P: Copy + Send + Sync>(
+    binning: &dyn Binning<Point = P>,
+    points: &[P],
+) -> Vec<[f64; 2]> {
+    let v = binning.grid().v_range();
+    let period = v[1] - v[0];
+    points
+        .iter()
+        .filter_map(|p| binning.param_of(p))
+        .flat_map(|[a, b]| [[a, b], [a, b - period], [a, b + period]])
+        .collect()
+}
+
 /// Every test of the suite on `s` (binned by `binning`), in report order. p-values are judged
 /// at a placeholder level here; the run re-judges them with the Šidák level.
 ///
@@ -266,9 +283,12 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
                 out.push(error_outcome(names::BATCH_CHI_SQUARE, &e));
             }
         }
+        let singular = singular_params(binning, &sampler.singular_points());
         for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
             out.push(
-                match ks_projection_test(binning, &pdf, &points, axis, alpha, opts) {
+                match ks_projection_test_with_singularities(
+                    binning, &pdf, &points, axis, alpha, opts, &singular,
+                ) {
                     Ok(o) => renamed(o, name),
                     Err(e) => error_outcome(name, e),
                 },

@@ -54,6 +54,13 @@ pub trait SamplerUnderTest<P>: Send + Sync {
     fn pdf_cells(&self) -> Option<brdf_sampling::PdfCells> {
         None
     }
+
+    /// Points where the pdf is singular or sharply peaked, for samplers that declare them
+    /// ([`brdf_sampling::DirectionSampler::singular_directions`]): the KS projection CDFs grade
+    /// their quadrature towards them. Empty by default.
+    fn singular_points(&self) -> Vec<P> {
+        Vec::new()
+    }
 }
 
 /// An integral with an accurately known value, and how the value was obtained.

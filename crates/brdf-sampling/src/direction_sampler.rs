@@ -67,4 +67,13 @@ pub trait DirectionSampler: Send + Sync {
 
     /// Bytes of the precomputed structures this sampler needs.
     fn bytes_used(&self) -> usize;
+
+    /// Directions (unit vectors, local frame) at or near which the pdf at `wo` is singular or
+    /// sharply peaked — e.g. `−ωo` for the half-vector samplers, whose solid-angle pdf
+    /// `p_h(h)/(2|ωo + ωi|)` has an integrable `1/|ωo + ωi|` wedge there, or the mirror
+    /// direction of a narrow lobe. A validation grades its quadrature towards them (see
+    /// `stats::singular`); declaring a direction never changes the pdf. Empty by default.
+    fn singular_directions(&self, _wo: &Vec3) -> Vec<Vec3> {
+        Vec::new()
+    }
 }

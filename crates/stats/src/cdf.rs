@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::binning::{Axis, Binning};
 use crate::error::StatsError;
 use crate::quadrature::{GaussLegendre, QuadratureOptions, integrate_1d};
+use crate::singular::{LINE_FLOOR_FRACTION, graded_breaks};
 
 const MIN_INITIAL_SLABS: usize = 32;
 const MAX_KNOT_DEPTH: u32 = 24;
@@ -146,7 +147,12 @@ impl TabulatedCdf {
     ) -> Result<Self, StatsError> {
         opts.validate()?;
         check_range(range)?;
-        build(range, n_samples, opts, MIN_INITIAL_SLABS, f)
+        build(
+            n_samples,
+            opts,
+            &graded_breaks(range, MIN_INITIAL_SLABS, &[], false),
+            f,
+        )
     }
 }
 
@@ -192,6 +198,7 @@ fn check_range(range: [f64; 2]) -> Result<(), StatsError> {
 /// The marginal density `f(t) = ∫ pdf J d(other)` over the section [`Binning::section`] is
 /// integrated by adaptive Gauss–Legendre quadrature (one piece per grid cell spanned, times
 /// `2^min_depth`, to absolute accuracy `ε / (8 · range)`), then tabulated as in the module docs.
+/// Same as [`projection_cdf_with_singularities`] with no singular point.
 ///
 /// # Errors
 /// Invalid options, or a density whose mass is not finite and positive or that is negative
@@ -203,6 +210,33 @@ pub fn projection_cdf<B: Binning + ?Sized>(
     n_samples: u64,
     opts: &QuadratureOptions,
 ) -> Result<TabulatedCdf, StatsError> {
+    projection_cdf_with_singularities(binning, pdf, axis, n_samples, opts, &[])
+}
+
+/// [`projection_cdf`] for a density with integrable point singularities at the parameter
+/// coordinates `singular` (`[u, v]`; wedge-shaped neighbourhoods, see [`crate::singular`]'s
+/// module docs, e.g. the half-vector pdfs at `ωi = −ωo`).
+///
+/// Every line integral `∫ pdf J d(other)` at `t` is split at each singular point's other
+/// coordinate `s₀` and graded geometrically towards it, down to `2⁻¹⁶ |t − t₀|` (`t₀` its
+/// coordinate on `axis`; at least `10⁻¹²` of the range), with the tolerance shared equally by
+/// the pieces. The knots are not graded towards `t₀`: there the marginal itself is at worst
+/// log-singular (integrable), which the adaptive slabs resolve by halving, while graded knots
+/// next to it cost a full-depth refinement for nothing (measured: the φ CDF of `analytic ×
+/// blinn` at 89° went from 0.8 s to > 300 s). Points outside the parameter rectangle grade towards the nearer edge when within
+/// one piece of it (pass `v ± 2π` copies for a periodic `φ`). An empty `singular` is exactly
+/// [`projection_cdf`].
+///
+/// # Errors
+/// As [`projection_cdf`].
+pub fn projection_cdf_with_singularities<B: Binning + ?Sized>(
+    binning: &B,
+    pdf: &(dyn Fn(B::Point) -> f64 + Sync),
+    axis: Axis,
+    n_samples: u64,
+    opts: &QuadratureOptions,
+    singular: &[[f64; 2]],
+) -> Result<TabulatedCdf, StatsError> {
     opts.validate()?;
     let rule = GaussLegendre::new(opts.order);
     let grid = binning.grid();
@@ -210,6 +244,15 @@ pub fn projection_cdf<B: Binning + ?Sized>(
         Axis::U => (grid.u_range(), grid.v_range(), grid.nv(), grid.nu()),
         Axis::V => (grid.v_range(), grid.u_range(), grid.nu(), grid.nv()),
     };
+    // (coordinate on `axis`, coordinate along the lines) of each singular point.
+    let points: Vec<(f64, f64)> = singular
+        .iter()
+        .filter(|p| p[0].is_finite() && p[1].is_finite())
+        .map(|p| match axis {
+            Axis::U => (p[0], p[1]),
+            Axis::V => (p[1], p[0]),
+        })
+        .collect();
     let eps = epsilon(n_samples, opts);
     let inner_tol = 0.125 * eps / (range[1] - range[0]);
     let marginal = |t: f64| -> f64 {
@@ -227,61 +270,63 @@ pub fn projection_cdf<B: Binning + ?Sized>(
                     };
                     pdf(binning.point_at(uv)) * binning.jacobian(uv)
                 };
-                integrate_1d(
-                    &g,
-                    [c0, c1],
-                    inner_tol,
-                    &rule,
-                    opts.max_depth.max(20),
-                    pieces,
-                )
-                .value
+                if points.is_empty() {
+                    return integrate_1d(
+                        &g,
+                        [c0, c1],
+                        inner_tol,
+                        &rule,
+                        opts.max_depth.max(20),
+                        pieces,
+                    )
+                    .value;
+                }
+                let centres: Vec<(f64, f64)> = points
+                    .iter()
+                    .map(|&(t0, s0)| (s0, LINE_FLOOR_FRACTION * (t - t0).abs()))
+                    .collect();
+                let breaks = graded_breaks([c0, c1], pieces, &centres, true);
+                // Equal shares of the tolerance; the graded pieces already have the scale of
+                // the feature, so refinement below them stops at `max_depth` (not 20: next to
+                // the singularity the pdf's round-off would otherwise drive every piece to the
+                // full depth).
+                let tol = inner_tol / (breaks.len() - 1).max(1) as f64;
+                breaks
+                    .windows(2)
+                    .map(|w| integrate_1d(&g, [w[0], w[1]], tol, &rule, opts.max_depth, 1).value)
+                    .sum::<f64>()
             })
             .sum()
     };
-    build(
-        range,
-        n_samples,
-        opts,
-        own_cells.max(MIN_INITIAL_SLABS),
-        &marginal,
-    )
+    let starts = graded_breaks(range, own_cells.max(MIN_INITIAL_SLABS), &[], false);
+    build(n_samples, opts, &starts, &marginal)
 }
 
 fn epsilon(n_samples: u64, opts: &QuadratureOptions) -> f64 {
     opts.accuracy / (n_samples.max(1) as f64).sqrt()
 }
 
-/// Tabulates the CDF of the 1D density `f` on `range` by adaptive slabs.
+/// Tabulates the CDF of the 1D density `f` on `[starts₀, starts_last]` by adaptive slabs,
+/// starting from the slabs between consecutive `starts` (sorted, at least two).
 fn build(
-    range: [f64; 2],
     n_samples: u64,
     opts: &QuadratureOptions,
-    initial_slabs: usize,
+    starts: &[f64],
     f: &(dyn Fn(f64) -> f64 + Sync),
 ) -> Result<TabulatedCdf, StatsError> {
     let rule = GaussLegendre::new(opts.order);
+    let range = [starts[0], starts[starts.len() - 1]];
     let ctx = Refine {
         eps: epsilon(n_samples, opts),
         width: range[1] - range[0],
         rule: &rule,
         f,
     };
-    let at = |k: usize| {
-        if k == initial_slabs {
-            range[1]
-        } else {
-            range[0] + ctx.width * (k as f64 / initial_slabs as f64)
-        }
-    };
-    let edge_density: Vec<f64> = (0..=initial_slabs)
-        .into_par_iter()
-        .map(|k| f(at(k)))
-        .collect();
-    let slabs: Vec<Vec<Knot>> = (0..initial_slabs)
+    let edge_density: Vec<f64> = starts.par_iter().map(|&x| f(x)).collect();
+    let slabs: Vec<Vec<Knot>> = (0..starts.len() - 1)
         .into_par_iter()
         .map(|i| {
-            let (a, b) = (at(i), at(i + 1));
+            let (a, b) = (starts[i], starts[i + 1]);
             let mut out = Vec::new();
             let ends = (edge_density[i], edge_density[i + 1]);
             ctx.refine(a, b, ctx.mass(a, b), ends, MAX_KNOT_DEPTH, &mut out);

@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use crate::binning::{Axis, Binning, histogram};
-use crate::cdf::{project, projection_cdf};
+use crate::cdf::{project, projection_cdf_with_singularities};
 use crate::chi_square::{ChiSquareResult, DEFAULT_MIN_EXPECTED, chi_square_gof};
 use crate::error::StatsError;
 use crate::ks::ks_onesample;
@@ -41,7 +41,7 @@ pub fn chi_square_test<B: Binning + ?Sized>(
 }
 
 /// One-sample KS test of the projection of `points` onto parameter axis `axis` against the
-/// projection of `pdf` (its CDF tabulated by [`projection_cdf`]), judged at level `alpha`.
+/// projection of `pdf` (its CDF tabulated by [`crate::projection_cdf`]), judged at level `alpha`.
 ///
 /// Points outside the domain fail the test outright (`p = 0`).
 ///
@@ -54,6 +54,24 @@ pub fn ks_projection_test<B: Binning + ?Sized>(
     axis: Axis,
     alpha: f64,
     opts: &QuadratureOptions,
+) -> Result<TestOutcome, StatsError> {
+    ks_projection_test_with_singularities(binning, pdf, points, axis, alpha, opts, &[])
+}
+
+/// [`ks_projection_test`] for a pdf with integrable point singularities at the parameter
+/// coordinates `singular` (its CDF tabulated by [`projection_cdf_with_singularities`], which
+/// grades its quadrature towards them).
+///
+/// # Errors
+/// As [`ks_projection_test`].
+pub fn ks_projection_test_with_singularities<B: Binning + ?Sized>(
+    binning: &B,
+    pdf: &(dyn Fn(B::Point) -> f64 + Sync),
+    points: &[B::Point],
+    axis: Axis,
+    alpha: f64,
+    opts: &QuadratureOptions,
+    singular: &[[f64; 2]],
 ) -> Result<TestOutcome, StatsError> {
     if points.is_empty() {
         return Err(StatsError::TooFewSamples { needed: 1, got: 0 });
@@ -69,7 +87,8 @@ pub fn ks_projection_test<B: Binning + ?Sized>(
             format!("{} samples outside the domain", proj.outside),
         ));
     }
-    let cdf = projection_cdf(binning, pdf, axis, points.len() as u64, opts)?;
+    let cdf =
+        projection_cdf_with_singularities(binning, pdf, axis, points.len() as u64, opts, singular)?;
     let r = ks_onesample(&proj.values, &|x| cdf.eval(x))?;
     Ok(r.outcome(&name, alpha))
 }

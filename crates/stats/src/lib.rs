@@ -64,17 +64,21 @@ mod error;
 mod ks;
 mod outcome;
 mod quadrature;
+pub mod singular;
 
 pub use binning::{
     Axis, Binning, Direction, DiscBinning, Edge, Grid, Histogram, Patch, Point2, RectBinning,
     SphereBinning, histogram,
 };
 pub use calibration::{Calibration, calibrate};
-pub use cdf::{Projection, TabulatedCdf, project, projection_cdf};
+pub use cdf::{
+    Projection, TabulatedCdf, project, projection_cdf, projection_cdf_with_singularities,
+};
 pub use cells::{CellRow, PiecewiseConstant};
 pub use checks::{
-    COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test, mean_z_test, normalisation,
-    pdf_consistency, support_coverage,
+    COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test,
+    ks_projection_test_with_singularities, mean_z_test, normalisation, pdf_consistency,
+    support_coverage,
 };
 pub use chi_square::{ChiSquareResult, DEFAULT_MIN_EXPECTED, chi_square_gof, chi_square_sf};
 pub use error::StatsError;

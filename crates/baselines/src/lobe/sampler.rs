@@ -266,4 +266,14 @@ impl DirectionSampler for LobeSampler {
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>() + self.fits.len() * std::mem::size_of::<LobeFit>()
     }
+
+    /// The mirror direction, where the lobe `max(0, ω_r·ωi)^n` peaks (narrowly for a large
+    /// fitted exponent `n`: width `≈ 1/√n`).
+    fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
+        if wo.z > 0.0 {
+            vec![mirror(wo)]
+        } else {
+            Vec::new()
+        }
+    }
 }

@@ -212,4 +212,17 @@ impl DirectionSampler for AnalyticSampler {
         // Nothing is precomputed: a few model parameters.
         0
     }
+
+    /// The mirror direction (the specular lobe's peak) and, for the samplers that reflect a
+    /// half vector (Blinn, Lewis, Ward, microfacet), `−ωo`: the fold of the reflection map,
+    /// where the half vector `(ωo+ωi)/|ωo+ωi|` has no limit, so the pdf's value depends on the
+    /// direction of approach — an integrable `1/|ωo+ωi|` wedge for `p_h/(2|ωo+ωi|)`, a bounded
+    /// one for the visible-normal pdf `G1 D(m)/(4 ωo_z)`. None for the cosine part alone.
+    fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
+        match &self.specular {
+            Some(Specular::Phong(_)) if wo.z > 0.0 => vec![mirror(wo)],
+            Some(_) if wo.z > 0.0 => vec![mirror(wo), -wo],
+            _ => Vec::new(),
+        }
+    }
 }
