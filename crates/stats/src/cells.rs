@@ -26,6 +26,19 @@ pub struct CellRow {
     pub densities: Vec<f64>,
 }
 
+impl CellRow {
+    /// The row's mass `∫ p du dv = (u₁ − u₀) Σ_k d_k (v_{k+1} − v_k)`.
+    pub fn mass(&self) -> f64 {
+        let along_v: f64 = self
+            .densities
+            .iter()
+            .zip(self.v_edges.windows(2))
+            .map(|(d, e)| d * (e[1] - e[0]))
+            .sum();
+        along_v * (self.u[1] - self.u[0])
+    }
+}
+
 /// A density `p(u, v) = Σ_cells d_c 1[(u, v) ∈ c]` on the cells of a row layout (see the
 /// module docs), zero outside the rows. Rows may leave gaps; they must not overlap for the
 /// masses to mean "the density's integral" (overlapping rows add up).
@@ -78,18 +91,7 @@ impl PiecewiseConstant {
 
     /// `∫ p du dv = Σ_c d_c |c|`.
     pub fn total_mass(&self) -> f64 {
-        self.rows
-            .iter()
-            .map(|r| {
-                let row: f64 = r
-                    .densities
-                    .iter()
-                    .zip(r.v_edges.windows(2))
-                    .map(|(d, e)| d * (e[1] - e[0]))
-                    .sum();
-                row * (r.u[1] - r.u[0])
-            })
-            .sum()
+        self.rows.iter().map(CellRow::mass).sum()
     }
 
     /// Mass of every cell of `grid` (index `i_v · n_u + i_u`, as [`Grid::cell`]):

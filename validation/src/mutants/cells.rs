@@ -42,19 +42,7 @@ impl RowScaledPdf {
         let plan = Plan::new(Tier::Quick, MIN_SAMPLES);
         let model = CellModel::new(&at_wo, cells.clone(), &plan)?;
         let density = model.density()?;
-        let masses: Vec<f64> = density
-            .rows()
-            .iter()
-            .map(|r| {
-                let row: f64 = r
-                    .densities
-                    .iter()
-                    .zip(r.v_edges.windows(2))
-                    .map(|(d, e)| d * (e[1] - e[0]))
-                    .sum();
-                row * (r.u[1] - r.u[0])
-            })
-            .collect();
+        let masses: Vec<f64> = density.rows().iter().map(|r| r.mass()).collect();
         let total: f64 = masses.iter().sum();
         let (i, m) = masses
             .iter()
