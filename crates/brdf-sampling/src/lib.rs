@@ -104,11 +104,11 @@ mod set;
 pub use direction_sampler::{DirSample, DirectionSampler};
 pub use disc::{
     DiscBrdf, DiscMap, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
-    solid_angle_pdf_to_area,
+    solid_angle_pdf_to_area, thread_evaluations,
 };
 pub use error::{SetError, SetFileError};
 pub use exact::{ExactError, ExactOptions, ExactReport, ExactSet};
-pub use layout::{SliceChoice, SliceLayout};
+pub use layout::{SliceChoice, SliceLayout, SliceLocator, Turn};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};
 pub use persist::SET_FORMAT_VERSION;

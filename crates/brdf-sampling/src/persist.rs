@@ -91,7 +91,7 @@ impl QuadTreeSet {
             probes: probes(self.brdf.as_ref()),
             variant: self.variant,
             options: self.options,
-            layout: self.layout,
+            layout: self.locator.layout(),
             grid_evaluations: self.grid_evaluations,
             maps: self.trees.iter().map(|t| t.density().map()).collect(),
             norms: self.norms.clone(),
@@ -207,11 +207,12 @@ impl QuadTreeSet {
             spec: s.spec,
             variant: s.variant,
             options: s.options,
-            layout: s.layout,
+            locator: crate::layout::SliceLocator::new(s.layout),
             trees,
             norms: s.norms,
             build_time: Duration::ZERO,
             grid_evaluations: s.grid_evaluations,
+            counters: partition_sampler::AuditCounters::new(),
         })
     }
 

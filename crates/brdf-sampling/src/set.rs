@@ -5,10 +5,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use brdf::{Brdf, Vec3, rotate_z};
+use brdf::{Brdf, Vec3};
 use partition_sampler::{
-    AllocationMode, Audit, Density, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler,
-    Sample2, Sampler2D, Scheme, TreeParams, UniformSource,
+    AllocationMode, Audit, AuditCounters, Density, GridOptions, LeafChoice, QuadTreeBuilder,
+    QuadTreeSampler, Sample2, Sampler2D, Scheme, TreeParams, UniformSource,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -19,7 +19,7 @@ use crate::direction_sampler::{DirSample, DirectionSampler};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
-use crate::layout::{SliceChoice, SliceLayout};
+use crate::layout::{SliceChoice, SliceLayout, SliceLocator};
 use crate::normalisation::{leaf_quadrature, per_leaf_quadrature};
 use crate::options::SetOptions;
 use crate::report::{CostMeasurement, SetReport};
@@ -80,12 +80,16 @@ pub struct QuadTreeSet {
     pub(crate) spec: String,
     pub(crate) variant: Variant,
     pub(crate) options: SetOptions,
-    pub(crate) layout: SliceLayout,
+    /// The layout, with the θ-edge cosines of the nearest-slice rule.
+    pub(crate) locator: SliceLocator,
     pub(crate) trees: Vec<QuadTreeSampler<SliceDensity>>,
     /// One per tree.
     pub(crate) norms: Vec<SliceNorm>,
     pub(crate) build_time: Duration,
     pub(crate) grid_evaluations: u64,
+    /// Trials, samples and violations of the set's own `sample` calls (the trees' counters
+    /// hold those of direct tree calls and of [`QuadTreeSet::measure_cost`]).
+    pub(crate) counters: AuditCounters,
 }
 
 impl std::fmt::Debug for QuadTreeSet {
@@ -93,7 +97,7 @@ impl std::fmt::Debug for QuadTreeSet {
         f.debug_struct("QuadTreeSet")
             .field("variant", &self.variant)
             .field("spec", &self.spec)
-            .field("layout", &self.layout)
+            .field("layout", &self.locator.layout())
             .field("options", &self.options)
             .finish_non_exhaustive()
     }
@@ -402,11 +406,12 @@ impl QuadTreeSet {
             spec,
             variant,
             options: *options,
-            layout,
+            locator: SliceLocator::new(layout),
             trees,
             norms,
             build_time: start.elapsed(),
             grid_evaluations,
+            counters: AuditCounters::new(),
         })
     }
 
@@ -444,7 +449,7 @@ impl QuadTreeSet {
 
     /// The slice layout.
     pub fn layout(&self) -> SliceLayout {
-        self.layout
+        self.locator.layout()
     }
 
     /// The tree of slice `index` (area pdf on the disc, see [`QuadTreeSampler`]).
@@ -475,9 +480,9 @@ impl QuadTreeSet {
     /// The slice(s) serving `wo` with their weights; `None` below the horizon.
     pub fn choices(&self, wo: &Vec3) -> Option<[SliceChoice; 2]> {
         if self.options.mixture {
-            self.layout.neighbours(wo)
+            self.locator.layout().neighbours(wo)
         } else {
-            self.layout
+            self.locator
                 .nearest(wo)
                 .map(|c| [c, SliceChoice { weight: 0.0, ..c }])
         }
@@ -493,7 +498,7 @@ impl QuadTreeSet {
             return 0.0;
         };
         let map = tree.density().map();
-        let v = rotate_z(wi, -c.rotation);
+        let v = c.rotation.undo(wi);
         map.area_to_solid_angle(tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index), wi)
     }
 
@@ -513,7 +518,7 @@ impl QuadTreeSet {
             return 0.0;
         };
         let map = tree.density().map();
-        let v = rotate_z(wi, -c.rotation);
+        let v = c.rotation.undo(wi);
         tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index)
     }
 
@@ -540,7 +545,7 @@ impl QuadTreeSet {
         &self,
         wo: &Vec3,
         u: &mut dyn UniformSource,
-        draw: &mut dyn FnMut(&QuadTreeSampler<SliceDensity>, &mut dyn UniformSource) -> Sample2,
+        mut draw: impl FnMut(&QuadTreeSampler<SliceDensity>, &mut dyn UniformSource) -> Sample2,
     ) -> DirSample {
         let up = DirSample {
             wi: Vec3::new(0.0, 0.0, 1.0),
@@ -557,7 +562,7 @@ impl QuadTreeSet {
         let s = draw(tree, u);
         let map = tree.density().map();
         let v = map.to_direction(s.point);
-        let wi = rotate_z(&v, c.rotation);
+        let wi = c.rotation.apply(&v);
         let p = map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v);
         let pdf = if cs[1 - drawn].weight > 0.0 {
             self.combine(&cs, drawn, p, &wi)
@@ -575,17 +580,18 @@ impl QuadTreeSet {
         let mut audit = Audit::default();
         let before = thread_evaluations();
         let mut samples = 0u64;
-        let dt = std::f64::consts::FRAC_PI_2 / self.layout.theta as f64;
-        let dp = self.layout.phi_period() / self.layout.phi as f64;
+        let layout = self.locator.layout();
+        let dt = std::f64::consts::FRAC_PI_2 / layout.theta as f64;
+        let dp = layout.phi_period() / layout.phi as f64;
         for i in 0..self.trees.len() {
             let mut rng =
                 Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(seed, i as u64));
-            let (t, p) = self.layout.angles_of(i);
+            let (t, p) = layout.angles_of(i);
             for _ in 0..per_slice {
                 let theta = t + (rng.next_uniform() - 0.5) * dt;
                 let phi = p + (rng.next_uniform() - 0.5) * dp;
                 let wo = brdf::direction_from_radians(theta, phi);
-                let _ = self.sample_with(&wo, &mut rng, &mut |tree, u| {
+                let _ = self.sample_with(&wo, &mut rng, |tree, u| {
                     let mut a = Audit::default();
                     let s = tree.sample_audited(u, &mut a);
                     tree.record_audit(&a);
@@ -611,7 +617,7 @@ impl QuadTreeSet {
             mixture: self.options.mixture,
             brdf: self.brdf.name().to_string(),
             spec: self.spec.clone(),
-            layout: self.layout,
+            layout: self.locator.layout(),
             trees: self.trees.len(),
             equal_area_trees: self
                 .trees
@@ -646,6 +652,11 @@ impl QuadTreeSet {
             r.bound_violations += s.bound_violations;
             r.exhausted += s.exhausted;
         }
+        let own = self.counters.snapshot();
+        r.samples += own.samples;
+        trials += own.trials as f64;
+        r.bound_violations += own.violations;
+        r.exhausted += own.exhausted;
         for n in &self.norms {
             if let Some(e) = n.rel_err {
                 r.max_integral_rel_err = Some(r.max_integral_rel_err.unwrap_or(0.0).max(e));
@@ -668,7 +679,10 @@ impl QuadTreeSet {
 
 impl DirectionSampler for QuadTreeSet {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
-        self.sample_with(wo, u, &mut |t, u| t.sample(u))
+        let mut a = Audit::default();
+        let s = self.sample_with(wo, u, |t, u| t.sample_audited(u, &mut a));
+        self.counters.record(&a);
+        s
     }
 
     fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
@@ -689,7 +703,7 @@ impl DirectionSampler for QuadTreeSet {
 
     fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
         let nearest = (!self.options.mixture)
-            .then(|| self.layout.nearest(wo))
+            .then(|| self.locator.nearest(wo))
             .flatten();
         match (self.variant, nearest) {
             (Variant::Paper, Some(c)) => {
@@ -704,7 +718,7 @@ impl DirectionSampler for QuadTreeSet {
                     .map(|s| {
                         let v = map.to_direction(s.point);
                         DirSample {
-                            wi: rotate_z(&v, c.rotation),
+                            wi: c.rotation.apply(&v),
                             pdf: map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v),
                         }
                     })

@@ -45,9 +45,13 @@ impl DirectionSampler for Broken<'_> {
             }
             Bug::NoCosine => self.set.slice_area_pdf(&c, wi),
             Bug::NoRotation => {
-                self.set
-                    .slice_area_pdf(&SliceChoice { rotation: 0.0, ..c }, wi)
-                    * wi.z
+                self.set.slice_area_pdf(
+                    &SliceChoice {
+                        rotation: brdf_sampling::Turn::IDENTITY,
+                        ..c
+                    },
+                    wi,
+                ) * wi.z
             }
         }
     }

@@ -21,7 +21,7 @@
 //! [`MerlBrdf::lookup_raw_rgb`] returns the signed scaled value.
 
 use crate::brdf::{Brdf, luminance};
-use crate::geometry::{Vec3, both_above, rotate_y, rotate_z};
+use crate::geometry::{Vec3, both_above, rotate_y};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fs;
 use std::io::{BufWriter, Write};
@@ -137,9 +137,19 @@ impl MerlIndex {
 /// `φd ∈ (−π, π]`), computed as in MERL's reference code with `ωi` as the "in" direction.
 pub fn half_diff_angles(wo: &Vec3, wi: &Vec3) -> (f64, f64, f64) {
     let h = (wo + wi).normalize();
-    let theta_h = h.z.clamp(-1.0, 1.0).acos();
-    let phi_h = h.y.atan2(h.x);
-    let d = rotate_y(&rotate_z(wi, -phi_h), -theta_h);
+    let cos_h = h.z.clamp(-1.0, 1.0);
+    let theta_h = cos_h.acos();
+    // d = R_y(−θh) R_z(−φh) ωi, with (cos φh, sin φh) = (h.x, h.y)/r and sin θh = r: no
+    // trigonometry but the two angles returned (φh = 0 when h is the normal).
+    let r = (h.x * h.x + h.y * h.y).sqrt();
+    let (cos_p, sin_p) = if r > 0.0 {
+        (h.x / r, h.y / r)
+    } else {
+        (1.0, 0.0)
+    };
+    let x = cos_p * wi.x + sin_p * wi.y;
+    let y = cos_p * wi.y - sin_p * wi.x;
+    let d = Vec3::new(cos_h * x - r * wi.z, y, r * x + cos_h * wi.z);
     (theta_h, d.z.clamp(-1.0, 1.0).acos(), d.y.atan2(d.x))
 }
 

@@ -157,3 +157,37 @@ pub(crate) fn flush_local(counters: &Arc<Counters>) {
         }
     });
 }
+
+/// Shared counters of a sampler made of several samplers (e.g. a set of quadtrees, one per
+/// outgoing angle), fed with [`Audit`]s the way [`crate::QuadTreeSampler::sample`] feeds its
+/// own: a thread-local buffer for trials and samples (flushed every [`FLUSH_EVERY`] records,
+/// when the thread records into other counters, by [`AuditCounters::snapshot`] and at thread
+/// exit), violations and exhausted samples added at once. Recording into one set's counters
+/// from draws of many trees avoids a buffer flush at every switch of tree.
+#[derive(Debug, Default)]
+pub struct AuditCounters(Arc<Counters>);
+
+impl AuditCounters {
+    /// Zeroed counters.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds the counts of one sample (or of several).
+    #[inline]
+    pub fn record(&self, a: &Audit) {
+        record_one(&self.0, a);
+    }
+
+    /// The counts so far (flushes the calling thread's buffer first).
+    pub fn snapshot(&self) -> Audit {
+        flush_local(&self.0);
+        self.0.snapshot()
+    }
+
+    /// Zeroes the counters (and the calling thread's buffer).
+    pub fn reset(&self) {
+        flush_local(&self.0);
+        self.0.reset();
+    }
+}

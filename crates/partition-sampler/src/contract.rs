@@ -27,13 +27,41 @@ pub struct Sample2 {
 pub trait UniformSource {
     /// The next uniform number in `[0, 1)`.
     fn next_uniform(&mut self) -> f64;
+
+    /// The next four numbers, in order: the same values as four [`Self::next_uniform`] calls
+    /// (one call instead of four through a `dyn UniformSource`; a rejection trial of the
+    /// quadtree sampler consumes four).
+    #[inline]
+    fn next_uniform4(&mut self) -> [f64; 4] {
+        [
+            self.next_uniform(),
+            self.next_uniform(),
+            self.next_uniform(),
+            self.next_uniform(),
+        ]
+    }
+}
+
+/// 53 random mantissa bits of `bits`: uniform on `[0, 1)` with spacing 2⁻⁵³.
+#[inline(always)]
+fn unit_from_bits(bits: u64) -> f64 {
+    (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 impl<R: Rng + ?Sized> UniformSource for R {
     #[inline]
     fn next_uniform(&mut self) -> f64 {
-        // 53 random mantissa bits: uniform on [0, 1) with spacing 2^-53.
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+        unit_from_bits(self.next_u64())
+    }
+
+    #[inline]
+    fn next_uniform4(&mut self) -> [f64; 4] {
+        [
+            unit_from_bits(self.next_u64()),
+            unit_from_bits(self.next_u64()),
+            unit_from_bits(self.next_u64()),
+            unit_from_bits(self.next_u64()),
+        ]
     }
 }
 

@@ -298,20 +298,33 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         crate::sample_par(self, n, seed)
     }
 
+    /// The alias table's leaf for the uniform `u0`: column `i = ⌊u0·n⌋`, kept when the
+    /// fraction `u0·n − i` is below its probability, else its alias. `leaves` must not be
+    /// empty.
+    #[inline(always)]
+    fn alias_leaf(&self, u0: f64) -> &Leaf {
+        let leaves = &self.tree.leaves;
+        let n = leaves.len();
+        let s = u0 * n as f64;
+        let i = (s as usize).min(n - 1);
+        let leaf = &leaves[i];
+        if s - (i as f64) < leaf.prob {
+            leaf
+        } else {
+            leaves.get(leaf.alias as usize).unwrap_or(leaf)
+        }
+    }
+
     #[inline(always)]
     fn pick_leaf<U: UniformSource + ?Sized>(&self, u: &mut U) -> Option<&Leaf> {
         let leaves = &self.tree.leaves;
         match self.tree.params.leaf_choice {
             LeafChoice::Alias => {
-                let n = leaves.len();
-                let s = u.next_uniform() * n as f64;
-                let i = (s as usize).min(n - 1);
-                let leaf = leaves.get(i)?;
-                if s - (i as f64) < leaf.prob {
-                    Some(leaf)
-                } else {
-                    leaves.get(leaf.alias as usize)
+                if leaves.is_empty() {
+                    let _ = u.next_uniform();
+                    return None;
                 }
+                Some(self.alias_leaf(u.next_uniform()))
             }
             LeafChoice::Descent => {
                 let mut code = self.tree.root_code;
@@ -351,15 +364,27 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         u: &mut U,
         a: &mut Audit,
     ) -> (Point2, Option<f64>) {
-        let s = f64::from(leaf.u0) + u.next_uniform() * f64::from(leaf.du);
-        let t = f64::from(leaf.v0) + u.next_uniform() * f64::from(leaf.dv);
+        let us = [u.next_uniform(), u.next_uniform(), u.next_uniform()];
+        self.trial_with::<MAP>(leaf, us, a)
+    }
+
+    /// [`Self::trial`] with its three uniforms (`x`, `y`, height) given.
+    #[inline(always)]
+    fn trial_with<const MAP: bool>(
+        &self,
+        leaf: &Leaf,
+        us: [f64; 3],
+        a: &mut Audit,
+    ) -> (Point2, Option<f64>) {
+        let s = f64::from(leaf.u0) + us[0] * f64::from(leaf.du);
+        let t = f64::from(leaf.v0) + us[1] * f64::from(leaf.dv);
         let (x, y) = if MAP {
             (self.frame.domain_coord(0, s), self.frame.domain_coord(1, t))
         } else {
             (s, t)
         };
         let m = leaf.bound(self.bound_scale);
-        let z = u.next_uniform() * m;
+        let z = us[2] * m;
         a.trials += 1;
         if self.disc && x * x + y * y > 1.0 {
             return ([x, y], None);
@@ -522,6 +547,29 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     ) -> Sample2 {
         let start = a.trials;
         let mut last = self.tree.root.center();
+        if self.tree.params.scheme == Scheme::Envelope
+            && self.tree.params.leaf_choice == LeafChoice::Alias
+            && !self.tree.leaves.is_empty()
+        {
+            // The loop below with the four uniforms of a trial (alias pick, x, y, height)
+            // fetched in one call: the same numbers in the same order.
+            loop {
+                let [u0, u1, u2, u3] = u.next_uniform4();
+                let leaf = self.alias_leaf(u0);
+                let (p, acc) = self.trial_with::<MAP>(leaf, [u1, u2, u3], a);
+                if let Some(f) = acc {
+                    a.samples += 1;
+                    return Sample2 {
+                        point: p,
+                        pdf: f * self.inv_integral,
+                    };
+                }
+                last = p;
+                if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
+                    return self.exhausted(last, a);
+                }
+            }
+        }
         loop {
             let Some(leaf) = self.pick_leaf(u) else {
                 a.trials += 1;

@@ -1,13 +1,14 @@
 //! [`CdfSampler`]: one tabulated (or compressed) CDF per outgoing slice of a BRDF, sampled as a
 //! [`DirectionSampler`] with the nearest slice.
 
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::TAU;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{
     CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SliceLayout,
+    SliceLocator,
 };
 use partition_sampler::UniformSource;
 use rayon::prelude::*;
@@ -148,10 +149,10 @@ pub fn cdf_layout(brdf: &dyn Brdf, options: &CdfOptions) -> SliceLayout {
 /// Every cell of every slice has positive mass (the defensive floor), so `p > 0` on the whole
 /// upper hemisphere and `(1/N) Σ f cos / p` is unbiased for any BRDF, however coarse the slices.
 pub struct CdfSampler<S> {
-    layout: SliceLayout,
-    /// `cos θ` of the θ-slice edges `(j + 1)(π/2)/nθ`, `j = 0..nθ−1` (decreasing): the slice
-    /// choice without `acos`.
-    theta_edges_cos: Vec<f64>,
+    /// The layout and the nearest-slice rule without trigonometry ([`SliceLocator::nearest`]);
+    /// `sample` and `pdf` both use it, so a direction's pdf is always evaluated with the slice
+    /// that sampled it.
+    locator: SliceLocator,
     shape: GridShape,
     slices: Vec<S>,
     report: CdfReport,
@@ -217,12 +218,8 @@ impl<S: SliceCdf> CdfSampler<S> {
             stored_points: slices.iter().map(S::stored_points).sum(),
             grid_evaluations,
         };
-        let theta_edges_cos = (1..layout.theta)
-            .map(|j| (j as f64 * FRAC_PI_2 / layout.theta as f64).cos())
-            .collect();
         Ok(Self {
-            layout,
-            theta_edges_cos,
+            locator: SliceLocator::new(layout),
             shape,
             slices,
             report,
@@ -236,7 +233,7 @@ impl<S: SliceCdf> CdfSampler<S> {
 
     /// The slice layout.
     pub fn layout(&self) -> SliceLayout {
-        self.layout
+        self.locator.layout()
     }
 
     /// The fine grid of every slice.
@@ -250,57 +247,11 @@ impl<S: SliceCdf> CdfSampler<S> {
     }
 }
 
-/// The slice serving an outgoing direction and the rotation `Δ = φo − φ_k` about the normal
-/// that maps the slice's frame to the world, as `(cos Δ, sin Δ)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct SliceFrame {
-    index: usize,
-    cos: f64,
-    sin: f64,
-}
-
-impl<S> CdfSampler<S> {
-    /// The nearest slice of `wo` (the same rule as [`SliceLayout::nearest`]: θ bin, nearest φ
-    /// slice circularly), without trigonometry for isotropic layouts; `None` when `wo` is at or
-    /// below the horizon or not finite. `sample` and `pdf` both use it, so a direction's pdf is
-    /// always evaluated with the slice that sampled it.
-    #[inline]
-    fn frame(&self, wo: &Vec3) -> Option<SliceFrame> {
-        if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
-            return None;
-        }
-        let j = self.theta_edges_cos.partition_point(|&c| wo.z <= c);
-        let r = wo.x.hypot(wo.y);
-        let (cos_o, sin_o) = if r > 0.0 {
-            (wo.x / r, wo.y / r)
-        } else {
-            (1.0, 0.0)
-        };
-        if self.layout.phi == 1 {
-            return Some(SliceFrame {
-                index: j,
-                cos: cos_o,
-                sin: sin_o,
-            });
-        }
-        let phi = sin_o.atan2(cos_o);
-        let period = self.layout.phi_period();
-        let step = period / self.layout.phi as f64;
-        let k = ((phi.rem_euclid(period) / step).round() as usize) % self.layout.phi;
-        let (sin, cos) = (phi - self.layout.phi_of(k)).sin_cos();
-        Some(SliceFrame {
-            index: j * self.layout.phi + k,
-            cos,
-            sin,
-        })
-    }
-}
-
 impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let u0 = u.next_uniform();
         let u1 = u.next_uniform();
-        let Some(f) = self.frame(wo) else {
+        let Some(f) = self.locator.nearest(wo) else {
             return DirSample {
                 wi: Vec3::new(0.0, 0.0, 1.0),
                 pdf: 0.0,
@@ -311,7 +262,7 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
         let (s, c) = p.phi.sin_cos();
         let (x, y) = (r * c, r * s);
         DirSample {
-            wi: Vec3::new(f.cos * x - f.sin * y, f.sin * x + f.cos * y, p.z),
+            wi: f.rotation.apply(&Vec3::new(x, y, p.z)),
             pdf: p.pdf,
         }
     }
@@ -320,12 +271,11 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
         if !(wi.z > 0.0) {
             return 0.0;
         }
-        let Some(f) = self.frame(wo) else {
+        let Some(f) = self.locator.nearest(wo) else {
             return 0.0;
         };
-        let x = f.cos * wi.x + f.sin * wi.y;
-        let y = f.cos * wi.y - f.sin * wi.x;
-        let mut phi = y.atan2(x);
+        let v = f.rotation.undo(wi);
+        let mut phi = v.y.atan2(v.x);
         if phi < 0.0 {
             phi += TAU;
         }
@@ -336,9 +286,9 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
     /// (`z ∈ [a/n_z, (a+1)/n_z)`), cut at [`SliceCdf::phi_edges`] and turned by the slice's
     /// rotation `Δ`; zero below the horizon (the rows tile the upper hemisphere).
     fn pdf_cells(&self, wo: &Vec3) -> Option<PdfCells> {
-        let f = self.frame(wo)?;
+        let f = self.locator.nearest(wo)?;
         let slice = &self.slices[f.index];
-        let turn = f.sin.atan2(f.cos);
+        let turn = f.rotation.angle();
         let n_z = self.shape.n_z;
         let rows = (0..n_z)
             .map(|a| {
@@ -362,41 +312,5 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
 
     fn bytes_used(&self) -> usize {
         self.report.bytes
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cdf::TabulatedCdf;
-
-    #[test]
-    fn the_slice_frame_is_the_layouts_nearest_slice() {
-        let o = CdfOptions {
-            slices: 7,
-            anisotropic_slices: [5, 6],
-            n_z: 2,
-            n_phi: 2,
-            supersampling: 1,
-            ..CdfOptions::default()
-        };
-        for spec in [
-            "phong",
-            "ward:alpha_x=0.1,alpha_y=0.3",
-            "lafortune:cx=-1,cy=-0.5",
-        ] {
-            let brdf = brdf::parse_spec(spec).unwrap();
-            let t = TabulatedCdf::build(brdf.as_ref(), &o).unwrap();
-            for i in 0..500 {
-                let theta = (i as f64 * 0.618).fract() * 89.9;
-                let phi = (i as f64 * 0.377).fract() * 720.0 - 360.0;
-                let wo = brdf::direction_from_angles(theta, phi);
-                let (c, f) = (t.layout().nearest(&wo).unwrap(), t.frame(&wo).unwrap());
-                assert_eq!(c.index, f.index, "{spec} θ {theta} φ {phi}");
-                let (s, co) = c.rotation.sin_cos();
-                assert!((s - f.sin).abs() < 1e-12 && (co - f.cos).abs() < 1e-12);
-            }
-            assert!(t.frame(&Vec3::new(1.0, 0.0, 0.0)).is_none());
-        }
     }
 }
