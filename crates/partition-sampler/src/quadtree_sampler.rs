@@ -396,6 +396,21 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         ([x, y], (z < f).then_some(f))
     }
 
+    /// After an envelope trial at `p` (`acc`: the density when accepted): the sample when it
+    /// was accepted, the exhausted sample when the trials since `start` reached the cap, else
+    /// `None` (try again).
+    #[inline(always)]
+    fn settle(&self, p: Point2, acc: Option<f64>, start: u64, a: &mut Audit) -> Option<Sample2> {
+        if let Some(f) = acc {
+            a.samples += 1;
+            return Some(Sample2 {
+                point: p,
+                pdf: f * self.inv_integral,
+            });
+        }
+        (a.trials - start >= MAX_TRIALS_PER_SAMPLE).then(|| self.exhausted(p, a))
+    }
+
     fn exhausted(&self, p: Point2, a: &mut Audit) -> Sample2 {
         a.exhausted += 1;
         a.samples += 1;
@@ -557,16 +572,8 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                 let [u0, u1, u2, u3] = u.next_uniform4();
                 let leaf = self.alias_leaf(u0);
                 let (p, acc) = self.trial_with::<MAP>(leaf, [u1, u2, u3], a);
-                if let Some(f) = acc {
-                    a.samples += 1;
-                    return Sample2 {
-                        point: p,
-                        pdf: f * self.inv_integral,
-                    };
-                }
-                last = p;
-                if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
-                    return self.exhausted(last, a);
+                if let Some(s) = self.settle(p, acc, start, a) {
+                    return s;
                 }
             }
         }
@@ -581,17 +588,10 @@ impl<D: RegionStats> QuadTreeSampler<D> {
             match self.tree.params.scheme {
                 Scheme::Envelope => {
                     let (p, acc) = self.trial::<MAP, U>(leaf, u, a);
-                    if let Some(f) = acc {
-                        a.samples += 1;
-                        return Sample2 {
-                            point: p,
-                            pdf: f * self.inv_integral,
-                        };
+                    if let Some(s) = self.settle(p, acc, start, a) {
+                        return s;
                     }
                     last = p;
-                    if a.trials - start >= MAX_TRIALS_PER_SAMPLE {
-                        return self.exhausted(last, a);
-                    }
                 }
                 Scheme::Paper => return self.draw_in_leaf::<MAP, U>(leaf, u, a),
             }
