@@ -87,8 +87,8 @@ pub struct SliceChoice {
 
 /// A [`SliceLayout`] with the cosines of its θ-slice edges, for the nearest-slice rule without
 /// `acos`: θ bin `j` holds `wo` when `cos((j+1)·Δθ) < wo.z ≤ cos(j·Δθ)` (found from a
-/// polynomial guess corrected against the edges' cosines), and for isotropic layouts the rotation is `(wo.x, wo.y)/|(wo.x, wo.y)|` — no
-/// trigonometry at all. It chooses the slice [`SliceLayout::nearest`] chooses (up to the
+/// polynomial guess corrected against the edges' cosines), and for isotropic layouts the
+/// rotation is `(wo.x, wo.y)/|(wo.x, wo.y)|` — no trigonometry at all. It chooses the slice [`SliceLayout::nearest`] chooses (up to the
 /// rounding of an edge's cosine).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SliceLocator {
@@ -131,11 +131,6 @@ impl SliceLocator {
             weight: 1.0,
             rotation,
         })
-    }
-
-    /// Bytes held.
-    pub fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>() + self.theta_edges_cos.capacity() * 8
     }
 
     /// The θ bin `j` of `cos θo = z`: the number of edges whose cosine is `≥ z`. A first guess

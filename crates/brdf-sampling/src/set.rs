@@ -565,7 +565,18 @@ impl QuadTreeSet {
                 pdf: 0.0,
             };
         };
-        let s = tree.sample_audited(u, a);
+        self.to_direction_sample(&c, tree, tree.sample_audited(u, a))
+    }
+
+    /// The direction of a disc sample `s` of slice `c`'s tree, turned by the slice's rotation,
+    /// with its pdf w.r.t. solid angle (the set's normalisation) under that slice alone.
+    #[inline]
+    fn to_direction_sample(
+        &self,
+        c: &SliceChoice,
+        tree: &QuadTreeSampler<SliceDensity>,
+        s: Sample2,
+    ) -> DirSample {
         let map = tree.density().map();
         let v = map.to_direction(s.point);
         DirSample {
@@ -594,11 +605,7 @@ impl QuadTreeSet {
         let Some(tree) = self.trees.get(c.index) else {
             return up;
         };
-        let s = draw(tree, u);
-        let map = tree.density().map();
-        let v = map.to_direction(s.point);
-        let wi = c.rotation.apply(&v);
-        let p = map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v);
+        let DirSample { wi, pdf: p } = self.to_direction_sample(&c, tree, draw(tree, u));
         let pdf = if cs[1 - drawn].weight > 0.0 {
             self.combine(&cs, drawn, p, &wi)
         } else {
@@ -750,17 +757,10 @@ impl DirectionSampler for QuadTreeSet {
                     return Vec::new();
                 };
                 let batch = tree.sample_batch(n, AllocationMode::RandomizedRemainder, u);
-                let map = tree.density().map();
                 batch
                     .samples
                     .iter()
-                    .map(|s| {
-                        let v = map.to_direction(s.point);
-                        DirSample {
-                            wi: c.rotation.apply(&v),
-                            pdf: map.area_to_solid_angle(s.pdf * self.norm_factor(c.index), &v),
-                        }
-                    })
+                    .map(|s| self.to_direction_sample(&c, tree, *s))
                     .collect()
             }
             _ => (0..n).map(|_| self.sample(wo, u)).collect(),
