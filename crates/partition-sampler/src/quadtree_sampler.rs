@@ -465,29 +465,32 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         let mut zs = [0.0f64; TRIAL_BLOCK];
         let mut bounds = [0.0f64; TRIAL_BLOCK];
         let mut fs = [0.0f64; TRIAL_BLOCK];
-        let mut picked = [false; TRIAL_BLOCK];
+        let mut us = [[0.0f64; 4]; TRIAL_BLOCK];
+        let mut picks = [0usize; TRIAL_BLOCK];
         let mut filled = 0;
         let mut since = 0u64;
-        let mut last = centre;
         while filled < out.len() {
             let k = (out.len() - filled).min(TRIAL_BLOCK);
+            // Three passes, each free of data-dependent branches so that the cache misses of
+            // a block overlap: the uniforms of every trial and its alias column (pick_leaf's
+            // alias branch, chosen by a select), then the picked leaf's point and height
+            // (trial's), then the densities.
             for j in 0..k {
-                // pick_leaf's alias branch, then trial's point and height.
-                let s = u.next_uniform() * nf;
+                us[j] = u.next_uniform4();
+                let s = us[j][0] * nf;
                 let i = (s as usize).min(n - 1);
                 let first = &leaves[i];
-                let leaf = if s - (i as f64) < first.prob {
-                    Some(first)
+                let alias = first.alias as usize;
+                picks[j] = if s - (i as f64) < first.prob || alias >= n {
+                    i
                 } else {
-                    leaves.get(first.alias as usize)
+                    alias
                 };
-                let Some(leaf) = leaf else {
-                    picked[j] = false;
-                    points[j] = centre;
-                    continue;
-                };
-                let s = f64::from(leaf.u0) + u.next_uniform() * f64::from(leaf.du);
-                let t = f64::from(leaf.v0) + u.next_uniform() * f64::from(leaf.dv);
+            }
+            for j in 0..k {
+                let leaf = &leaves[picks[j]];
+                let s = f64::from(leaf.u0) + us[j][1] * f64::from(leaf.du);
+                let t = f64::from(leaf.v0) + us[j][2] * f64::from(leaf.dv);
                 points[j] = if MAP {
                     [self.frame.domain_coord(0, s), self.frame.domain_coord(1, t)]
                 } else {
@@ -495,36 +498,28 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                 };
                 let m = leaf.bound(self.bound_scale);
                 bounds[j] = m;
-                zs[j] = u.next_uniform() * m;
-                picked[j] = true;
+                zs[j] = us[j][3] * m;
             }
             self.density.eval_block(&points[..k], &mut fs[..k]);
             for j in 0..k {
                 a.trials += 1;
                 since += 1;
-                if picked[j] {
-                    let f = fs[j];
-                    if f > bounds[j] {
-                        a.violations += 1;
-                    }
-                    if zs[j] < f {
-                        a.samples += 1;
-                        out[filled] = Sample2 {
-                            point: points[j],
-                            pdf: f * self.inv_integral,
-                        };
-                        filled += 1;
-                        since = 0;
-                        last = centre;
-                        continue;
-                    }
-                    last = points[j];
+                let f = fs[j];
+                if f > bounds[j] {
+                    a.violations += 1;
                 }
-                if since >= MAX_TRIALS_PER_SAMPLE {
-                    out[filled] = self.exhausted(last, a);
+                if zs[j] < f {
+                    a.samples += 1;
+                    out[filled] = Sample2 {
+                        point: points[j],
+                        pdf: f * self.inv_integral,
+                    };
                     filled += 1;
                     since = 0;
-                    last = centre;
+                } else if since >= MAX_TRIALS_PER_SAMPLE {
+                    out[filled] = self.exhausted(points[j], a);
+                    filled += 1;
+                    since = 0;
                 }
             }
         }

@@ -62,7 +62,8 @@ use chebyshev::{ChebyshevTable, lobatto_nodes};
 use density::{IntervalEnvelope, QueryDensity};
 
 /// The largest outgoing polar angle the nodes use (degrees): `f_r` at exactly 90° is 0 or
-/// undefined. Queries above it are served by the last interval with `A` clamped to this angle.
+/// undefined. A query above it is served as the direction of the same azimuth at this angle
+/// (samples ∝ `f_r(ωo', ·) cos θi`, pdf normalised, bounds valid; `f_r` may diverge there).
 pub const THETA_TOP_DEG: f64 = 89.99;
 
 /// Settings of [`ExactSet`]. `set` supplies the tree parameters, image map, safety factor,
@@ -331,6 +332,9 @@ struct Job {
 struct Query {
     cell: usize,
     interval: usize,
+    /// The outgoing direction served: the query's, or above [`THETA_TOP_DEG`] the direction of
+    /// the same azimuth at that angle.
+    wo: Vec3,
     theta: f64,
     /// `cos θo`.
     cos: f64,
@@ -515,7 +519,18 @@ impl ExactSet {
         if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
             return None;
         }
-        let theta = wo.z.min(1.0).acos();
+        let top = THETA_TOP_DEG.to_radians();
+        let mut theta = wo.z.min(1.0).acos();
+        let mut served = *wo;
+        if theta > top {
+            // f_r at grazing θo may diverge (1/cos θo factors) where no bound node was put:
+            // serve the direction at `top` (same azimuth) instead, so that the bounds hold and
+            // the pdf stays normalised; the law differs from f_r(ωo, ·) cos θi only there.
+            let (s, r) = (top.sin(), wo.x.hypot(wo.y));
+            served = Vec3::new(wo.x / r * s, wo.y / r * s, top.cos());
+            theta = top;
+        }
+        let wo = &served;
         let phi = wo.y.atan2(wo.x);
         let (cell, rot, delta) = if self.isotropic {
             (0, phi, 0.0)
@@ -538,6 +553,7 @@ impl ExactSet {
         Some(Query {
             cell,
             interval,
+            wo: served,
             theta,
             cos: wo.z.min(1.0),
             delta,
@@ -556,7 +572,7 @@ impl ExactSet {
     ) -> Option<(DirSample, &QuadTreeSampler<SliceDensity>)> {
         let q = self.locate(wo)?;
         let iv = self.interval(&q);
-        let g = QueryDensity::new(self.brdf.as_ref(), *wo, q.rot, iv.map);
+        let g = QueryDensity::new(self.brdf.as_ref(), q.wo, q.rot, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
         let s = match drawn {
             Some((x, gx)) => {
@@ -615,6 +631,41 @@ impl ExactSet {
             exhausted: total.exhausted,
         }
     }
+}
+
+/// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
+/// moving mirror direction (see [`peak_track`]).
+const PEAK_TRACK_THETAS: usize = 65;
+
+/// Azimuth offsets per anisotropic cell for the same track.
+const PEAK_TRACK_DELTAS: usize = 9;
+
+/// The peak track of an interval `[ta, tb]` of cell `phi_k` (azimuth offsets `deltas`): for
+/// every outgoing direction `(θ, φ_k + δ)` of a fine grid, its mirror direction's point in the
+/// interval's frame and disc map, and the member density there (`QueryDensity`).
+fn peak_track<'a>(
+    brdf: &'a dyn Brdf,
+    ta: f64,
+    tb: f64,
+    phi_k: f64,
+    deltas: &[f64],
+    map: DiscMap,
+) -> Vec<crate::image_map::TrackPoint<'a>> {
+    let mut track = Vec::new();
+    for n in 0..PEAK_TRACK_THETAS {
+        let t = ta + (tb - ta) * n as f64 / (PEAK_TRACK_THETAS - 1) as f64;
+        for &d in deltas {
+            let wo = direction_from_radians(t, phi_k + d);
+            let g = QueryDensity::new(brdf, wo, d, map);
+            // `g` evaluates f(ωo, R_d v): its peak is at v = R_{−d} mirror(ωo).
+            let at = map.to_disc(&rotate_z(&brdf::mirror(&wo), -d));
+            track.push(crate::image_map::TrackPoint {
+                at,
+                density: Box::new(move |p| g.at(p)),
+            });
+        }
+    }
+    track
 }
 
 /// Builds the tree and normaliser table of one interval.
@@ -682,6 +733,16 @@ fn build_interval(
         phi_deg,
         source,
     })?;
+    // The members' peaks: the mirror direction of every outgoing direction of the interval
+    // moves with θo (and δ), and a cusp there (Beard–Maxwell) falls between the bound nodes'.
+    let image = image.with_track(peak_track(
+        brdf.as_ref(),
+        ta,
+        tb,
+        phi_k,
+        &deltas(PEAK_TRACK_DELTAS),
+        map,
+    ));
     let params = TreeParams {
         scheme: Scheme::Envelope,
         leaf_choice: LeafChoice::Alias,
@@ -787,7 +848,7 @@ impl DirectionSampler for ExactSet {
             return 0.0;
         };
         let a = self.interval(&q).normaliser(&q);
-        self.brdf.eval(wo, wi) * wi.z / a
+        self.brdf.eval(&q.wo, wi) * wi.z / a
     }
 
     fn bound_violations(&self) -> Option<u64> {

@@ -243,6 +243,7 @@ impl Sampler2D for PiecewiseConstant2D {
         let mut cols = [0.0f64; BLOCK];
         let mut rows = [(0usize, 0.0f64); BLOCK];
         let mut starts = [0u32; BLOCK];
+        let mut firsts = [0.0f64; BLOCK];
         for chunk in out.chunks_mut(BLOCK) {
             for j in 0..chunk.len() {
                 let u0 = clamp_unit(u.next_uniform());
@@ -254,6 +255,13 @@ impl Sampler2D for PiecewiseConstant2D {
                 rows[j] = (row, dv);
                 starts[j] = self.conditional_guide[row * w + g];
             }
+            // Second stage: the conditional entry each scan starts from, loaded for the whole
+            // block in a branch-free loop, so that these misses overlap too (in the scan loop
+            // below they would wait behind its data-dependent branches).
+            for j in 0..chunk.len() {
+                firsts[j] = self.conditional[rows[j].0 * (w + 1) + starts[j] as usize][0];
+            }
+            std::hint::black_box(&firsts);
             for (j, slot) in chunk.iter_mut().enumerate() {
                 let (row, dv) = rows[j];
                 let start = row * (w + 1);
