@@ -5,8 +5,8 @@
 //! `/proc/thread-self/stat`, Linux; the figure to quote on a loaded machine), the wall time,
 //! and the BRDF evaluations per sample.
 //!
-//! `cargo run --release -p brdf-sampling --example set_loop -- [SPEC|all] [N]` (defaults
-//! `phong`, 2 000 000). `all` runs every model of `brdf::models()` at its defaults and a
+//! `cargo run --release -p brdf-sampling --example set_loop -- [SPEC|all] [N] [adaptive|exact]`
+//! (defaults `phong`, 2 000 000, `adaptive`; `exact` builds the `adaptive-exact` set instead). `all` runs every model of `brdf::models()` at its defaults and a
 //! synthetic MERL table (`merl(phong:n=50)`, as `model_table` does) and prints the mean
 //! samples/s; `merl(SPEC)` tabulates SPEC in the MERL layout.
 
@@ -14,7 +14,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use brdf::parse_spec;
-use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant, thread_evaluations};
+use brdf_sampling::{
+    DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SetOptions, Variant, thread_evaluations,
+};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
@@ -30,14 +32,28 @@ fn thread_cpu_seconds() -> Option<f64> {
 
 /// One line per spec: CPU and wall time per sample, evaluations per sample; returns M samples/s
 /// from the thread's CPU time (wall time where CPU time is unavailable).
-fn run(spec: &str, n: usize) -> Result<f64, Box<dyn std::error::Error>> {
+fn run(spec: &str, n: usize, exact: bool) -> Result<f64, Box<dyn std::error::Error>> {
     let brdf: Arc<dyn brdf::Brdf> =
         if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
             Arc::new(brdf::MerlBrdf::tabulate(&*parse_spec(inner)?))
         } else {
             Arc::from(parse_spec(spec)?)
         };
-    let set = QuadTreeSet::build(brdf, Variant::Adaptive, &SetOptions::default())?;
+    if exact {
+        let set = ExactSet::build(brdf, &ExactOptions::default(), None)?;
+        time_loop(spec, &set, n)
+    } else {
+        let set = QuadTreeSet::build(brdf, Variant::Adaptive, &SetOptions::default())?;
+        time_loop(spec, &set, n)
+    }
+}
+
+/// Times `n` samples of `set` (see the module docs) and prints one line.
+fn time_loop<S: DirectionSampler>(
+    spec: &str,
+    set: &S,
+    n: usize,
+) -> Result<f64, Box<dyn std::error::Error>> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
     let wos: Vec<_> = (0..1024)
         .map(|_| {
@@ -71,8 +87,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(2_000_000);
+    let exact = match args.get(2).map(String::as_str) {
+        None | Some("adaptive") => false,
+        Some("exact") => true,
+        Some(other) => return Err(format!("unknown sampler {other} (adaptive|exact)").into()),
+    };
     if spec != "all" {
-        run(spec, n)?;
+        run(spec, n, exact)?;
         return Ok(());
     }
     let mut specs: Vec<String> = brdf::models()
@@ -83,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     specs.push("merl(phong:n=50)".to_string());
     let mut rates = Vec::new();
     for s in &specs {
-        rates.push(run(s, n)?);
+        rates.push(run(s, n, exact)?);
     }
     println!(
         "mean over {} models: {:.2} M samples/s (CPU time)",

@@ -74,6 +74,41 @@ pub(crate) fn tail_estimate(values: &[f64]) -> f64 {
     coeff(n - 1).abs() + coeff(n - 2).abs()
 }
 
+/// The Chebyshev series `p(x) = Σ_k b_k T_k(x)` of the polynomial interpolating `values` at
+/// the Lobatto nodes `x_j = cos(π j/m)`, `m = n − 1` (the order of [`lobatto_nodes`], mapped
+/// to `[−1, 1]`): `b_k = (2/m) Σ''_j v_j cos(π j k/m)`, halved for `k = 0` and `k = m`
+/// (`Σ''`: first and last terms halved; a type-I discrete cosine transform).
+pub(crate) fn chebyshev_series(values: &[f64]) -> Vec<f64> {
+    let n = values.len();
+    if n < 2 {
+        return values.to_vec();
+    }
+    let m = (n - 1) as f64;
+    (0..n)
+        .map(|k| {
+            let mut s = 0.0;
+            for (j, v) in values.iter().enumerate() {
+                let w = if j == 0 || j == n - 1 { 0.5 } else { 1.0 };
+                s += w * v * (std::f64::consts::PI * (j * k) as f64 / m).cos();
+            }
+            let b = 2.0 * s / m;
+            if k == 0 || k == n - 1 { 0.5 * b } else { b }
+        })
+        .collect()
+}
+
+/// `Σ_k b_k T_k(x)` by Clenshaw's recurrence (`2n` multiply-adds, no division).
+#[inline]
+pub(crate) fn clenshaw(series: &[f64], x: f64) -> f64 {
+    let (mut y1, mut y2) = (0.0, 0.0);
+    for &b in series.iter().skip(1).rev() {
+        let y = 2.0 * x * y1 - y2 + b;
+        y2 = y1;
+        y1 = y;
+    }
+    x * y1 - y2 + series.first().copied().unwrap_or(0.0)
+}
+
 /// A tensor Chebyshev–Lobatto table over `θ ∈ [θ_a, θ_b]` × `δ ∈ [−h, h]` (one δ node when the
 /// BRDF is isotropic).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,16 +117,43 @@ pub(crate) struct ChebyshevTable {
     pub(crate) delta: Vec<f64>,
     /// `values[i · delta.len() + k]` at `(theta[i], delta[k])`.
     pub(crate) values: Vec<f64>,
+    /// One δ node: the θ interpolant as a Chebyshev series ([`chebyshev_series`]), evaluated by
+    /// Clenshaw's recurrence (the same polynomial as the barycentric formula, without its
+    /// `n` divisions per query); empty otherwise.
+    series: Vec<f64>,
+    /// `(θ_a + θ_b)/2` and `2/(θ_b − θ_a)` (0 for a one-point interval): `x = (θ − centre)·scale`.
+    centre: f64,
+    scale: f64,
 }
 
 impl ChebyshevTable {
+    /// The table of `values` (`values[i · delta.len() + k]` at `(theta[i], delta[k])`, nodes
+    /// from [`lobatto_nodes`]).
+    pub(crate) fn new(theta: Vec<f64>, delta: Vec<f64>, values: Vec<f64>) -> Self {
+        let (lo, hi) = (theta[theta.len() - 1], theta[0]);
+        let series = if delta.len() == 1 {
+            chebyshev_series(&values)
+        } else {
+            Vec::new()
+        };
+        Self {
+            series,
+            centre: 0.5 * (lo + hi),
+            scale: if hi > lo { 2.0 / (hi - lo) } else { 0.0 },
+            theta,
+            delta,
+            values,
+        }
+    }
+
     /// The interpolant at `(θ, δ)` (arguments outside the box are clamped to it).
     pub(crate) fn eval(&self, theta: f64, delta: f64) -> f64 {
         let nd = self.delta.len();
         let (lo, hi) = (self.theta[self.theta.len() - 1], self.theta[0]);
         let t = theta.clamp(lo, hi);
         if nd == 1 {
-            return interpolate(&self.theta, &self.values, t);
+            let x = ((t - self.centre) * self.scale).clamp(-1.0, 1.0);
+            return clenshaw(&self.series, x);
         }
         let (dlo, dhi) = (self.delta[nd - 1], self.delta[0]);
         let d = delta.clamp(dlo, dhi);
@@ -188,6 +250,25 @@ mod tests {
         }
     }
 
+    proptest! {
+        /// The Clenshaw series of a one-angle table is the barycentric interpolant.
+        #[test]
+        fn series_is_the_interpolant(a in -2.0f64..2.0, w in 0.01f64..3.0, n in 1usize..18,
+                                     v in proptest::collection::vec(0.1f64..10.0, 18),
+                                     s in 0.0f64..1.0) {
+            let nodes = lobatto_nodes(a, a + w, n);
+            let values = v[..n].to_vec();
+            let table = ChebyshevTable::new(nodes.clone(), vec![0.0], values.clone());
+            let t = a + s * w;
+            let exact = interpolate(&nodes, &values, t);
+            prop_assert!((table.eval(t, 0.0) - exact).abs() <= 1e-12 * 10.0 * n as f64,
+                "{} vs {}", table.eval(t, 0.0), exact);
+            for (j, &x) in nodes.iter().enumerate() {
+                prop_assert!((table.eval(x, 0.0) - values[j]).abs() <= 1e-12 * 10.0 * n as f64);
+            }
+        }
+    }
+
     #[test]
     fn tensor_table_interpolates_both_angles() {
         let f = |t: f64, d: f64| (t.cos() + 0.3) * (1.0 + 0.2 * (2.0 * d).cos());
@@ -197,11 +278,7 @@ mod tests {
             .iter()
             .flat_map(|&t| delta.iter().map(move |&d| f(t, d)))
             .collect();
-        let table = ChebyshevTable {
-            theta,
-            delta,
-            values,
-        };
+        let table = ChebyshevTable::new(theta, delta, values);
         for (t, d) in [(0.1, 0.0), (0.27, -0.13), (0.4, 0.2), (0.33, 0.05)] {
             assert!((table.eval(t, d) - f(t, d)).abs() < 1e-10, "{t} {d}");
         }

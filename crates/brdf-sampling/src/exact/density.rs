@@ -8,6 +8,7 @@ use brdf::{Brdf, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
 
 use crate::disc::{DiscMap, count_evaluations};
+use crate::layout::Turn;
 
 /// The disc density of `f_r(ωo, R_rot ·) cos θi` at one outgoing direction:
 /// `g(x) = f_r(ωo, R_rot h⁻¹(x))` (projected map) or `2 f_r(ωo, R_rot h_e⁻¹(x)) cos θi`
@@ -48,6 +49,35 @@ impl<'a> QueryDensity<'a> {
                 brdf,
                 wo,
                 rot: Some(rot.sin_cos()),
+                map,
+            }
+        }
+    }
+
+    /// [`QueryDensity::new`] for the rotation `turn` held as `(cos, sin)`: an isotropic BRDF is
+    /// evaluated at `R_{−turn} ωo` (no trigonometry), an anisotropic one rotates the trial
+    /// points.
+    #[inline]
+    pub(crate) fn in_frame(brdf: &'a dyn Brdf, wo: &Vec3, turn: Turn, map: DiscMap) -> Self {
+        if turn == Turn::IDENTITY {
+            Self {
+                brdf,
+                wo: *wo,
+                rot: None,
+                map,
+            }
+        } else if brdf.is_isotropic() {
+            Self {
+                brdf,
+                wo: turn.undo(wo),
+                rot: None,
+                map,
+            }
+        } else {
+            Self {
+                brdf,
+                wo: *wo,
+                rot: Some((turn.sin, turn.cos)),
                 map,
             }
         }

@@ -45,8 +45,8 @@ use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3, direction_from_radians, rotate_z};
 use partition_sampler::{
-    Audit, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sampler2D, Scheme,
-    TreeParams, UniformSource,
+    Audit, AuditCounters, GridOptions, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Sampler2D,
+    Scheme, TreeParams, UniformSource,
 };
 use rayon::prelude::*;
 
@@ -54,6 +54,7 @@ use crate::direction_sampler::{DirSample, DirectionSampler};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
+use crate::layout::Turn;
 use crate::normalisation::per_leaf_quadrature;
 use crate::options::{OptionsError, SetOptions};
 use crate::set::layout_for;
@@ -229,6 +230,57 @@ struct Cell {
     /// Upper θ edges of the intervals (radians), increasing; the last is π/2.
     upper: Vec<f64>,
     intervals: Vec<Interval>,
+    /// Guide table over θ ∈ [0, π/2]: `guide[g]` is the interval of `θ = g · π/2 / GUIDE_LEN`,
+    /// where the search for any θ of bucket `g` starts (see [`Cell::interval_of`]).
+    guide: Vec<u32>,
+}
+
+/// Buckets of a cell's guide table.
+const GUIDE_LEN: usize = 256;
+
+impl Cell {
+    fn new(phi: f64, upper: Vec<f64>, intervals: Vec<Interval>) -> Self {
+        let guide = interval_guide(&upper);
+        Self {
+            phi,
+            upper,
+            intervals,
+            guide,
+        }
+    }
+
+    #[inline]
+    fn interval_of(&self, theta: f64) -> usize {
+        guided_interval(&self.upper, &self.guide, theta)
+    }
+}
+
+/// The guide table of the interval edges `upper` (increasing, not empty): entry `g` is the
+/// interval of `θ = g · π/2 / GUIDE_LEN`.
+fn interval_guide(upper: &[f64]) -> Vec<u32> {
+    let step = std::f64::consts::FRAC_PI_2 / GUIDE_LEN as f64;
+    let last = upper.len().saturating_sub(1);
+    (0..GUIDE_LEN)
+        .map(|g| upper.partition_point(|&u| u < g as f64 * step).min(last) as u32)
+        .collect()
+}
+
+/// The first interval whose upper edge is ≥ θ (the last one when none is): the binary search
+/// `upper.partition_point(|u| u < θ)`, by a scan from the guide table's bucket of θ (usually
+/// zero or one step; down only if rounding put θ in the bucket above its own).
+#[inline]
+fn guided_interval(upper: &[f64], guide: &[u32], theta: f64) -> usize {
+    let last = upper.len() - 1;
+    let g =
+        ((theta * (GUIDE_LEN as f64 / std::f64::consts::FRAC_PI_2)) as usize).min(GUIDE_LEN - 1);
+    let mut i = (guide[g] as usize).min(last);
+    while i > 0 && upper[i - 1] >= theta {
+        i -= 1;
+    }
+    while i < last && upper[i] < theta {
+        i += 1;
+    }
+    i
 }
 
 /// The layout and statistics of an [`ExactSet`].
@@ -308,6 +360,10 @@ pub struct ExactSet {
     period: f64,
     cells: Vec<Cell>,
     build_time: Duration,
+    /// Trials, samples and violations of the set's own `sample` calls, counted set-wide (one
+    /// thread-local buffer for every tree: at random θo consecutive samples use different
+    /// trees); `measure_cost` records into the trees.
+    counters: AuditCounters,
 }
 
 impl std::fmt::Debug for ExactSet {
@@ -339,7 +395,8 @@ struct Query {
     /// `cos θo`.
     cos: f64,
     delta: f64,
-    rot: f64,
+    /// The rotation about the normal from the tree's frame to the world's.
+    turn: Turn,
 }
 
 impl ExactSet {
@@ -416,18 +473,18 @@ impl ExactSet {
                 .partial_cmp(&(b.0.cell, b.0.theta[0]))
                 .unwrap_or(std::cmp::Ordering::Equal)
         });
-        let mut cells: Vec<Cell> = (0..n_cells)
-            .map(|k| Cell {
-                phi: layout.phi_of(k),
-                upper: Vec::new(),
-                intervals: Vec::new(),
-            })
-            .collect();
+        let mut per_cell: Vec<(Vec<f64>, Vec<Interval>)> =
+            (0..n_cells).map(|_| (Vec::new(), Vec::new())).collect();
         for (job, iv) in done {
-            let c = &mut cells[job.cell];
-            c.upper.push(job.theta[1]);
-            c.intervals.push(iv);
+            let c = &mut per_cell[job.cell];
+            c.0.push(job.theta[1]);
+            c.1.push(iv);
         }
+        let cells: Vec<Cell> = per_cell
+            .into_iter()
+            .enumerate()
+            .map(|(k, (upper, intervals))| Cell::new(layout.phi_of(k), upper, intervals))
+            .collect();
         Ok(Self {
             brdf,
             options: *options,
@@ -435,6 +492,7 @@ impl ExactSet {
             period,
             cells,
             build_time: start.elapsed(),
+            counters: AuditCounters::new(),
         })
     }
 
@@ -480,7 +538,8 @@ impl ExactSet {
     /// Layout, cost and audit figures.
     pub fn report(&self) -> ExactReport {
         let all = || self.cells.iter().flat_map(|c| c.intervals.iter());
-        let (mut violations, mut samples, mut trials) = (0, 0, 0u64);
+        let own = self.counters.snapshot();
+        let (mut violations, mut samples, mut trials) = (own.violations, own.samples, own.trials);
         for iv in all() {
             let s = iv.tree.stats();
             violations += s.bound_violations;
@@ -526,15 +585,26 @@ impl ExactSet {
             // f_r at grazing θo may diverge (1/cos θo factors) where no bound node was put:
             // serve the direction at `top` (same azimuth) instead, so that the bounds hold and
             // the pdf stays normalised; the law differs from f_r(ωo, ·) cos θi only there.
-            let (s, r) = (top.sin(), wo.x.hypot(wo.y));
+            let (s, r) = (top.sin(), (wo.x * wo.x + wo.y * wo.y).sqrt());
             served = Vec3::new(wo.x / r * s, wo.y / r * s, top.cos());
             theta = top;
         }
         let wo = &served;
-        let phi = wo.y.atan2(wo.x);
-        let (cell, rot, delta) = if self.isotropic {
-            (0, phi, 0.0)
+        let (cell, turn, delta) = if self.isotropic {
+            // The rotation that takes the frame's ωo (at φ = 0) to the query's, without
+            // trigonometry: (cos φo, sin φo) = (x, y)/r.
+            let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
+            let turn = if r > 0.0 {
+                Turn {
+                    cos: wo.x / r,
+                    sin: wo.y / r,
+                }
+            } else {
+                Turn::IDENTITY
+            };
+            (0, turn, 0.0)
         } else {
+            let phi = wo.y.atan2(wo.x);
             let n = self.cells.len();
             let step = self.period / n as f64;
             let k = ((phi.rem_euclid(self.period) / step).round() as usize) % n;
@@ -543,13 +613,9 @@ impl ExactSet {
             if delta > 0.5 * self.period {
                 delta -= self.period;
             }
-            (k, rot, delta)
+            (k, Turn::from_angle(rot), delta)
         };
-        let c = &self.cells[cell];
-        let interval = c
-            .upper
-            .partition_point(|&u| u < theta)
-            .min(c.intervals.len() - 1);
+        let interval = self.cells[cell].interval_of(theta);
         Some(Query {
             cell,
             interval,
@@ -557,7 +623,7 @@ impl ExactSet {
             theta,
             cos: wo.z.min(1.0),
             delta,
-            rot,
+            turn,
         })
     }
 
@@ -572,14 +638,14 @@ impl ExactSet {
     ) -> Option<(DirSample, &QuadTreeSampler<SliceDensity>)> {
         let q = self.locate(wo)?;
         let iv = self.interval(&q);
-        let g = QueryDensity::new(self.brdf.as_ref(), q.wo, q.rot, iv.map);
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), &q.wo, q.turn, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
         let s = match drawn {
             Some((x, gx)) => {
                 let a = iv.normaliser(&q);
                 let v = iv.map.to_direction(x);
                 DirSample {
-                    wi: rotate_z(&v, q.rot),
+                    wi: q.turn.apply(&v),
                     pdf: iv.map.area_to_solid_angle(gx / a, &v),
                 }
             }
@@ -787,11 +853,7 @@ fn build_interval(
                 values.push(r.total * t.cos());
             }
         }
-        let table = ChebyshevTable {
-            theta: theta_nodes.clone(),
-            delta: delta_nodes,
-            values,
-        };
+        let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
         if half == 0.0 || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
@@ -828,8 +890,8 @@ impl DirectionSampler for ExactSet {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let mut a = Audit::default();
         match self.draw(wo, u, &mut a) {
-            Some((s, tree)) => {
-                tree.record_one_sample(&a);
+            Some((s, _)) => {
+                self.counters.record(&a);
                 s
             }
             None => DirSample {
@@ -852,13 +914,13 @@ impl DirectionSampler for ExactSet {
     }
 
     fn bound_violations(&self) -> Option<u64> {
-        Some(
-            self.cells
-                .iter()
-                .flat_map(|c| c.intervals.iter())
-                .map(|iv| iv.tree.stats().bound_violations)
-                .sum(),
-        )
+        let trees: u64 = self
+            .cells
+            .iter()
+            .flat_map(|c| c.intervals.iter())
+            .map(|iv| iv.tree.stats().bound_violations)
+            .sum();
+        Some(trees + self.counters.snapshot().violations)
     }
 
     fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {

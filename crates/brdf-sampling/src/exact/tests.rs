@@ -137,3 +137,28 @@ fn invalid_options_are_refused() {
         Err(ExactError::Invalid { .. })
     ));
 }
+
+proptest::proptest! {
+    /// The guided interval search is the binary search, at random angles, at the edges and at
+    /// their float neighbours.
+    #[test]
+    fn guided_interval_search_is_the_binary_search(
+        cuts in proptest::collection::vec(0.0f64..1.0, 0..60),
+        probes in proptest::collection::vec(0.0f64..1.0, 50),
+    ) {
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let mut upper: Vec<f64> = cuts.iter().map(|c| c * half_pi).collect();
+        upper.sort_by(f64::total_cmp);
+        upper.dedup();
+        upper.push(half_pi);
+        let guide = interval_guide(&upper);
+        let last = upper.len() - 1;
+        let mut thetas: Vec<f64> = probes.iter().map(|p| p * half_pi).collect();
+        thetas.extend(upper.iter().flat_map(|&u| [u, u.next_down(), u.next_up().min(half_pi)]));
+        thetas.extend((0..=GUIDE_LEN).map(|g| g as f64 * half_pi / GUIDE_LEN as f64));
+        for t in thetas.into_iter().map(|t| t.max(0.0)) {
+            let expected = upper.partition_point(|&u| u < t).min(last);
+            proptest::prop_assert_eq!(guided_interval(&upper, &guide, t), expected, "θ = {}", t);
+        }
+    }
+}

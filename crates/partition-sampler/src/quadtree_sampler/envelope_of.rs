@@ -9,6 +9,7 @@
 //! trials is `Σ V_i / ∫ g`.
 
 use super::QuadTreeSampler;
+use crate::LeafChoice;
 use crate::audit::{Audit, record_one};
 use crate::contract::{Point2, UniformSource};
 use crate::density::RegionStats;
@@ -41,25 +42,35 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         U: UniformSource + ?Sized,
     {
         let start = audit.trials;
+        let alias =
+            self.tree.params.leaf_choice == LeafChoice::Alias && !self.tree.leaves.is_empty();
         loop {
             if audit.trials - start >= crate::MAX_TRIALS_PER_SAMPLE {
                 audit.exhausted += 1;
                 audit.samples += 1;
                 return None;
             }
-            let Some(leaf) = self.pick_leaf(u) else {
-                audit.trials += 1;
-                continue;
+            // The leaf pick's uniform and the trial's three, in this order; with the alias
+            // table (one uniform per pick) in one call (one dynamic call per trial).
+            let (leaf, us) = if alias {
+                let us = u.next_uniform4();
+                (self.alias_leaf(us[0]), [us[1], us[2], us[3]])
+            } else {
+                let Some(leaf) = self.pick_leaf(u) else {
+                    audit.trials += 1;
+                    continue;
+                };
+                (leaf, [u.next_uniform(), u.next_uniform(), u.next_uniform()])
             };
-            let s = f64::from(leaf.u0) + u.next_uniform() * f64::from(leaf.du);
-            let t = f64::from(leaf.v0) + u.next_uniform() * f64::from(leaf.dv);
+            let s = f64::from(leaf.u0) + us[0] * f64::from(leaf.du);
+            let t = f64::from(leaf.v0) + us[1] * f64::from(leaf.dv);
             let (x, y) = if self.identity {
                 (s, t)
             } else {
                 (self.frame.domain_coord(0, s), self.frame.domain_coord(1, t))
             };
             let m = leaf.bound(self.bound_scale);
-            let z = u.next_uniform() * m;
+            let z = us[2] * m;
             audit.trials += 1;
             if self.disc && x * x + y * y >= 1.0 {
                 continue;
