@@ -298,21 +298,28 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         crate::sample_par(self, n, seed)
     }
 
-    /// The alias table's leaf for the uniform `u0`: column `i = ⌊u0·n⌋`, kept when the
-    /// fraction `u0·n − i` is below its probability, else its alias. `leaves` must not be
-    /// empty.
+    /// The alias table's leaf index for the uniform `u0`: column `i = ⌊u0·n⌋`, kept when the
+    /// fraction `u0·n − i` is below its probability, else its alias (`i` if the alias is out
+    /// of range). `leaves` must not be empty.
     #[inline(always)]
-    fn alias_leaf(&self, u0: f64) -> &Leaf {
+    fn alias_index(&self, u0: f64) -> usize {
         let leaves = &self.tree.leaves;
         let n = leaves.len();
         let s = u0 * n as f64;
         let i = (s as usize).min(n - 1);
-        let leaf = &leaves[i];
-        if s - (i as f64) < leaf.prob {
-            leaf
+        let first = &leaves[i];
+        let alias = first.alias as usize;
+        if s - (i as f64) < first.prob || alias >= n {
+            i
         } else {
-            leaves.get(leaf.alias as usize).unwrap_or(leaf)
+            alias
         }
+    }
+
+    /// The leaf of [`Self::alias_index`].
+    #[inline(always)]
+    fn alias_leaf(&self, u0: f64) -> &Leaf {
+        &self.tree.leaves[self.alias_index(u0)]
     }
 
     #[inline(always)]
@@ -458,8 +465,6 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         a: &mut Audit,
     ) {
         let leaves = &self.tree.leaves;
-        let n = leaves.len();
-        let nf = n as f64;
         let centre = self.tree.root.center();
         let mut points = [centre; TRIAL_BLOCK];
         let mut zs = [0.0f64; TRIAL_BLOCK];
@@ -477,15 +482,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
             // (trial's), then the densities.
             for j in 0..k {
                 us[j] = u.next_uniform4();
-                let s = us[j][0] * nf;
-                let i = (s as usize).min(n - 1);
-                let first = &leaves[i];
-                let alias = first.alias as usize;
-                picks[j] = if s - (i as f64) < first.prob || alias >= n {
-                    i
-                } else {
-                    alias
-                };
+                picks[j] = self.alias_index(us[j][0]);
             }
             for j in 0..k {
                 let leaf = &leaves[picks[j]];

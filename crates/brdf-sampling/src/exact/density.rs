@@ -30,28 +30,7 @@ impl<'a> QueryDensity<'a> {
     /// at `R_{−rot} ωo` instead (the same value, `f(ωo, R ωi) = f(R⁻¹ωo, ωi)`), which saves
     /// the rotation of every trial point.
     pub(crate) fn new(brdf: &'a dyn Brdf, wo: Vec3, rot: f64, map: DiscMap) -> Self {
-        if rot == 0.0 {
-            Self {
-                brdf,
-                wo,
-                rot: None,
-                map,
-            }
-        } else if brdf.is_isotropic() {
-            Self {
-                brdf,
-                wo: rotate_z(&wo, -rot),
-                rot: None,
-                map,
-            }
-        } else {
-            Self {
-                brdf,
-                wo,
-                rot: Some(rot.sin_cos()),
-                map,
-            }
-        }
+        Self::in_frame(brdf, &wo, Turn::from_angle(rot), map)
     }
 
     /// [`QueryDensity::new`] for the rotation `turn` held as `(cos, sin)`: an isotropic BRDF is

@@ -627,15 +627,9 @@ impl ExactSet {
         })
     }
 
-    /// One direction; `audit` receives the trials. Also returns the interval's tree (to record
-    /// the audit in).
+    /// One direction; `audit` receives the trials.
     #[inline]
-    fn draw(
-        &self,
-        wo: &Vec3,
-        u: &mut dyn UniformSource,
-        audit: &mut Audit,
-    ) -> Option<(DirSample, &QuadTreeSampler<SliceDensity>)> {
+    fn draw(&self, wo: &Vec3, u: &mut dyn UniformSource, audit: &mut Audit) -> Option<DirSample> {
         let q = self.locate(wo)?;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), &q.wo, q.turn, iv.map);
@@ -654,7 +648,7 @@ impl ExactSet {
                 pdf: 0.0,
             },
         };
-        Some((s, &iv.tree))
+        Some(s)
     }
 
     /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
@@ -890,7 +884,7 @@ impl DirectionSampler for ExactSet {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let mut a = Audit::default();
         match self.draw(wo, u, &mut a) {
-            Some((s, _)) => {
+            Some(s) => {
                 self.counters.record(&a);
                 s
             }
