@@ -2,10 +2,12 @@
 //! [`DiscMap`]: the query density at one outgoing direction, and the envelope over the
 //! interval that the tree is built from.
 
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::{Arc, Mutex};
 
 use brdf::{Brdf, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
+use rustc_hash::FxHashMap;
 
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
@@ -89,28 +91,131 @@ impl Density for QueryDensity<'_> {
     }
 }
 
+/// Values `f_r(ωo_n, R_{δ_n} ωi)` of one node, keyed by the bits of `ωi` (exact: a hit
+/// returns the value the BRDF gives for that very direction).
+type ValueMap = FxHashMap<[u64; 3], f64>;
+
+/// Every value known for one bound node: the maps of the builds that evaluated it, largest
+/// first, shared (not copied) between an interval and its descendants.
+#[derive(Clone, Default)]
+pub(crate) struct NodeValues {
+    layers: Vec<Arc<ValueMap>>,
+}
+
+impl NodeValues {
+    #[inline]
+    fn get(&self, key: &[u64; 3]) -> Option<f64> {
+        self.layers.iter().find_map(|m| m.get(key).copied())
+    }
+}
+
+/// The identity of a bound node within its azimuth cell: `θ_n = (π/2) · num / den` with the
+/// set-wide denominator, and the bits of `δ_n`. A split interval's children compute their
+/// shared nodes with the same `num` (see `exact::theta_of`), hence the same `ωo_n` bits.
+pub(crate) type NodeKey = (u64, u64);
+
+/// Shards of a node's cache of fresh values (the image map evaluates in parallel).
+const SHARDS: usize = 16;
+
+/// One bound node of an [`IntervalEnvelope`].
+pub(crate) struct EnvelopeNode {
+    pub(crate) key: NodeKey,
+    pub(crate) wo: Vec3,
+    pub(crate) delta: f64,
+    /// Values this node already had in the interval's parent (same node, same lattice).
+    pub(crate) inherited: Option<Arc<NodeValues>>,
+    /// Values evaluated by this build, kept for the children when caching is on.
+    fresh: Option<Vec<Mutex<ValueMap>>>,
+}
+
+impl EnvelopeNode {
+    /// A node at `wo` turned by `delta`; `cache`: keep the values this build evaluates.
+    pub(crate) fn new(
+        key: NodeKey,
+        wo: Vec3,
+        delta: f64,
+        inherited: Option<Arc<NodeValues>>,
+        cache: bool,
+    ) -> Self {
+        Self {
+            key,
+            wo,
+            delta,
+            inherited,
+            fresh: cache.then(|| (0..SHARDS).map(|_| Mutex::default()).collect()),
+        }
+    }
+
+    fn value(&self, brdf: &dyn Brdf, wi: &Vec3, evaluations: &AtomicU64) -> f64 {
+        let key = [wi.x.to_bits(), wi.y.to_bits(), wi.z.to_bits()];
+        if let Some(v) = self.inherited.as_ref().and_then(|m| m.get(&key)) {
+            return v;
+        }
+        let w = if self.delta == 0.0 {
+            *wi
+        } else {
+            rotate_z(wi, self.delta)
+        };
+        let v = brdf.eval(&self.wo, &w);
+        if let Some(shards) = &self.fresh {
+            evaluations.fetch_add(1, Relaxed);
+            let shard = (key[0] ^ key[1].rotate_left(21) ^ key[2].rotate_left(42))
+                .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                >> 60;
+            if let Ok(mut m) = shards[shard as usize % SHARDS].lock() {
+                m.insert(key, v);
+            }
+        }
+        v
+    }
+
+    /// Whether this node keeps the values it evaluates.
+    pub(crate) fn caches(&self) -> bool {
+        self.fresh.is_some()
+    }
+
+    /// Every value known for this node (inherited and fresh), for the children.
+    pub(crate) fn into_values(self) -> (NodeKey, Arc<NodeValues>) {
+        let mut values = self.inherited.map(Arc::unwrap_or_clone).unwrap_or_default();
+        let mut fresh = ValueMap::default();
+        for m in self.fresh.unwrap_or_default() {
+            if let Ok(m) = m.into_inner() {
+                fresh.extend(m);
+            }
+        }
+        if !fresh.is_empty() {
+            values.layers.push(Arc::new(fresh));
+            values.layers.sort_by_key(|m| std::cmp::Reverse(m.len()));
+        }
+        (self.key, Arc::new(values))
+    }
+}
+
 /// The envelope of an interval as a BRDF of the incident direction only:
 /// `F(ωi) = max_n f_r(ωo_n, R_{δ_n} ωi)` over the interval's bound nodes
 /// `(θ_n, φ_k + δ_n)` (the outgoing argument of [`Brdf::eval`] is ignored). Wrapped in a
 /// [`crate::DiscBrdf`] it is the density the interval's tree is built from, with the set's image
-/// map, rim band, safety factor and audit.
+/// map, rim band, safety factor and audit. Node values the parent interval already evaluated
+/// are looked up instead of evaluated again (bit-identical: same node, same `ωi`).
 pub(crate) struct IntervalEnvelope {
     pub(crate) brdf: Arc<dyn Brdf>,
-    /// `(ωo_n, δ_n)`.
-    pub(crate) nodes: Vec<(Vec3, f64)>,
+    pub(crate) nodes: Vec<EnvelopeNode>,
+    /// BRDF evaluations made by nodes that cache (their misses); the others are counted by
+    /// the image map's counter.
+    pub(crate) evaluations: AtomicU64,
 }
 
 impl Brdf for IntervalEnvelope {
     fn eval(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
-        self.nodes.iter().fold(0.0f64, |m, (wo, d)| {
-            let w = if *d == 0.0 { *wi } else { rotate_z(wi, *d) };
-            m.max(self.brdf.eval(wo, &w))
+        self.nodes.iter().fold(0.0f64, |m, node| {
+            m.max(node.value(self.brdf.as_ref(), wi, &self.evaluations))
         })
     }
     fn is_mirror_symmetric(&self) -> bool {
         // Every node lies in the xz-plane (isotropic layouts): the max of even functions of y
         // is even.
-        self.brdf.is_mirror_symmetric() && self.nodes.iter().all(|(wo, d)| wo.y == 0.0 && *d == 0.0)
+        self.brdf.is_mirror_symmetric()
+            && self.nodes.iter().all(|n| n.wo.y == 0.0 && n.delta == 0.0)
     }
     fn bounded_at_horizon(&self) -> bool {
         self.brdf.bounded_at_horizon()

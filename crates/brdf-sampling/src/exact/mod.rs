@@ -36,6 +36,15 @@
 //! estimate, if larger: below it the tail is quadrature noise), down to
 //! [`ExactOptions::min_width_deg`]: sharp lobes and grazing angles get narrow intervals, smooth
 //! models keep the initial ones. The layout is reported by [`ExactSet::report`].
+//!
+//! **Build cost.** Interval edges and bound nodes are exact rationals of `π/2` (one
+//! denominator for the set), so a halved interval's ends and midpoint are bound nodes of its
+//! children too, with the same bits; for isotropic BRDFs slower than [`CACHE_ABOVE_NS`] per
+//! evaluation, a child looks up the values its parent's nodes took at the same incident
+//! directions of the image-map lattice instead of evaluating them again (bit-identical; with
+//! 3 nodes a child evaluates one node afresh). The normaliser nodes are integrated ends and
+//! middle first: the first whose `ΣV/A` exceeds the cap decides the split, and the others are
+//! not integrated.
 
 mod chebyshev;
 mod density;
@@ -60,7 +69,7 @@ use crate::options::{OptionsError, SetOptions};
 use crate::set::layout_for;
 
 use chebyshev::{ChebyshevTable, lobatto_nodes};
-use density::{IntervalEnvelope, QueryDensity};
+use density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryDensity};
 
 /// The largest outgoing polar angle the nodes use (degrees): `f_r` at exactly 90° is 0 or
 /// undefined. A query above it is served as the direction of the same azimuth at this angle
@@ -95,7 +104,7 @@ impl ExactOptions {
     /// Default initial interval count.
     pub const DEFAULT_INITIAL_INTERVALS: usize = 6;
     /// Default θ bound nodes.
-    pub const DEFAULT_BOUND_NODES: usize = 5;
+    pub const DEFAULT_BOUND_NODES: usize = 3;
     /// Default δ bound nodes.
     pub const DEFAULT_PHI_BOUND_NODES: usize = 3;
     /// Default θ normaliser nodes.
@@ -376,11 +385,69 @@ impl std::fmt::Debug for ExactSet {
     }
 }
 
-/// A request to build one interval.
-#[derive(Debug, Clone, Copy)]
+/// A request to build one interval `θ ∈ [θ(num[0]), θ(num[1])]` (see [`Grid`]), with the node
+/// values its parent already evaluated.
+#[derive(Clone)]
 struct Job {
     cell: usize,
-    theta: [f64; 2],
+    num: [u64; 2],
+    inherited: Arc<Vec<(NodeKey, Arc<NodeValues>)>>,
+}
+
+impl Job {
+    /// Whether halving keeps the interval at least `min_width` (radians) wide.
+    fn can_split(&self, grid: &Grid, min_width: f64) -> bool {
+        let even = (self.num[1] - self.num[0]).is_multiple_of(2);
+        even && 0.5 * (grid.edge(self.num[1]) - grid.edge(self.num[0])) >= min_width
+    }
+}
+
+/// Exact interval edges and bound nodes: `θ = (π/2) · num / den` with one denominator for the
+/// whole set, so that a node shared by a split interval and its children is the same rational,
+/// hence the same `f64` (a correctly rounded quotient) and the same `ωo` bits.
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    /// Denominator of the interval edges: `initial_intervals · 2^EDGE_BITS`.
+    den: u64,
+    /// `bound_nodes − 1`: node `n` of `[a, b]` is `(a·m + (b − a)·n) / (den·m)`.
+    m: u64,
+}
+
+/// Halvings an initial interval can take (far below any useful `min_width_deg`).
+const EDGE_BITS: u32 = 40;
+
+impl Grid {
+    fn theta(num: u64, den: u64) -> f64 {
+        std::f64::consts::FRAC_PI_2 * (num as f64 / den as f64)
+    }
+    fn edge(&self, num: u64) -> f64 {
+        Self::theta(num, self.den)
+    }
+    /// Numerator (over `den · m`) and angle of bound node `n` of the interval `num`.
+    fn node(&self, num: [u64; 2], n: u64) -> (u64, f64) {
+        let k = num[0] * self.m + (num[1] - num[0]) * n;
+        (k, Self::theta(k, self.den * self.m))
+    }
+}
+
+/// BRDFs slower than this per evaluation (nanoseconds) keep their bound nodes' values for the
+/// children of a split interval (measured break-even: beckmann at ~140 ns per evaluation
+/// builds as fast with the cache as without).
+const CACHE_ABOVE_NS: f64 = 250.0;
+
+/// Mean time of one evaluation of `brdf` (a few thousand directions, one thread).
+fn eval_cost_ns(brdf: &dyn Brdf) -> f64 {
+    let n = 2048;
+    let wo = direction_from_radians(0.6, 0.3);
+    let start = Instant::now();
+    let mut sink = 0.0;
+    for k in 0..n {
+        let t = 1.5 * (k as f64 + 0.5) / n as f64;
+        let wi = direction_from_radians(t, 2.399 * k as f64);
+        sink += brdf.eval(&wo, &wi);
+    }
+    std::hint::black_box(sink);
+    start.elapsed().as_secs_f64() * 1e9 / n as f64
 }
 
 /// Where a query lands.
@@ -407,6 +474,18 @@ impl ExactSet {
         options: &ExactOptions,
         progress: Option<crate::Progress<'_>>,
     ) -> Result<Self, ExactError> {
+        Self::build_with(brdf, options, progress, None)
+    }
+
+    /// [`ExactSet::build`]; `cache` forces the node-value cache on or off (`None`: on for
+    /// isotropic BRDFs slower than [`CACHE_ABOVE_NS`] per evaluation). The set is the same
+    /// either way.
+    fn build_with(
+        brdf: Arc<dyn Brdf>,
+        options: &ExactOptions,
+        progress: Option<crate::Progress<'_>>,
+        cache: Option<bool>,
+    ) -> Result<Self, ExactError> {
         options.validate()?;
         let start = Instant::now();
         let layout = layout_for(brdf.as_ref(), &options.set);
@@ -419,65 +498,87 @@ impl ExactSet {
             0.5 * period / n_cells as f64
         };
         let min_width = options.min_width_deg.to_radians();
-        let n0 = options.initial_intervals;
+        let n0 = options.initial_intervals as u64;
+        let grid = Grid {
+            den: n0 << EDGE_BITS,
+            m: options.bound_nodes as u64 - 1,
+        };
+        // Bit-identical results either way; the cache only pays for expensive BRDFs, and
+        // anisotropic cells (many nodes, many intervals) would hold too many values.
+        let cache =
+            isotropic && cache.unwrap_or_else(|| eval_cost_ns(brdf.as_ref()) > CACHE_ABOVE_NS);
+        let none = Arc::new(Vec::new());
         let mut jobs: Vec<Job> = (0..n_cells)
             .flat_map(|cell| {
+                let none = &none;
                 (0..n0).map(move |i| Job {
                     cell,
-                    theta: [
-                        std::f64::consts::FRAC_PI_2 * i as f64 / n0 as f64,
-                        std::f64::consts::FRAC_PI_2 * (i + 1) as f64 / n0 as f64,
-                    ],
+                    num: [i << EDGE_BITS, (i + 1) << EDGE_BITS],
+                    inherited: Arc::clone(none),
                 })
             })
             .collect();
-        let mut done: Vec<(Job, Interval)> = Vec::new();
+        let mut done: Vec<(usize, [u64; 2], Interval)> = Vec::new();
         let (mut built, mut queued) = (0usize, jobs.len());
+        // Depth first, a few intervals at a time: a split parent's node values are released
+        // once its children are built (the set does not depend on the order).
+        jobs.reverse();
+        let batch_len = 2 * rayon::current_num_threads().max(1);
         while !jobs.is_empty() {
-            let results: Vec<Result<(Job, Interval), ExactError>> = jobs
+            let batch = jobs.split_off(jobs.len().saturating_sub(batch_len));
+            let results: Vec<Result<(Job, Built), ExactError>> = batch
                 .par_iter()
                 .map(|job| {
-                    build_interval(&brdf, options, *job, layout.phi_of(job.cell), half)
-                        .map(|iv| (*job, iv))
+                    let ctx = IntervalContext {
+                        grid,
+                        phi_k: layout.phi_of(job.cell),
+                        half,
+                        cache,
+                        can_split: job.can_split(&grid, min_width),
+                    };
+                    build_interval(&brdf, options, job, &ctx).map(|b| (job.clone(), b))
                 })
                 .collect();
             let mut next = Vec::new();
             for r in results {
-                let (job, iv) = r?;
+                let (job, (iv, values)) = r?;
                 built += 1;
-                let width = job.theta[1] - job.theta[0];
-                let wants = iv.worst_trials > options.max_trials
-                    || iv.table.rel_tail_theta() > options.normaliser_tol.max(iv.quad_err);
-                if wants && 0.5 * width >= min_width {
-                    let mid = 0.5 * (job.theta[0] + job.theta[1]);
-                    next.push(Job {
-                        cell: job.cell,
-                        theta: [job.theta[0], mid],
-                    });
-                    next.push(Job {
-                        cell: job.cell,
-                        theta: [mid, job.theta[1]],
-                    });
-                    queued += 2;
-                } else {
-                    done.push((job, iv));
+                let wants = iv.as_ref().is_none_or(|iv| {
+                    iv.worst_trials > options.max_trials
+                        || iv.table.rel_tail_theta() > options.normaliser_tol.max(iv.quad_err)
+                });
+                match iv {
+                    // Only the edges are kept (the node values go with `job`).
+                    Some(iv) if !(wants && job.can_split(&grid, min_width)) => {
+                        done.push((job.cell, job.num, iv));
+                    }
+                    // `None` only comes from an interval that can be split.
+                    _ => {
+                        let mid = job.num[0] + (job.num[1] - job.num[0]) / 2;
+                        let values = Arc::new(values);
+                        for num in [[job.num[0], mid], [mid, job.num[1]]] {
+                            next.push(Job {
+                                cell: job.cell,
+                                num,
+                                inherited: Arc::clone(&values),
+                            });
+                        }
+                        queued += 2;
+                    }
                 }
                 if let Some(p) = progress {
                     p(built, queued);
                 }
             }
-            jobs = next;
+            // Children on top of the stack, the left one first.
+            jobs.extend(next.into_iter().rev());
         }
-        done.sort_by(|a, b| {
-            (a.0.cell, a.0.theta[0])
-                .partial_cmp(&(b.0.cell, b.0.theta[0]))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        });
+        done.sort_by_key(|(cell, num, _)| (*cell, num[0]));
         let mut per_cell: Vec<(Vec<f64>, Vec<Interval>)> =
             (0..n_cells).map(|_| (Vec::new(), Vec::new())).collect();
-        for (job, iv) in done {
-            let c = &mut per_cell[job.cell];
-            c.0.push(job.theta[1]);
+        for (cell, num, iv) in done {
+            let c = &mut per_cell[cell];
+            c.0.push(grid.edge(num[1]));
             c.1.push(iv);
         }
         let cells: Vec<Cell> = per_cell
@@ -728,22 +829,39 @@ fn peak_track<'a>(
     track
 }
 
-/// Builds the tree and normaliser table of one interval.
+/// What every interval of one azimuth cell shares.
+struct IntervalContext {
+    grid: Grid,
+    /// The cell's centre azimuth.
+    phi_k: f64,
+    /// The cell's half-width (0: isotropic).
+    half: f64,
+    /// Keep the bound nodes' values for the children.
+    cache: bool,
+    /// The interval may be halved (it is wide enough).
+    can_split: bool,
+}
+
+/// A built interval (`None`: to be split) and its bound nodes' values.
+type Built = (Option<Interval>, Vec<(NodeKey, Arc<NodeValues>)>);
+
+/// Builds the tree and normaliser table of one interval (`None`: its mean trials exceed the cap
+/// at a normaliser node, and it can be split), and returns its bound nodes' values (empty
+/// unless `ctx.cache`) for its children should it be split.
 fn build_interval(
     brdf: &Arc<dyn Brdf>,
     options: &ExactOptions,
-    job: Job,
-    phi_k: f64,
-    half: f64,
-) -> Result<Interval, ExactError> {
+    job: &Job,
+    ctx: &IntervalContext,
+) -> Result<Built, ExactError> {
+    let (grid, phi_k, half) = (ctx.grid, ctx.phi_k, ctx.half);
     let top = THETA_TOP_DEG.to_radians();
-    let (ta, tb) = (job.theta[0].min(top), job.theta[1].min(top));
+    let theta_b = grid.edge(job.num[1]);
+    let (ta, tb) = (grid.edge(job.num[0]).min(top), theta_b.min(top));
     let set = &options.set;
-    let map = set.disc_map.map_for(
-        brdf.as_ref(),
-        job.theta[1].to_degrees(),
-        set.equal_area_from_deg,
-    );
+    let map = set
+        .disc_map
+        .map_for(brdf.as_ref(), theta_b.to_degrees(), set.equal_area_from_deg);
     let deltas = |n: usize| -> Vec<f64> {
         if half == 0.0 {
             vec![0.0]
@@ -753,25 +871,38 @@ fn build_interval(
                 .collect()
         }
     };
-    let nb = options.bound_nodes;
     let mut nodes = Vec::new();
-    for n in 0..nb {
-        let t = ta + (tb - ta) * n as f64 / (nb - 1) as f64;
+    for n in 0..=grid.m {
+        let (num, t) = grid.node(job.num, n);
+        // Nodes past the top angle sit at it (no longer the shared rational: not cached).
+        let (t, cacheable) = if t > top {
+            (top, false)
+        } else {
+            (t, ctx.cache)
+        };
         for d in deltas(options.phi_bound_nodes) {
-            nodes.push((direction_from_radians(t, phi_k + d), d));
+            let key = (num, d.to_bits());
+            let inherited = job
+                .inherited
+                .iter()
+                .find(|(k, _)| *k == key && cacheable)
+                .map(|(_, v)| Arc::clone(v));
+            let wo = direction_from_radians(t, phi_k + d);
+            nodes.push(EnvelopeNode::new(key, wo, d, inherited, cacheable));
         }
     }
     let n_nodes = nodes.len() as u64;
     let mirror_y = set.symmetries && brdf.is_mirror_symmetric() && half == 0.0;
-    let envelope: Arc<dyn Brdf> = Arc::new(IntervalEnvelope {
+    let envelope = Arc::new(IntervalEnvelope {
         brdf: Arc::clone(brdf),
         nodes,
+        evaluations: Default::default(),
     });
     let centre = direction_from_radians(0.5 * (ta + tb), phi_k);
-    let f = DiscBrdf::with_map(envelope, centre, map);
+    let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, map);
     let counter = EvalCounter::new();
     let (theta_deg, phi_deg) = (0.5 * (ta + tb).to_degrees(), phi_k.to_degrees());
-    let slice = (job.theta[0].to_degrees() * 1000.0) as usize;
+    let slice = (ta.to_degrees() * 1000.0) as usize;
     let grid_options = GridOptions {
         refinement: set.grid_refinement,
         mirror_y,
@@ -817,11 +948,34 @@ fn build_interval(
             source,
         })?;
     drop(image);
-    let build_evals = counter.total() * n_nodes;
+    // Node evaluations: the cached nodes counted their misses, the others every point.
+    let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
+    let build_evals = counter.total() * (n_nodes - cached)
+        + envelope
+            .evaluations
+            .load(std::sync::atomic::Ordering::Relaxed);
+    // The sampler keeps the envelope without its node values; they go to the children.
+    let plain = Arc::new(IntervalEnvelope {
+        brdf: Arc::clone(brdf),
+        nodes: envelope
+            .nodes
+            .iter()
+            .map(|n| EnvelopeNode::new(n.key, n.wo, n.delta, None, false))
+            .collect(),
+        evaluations: Default::default(),
+    });
+    drop(f);
+    let f = DiscBrdf::with_map(plain, centre, map);
     // The normaliser at the Chebyshev nodes, by the leaf quadrature of this tree; the δ nodes
     // double (Lobatto-nested) while their tail exceeds the tolerance.
     let theta_nodes = lobatto_nodes(ta, tb, options.normaliser_nodes);
     let before = crate::disc::thread_evaluations();
+    let volume = tree.volume();
+    // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
+    // split, and the other nodes' quadratures are not needed.
+    let nt = theta_nodes.len();
+    let mut order = vec![0, nt - 1, nt / 2];
+    order.extend((1..nt - 1).filter(|&i| i != nt / 2));
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
         let delta_nodes = if half == 0.0 {
@@ -829,10 +983,11 @@ fn build_interval(
         } else {
             lobatto_nodes(-half, half, nd)
         };
-        let mut values = Vec::with_capacity(theta_nodes.len() * delta_nodes.len());
+        let mut values = vec![0.0; nt * delta_nodes.len()];
         let mut quad_err = 0.0f64;
-        for &t in &theta_nodes {
-            for &d in &delta_nodes {
+        for &i in &order {
+            let t = theta_nodes[i];
+            for (j, &d) in delta_nodes.iter().enumerate() {
                 let q =
                     QueryDensity::new(brdf.as_ref(), direction_from_radians(t, phi_k + d), d, map);
                 let r = per_leaf_quadrature(&q, tree.leaves(), tree.integral(), mirror_y);
@@ -843,8 +998,11 @@ fn build_interval(
                         phi_deg: (phi_k + d).to_degrees(),
                     });
                 }
+                if ctx.can_split && volume / r.total > options.max_trials {
+                    return Ok((None, values_of(envelope)));
+                }
                 quad_err = quad_err.max(r.rel_err);
-                values.push(r.total * t.cos());
+                values[i * delta_nodes.len() + j] = r.total * t.cos();
             }
         }
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
@@ -856,7 +1014,6 @@ fn build_interval(
         nd = 2 * nd - 1;
     };
     let quad_evals = crate::disc::thread_evaluations() - before;
-    let volume = tree.volume();
     // The table holds A · cos θ.
     let worst_trials = table
         .values
@@ -869,15 +1026,31 @@ fn build_interval(
     let shape = *tree.shape();
     let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
         .map_err(|source| SetError::Attach { slice, source })?;
-    Ok(Interval {
-        tree: sampler,
-        map,
-        table,
-        worst_trials,
-        norm_err,
-        quad_err,
-        evaluations: build_evals + quad_evals,
-    })
+    Ok((
+        Some(Interval {
+            tree: sampler,
+            map,
+            table,
+            worst_trials,
+            norm_err,
+            quad_err,
+            evaluations: build_evals + quad_evals,
+        }),
+        values_of(envelope),
+    ))
+}
+
+/// The values the caching nodes of a built interval know, for its children.
+fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)> {
+    match Arc::try_unwrap(envelope) {
+        Ok(env) => env
+            .nodes
+            .into_iter()
+            .filter(|n| n.caches())
+            .map(EnvelopeNode::into_values)
+            .collect(),
+        Err(_) => Vec::new(),
+    }
 }
 
 impl DirectionSampler for ExactSet {
