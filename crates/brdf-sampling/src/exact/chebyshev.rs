@@ -97,6 +97,26 @@ pub(crate) fn chebyshev_series(values: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Trailing coefficients below rounding noise dropped: while their summed magnitude stays
+/// within [`TRIM_REL`] of the largest value, `|T_k| ≤ 1` bounds the change of the series by that
+/// much (a constant or linear normaliser then costs one or two terms per query, not `n`).
+fn trimmed(mut series: Vec<f64>, values: &[f64]) -> Vec<f64> {
+    let limit = TRIM_REL * values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut dropped = 0.0;
+    while series.len() > 1 {
+        let last = series[series.len() - 1].abs();
+        if dropped + last > limit {
+            break;
+        }
+        dropped += last;
+        series.pop();
+    }
+    series
+}
+
+/// Relative size of the coefficients [`trimmed`] may drop (rounding noise of the values).
+const TRIM_REL: f64 = 1e-13;
+
 /// `Σ_k b_k T_k(x)` by Clenshaw's recurrence (`2n` multiply-adds, no division).
 #[inline]
 pub(crate) fn clenshaw(series: &[f64], x: f64) -> f64 {
@@ -132,7 +152,7 @@ impl ChebyshevTable {
     pub(crate) fn new(theta: Vec<f64>, delta: Vec<f64>, values: Vec<f64>) -> Self {
         let (lo, hi) = (theta[theta.len() - 1], theta[0]);
         let series = if delta.len() == 1 {
-            chebyshev_series(&values)
+            trimmed(chebyshev_series(&values), &values)
         } else {
             Vec::new()
         };
@@ -216,6 +236,21 @@ impl ChebyshevTable {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A linear function's series keeps two terms (the rest is rounding noise, dropped), and
+    /// still interpolates; a quartic keeps its five.
+    #[test]
+    fn trailing_noise_coefficients_are_dropped() {
+        let nodes = lobatto_nodes(0.2, 0.9, 9);
+        let linear: Vec<f64> = nodes.iter().map(|t| 3.0 - 2.0 * t).collect();
+        let table = ChebyshevTable::new(nodes.clone(), vec![0.0], linear);
+        assert!(table.series.len() <= 2, "{:?}", table.series);
+        assert!((table.eval(0.37, 0.0) - (3.0 - 2.0 * 0.37)).abs() < 1e-14);
+        let quartic: Vec<f64> = nodes.iter().map(|t| 1.0 + t.powi(4)).collect();
+        let table = ChebyshevTable::new(nodes, vec![0.0], quartic);
+        assert_eq!(table.series.len(), 5, "{:?}", table.series);
+        assert!((table.eval(0.37, 0.0) - (1.0 + 0.37f64.powi(4))).abs() < 1e-14);
+    }
 
     #[test]
     fn nine_nodes_interpolate_a_smooth_function_to_1e9() {

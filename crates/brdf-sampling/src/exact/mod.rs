@@ -27,8 +27,11 @@
 //! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`);
 //! the δ nodes are doubled (Lobatto-nested, up to 17) while the δ tail exceeds the same floor;
 //! `A · cos θo` is interpolated ([`chebyshev`]): it stays smooth up to grazing angles for models
-//! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The reported normaliser error is the quadrature's estimate
-//! plus the interpolation's (the Chebyshev tail).
+//! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The
+//! table's variable is `cos θo` for isotropic BRDFs (`A` is even in `θo`, so smooth in
+//! `cos θo`; a query then needs no `acos`) and `θo` for anisotropic cells ([`TableVar`]). The
+//! reported normaliser error is the quadrature's estimate plus the interpolation's (the
+//! Chebyshev tail).
 //!
 //! **Adaptive intervals.** An interval is halved while its tree would need more than
 //! [`ExactOptions::max_trials`] mean trials at one of its normaliser nodes (`Σ V_i / A`) or its
@@ -211,7 +214,10 @@ pub enum ExactError {
 struct Interval {
     tree: QuadTreeSampler<SliceDensity>,
     map: DiscMap,
+    /// `A · cos θo` over the table variable `v` (`cos θo` for isotropic BRDFs, `θo` otherwise,
+    /// see [`TableVar`]) and `δ`.
     table: ChebyshevTable,
+    var: TableVar,
     /// Largest `Σ V_i / A` over the normaliser nodes.
     worst_trials: f64,
     /// Quadrature + interpolation relative error estimate of `A`.
@@ -223,13 +229,65 @@ struct Interval {
 
 impl Interval {
     /// `A(θo, δ)`: the table holds `A · cos θo` (smooth at grazing angles also for BRDFs with
-    /// a `1/cos θo` factor), θo clamped to the table's nodes.
+    /// a `1/cos θo` factor), its variable clamped to the table's nodes.
     #[inline]
     fn normaliser(&self, q: &Query) -> f64 {
         let t = &self.table.theta;
-        let theta = q.theta.clamp(t[t.len() - 1], t[0]);
-        let cos = if theta == q.theta { q.cos } else { theta.cos() };
-        self.table.eval(theta, q.delta) / cos
+        let v = q.var.clamp(t[t.len() - 1], t[0]);
+        let cos = if v == q.var { q.cos } else { self.var.cos(v) };
+        self.table.eval(v, q.delta) / cos
+    }
+}
+
+/// The variable of an interval's normaliser table and of its search.
+///
+/// Isotropic BRDFs use `v = cos θo`: `A` is then an even function of `θo` (`ωo` at `−θo` is
+/// `ωo` at `θo` turned by π), hence a smooth function of `cos θo` up to normal incidence, and
+/// a query needs no `acos`. Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
+/// is not even in `θo` at a fixed azimuth, and `cos θo` would put a square-root singularity at
+/// normal incidence).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TableVar {
+    Cos,
+    Theta,
+}
+
+impl TableVar {
+    /// `v` of the outgoing polar angle `θ`.
+    fn of(self, theta: f64) -> f64 {
+        match self {
+            Self::Cos => theta.cos(),
+            Self::Theta => theta,
+        }
+    }
+    /// `θ` of `v`.
+    fn theta(self, v: f64) -> f64 {
+        match self {
+            Self::Cos => v.clamp(-1.0, 1.0).acos(),
+            Self::Theta => v,
+        }
+    }
+    /// `cos θ` of `v`.
+    #[inline]
+    fn cos(self, v: f64) -> f64 {
+        match self {
+            Self::Cos => v,
+            Self::Theta => v.cos(),
+        }
+    }
+    /// The search key of `v`, increasing with θ over `[0, key_range]`: `1 − cos θ` or `θ`.
+    #[inline]
+    fn key(self, v: f64) -> f64 {
+        match self {
+            Self::Cos => 1.0 - v,
+            Self::Theta => v,
+        }
+    }
+    fn key_range(self) -> f64 {
+        match self {
+            Self::Cos => 1.0,
+            Self::Theta => std::f64::consts::FRAC_PI_2,
+        }
     }
 }
 
@@ -238,55 +296,67 @@ struct Cell {
     phi: f64,
     /// Upper θ edges of the intervals (radians), increasing; the last is π/2.
     upper: Vec<f64>,
+    /// The same edges as search keys ([`TableVar::key`]), increasing.
+    keys: Vec<f64>,
     intervals: Vec<Interval>,
-    /// Guide table over θ ∈ [0, π/2]: `guide[g]` is the interval of `θ = g · π/2 / GUIDE_LEN`,
-    /// where the search for any θ of bucket `g` starts (see [`Cell::interval_of`]).
+    /// Guide table over the keys `[0, range]`: `guide[g]` is the interval of the key
+    /// `g · range / GUIDE_LEN`, where the search for any key of bucket `g` starts (see
+    /// [`Cell::interval_of`]).
     guide: Vec<u32>,
+    range: f64,
 }
 
 /// Buckets of a cell's guide table.
 const GUIDE_LEN: usize = 256;
 
 impl Cell {
-    fn new(phi: f64, upper: Vec<f64>, intervals: Vec<Interval>) -> Self {
-        let guide = interval_guide(&upper);
+    fn new(phi: f64, upper: Vec<f64>, intervals: Vec<Interval>, var: TableVar) -> Self {
+        let mut keys: Vec<f64> = upper.iter().map(|&t| var.key(var.of(t))).collect();
+        // Monotone despite rounding (the search needs sorted keys).
+        for i in 1..keys.len() {
+            keys[i] = keys[i].max(keys[i - 1]);
+        }
+        let range = var.key_range();
+        let guide = interval_guide(&keys, range);
         Self {
             phi,
             upper,
+            keys,
             intervals,
             guide,
+            range,
         }
     }
 
+    /// The interval of the search key `key`.
     #[inline]
-    fn interval_of(&self, theta: f64) -> usize {
-        guided_interval(&self.upper, &self.guide, theta)
+    fn interval_of(&self, key: f64) -> usize {
+        guided_interval(&self.keys, &self.guide, self.range, key)
     }
 }
 
-/// The guide table of the interval edges `upper` (increasing, not empty): entry `g` is the
-/// interval of `θ = g · π/2 / GUIDE_LEN`.
-fn interval_guide(upper: &[f64]) -> Vec<u32> {
-    let step = std::f64::consts::FRAC_PI_2 / GUIDE_LEN as f64;
+/// The guide table of the interval edges `upper` (increasing, not empty) over `[0, range]`:
+/// entry `g` is the interval of `g · range / GUIDE_LEN`.
+fn interval_guide(upper: &[f64], range: f64) -> Vec<u32> {
+    let step = range / GUIDE_LEN as f64;
     let last = upper.len().saturating_sub(1);
     (0..GUIDE_LEN)
         .map(|g| upper.partition_point(|&u| u < g as f64 * step).min(last) as u32)
         .collect()
 }
 
-/// The first interval whose upper edge is ≥ θ (the last one when none is): the binary search
-/// `upper.partition_point(|u| u < θ)`, by a scan from the guide table's bucket of θ (usually
-/// zero or one step; down only if rounding put θ in the bucket above its own).
+/// The first interval whose upper edge is ≥ `x` (the last one when none is): the binary search
+/// `upper.partition_point(|u| u < x)`, by a scan from the guide table's bucket of `x` (usually
+/// zero or one step; down only if rounding put `x` in the bucket above its own).
 #[inline]
-fn guided_interval(upper: &[f64], guide: &[u32], theta: f64) -> usize {
+fn guided_interval(upper: &[f64], guide: &[u32], range: f64, x: f64) -> usize {
     let last = upper.len() - 1;
-    let g =
-        ((theta * (GUIDE_LEN as f64 / std::f64::consts::FRAC_PI_2)) as usize).min(GUIDE_LEN - 1);
+    let g = ((x * (GUIDE_LEN as f64 / range)) as usize).min(GUIDE_LEN - 1);
     let mut i = (guide[g] as usize).min(last);
-    while i > 0 && upper[i - 1] >= theta {
+    while i > 0 && upper[i - 1] >= x {
         i -= 1;
     }
-    while i < last && upper[i] < theta {
+    while i < last && upper[i] < x {
         i += 1;
     }
     i
@@ -368,6 +438,10 @@ pub struct ExactSet {
     /// Azimuth period of the cells (2π, or π for half-turn-symmetric BRDFs).
     period: f64,
     cells: Vec<Cell>,
+    /// The variable of the normaliser tables and of the interval search.
+    var: TableVar,
+    /// `cos` of [`THETA_TOP_DEG`]: queries below it are served there.
+    top_cos: f64,
     build_time: Duration,
     /// Trials, samples and violations of the set's own `sample` calls, counted set-wide (one
     /// thread-local buffer for every tree: at random θo consecutive samples use different
@@ -458,7 +532,8 @@ struct Query {
     /// The outgoing direction served: the query's, or above [`THETA_TOP_DEG`] the direction of
     /// the same azimuth at that angle.
     wo: Vec3,
-    theta: f64,
+    /// The table variable ([`TableVar`]) of the served direction.
+    var: f64,
     /// `cos θo`.
     cos: f64,
     delta: f64,
@@ -584,7 +659,9 @@ impl ExactSet {
         let cells: Vec<Cell> = per_cell
             .into_iter()
             .enumerate()
-            .map(|(k, (upper, intervals))| Cell::new(layout.phi_of(k), upper, intervals))
+            .map(|(k, (upper, intervals))| {
+                Cell::new(layout.phi_of(k), upper, intervals, table_var(isotropic))
+            })
             .collect();
         Ok(Self {
             brdf,
@@ -592,6 +669,8 @@ impl ExactSet {
             isotropic,
             period,
             cells,
+            var: table_var(isotropic),
+            top_cos: THETA_TOP_DEG.to_radians().cos(),
             build_time: start.elapsed(),
             counters: AuditCounters::new(),
         })
@@ -679,18 +758,17 @@ impl ExactSet {
         if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
             return None;
         }
-        let top = THETA_TOP_DEG.to_radians();
-        let mut theta = wo.z.min(1.0).acos();
         let mut served = *wo;
-        if theta > top {
+        if wo.z < self.top_cos {
             // f_r at grazing θo may diverge (1/cos θo factors) where no bound node was put:
             // serve the direction at `top` (same azimuth) instead, so that the bounds hold and
             // the pdf stays normalised; the law differs from f_r(ωo, ·) cos θi only there.
+            let top = THETA_TOP_DEG.to_radians();
             let (s, r) = (top.sin(), (wo.x * wo.x + wo.y * wo.y).sqrt());
-            served = Vec3::new(wo.x / r * s, wo.y / r * s, top.cos());
-            theta = top;
+            served = Vec3::new(wo.x / r * s, wo.y / r * s, self.top_cos);
         }
         let wo = &served;
+        let cos = wo.z.min(1.0);
         let (cell, turn, delta) = if self.isotropic {
             // The rotation that takes the frame's ωo (at φ = 0) to the query's, without
             // trigonometry: (cos φo, sin φo) = (x, y)/r.
@@ -716,13 +794,17 @@ impl ExactSet {
             }
             (k, Turn::from_angle(rot), delta)
         };
-        let interval = self.cells[cell].interval_of(theta);
+        let var = match self.var {
+            TableVar::Cos => cos,
+            TableVar::Theta => cos.acos(),
+        };
+        let interval = self.cells[cell].interval_of(self.var.key(var));
         Some(Query {
             cell,
             interval,
             wo: served,
-            theta,
-            cos: wo.z.min(1.0),
+            var,
+            cos,
             delta,
             turn,
         })
@@ -844,6 +926,15 @@ struct IntervalContext {
 
 /// A built interval (`None`: to be split) and its bound nodes' values.
 type Built = (Option<Interval>, Vec<(NodeKey, Arc<NodeValues>)>);
+
+/// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell).
+fn table_var(isotropic: bool) -> TableVar {
+    if isotropic {
+        TableVar::Cos
+    } else {
+        TableVar::Theta
+    }
+}
 
 /// Builds the tree and normaliser table of one interval (`None`: its mean trials exceed the cap
 /// at a normaliser node, and it can be split), and returns its bound nodes' values (empty
@@ -968,7 +1059,9 @@ fn build_interval(
     let f = DiscBrdf::with_map(plain, centre, map);
     // The normaliser at the Chebyshev nodes, by the leaf quadrature of this tree; the δ nodes
     // double (Lobatto-nested) while their tail exceeds the tolerance.
-    let theta_nodes = lobatto_nodes(ta, tb, options.normaliser_nodes);
+    let var = table_var(half == 0.0);
+    let (va, vb) = (var.of(ta), var.of(tb));
+    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), options.normaliser_nodes);
     let before = crate::disc::thread_evaluations();
     let volume = tree.volume();
     // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
@@ -986,7 +1079,8 @@ fn build_interval(
         let mut values = vec![0.0; nt * delta_nodes.len()];
         let mut quad_err = 0.0f64;
         for &i in &order {
-            let t = theta_nodes[i];
+            let t = var.theta(theta_nodes[i]);
+            let cos = var.cos(theta_nodes[i]);
             for (j, &d) in delta_nodes.iter().enumerate() {
                 let q =
                     QueryDensity::new(brdf.as_ref(), direction_from_radians(t, phi_k + d), d, map);
@@ -1002,7 +1096,7 @@ fn build_interval(
                     return Ok((None, values_of(envelope)));
                 }
                 quad_err = quad_err.max(r.rel_err);
-                values[i * delta_nodes.len() + j] = r.total * t.cos();
+                values[i * delta_nodes.len() + j] = r.total * cos;
             }
         }
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
@@ -1019,7 +1113,7 @@ fn build_interval(
         .values
         .iter()
         .enumerate()
-        .map(|(k, ac)| volume * table.theta[k / table.delta.len()].cos() / ac)
+        .map(|(k, ac)| volume * var.cos(table.theta[k / table.delta.len()]) / ac)
         .fold(0.0, f64::max);
     let norm_err = quad_err + table.rel_tail();
     let tree = tree.clone();
@@ -1031,6 +1125,7 @@ fn build_interval(
             tree: sampler,
             map,
             table,
+            var,
             worst_trials,
             norm_err,
             quad_err,

@@ -186,14 +186,14 @@ proptest::proptest! {
         upper.sort_by(f64::total_cmp);
         upper.dedup();
         upper.push(half_pi);
-        let guide = interval_guide(&upper);
+        let guide = interval_guide(&upper, half_pi);
         let last = upper.len() - 1;
         let mut thetas: Vec<f64> = probes.iter().map(|p| p * half_pi).collect();
         thetas.extend(upper.iter().flat_map(|&u| [u, u.next_down(), u.next_up().min(half_pi)]));
         thetas.extend((0..=GUIDE_LEN).map(|g| g as f64 * half_pi / GUIDE_LEN as f64));
         for t in thetas.into_iter().map(|t| t.max(0.0)) {
             let expected = upper.partition_point(|&u| u < t).min(last);
-            proptest::prop_assert_eq!(guided_interval(&upper, &guide, t), expected, "θ = {}", t);
+            proptest::prop_assert_eq!(guided_interval(&upper, &guide, half_pi, t), expected, "θ = {}", t);
         }
     }
 }
