@@ -111,7 +111,7 @@ impl NodeValues {
 
 /// The identity of a bound node within its azimuth cell: `θ_n = (π/2) · num / den` with the
 /// set-wide denominator, and the bits of `δ_n`. A split interval's children compute their
-/// shared nodes with the same `num` (see `exact::theta_of`), hence the same `ωo_n` bits.
+/// shared nodes with the same `num` (see `exact::Grid`), hence the same `ωo_n` bits.
 pub(crate) type NodeKey = (u64, u64);
 
 /// Shards of a node's cache of fresh values (the image map evaluates in parallel).
@@ -123,7 +123,7 @@ pub(crate) struct EnvelopeNode {
     pub(crate) wo: Vec3,
     pub(crate) delta: f64,
     /// Values this node already had in the interval's parent (same node, same lattice).
-    pub(crate) inherited: Option<Arc<NodeValues>>,
+    inherited: Option<Arc<NodeValues>>,
     /// Values evaluated by this build, kept for the children when caching is on.
     fresh: Option<Vec<Mutex<ValueMap>>>,
 }
