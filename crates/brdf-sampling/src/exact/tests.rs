@@ -174,26 +174,58 @@ fn invalid_options_are_refused() {
 }
 
 proptest::proptest! {
-    /// The guided interval search is the binary search, at random angles, at the edges and at
-    /// their float neighbours.
+    /// The guided interval search is the binary search, at random keys, at the edges and at
+    /// their float neighbours, over both key ranges (θ ∈ [0, π/2] and 1 − cos θ ∈ [0, 1]).
     #[test]
     fn guided_interval_search_is_the_binary_search(
         cuts in proptest::collection::vec(0.0f64..1.0, 0..60),
         probes in proptest::collection::vec(0.0f64..1.0, 50),
     ) {
-        let half_pi = std::f64::consts::FRAC_PI_2;
-        let mut upper: Vec<f64> = cuts.iter().map(|c| c * half_pi).collect();
-        upper.sort_by(f64::total_cmp);
-        upper.dedup();
-        upper.push(half_pi);
-        let guide = interval_guide(&upper, half_pi);
-        let last = upper.len() - 1;
-        let mut thetas: Vec<f64> = probes.iter().map(|p| p * half_pi).collect();
-        thetas.extend(upper.iter().flat_map(|&u| [u, u.next_down(), u.next_up().min(half_pi)]));
-        thetas.extend((0..=GUIDE_LEN).map(|g| g as f64 * half_pi / GUIDE_LEN as f64));
-        for t in thetas.into_iter().map(|t| t.max(0.0)) {
-            let expected = upper.partition_point(|&u| u < t).min(last);
-            proptest::prop_assert_eq!(guided_interval(&upper, &guide, half_pi, t), expected, "θ = {}", t);
+        for range in [std::f64::consts::FRAC_PI_2, 1.0] {
+            let mut upper: Vec<f64> = cuts.iter().map(|c| c * range).collect();
+            upper.sort_by(f64::total_cmp);
+            upper.dedup();
+            upper.push(range);
+            let guide = interval_guide(&upper, range);
+            let last = upper.len() - 1;
+            let mut keys: Vec<f64> = probes.iter().map(|p| p * range).collect();
+            keys.extend(upper.iter().flat_map(|&u| [u, u.next_down(), u.next_up().min(range)]));
+            keys.extend((0..=GUIDE_LEN).map(|g| g as f64 * range / GUIDE_LEN as f64));
+            for t in keys.into_iter().map(|t| t.max(0.0)) {
+                let expected = upper.partition_point(|&u| u < t).min(last);
+                proptest::prop_assert_eq!(
+                    guided_interval(&upper, &guide, range, t),
+                    expected,
+                    "key {} (range {})",
+                    t,
+                    range
+                );
+            }
         }
+    }
+}
+
+/// The isotropic sets search by `1 − cos θo`: every query lands in the interval whose θ edges
+/// hold it (up to the rounding of an edge itself), at random angles and next to every edge.
+#[test]
+fn queries_land_in_the_interval_that_holds_their_angle() {
+    let (brdf, opts) = small("phong:n=200");
+    let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+    let cell = &set.cells[0];
+    let mut thetas: Vec<f64> = (0..2000).map(|k| k as f64 * 89.99 / 1999.0).collect();
+    for &u in &cell.upper[..cell.upper.len() - 1] {
+        let d = u.to_degrees();
+        thetas.extend([d - 1e-7, d + 1e-7]);
+    }
+    for t in thetas {
+        let q = set.locate(&brdf::direction_from_angles(t, 33.0)).unwrap();
+        let i = q.interval;
+        let lo = if i == 0 { 0.0 } else { cell.upper[i - 1] };
+        let r = t.to_radians();
+        assert!(
+            lo - 1e-12 <= r && r <= cell.upper[i] + 1e-12,
+            "θo {t}° in interval {i} [{lo}, {}]",
+            cell.upper[i]
+        );
     }
 }
