@@ -28,7 +28,7 @@ use brdf::{Brdf, Vec3};
 use partition_sampler::{LeafInfo, Rect};
 
 use crate::disc::DiscMap;
-use crate::normalisation::adaptive_quadrature;
+use crate::normalisation::{Grading, adaptive_quadrature};
 
 /// Evaluation budget of [`reference_albedo`] (about 0.1–0.3 s for an analytic model).
 pub const REFERENCE_BUDGET: u64 = 4_000_000;
@@ -145,7 +145,14 @@ pub(crate) fn albedo_of(
         mirror,
         &mut leaves,
     );
-    let q = adaptive_quadrature(&density, leaves.into_iter(), REFERENCE_TOL, mirror, budget);
+    let q = adaptive_quadrature(
+        &density,
+        leaves.into_iter(),
+        REFERENCE_TOL,
+        mirror,
+        budget,
+        Grading::Fixed,
+    );
     if !(q.total.is_finite() && q.abs_err.is_finite()) {
         return Err(ReferenceError::NotFinite(brdf.name().to_string()));
     }

@@ -20,7 +20,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout, SliceLocator};
-use crate::normalisation::{leaf_quadrature, per_leaf_quadrature};
+use crate::normalisation::{Grading, leaf_quadrature, per_leaf_quadrature};
 use crate::options::SetOptions;
 use crate::report::{CostMeasurement, SetReport};
 
@@ -301,7 +301,13 @@ fn build_slice(
                 f: &f,
                 counter: &counter,
             };
-            let q = per_leaf_quadrature(&counted, tree.leaves(), tree.integral(), false);
+            let q = per_leaf_quadrature(
+                &counted,
+                tree.leaves(),
+                tree.integral(),
+                false,
+                Grading::Fixed,
+            );
             let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
             // Only the estimates decide here: the leaf rule's per-leaf values also set the
             // leaf probabilities, and on the Cornell fixture the disagreement rule of the

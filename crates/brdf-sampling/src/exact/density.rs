@@ -114,8 +114,11 @@ impl NodeValues {
 /// shared nodes with the same `num` (see `exact::Grid`), hence the same `ωo_n` bits.
 pub(crate) type NodeKey = (u64, u64);
 
-/// Shards of a node's cache of fresh values (the image map evaluates in parallel).
-const SHARDS: usize = 16;
+/// One thread's fresh values, on a cache line of its own (the image map evaluates in
+/// parallel; each worker appends to its own buffer, uncontended).
+#[repr(align(128))]
+#[derive(Default)]
+struct FreshBuffer(Mutex<Vec<([u64; 3], f64)>>);
 
 /// One bound node of an [`IntervalEnvelope`].
 pub(crate) struct EnvelopeNode {
@@ -124,8 +127,9 @@ pub(crate) struct EnvelopeNode {
     pub(crate) delta: f64,
     /// Values this node already had in the interval's parent (same node, same lattice).
     inherited: Option<Arc<NodeValues>>,
-    /// Values evaluated by this build, kept for the children when caching is on.
-    fresh: Option<Vec<Mutex<ValueMap>>>,
+    /// Values evaluated by this build, kept for the children when caching is on: one buffer
+    /// per worker thread and one for callers outside the pool.
+    fresh: Option<Vec<FreshBuffer>>,
 }
 
 impl EnvelopeNode {
@@ -142,7 +146,11 @@ impl EnvelopeNode {
             wo,
             delta,
             inherited,
-            fresh: cache.then(|| (0..SHARDS).map(|_| Mutex::default()).collect()),
+            fresh: cache.then(|| {
+                (0..=rayon::current_num_threads())
+                    .map(|_| FreshBuffer::default())
+                    .collect()
+            }),
         }
     }
 
@@ -157,13 +165,11 @@ impl EnvelopeNode {
             rotate_z(wi, self.delta)
         };
         let v = brdf.eval(&self.wo, &w);
-        if let Some(shards) = &self.fresh {
+        if let Some(buffers) = &self.fresh {
             evaluations.fetch_add(1, Relaxed);
-            let shard = (key[0] ^ key[1].rotate_left(21) ^ key[2].rotate_left(42))
-                .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                >> 60;
-            if let Ok(mut m) = shards[shard as usize % SHARDS].lock() {
-                m.insert(key, v);
+            let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
+            if let Some(Ok(mut b)) = buffers.get(worker).map(|b| b.0.lock()) {
+                b.push((key, v));
             }
         }
         v
@@ -177,11 +183,18 @@ impl EnvelopeNode {
     /// Every value known for this node (inherited and fresh), for the children.
     pub(crate) fn into_values(self) -> (NodeKey, Arc<NodeValues>) {
         let mut values = self.inherited.map(Arc::unwrap_or_clone).unwrap_or_default();
-        let mut fresh = ValueMap::default();
-        for m in self.fresh.unwrap_or_default() {
-            if let Ok(m) = m.into_inner() {
-                fresh.extend(m);
-            }
+        let buffers: Vec<Vec<([u64; 3], f64)>> = self
+            .fresh
+            .unwrap_or_default()
+            .into_iter()
+            .filter_map(|b| b.0.into_inner().ok())
+            .collect();
+        let mut fresh = ValueMap::with_capacity_and_hasher(
+            buffers.iter().map(Vec::len).sum(),
+            Default::default(),
+        );
+        for b in buffers {
+            fresh.extend(b);
         }
         if !fresh.is_empty() {
             values.layers.push(Arc::new(fresh));

@@ -47,7 +47,10 @@
 //! directions of the image-map lattice instead of evaluating them again (bit-identical; with
 //! 3 nodes a child evaluates one node afresh). The normaliser nodes are integrated ends and
 //! middle first: the first whose `ΣV/A` exceeds the cap decides the split, and the others are
-//! not integrated.
+//! not integrated. A child takes the normaliser at the end it shares with its parent from the
+//! parent's quadrature (same node bits), and a doubled δ grid keeps the nodes it already has;
+//! each quadrature uses the graded rule (`normalisation::Grading::Graded`: orders 5 and 3
+//! first, order 8 only on the pieces that need it).
 
 mod chebyshev;
 mod density;
@@ -67,7 +70,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::Turn;
-use crate::normalisation::per_leaf_quadrature;
+use crate::normalisation::{Grading, per_leaf_quadrature};
 use crate::options::{OptionsError, SetOptions};
 use crate::set::layout_for;
 
@@ -217,7 +220,6 @@ struct Interval {
     /// `A · cos θo` over the table variable `v` (`cos θo` for isotropic BRDFs, `θo` otherwise,
     /// see [`TableVar`]) and `δ`.
     table: ChebyshevTable,
-    var: TableVar,
     /// Largest `Σ V_i / A` over the normaliser nodes.
     worst_trials: f64,
     /// Quadrature + interpolation relative error estimate of `A`.
@@ -229,12 +231,12 @@ struct Interval {
 
 impl Interval {
     /// `A(θo, δ)`: the table holds `A · cos θo` (smooth at grazing angles also for BRDFs with
-    /// a `1/cos θo` factor), its variable clamped to the table's nodes.
+    /// a `1/cos θo` factor), its variable (the set's `var`) clamped to the table's nodes.
     #[inline]
-    fn normaliser(&self, q: &Query) -> f64 {
+    fn normaliser(&self, var: TableVar, q: &Query) -> f64 {
         let t = &self.table.theta;
         let v = q.var.clamp(t[t.len() - 1], t[0]);
-        let cos = if v == q.var { q.cos } else { self.var.cos(v) };
+        let cos = if v == q.var { q.cos } else { var.cos(v) };
         self.table.eval(v, q.delta) / cos
     }
 }
@@ -459,13 +461,32 @@ impl std::fmt::Debug for ExactSet {
     }
 }
 
-/// A request to build one interval `θ ∈ [θ(num[0]), θ(num[1])]` (see [`Grid`]), with the node
-/// values its parent already evaluated.
+/// A request to build one interval `θ ∈ [θ(num[0]), θ(num[1])]` (see [`Grid`]), with what its
+/// parent already evaluated.
 #[derive(Clone)]
 struct Job {
     cell: usize,
     num: [u64; 2],
-    inherited: Arc<Vec<(NodeKey, Arc<NodeValues>)>>,
+    inherited: Arc<Inheritance>,
+}
+
+/// What a split interval hands to its children: its caching bound nodes' values, and the
+/// normalisers it integrated, keyed by the bits of the node's table variable and of `δ` (a
+/// child's end is its parent's end with the same bits, so its quadrature is not repeated).
+#[derive(Default)]
+struct Inheritance {
+    nodes: Vec<(NodeKey, Arc<NodeValues>)>,
+    normalisers: Vec<(NormaliserKey, Normaliser)>,
+}
+
+/// A normaliser node: the bits of its table variable and of `δ`.
+type NormaliserKey = (u64, u64);
+
+/// One normaliser node's quadrature: `A` and its relative error estimate.
+#[derive(Clone, Copy)]
+struct Normaliser {
+    total: f64,
+    rel_err: f64,
 }
 
 impl Job {
@@ -565,6 +586,7 @@ impl ExactSet {
         let start = Instant::now();
         let layout = layout_for(brdf.as_ref(), &options.set);
         let isotropic = brdf.is_isotropic();
+        let var = table_var(isotropic);
         let period = layout.phi_period();
         let n_cells = layout.phi;
         let half = if isotropic {
@@ -582,7 +604,7 @@ impl ExactSet {
         // anisotropic cells (many nodes, many intervals) would hold too many values.
         let cache =
             isotropic && cache.unwrap_or_else(|| eval_cost_ns(brdf.as_ref()) > CACHE_ABOVE_NS);
-        let none = Arc::new(Vec::new());
+        let none = Arc::new(Inheritance::default());
         let mut jobs: Vec<Job> = (0..n_cells)
             .flat_map(|cell| {
                 let none = &none;
@@ -608,6 +630,7 @@ impl ExactSet {
                         grid,
                         phi_k: layout.phi_of(job.cell),
                         half,
+                        var,
                         cache,
                         can_split: job.can_split(&grid, min_width),
                     };
@@ -616,7 +639,13 @@ impl ExactSet {
                 .collect();
             let mut next = Vec::new();
             for r in results {
-                let (job, (iv, values)) = r?;
+                let (
+                    job,
+                    Built {
+                        interval: iv,
+                        inheritance,
+                    },
+                ) = r?;
                 built += 1;
                 let wants = iv.as_ref().is_none_or(|iv| {
                     iv.worst_trials > options.max_trials
@@ -630,12 +659,12 @@ impl ExactSet {
                     // `None` only comes from an interval that can be split.
                     _ => {
                         let mid = job.num[0] + (job.num[1] - job.num[0]) / 2;
-                        let values = Arc::new(values);
+                        let inheritance = Arc::new(inheritance);
                         for num in [[job.num[0], mid], [mid, job.num[1]]] {
                             next.push(Job {
                                 cell: job.cell,
                                 num,
-                                inherited: Arc::clone(&values),
+                                inherited: Arc::clone(&inheritance),
                             });
                         }
                         queued += 2;
@@ -659,9 +688,7 @@ impl ExactSet {
         let cells: Vec<Cell> = per_cell
             .into_iter()
             .enumerate()
-            .map(|(k, (upper, intervals))| {
-                Cell::new(layout.phi_of(k), upper, intervals, table_var(isotropic))
-            })
+            .map(|(k, (upper, intervals))| Cell::new(layout.phi_of(k), upper, intervals, var))
             .collect();
         Ok(Self {
             brdf,
@@ -669,7 +696,7 @@ impl ExactSet {
             isotropic,
             period,
             cells,
-            var: table_var(isotropic),
+            var,
             top_cos: THETA_TOP_DEG.to_radians().cos(),
             build_time: start.elapsed(),
             counters: AuditCounters::new(),
@@ -700,7 +727,7 @@ impl ExactSet {
     /// (`None` below the horizon).
     pub fn normaliser(&self, wo: &Vec3) -> Option<f64> {
         let q = self.locate(wo)?;
-        Some(self.interval(&q).normaliser(&q))
+        Some(self.interval(&q).normaliser(self.var, &q))
     }
 
     /// The θ edges (degrees) of every cell's intervals.
@@ -819,7 +846,7 @@ impl ExactSet {
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
         let s = match drawn {
             Some((x, gx)) => {
-                let a = iv.normaliser(&q);
+                let a = iv.normaliser(self.var, &q);
                 let v = iv.map.to_direction(x);
                 DirSample {
                     wi: q.turn.apply(&v),
@@ -918,14 +945,19 @@ struct IntervalContext {
     phi_k: f64,
     /// The cell's half-width (0: isotropic).
     half: f64,
+    /// The set's table variable.
+    var: TableVar,
     /// Keep the bound nodes' values for the children.
     cache: bool,
     /// The interval may be halved (it is wide enough).
     can_split: bool,
 }
 
-/// A built interval (`None`: to be split) and its bound nodes' values.
-type Built = (Option<Interval>, Vec<(NodeKey, Arc<NodeValues>)>);
+/// One interval's build: the interval (`None`: to be split) and what its children can reuse.
+struct Built {
+    interval: Option<Interval>,
+    inheritance: Inheritance,
+}
 
 /// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell).
 fn table_var(isotropic: bool) -> TableVar {
@@ -975,6 +1007,7 @@ fn build_interval(
             let key = (num, d.to_bits());
             let inherited = job
                 .inherited
+                .nodes
                 .iter()
                 .find(|(k, _)| *k == key && cacheable)
                 .map(|(_, v)| Arc::clone(v));
@@ -1059,7 +1092,7 @@ fn build_interval(
     let f = DiscBrdf::with_map(plain, centre, map);
     // The normaliser at the Chebyshev nodes, by the leaf quadrature of this tree; the δ nodes
     // double (Lobatto-nested) while their tail exceeds the tolerance.
-    let var = table_var(half == 0.0);
+    let var = ctx.var;
     let (va, vb) = (var.of(ta), var.of(tb));
     let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), options.normaliser_nodes);
     let before = crate::disc::thread_evaluations();
@@ -1067,8 +1100,7 @@ fn build_interval(
     // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
     // split, and the other nodes' quadratures are not needed.
     let nt = theta_nodes.len();
-    let mut order = vec![0, nt - 1, nt / 2];
-    order.extend((1..nt - 1).filter(|&i| i != nt / 2));
+    let mut normalisers: Vec<(NormaliserKey, Normaliser)> = Vec::new();
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
         let delta_nodes = if half == 0.0 {
@@ -1076,28 +1108,73 @@ fn build_interval(
         } else {
             lobatto_nodes(-half, half, nd)
         };
+        // The nodes the parent integrated first (the split test costs nothing there), then the
+        // ends and the middle.
+        let known = |own: &[(NormaliserKey, Normaliser)], i: usize, d: f64| {
+            let key = (theta_nodes[i].to_bits(), d.to_bits());
+            job.inherited
+                .normalisers
+                .iter()
+                .chain(own)
+                .find(|(k, _)| *k == key)
+                .map(|(_, n)| *n)
+        };
+        let mut order: Vec<(usize, usize)> = [0, nt - 1, nt / 2]
+            .into_iter()
+            .chain((1..nt - 1).filter(|&i| i != nt / 2))
+            .flat_map(|i| (0..delta_nodes.len()).map(move |j| (i, j)))
+            .collect();
+        order.sort_by_key(|&(i, j)| known(&normalisers, i, delta_nodes[j]).is_none());
         let mut values = vec![0.0; nt * delta_nodes.len()];
         let mut quad_err = 0.0f64;
-        for &i in &order {
-            let t = var.theta(theta_nodes[i]);
-            let cos = var.cos(theta_nodes[i]);
-            for (j, &d) in delta_nodes.iter().enumerate() {
-                let q =
-                    QueryDensity::new(brdf.as_ref(), direction_from_radians(t, phi_k + d), d, map);
-                let r = per_leaf_quadrature(&q, tree.leaves(), tree.integral(), mirror_y);
-                if !(r.total.is_finite() && r.total > 0.0) {
-                    return Err(ExactError::Normaliser {
-                        value: r.total,
-                        theta_deg: t.to_degrees(),
-                        phi_deg: (phi_k + d).to_degrees(),
-                    });
+        for (i, j) in order {
+            let (t, cos, d) = (
+                var.theta(theta_nodes[i]),
+                var.cos(theta_nodes[i]),
+                delta_nodes[j],
+            );
+            let r = match known(&normalisers, i, d) {
+                Some(r) => r,
+                None => {
+                    let q = QueryDensity::new(
+                        brdf.as_ref(),
+                        direction_from_radians(t, phi_k + d),
+                        d,
+                        map,
+                    );
+                    let r = per_leaf_quadrature(
+                        &q,
+                        tree.leaves(),
+                        tree.integral(),
+                        mirror_y,
+                        Grading::Graded,
+                    );
+                    let r = Normaliser {
+                        total: r.total,
+                        rel_err: r.rel_err,
+                    };
+                    normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
+                    r
                 }
-                if ctx.can_split && volume / r.total > options.max_trials {
-                    return Ok((None, values_of(envelope)));
-                }
-                quad_err = quad_err.max(r.rel_err);
-                values[i * delta_nodes.len() + j] = r.total * cos;
+            };
+            if !(r.total.is_finite() && r.total > 0.0) {
+                return Err(ExactError::Normaliser {
+                    value: r.total,
+                    theta_deg: t.to_degrees(),
+                    phi_deg: (phi_k + d).to_degrees(),
+                });
             }
+            if ctx.can_split && volume / r.total > options.max_trials {
+                return Ok(Built {
+                    interval: None,
+                    inheritance: Inheritance {
+                        nodes: values_of(envelope),
+                        normalisers,
+                    },
+                });
+            }
+            quad_err = quad_err.max(r.rel_err);
+            values[i * delta_nodes.len() + j] = r.total * cos;
         }
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
@@ -1120,19 +1197,21 @@ fn build_interval(
     let shape = *tree.shape();
     let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
         .map_err(|source| SetError::Attach { slice, source })?;
-    Ok((
-        Some(Interval {
+    Ok(Built {
+        interval: Some(Interval {
             tree: sampler,
             map,
             table,
-            var,
             worst_trials,
             norm_err,
             quad_err,
             evaluations: build_evals + quad_evals,
         }),
-        values_of(envelope),
-    ))
+        inheritance: Inheritance {
+            nodes: values_of(envelope),
+            normalisers,
+        },
+    })
 }
 
 /// The values the caching nodes of a built interval know, for its children.
@@ -1171,7 +1250,7 @@ impl DirectionSampler for ExactSet {
         let Some(q) = self.locate(wo) else {
             return 0.0;
         };
-        let a = self.interval(&q).normaliser(&q);
+        let a = self.interval(&q).normaliser(self.var, &q);
         self.brdf.eval(&q.wo, wi) * wi.z / a
     }
 
