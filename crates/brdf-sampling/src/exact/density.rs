@@ -32,14 +32,20 @@ impl<'a> QueryDensity<'a> {
     /// at `R_{−rot} ωo` instead (the same value, `f(ωo, R ωi) = f(R⁻¹ωo, ωi)`), which saves
     /// the rotation of every trial point.
     pub(crate) fn new(brdf: &'a dyn Brdf, wo: Vec3, rot: f64, map: DiscMap) -> Self {
-        Self::in_frame(brdf, &wo, Turn::from_angle(rot), map)
+        Self::in_frame(brdf, brdf.is_isotropic(), &wo, Turn::from_angle(rot), map)
     }
 
-    /// [`QueryDensity::new`] for the rotation `turn` held as `(cos, sin)`: an isotropic BRDF is
-    /// evaluated at `R_{−turn} ωo` (no trigonometry), an anisotropic one rotates the trial
-    /// points.
+    /// [`QueryDensity::new`] for the rotation `turn` held as `(cos, sin)`: an isotropic BRDF
+    /// (`isotropic`: `brdf.is_isotropic()`, known to the caller) is evaluated at `R_{−turn} ωo`
+    /// (no trigonometry), an anisotropic one rotates the trial points.
     #[inline]
-    pub(crate) fn in_frame(brdf: &'a dyn Brdf, wo: &Vec3, turn: Turn, map: DiscMap) -> Self {
+    pub(crate) fn in_frame(
+        brdf: &'a dyn Brdf,
+        isotropic: bool,
+        wo: &Vec3,
+        turn: Turn,
+        map: DiscMap,
+    ) -> Self {
         if turn == Turn::IDENTITY {
             Self {
                 brdf,
@@ -47,7 +53,7 @@ impl<'a> QueryDensity<'a> {
                 rot: None,
                 map,
             }
-        } else if brdf.is_isotropic() {
+        } else if isotropic {
             Self {
                 brdf,
                 wo: turn.undo(wo),

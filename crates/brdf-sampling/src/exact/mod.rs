@@ -274,7 +274,7 @@ impl TableVar {
     fn cos(self, v: f64) -> f64 {
         match self {
             Self::Cos => v,
-            Self::Theta => v.cos(),
+            Self::Theta => cos_not_speculated(v),
         }
     }
     /// The search key of `v`, increasing with θ over `[0, key_range]`: `1 − cos θ` or `θ`.
@@ -291,6 +291,14 @@ impl TableVar {
             Self::Theta => std::f64::consts::FRAC_PI_2,
         }
     }
+}
+
+/// `cos v` behind a call the optimiser cannot hoist: inlined, `libm`'s `cos` (which it treats
+/// as pure) was computed on every query of an isotropic set and the result discarded (5 % of
+/// the sampling loop of `ward` in `perf`).
+#[inline(never)]
+fn cos_not_speculated(v: f64) -> f64 {
+    v.cos()
 }
 
 /// One azimuth cell: its centre and its intervals, ordered by θ.
@@ -842,7 +850,7 @@ impl ExactSet {
     fn draw(&self, wo: &Vec3, u: &mut dyn UniformSource, audit: &mut Audit) -> Option<DirSample> {
         let q = self.locate(wo)?;
         let iv = self.interval(&q);
-        let g = QueryDensity::in_frame(self.brdf.as_ref(), &q.wo, q.turn, iv.map);
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
         let s = match drawn {
             Some((x, gx)) => {
