@@ -107,7 +107,7 @@ pub use disc::{
     solid_angle_pdf_to_area, thread_evaluations,
 };
 pub use error::{SetError, SetFileError};
-pub use exact::{ExactError, ExactOptions, ExactReport, ExactSet};
+pub use exact::{CellLayout, ExactError, ExactOptions, ExactReport, ExactSet};
 pub use layout::{SliceChoice, SliceLayout, SliceLocator, Turn};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};

@@ -2,21 +2,24 @@
 //! with interval-bounded trees (issue 14).
 //!
 //! # Math
-//! The outgoing angles are partitioned into θ intervals `[θ_a, θ_b]` (and, for anisotropic
-//! BRDFs, the azimuth cells of [`SetOptions::anisotropic_slices`] with centres `φ_k` and
-//! half-width `h`; half-turn-symmetric BRDFs store `[0, π)`). Each interval holds one quadtree
+//! The outgoing angles are partitioned into θ intervals `[θ_a, θ_b]` (for anisotropic BRDFs,
+//! rectangles `[θ_a, θ_b] × [δ_a, δ_b]` of azimuth cells with centres `φ_k`, offsets
+//! `δ ∈ [−h, h]`, [`ExactOptions::initial_phi_cells`] of them before splitting;
+//! half-turn-symmetric BRDFs store `[0, π)`). Each interval holds one quadtree
 //! on the unit disc of its [`DiscMap`] (equal-area when `θ_b` reaches
 //! [`SetOptions::equal_area_from_deg`] or the BRDF is unbounded at the horizon), built with the
 //! set's image map, rim band, safety factor and tree parameters from the **envelope**
 //! `F(x) = max_n g_n(x)` of the query densities at the interval's bound nodes (a uniform grid
-//! of [`ExactOptions::bound_nodes`] θ values × [`ExactOptions::phi_bound_nodes`] δ values).
+//! of [`ExactOptions::bound_nodes`] θ values × [`ExactOptions::phi_bound_nodes`] δ values of
+//! the interval).
 //! The leaf bounds `M_i` thus hold for every outgoing direction of the interval (between the
 //! nodes, the safety factor covers the envelope's dips; every trial above its bound is counted
 //! by the audit, [`crate::DirectionSampler::bound_violations`]).
 //!
 //! For a query `ωo = (θo, φo)`: the cell `k` with the nearest `φ_k`, the rotation
-//! `r = φo − φ_k` (`δ = r` reduced to `[−h, h]`; 0 cells and `r = φo` for isotropic BRDFs),
-//! the interval containing `θo`, and the query density `g(x) = f_r(ωo, R_r h⁻¹(x))`
+//! `r = φo − φ_k` (`δ = r` reduced to `[−h, h]`; one cell and `r = φo` for isotropic BRDFs),
+//! the interval containing `(θo, δ)` (a guide table over the cell's θ strips, then the strip's
+//! δ edges), and the query density `g(x) = f_r(ωo, R_r h⁻¹(x))`
 //! (projected) or `2 f_r(ωo, R_r h_e⁻¹(x)) cos θi` (equal-area). A leaf is chosen ∝
 //! `V_i = area_i · M_i`, a point `x` uniformly in it and accepted when `z · M_i < g(x)`; the
 //! accepted `x` has density `g / ∫ g` exactly, and `ωi = R_r h⁻¹(x)`.
@@ -35,10 +38,13 @@
 //!
 //! **Adaptive intervals.** An interval is halved while its tree would need more than
 //! [`ExactOptions::max_trials`] mean trials at one of its normaliser nodes (`Σ V_i / A`) or its
-//! θ interpolation tail exceeds [`ExactOptions::normaliser_tol`] (or the quadrature's own error
-//! estimate, if larger: below it the tail is quadrature noise), down to
+//! θ (δ) interpolation tail exceeds [`ExactOptions::normaliser_tol`] (or the quadrature's own
+//! error estimate, if larger: below it the tail is quadrature noise), down to
 //! [`ExactOptions::min_width_deg`]: sharp lobes and grazing angles get narrow intervals, smooth
-//! models keep the initial ones. The layout is reported by [`ExactSet::report`].
+//! models keep the initial ones. Too many trials halve θ, or δ when the bound nodes'
+//! densities overlap clearly less along δ than along θ and the azimuth loss alone explains the
+//! excess (`split_axis`): an anisotropic lobe far from the normal gets narrow azimuth cells, the
+//! rest of the hemisphere wide ones. The layout is reported by [`ExactSet::report`].
 //!
 //! **Build cost.** Interval edges and bound nodes are exact rationals of `π/2` (one
 //! denominator for the set), so a halved interval's ends and midpoint are bound nodes of its
@@ -72,7 +78,6 @@ use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::Turn;
 use crate::normalisation::{Grading, per_leaf_quadrature};
 use crate::options::{OptionsError, SetOptions};
-use crate::set::layout_for;
 
 use chebyshev::{ChebyshevTable, lobatto_nodes};
 use density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryDensity};
@@ -83,16 +88,21 @@ use density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryDensity}
 pub const THETA_TOP_DEG: f64 = 89.99;
 
 /// Settings of [`ExactSet`]. `set` supplies the tree parameters, image map, safety factor,
-/// disc-map policy, symmetries and the anisotropic azimuth cells (its θ slice count is unused).
+/// disc-map policy and symmetries (its slice counts are unused: the intervals and azimuth cells
+/// adapt).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExactOptions {
     /// The quadtree settings shared with the other adaptive sets.
     pub set: SetOptions,
     /// θ intervals before splitting (equal widths over `[0°, 90°]`).
     pub initial_intervals: usize,
+    /// Azimuth cells per full turn before splitting (anisotropic BRDFs; an even count is halved
+    /// over `[0, π)` for half-turn-symmetric ones, as the sets' `anisotropic_slices`).
+    pub initial_phi_cells: usize,
     /// θ nodes of the bound envelope per interval (uniform, ends included; ≥ 2).
     pub bound_nodes: usize,
-    /// δ nodes of the bound envelope per azimuth cell (anisotropic BRDFs; ≥ 2).
+    /// δ nodes of the bound envelope per interval (anisotropic BRDFs; ≥ 2), more where the
+    /// interval is wider in azimuth than this many nodes [`MAX_DELTA_NODE_SPACING_DEG`] apart.
     pub phi_bound_nodes: usize,
     /// Chebyshev–Lobatto θ nodes of the normaliser table (3 ..= 32).
     pub normaliser_nodes: usize,
@@ -102,13 +112,15 @@ pub struct ExactOptions {
     pub max_trials: f64,
     /// Split an interval whose relative interpolation tail exceeds this (> 0).
     pub normaliser_tol: f64,
-    /// Narrowest interval (degrees, > 0).
+    /// Narrowest interval, in θ and in azimuth (degrees, > 0).
     pub min_width_deg: f64,
 }
 
 impl ExactOptions {
     /// Default initial interval count.
     pub const DEFAULT_INITIAL_INTERVALS: usize = 6;
+    /// Default azimuth cells per turn before splitting.
+    pub const DEFAULT_INITIAL_PHI_CELLS: usize = 8;
     /// Default θ bound nodes.
     pub const DEFAULT_BOUND_NODES: usize = 3;
     /// Default δ bound nodes.
@@ -129,6 +141,7 @@ impl ExactOptions {
         Self {
             set,
             initial_intervals: Self::DEFAULT_INITIAL_INTERVALS,
+            initial_phi_cells: Self::DEFAULT_INITIAL_PHI_CELLS,
             bound_nodes: Self::DEFAULT_BOUND_NODES,
             phi_bound_nodes: Self::DEFAULT_PHI_BOUND_NODES,
             normaliser_nodes: Self::DEFAULT_NORMALISER_NODES,
@@ -147,6 +160,12 @@ impl ExactOptions {
             return bad(
                 "initial_intervals (1 ..= 90)",
                 self.initial_intervals as f64,
+            );
+        }
+        if !(1..=64).contains(&self.initial_phi_cells) {
+            return bad(
+                "initial_phi_cells (1 ..= 64)",
+                self.initial_phi_cells as f64,
             );
         }
         if !(2..=64).contains(&self.bound_nodes) {
@@ -215,6 +234,10 @@ pub enum ExactError {
 
 /// One built interval.
 struct Interval {
+    /// Its θ range (radians).
+    theta: [f64; 2],
+    /// Its azimuth offsets from the cell's centre (radians; `[0, 0]` for isotropic BRDFs).
+    delta: [f64; 2],
     tree: QuadTreeSampler<SliceDensity>,
     map: DiscMap,
     /// `A · cos θo` over the table variable `v` (`cos θo` for isotropic BRDFs, `θo` otherwise,
@@ -301,26 +324,45 @@ fn cos_not_speculated(v: f64) -> f64 {
     v.cos()
 }
 
-/// One azimuth cell: its centre and its intervals, ordered by θ.
+/// One azimuth cell: its centre and its intervals. The cell is cut into θ **strips** at every
+/// interval's θ edges; a strip holds the intervals that cover it, ordered by δ (one, unless
+/// the cell was split in azimuth there).
 struct Cell {
     phi: f64,
-    /// Upper θ edges of the intervals (radians), increasing; the last is π/2.
+    /// Upper θ edges of the strips (radians), increasing; the last is π/2.
     upper: Vec<f64>,
     /// The same edges as search keys ([`TableVar::key`]), increasing.
     keys: Vec<f64>,
-    intervals: Vec<Interval>,
-    /// Guide table over the keys `[0, range]`: `guide[g]` is the interval of the key
+    /// Guide table over the keys `[0, range]`: `guide[g]` is the strip of the key
     /// `g · range / GUIDE_LEN`, where the search for any key of bucket `g` starts (see
     /// [`Cell::interval_of`]).
     guide: Vec<u32>,
     range: f64,
+    /// Strip `s` holds the intervals `members[strips[s]..strips[s + 1]]`; empty when every
+    /// strip holds one interval, the strip's own index (no azimuth split in the cell).
+    strips: Vec<u32>,
+    /// Upper δ edge of each strip entry, increasing within a strip.
+    delta_upper: Vec<f64>,
+    /// The interval of each strip entry.
+    members: Vec<u32>,
+    /// The intervals, ordered by θ, then δ.
+    intervals: Vec<Interval>,
 }
+
+/// An interval with its θ and δ numerators ([`Grid`]).
+type Placed = ([u64; 2], [u64; 2], Interval);
 
 /// Buckets of a cell's guide table.
 const GUIDE_LEN: usize = 256;
 
 impl Cell {
-    fn new(phi: f64, upper: Vec<f64>, intervals: Vec<Interval>, var: TableVar) -> Self {
+    /// The cell of centre `phi` tiled by `members` (θ numerators, δ numerators and interval,
+    /// ordered by θ then δ; see [`Grid`]).
+    fn new(phi: f64, members: Vec<Placed>, grid: &Grid, var: TableVar) -> Self {
+        let mut edges: Vec<u64> = members.iter().map(|(num, _, _)| num[1]).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let upper: Vec<f64> = edges.iter().map(|&e| grid.edge(e)).collect();
         let mut keys: Vec<f64> = upper.iter().map(|&t| var.key(var.of(t))).collect();
         // Monotone despite rounding (the search needs sorted keys).
         for i in 1..keys.len() {
@@ -328,20 +370,73 @@ impl Cell {
         }
         let range = var.key_range();
         let guide = interval_guide(&keys, range);
+        let (mut strips, mut delta_upper, mut entries) = (vec![0u32], Vec::new(), Vec::new());
+        let mut lower = 0u64;
+        for &e in &edges {
+            let mut strip: Vec<(u64, usize)> = members
+                .iter()
+                .enumerate()
+                .filter(|(_, (num, _, _))| num[0] <= lower && num[1] >= e)
+                .map(|(i, (_, dnum, _))| (dnum[1], i))
+                .collect();
+            strip.sort_unstable();
+            for (d, i) in strip {
+                delta_upper.push(grid.delta(d));
+                entries.push(i as u32);
+            }
+            strips.push(entries.len() as u32);
+            lower = e;
+        }
+        let plain = entries.len() == edges.len();
+        let intervals = members.into_iter().map(|(_, _, iv)| iv).collect();
         Self {
             phi,
             upper,
             keys,
-            intervals,
             guide,
             range,
+            strips: if plain { Vec::new() } else { strips },
+            delta_upper: if plain { Vec::new() } else { delta_upper },
+            members: if plain { Vec::new() } else { entries },
+            intervals,
         }
     }
 
-    /// The interval of the search key `key`.
+    /// The interval of the search key `key` and azimuth offset `delta`.
     #[inline]
-    fn interval_of(&self, key: f64) -> usize {
-        guided_interval(&self.keys, &self.guide, self.range, key)
+    fn interval_of(&self, key: f64, delta: f64) -> usize {
+        let s = guided_interval(&self.keys, &self.guide, self.range, key);
+        if self.strips.is_empty() {
+            return s;
+        }
+        let (mut j, last) = (self.strips[s] as usize, self.strips[s + 1] as usize - 1);
+        while j < last && self.delta_upper[j] < delta {
+            j += 1;
+        }
+        self.members[j] as usize
+    }
+
+    /// The intervals of strip `s`, ordered by δ.
+    fn strip(&self, s: usize) -> Vec<usize> {
+        if self.strips.is_empty() {
+            return vec![s];
+        }
+        (self.strips[s]..self.strips[s + 1])
+            .map(|j| self.members[j as usize] as usize)
+            .collect()
+    }
+
+    /// Per strip, its intervals' azimuth edges (degrees, absolute).
+    fn phi_edges_deg(&self) -> Vec<Vec<f64>> {
+        (0..self.upper.len())
+            .map(|s| {
+                let ivs = self.strip(s);
+                let deg = |d: f64| (self.phi + d).to_degrees();
+                let mut e = vec![deg(self.intervals[ivs[0]].delta[0])];
+                e.extend(ivs.iter().map(|&i| deg(self.intervals[i].delta[1])));
+                e
+            })
+            .collect()
     }
 }
 
@@ -372,15 +467,28 @@ fn guided_interval(upper: &[f64], guide: &[u32], range: f64, x: f64) -> usize {
     i
 }
 
+/// The intervals of one azimuth cell of an [`ExactSet`]: θ strips cut at every interval's θ
+/// edges, each strip split in azimuth where its intervals were.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellLayout {
+    /// The cell's centre azimuth (degrees).
+    pub phi_deg: f64,
+    /// The strips' θ edges (degrees, from 0 to 90).
+    pub theta_edges_deg: Vec<f64>,
+    /// Per strip, the azimuth edges of its intervals (degrees, increasing, from the cell's lower
+    /// edge to its upper one); empty for isotropic BRDFs.
+    pub phi_edges_deg: Vec<Vec<f64>>,
+}
+
 /// The layout and statistics of an [`ExactSet`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExactReport {
     /// BRDF name.
     pub brdf: String,
-    /// Azimuth cells (1 for isotropic BRDFs).
+    /// Azimuth cells before their splits (1 for isotropic BRDFs).
     pub cells: usize,
-    /// Per cell: its centre φ (degrees) and the interval edges in θ (degrees, from 0 to 90).
-    pub layout: Vec<(f64, Vec<f64>)>,
+    /// Per azimuth cell: its θ strips and their intervals' azimuth edges.
+    pub layout: Vec<CellLayout>,
     /// Trees (= intervals over all cells).
     pub trees: usize,
     /// Trees on the equal-area disc.
@@ -414,9 +522,19 @@ impl std::fmt::Display for ExactReport {
             "intervals  {} in {} azimuth cell(s) ({} equal-area)",
             self.trees, self.cells, self.equal_area_trees
         )?;
-        for (phi, edges) in &self.layout {
-            let e: Vec<String> = edges.iter().map(|t| format!("{t:.2}")).collect();
-            writeln!(f, "  φ {phi:7.2}°  θ edges [{}]", e.join(", "))?;
+        let list = |v: &[f64]| -> String {
+            let e: Vec<String> = v.iter().map(|t| format!("{t:.2}")).collect();
+            e.join(", ")
+        };
+        for c in &self.layout {
+            let (phi, edges) = (c.phi_deg, &c.theta_edges_deg);
+            writeln!(f, "  φ {phi:7.2}°  θ edges [{}]", list(edges))?;
+            for (s, phis) in c.phi_edges_deg.iter().enumerate() {
+                if phis.len() > 2 {
+                    let (a, b) = (edges[s], edges[s + 1]);
+                    writeln!(f, "    θ {a:.2}–{b:.2}°  φ edges [{}]", list(phis))?;
+                }
+            }
         }
         writeln!(f, "leaves     {}", self.leaves)?;
         writeln!(
@@ -475,6 +593,8 @@ impl std::fmt::Debug for ExactSet {
 struct Job {
     cell: usize,
     num: [u64; 2],
+    /// The azimuth offsets `δ ∈ [δ(dnum[0]), δ(dnum[1])]` of the cell (see [`Grid::delta`]).
+    dnum: [u64; 2],
     inherited: Arc<Inheritance>,
 }
 
@@ -498,10 +618,43 @@ struct Normaliser {
 }
 
 impl Job {
-    /// Whether halving keeps the interval at least `min_width` (radians) wide.
-    fn can_split(&self, grid: &Grid, min_width: f64) -> bool {
+    /// Whether halving θ keeps the interval at least `min_width` (radians) wide.
+    fn can_split_theta(&self, grid: &Grid, min_width: f64) -> bool {
         let even = (self.num[1] - self.num[0]).is_multiple_of(2);
         even && 0.5 * (grid.edge(self.num[1]) - grid.edge(self.num[0])) >= min_width
+    }
+    /// Whether halving δ keeps the interval at least `min_width` (radians of azimuth) wide
+    /// (never for isotropic BRDFs, whose one cell has `δ = 0`).
+    fn can_split_delta(&self, grid: &Grid, min_width: f64) -> bool {
+        let even = (self.dnum[1] - self.dnum[0]).is_multiple_of(2);
+        grid.half > 0.0
+            && even
+            && 0.5 * (grid.delta(self.dnum[1]) - grid.delta(self.dnum[0])) >= min_width
+    }
+    /// `axis` (`true`: δ) if the interval can be halved along it.
+    fn can_split_along(&self, grid: &Grid, min_width: f64, delta: bool) -> Option<bool> {
+        let can = if delta {
+            self.can_split_delta(grid, min_width)
+        } else {
+            self.can_split_theta(grid, min_width)
+        };
+        can.then_some(delta)
+    }
+    /// The two halves along the chosen axis (`delta`: split δ).
+    fn halves(&self, delta: bool) -> [([u64; 2], [u64; 2]); 2] {
+        if delta {
+            let mid = self.dnum[0] + (self.dnum[1] - self.dnum[0]) / 2;
+            [
+                (self.num, [self.dnum[0], mid]),
+                (self.num, [mid, self.dnum[1]]),
+            ]
+        } else {
+            let mid = self.num[0] + (self.num[1] - self.num[0]) / 2;
+            [
+                ([self.num[0], mid], self.dnum),
+                ([mid, self.num[1]], self.dnum),
+            ]
+        }
     }
 }
 
@@ -514,6 +667,8 @@ struct Grid {
     den: u64,
     /// `bound_nodes − 1`: node `n` of `[a, b]` is `(a·m + (b − a)·n) / (den·m)`.
     m: u64,
+    /// Half-width of the azimuth cells (0: isotropic); `δ = h · (2 · num / 2^EDGE_BITS − 1)`.
+    half: f64,
 }
 
 /// Halvings an initial interval can take (far below any useful `min_width_deg`).
@@ -525,6 +680,10 @@ impl Grid {
     }
     fn edge(&self, num: u64) -> f64 {
         Self::theta(num, self.den)
+    }
+    /// The azimuth offset of the numerator `num` (over `2^EDGE_BITS`).
+    fn delta(&self, num: u64) -> f64 {
+        self.half * (2.0 * (num as f64 / (1u64 << EDGE_BITS) as f64) - 1.0)
     }
     /// Numerator (over `den · m`) and angle of bound node `n` of the interval `num`.
     fn node(&self, num: [u64; 2], n: u64) -> (u64, f64) {
@@ -592,21 +751,34 @@ impl ExactSet {
     ) -> Result<Self, ExactError> {
         options.validate()?;
         let start = Instant::now();
-        let layout = layout_for(brdf.as_ref(), &options.set);
         let isotropic = brdf.is_isotropic();
         let var = table_var(isotropic);
-        let period = layout.phi_period();
-        let n_cells = layout.phi;
-        let half = if isotropic {
-            0.0
+        // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
+        let half_turn = !isotropic
+            && options.set.symmetries
+            && brdf.is_half_turn_symmetric()
+            && options.initial_phi_cells.is_multiple_of(2);
+        let period = if half_turn {
+            std::f64::consts::PI
         } else {
-            0.5 * period / n_cells as f64
+            std::f64::consts::TAU
         };
+        let n_cells = match (isotropic, half_turn) {
+            (true, _) => 1,
+            (false, true) => options.initial_phi_cells / 2,
+            (false, false) => options.initial_phi_cells,
+        };
+        let phi_of = |k: usize| k as f64 * period / n_cells as f64;
         let min_width = options.min_width_deg.to_radians();
         let n0 = options.initial_intervals as u64;
         let grid = Grid {
             den: n0 << EDGE_BITS,
             m: options.bound_nodes as u64 - 1,
+            half: if isotropic {
+                0.0
+            } else {
+                0.5 * period / n_cells as f64
+            },
         };
         // Bit-identical results either way; the cache only pays for expensive BRDFs, and
         // anisotropic cells (many nodes, many intervals) would hold too many values.
@@ -619,11 +791,12 @@ impl ExactSet {
                 (0..n0).map(move |i| Job {
                     cell,
                     num: [i << EDGE_BITS, (i + 1) << EDGE_BITS],
+                    dnum: [0, 1 << EDGE_BITS],
                     inherited: Arc::clone(none),
                 })
             })
             .collect();
-        let mut done: Vec<(usize, [u64; 2], Interval)> = Vec::new();
+        let mut done: Vec<(usize, Placed)> = Vec::new();
         let (mut built, mut queued) = (0usize, jobs.len());
         // Depth first, a few intervals at a time: a split parent's node values are released
         // once its children are built (the set does not depend on the order).
@@ -636,11 +809,11 @@ impl ExactSet {
                 .map(|job| {
                     let ctx = IntervalContext {
                         grid,
-                        phi_k: layout.phi_of(job.cell),
-                        half,
+                        phi_k: phi_of(job.cell),
+                        delta: [grid.delta(job.dnum[0]), grid.delta(job.dnum[1])],
                         var,
                         cache,
-                        can_split: job.can_split(&grid, min_width),
+                        min_width,
                     };
                     build_interval(&brdf, options, job, &ctx).map(|b| (job.clone(), b))
                 })
@@ -652,31 +825,48 @@ impl ExactSet {
                     Built {
                         interval: iv,
                         inheritance,
+                        axis: trials_axis,
                     },
                 ) = r?;
                 built += 1;
-                let wants = iv.as_ref().is_none_or(|iv| {
-                    iv.worst_trials > options.max_trials
-                        || iv.table.rel_tail_theta() > options.normaliser_tol.max(iv.quad_err)
-                });
-                match iv {
-                    // Only the edges are kept (the node values go with `job`).
-                    Some(iv) if !(wants && job.can_split(&grid, min_width)) => {
-                        done.push((job.cell, job.num, iv));
-                    }
+                // The axis to halve (`Some(true)`: δ), if any: too many trials (either axis),
+                // or an interpolation tail above the tolerance (or the quadrature's own error,
+                // if larger: below it the tail is quadrature noise) along θ or δ.
+                let floor = |iv: &Interval| options.normaliser_tol.max(iv.quad_err);
+                let axis = match &iv {
                     // `None` only comes from an interval that can be split.
-                    _ => {
-                        let mid = job.num[0] + (job.num[1] - job.num[0]) / 2;
-                        let inheritance = Arc::new(inheritance);
-                        for num in [[job.num[0], mid], [mid, job.num[1]]] {
-                            next.push(Job {
-                                cell: job.cell,
-                                num,
-                                inherited: Arc::clone(&inheritance),
-                            });
-                        }
-                        queued += 2;
+                    None => trials_axis,
+                    Some(iv) if iv.worst_trials > options.max_trials && trials_axis.is_some() => {
+                        trials_axis
                     }
+                    Some(iv)
+                        if iv.table.rel_tail_theta() > floor(iv)
+                            && job.can_split_theta(&grid, min_width) =>
+                    {
+                        Some(false)
+                    }
+                    Some(iv)
+                        if iv.table.rel_tail_delta() > floor(iv)
+                            && job.can_split_delta(&grid, min_width) =>
+                    {
+                        Some(true)
+                    }
+                    Some(_) => None,
+                };
+                if let Some(delta) = axis {
+                    let inheritance = Arc::new(inheritance);
+                    for (num, dnum) in job.halves(delta) {
+                        next.push(Job {
+                            cell: job.cell,
+                            num,
+                            dnum,
+                            inherited: Arc::clone(&inheritance),
+                        });
+                    }
+                    queued += 2;
+                } else if let Some(iv) = iv {
+                    // Only the edges are kept (the node values go with `job`).
+                    done.push((job.cell, (job.num, job.dnum, iv)));
                 }
                 if let Some(p) = progress {
                     p(built, queued);
@@ -685,18 +875,15 @@ impl ExactSet {
             // Children on top of the stack, the left one first.
             jobs.extend(next.into_iter().rev());
         }
-        done.sort_by_key(|(cell, num, _)| (*cell, num[0]));
-        let mut per_cell: Vec<(Vec<f64>, Vec<Interval>)> =
-            (0..n_cells).map(|_| (Vec::new(), Vec::new())).collect();
-        for (cell, num, iv) in done {
-            let c = &mut per_cell[cell];
-            c.0.push(grid.edge(num[1]));
-            c.1.push(iv);
+        done.sort_by_key(|(cell, (num, dnum, _))| (*cell, num[0], dnum[0]));
+        let mut per_cell: Vec<Vec<Placed>> = (0..n_cells).map(|_| Vec::new()).collect();
+        for (cell, placed) in done {
+            per_cell[cell].push(placed);
         }
         let cells: Vec<Cell> = per_cell
             .into_iter()
             .enumerate()
-            .map(|(k, (upper, intervals))| Cell::new(layout.phi_of(k), upper, intervals, var))
+            .map(|(k, members)| Cell::new(phi_of(k), members, &grid, var))
             .collect();
         Ok(Self {
             brdf,
@@ -738,14 +925,23 @@ impl ExactSet {
         Some(self.interval(&q).normaliser(self.var, &q))
     }
 
-    /// The θ edges (degrees) of every cell's intervals.
-    pub fn layout(&self) -> Vec<(f64, Vec<f64>)> {
+    /// The layout of every azimuth cell: its θ strips and, per strip, its intervals' azimuth
+    /// edges.
+    pub fn layout(&self) -> Vec<CellLayout> {
         self.cells
             .iter()
             .map(|c| {
-                let mut e = vec![0.0];
-                e.extend(c.upper.iter().map(|t| t.to_degrees()));
-                (c.phi.to_degrees(), e)
+                let mut theta_edges_deg = vec![0.0];
+                theta_edges_deg.extend(c.upper.iter().map(|t| t.to_degrees()));
+                CellLayout {
+                    phi_deg: c.phi.to_degrees(),
+                    theta_edges_deg,
+                    phi_edges_deg: if self.isotropic {
+                        Vec::new()
+                    } else {
+                        c.phi_edges_deg()
+                    },
+                }
             })
             .collect()
     }
@@ -833,7 +1029,7 @@ impl ExactSet {
             TableVar::Cos => cos,
             TableVar::Theta => cos.acos(),
         };
-        let interval = self.cells[cell].interval_of(self.var.key(var));
+        let interval = self.cells[cell].interval_of(self.var.key(var), delta);
         Some(Query {
             cell,
             interval,
@@ -870,35 +1066,33 @@ impl ExactSet {
     }
 
     /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
-    /// uniform in the interval, φ uniform in the cell) on the calling thread, and counts trials,
+    /// and φ uniform in the interval's ranges) on the calling thread, and counts trials,
     /// BRDF evaluations, violations and exhausted samples (also added to the trees' counts).
     pub fn measure_cost(&self, per_interval: usize, seed: u64) -> crate::CostMeasurement {
         use rand::SeedableRng;
         let before = crate::disc::thread_evaluations();
         let mut total = Audit::default();
         let mut index = 0u64;
-        let step = self.period / self.cells.len() as f64;
         for c in &self.cells {
-            let mut lo = 0.0;
-            for (iv, &hi) in c.intervals.iter().zip(&c.upper) {
+            for iv in &c.intervals {
                 let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(
                     partition_sampler::chunk_seed(seed, index),
                 );
                 index += 1;
+                let ([lo, hi], [da, db]) = (iv.theta, iv.delta);
                 let mut a = Audit::default();
                 for _ in 0..per_interval {
                     let theta = lo + rng.next_uniform() * (hi - lo);
                     let phi = if self.isotropic {
                         0.0
                     } else {
-                        c.phi + (rng.next_uniform() - 0.5) * step
+                        c.phi + da + rng.next_uniform() * (db - da)
                     };
                     let wo = direction_from_radians(theta, phi);
                     let _ = self.draw(&wo, &mut rng, &mut a);
                 }
                 iv.tree.record_audit(&a);
                 total.merge(&a);
-                lo = hi;
             }
         }
         crate::CostMeasurement {
@@ -915,8 +1109,15 @@ impl ExactSet {
 /// moving mirror direction (see [`peak_track`]).
 const PEAK_TRACK_THETAS: usize = 65;
 
-/// Azimuth offsets per anisotropic cell for the same track.
+/// Azimuth offsets per anisotropic interval for the same track (at least; 4 per bound node
+/// spacing).
 const PEAK_TRACK_DELTAS: usize = 9;
+
+/// Largest azimuth spacing of an interval's δ bound nodes (degrees): an anisotropic lobe turns
+/// with δ, and the envelope of nodes farther apart dips below the densities between them (a
+/// 90° cell with 3 nodes let 3 trials in 10⁶ exceed their bound on `ward` with
+/// `alpha_x = 0.1, alpha_y = 0.3`).
+pub const MAX_DELTA_NODE_SPACING_DEG: f64 = 11.25;
 
 /// The peak track of an interval `[ta, tb]` of cell `phi_k` (azimuth offsets `deltas`): for
 /// every outgoing direction `(θ, φ_k + δ)` of a fine grid, its mirror direction's point in the
@@ -946,25 +1147,29 @@ fn peak_track<'a>(
     track
 }
 
-/// What every interval of one azimuth cell shares.
+/// What one interval's build needs besides its [`Job`].
 struct IntervalContext {
     grid: Grid,
     /// The cell's centre azimuth.
     phi_k: f64,
-    /// The cell's half-width (0: isotropic).
-    half: f64,
+    /// The interval's azimuth offsets `[δ_a, δ_b]` from the cell's centre (`[0, 0]`:
+    /// isotropic).
+    delta: [f64; 2],
     /// The set's table variable.
     var: TableVar,
     /// Keep the bound nodes' values for the children.
     cache: bool,
-    /// The interval may be halved (it is wide enough).
-    can_split: bool,
+    /// Narrowest interval (radians, θ and azimuth).
+    min_width: f64,
 }
 
 /// One interval's build: the interval (`None`: to be split) and what its children can reuse.
 struct Built {
     interval: Option<Interval>,
     inheritance: Inheritance,
+    /// The axis to halve should its mean trials exceed the cap (`Some(true)`: δ; `None`: that
+    /// axis is at its narrowest), see [`split_axis`].
+    axis: Option<bool>,
 }
 
 /// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell).
@@ -985,7 +1190,8 @@ fn build_interval(
     job: &Job,
     ctx: &IntervalContext,
 ) -> Result<Built, ExactError> {
-    let (grid, phi_k, half) = (ctx.grid, ctx.phi_k, ctx.half);
+    let (grid, phi_k, [da, db]) = (ctx.grid, ctx.phi_k, ctx.delta);
+    let isotropic = grid.half == 0.0;
     let top = THETA_TOP_DEG.to_radians();
     let theta_b = grid.edge(job.num[1]);
     let (ta, tb) = (grid.edge(job.num[0]).min(top), theta_b.min(top));
@@ -994,14 +1200,23 @@ fn build_interval(
         .disc_map
         .map_for(brdf.as_ref(), theta_b.to_degrees(), set.equal_area_from_deg);
     let deltas = |n: usize| -> Vec<f64> {
-        if half == 0.0 {
+        if isotropic {
             vec![0.0]
         } else {
+            // Exact ends (a child's end is its parent's, bit for bit).
             (0..n)
-                .map(|m| -half + 2.0 * half * m as f64 / (n - 1) as f64)
+                .map(|m| match m {
+                    0 => da,
+                    m if m == n - 1 => db,
+                    m => da + (db - da) * m as f64 / (n - 1) as f64,
+                })
                 .collect()
         }
     };
+    // Bound nodes at most MAX_DELTA_NODE_SPACING_DEG apart in azimuth.
+    let n_delta = options
+        .phi_bound_nodes
+        .max(((db - da).to_degrees() / MAX_DELTA_NODE_SPACING_DEG - 1e-9).ceil() as usize + 1);
     let mut nodes = Vec::new();
     for n in 0..=grid.m {
         let (num, t) = grid.node(job.num, n);
@@ -1011,7 +1226,7 @@ fn build_interval(
         } else {
             (t, ctx.cache)
         };
-        for d in deltas(options.phi_bound_nodes) {
+        for d in deltas(n_delta) {
             let key = (num, d.to_bits());
             let inherited = job
                 .inherited
@@ -1024,7 +1239,7 @@ fn build_interval(
         }
     }
     let n_nodes = nodes.len() as u64;
-    let mirror_y = set.symmetries && brdf.is_mirror_symmetric() && half == 0.0;
+    let mirror_y = set.symmetries && brdf.is_mirror_symmetric() && isotropic;
     let envelope = Arc::new(IntervalEnvelope {
         brdf: Arc::clone(brdf),
         nodes,
@@ -1063,7 +1278,7 @@ fn build_interval(
         ta,
         tb,
         phi_k,
-        &deltas(PEAK_TRACK_DELTAS),
+        &deltas(PEAK_TRACK_DELTAS.max(4 * n_delta - 3)),
         map,
     ));
     let params = TreeParams {
@@ -1080,6 +1295,17 @@ fn build_interval(
             source,
         })?;
     drop(image);
+    let axis_from = crate::disc::thread_evaluations();
+    let axis = split_axis(
+        brdf.as_ref(),
+        job,
+        ctx,
+        &envelope.nodes,
+        &tree,
+        map,
+        options.max_trials,
+    );
+    let axis_evals = crate::disc::thread_evaluations() - axis_from;
     // Node evaluations: the cached nodes counted their misses, the others every point.
     let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
     let build_evals = counter.total() * (n_nodes - cached)
@@ -1111,10 +1337,10 @@ fn build_interval(
     let mut normalisers: Vec<(NormaliserKey, Normaliser)> = Vec::new();
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
-        let delta_nodes = if half == 0.0 {
+        let delta_nodes = if isotropic {
             vec![0.0]
         } else {
-            lobatto_nodes(-half, half, nd)
+            lobatto_nodes(da, db, nd)
         };
         // The nodes the parent integrated first (the split test costs nothing there), then the
         // ends and the middle.
@@ -1172,8 +1398,9 @@ fn build_interval(
                     phi_deg: (phi_k + d).to_degrees(),
                 });
             }
-            if ctx.can_split && volume / r.total > options.max_trials {
+            if axis.is_some() && volume / r.total > options.max_trials {
                 return Ok(Built {
+                    axis,
                     interval: None,
                     inheritance: Inheritance {
                         nodes: values_of(envelope),
@@ -1187,7 +1414,7 @@ fn build_interval(
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
-        if half == 0.0 || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
+        if isotropic || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
             break (table, quad_err);
         }
         nd = 2 * nd - 1;
@@ -1206,14 +1433,17 @@ fn build_interval(
     let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
         .map_err(|source| SetError::Attach { slice, source })?;
     Ok(Built {
+        axis,
         interval: Some(Interval {
+            theta: [grid.edge(job.num[0]), theta_b],
+            delta: ctx.delta,
             tree: sampler,
             map,
             table,
             worst_trials,
             norm_err,
             quad_err,
-            evaluations: build_evals + quad_evals,
+            evaluations: build_evals + axis_evals + quad_evals,
         }),
         inheritance: Inheritance {
             nodes: values_of(envelope),
@@ -1221,6 +1451,63 @@ fn build_interval(
         },
     })
 }
+
+/// The axis to halve (`Some(true)`: δ) should the interval's mean trials exceed the cap, if it
+/// can be halved along it: θ for isotropic BRDFs; for anisotropic cells the axis along which
+/// the bound nodes' densities overlap least. With `g_ij` the density at θ node `i` and δ node
+/// `j` and `(c, d)` the middle nodes, the losses `∫ max_i g_id / ∫ g_cd` (θ) and
+/// `∫ max_j g_cj / ∫ g_cd` (δ) are compared, by the midpoint rule on 2 × 2 points per leaf
+/// of the interval's tree. At grazing angles the lobe changes with θo, not with δ: the θ loss
+/// wins, and an interval at its narrowest θ is kept rather than cut in azimuth for nothing.
+fn split_axis(
+    brdf: &dyn Brdf,
+    job: &Job,
+    ctx: &IntervalContext,
+    nodes: &[EnvelopeNode],
+    tree: &partition_sampler::QuadTree,
+    map: DiscMap,
+    max_trials: f64,
+) -> Option<bool> {
+    let (grid, min_width) = (&ctx.grid, ctx.min_width);
+    if grid.half == 0.0 || !job.can_split_delta(grid, min_width) {
+        return job.can_split_along(grid, min_width, false);
+    }
+    let n_theta = grid.m as usize + 1;
+    let n_delta = nodes.len() / n_theta;
+    let (c, d) = (n_theta / 2, n_delta / 2);
+    let g: Vec<QueryDensity> = nodes
+        .iter()
+        .map(|n| QueryDensity::new(brdf, n.wo, n.delta, map))
+        .collect();
+    let (mut centre, mut theta, mut delta) = (0.0, 0.0, 0.0);
+    for leaf in tree.leaves() {
+        let r = leaf.rect;
+        let w = 0.25 * (r.x1 - r.x0) * (r.y1 - r.y0);
+        for (a, b) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
+            let p = [r.x0 + a * (r.x1 - r.x0), r.y0 + b * (r.y1 - r.y0)];
+            let at = |i: usize, j: usize| g[i * n_delta + j].at(p);
+            let mid = at(c, d);
+            let others = |n: usize, skip: usize, f: &dyn Fn(usize) -> f64| {
+                (0..n).filter(|&k| k != skip).map(f).fold(mid, f64::max)
+            };
+            centre += w * mid;
+            theta += w * others(n_theta, c, &|i| at(i, d));
+            delta += w * others(n_delta, d, &|j| at(c, j));
+        }
+    }
+    // θ unless the azimuth loses clearly more (the axis of the isotropic sets; near grazing
+    // the mean trials of a single node exceed the cap, and only θ splits take the interval
+    // away from the top angle where the bounds cannot follow the lobe).
+    let by_delta = centre > 0.0
+        && delta > theta
+        && delta > (1.0 + MIN_DELTA_LOSS) * centre
+        && tree.volume() / delta <= max_trials;
+    job.can_split_along(grid, min_width, by_delta)
+}
+
+/// Relative overlap loss along δ below which an interval is not cut in azimuth
+/// ([`split_axis`]).
+const MIN_DELTA_LOSS: f64 = 0.1;
 
 /// The values the caching nodes of a built interval know, for its children.
 fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)> {
