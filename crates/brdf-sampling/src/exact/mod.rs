@@ -683,7 +683,12 @@ impl Grid {
     }
     /// The azimuth offset of the numerator `num` (over `2^EDGE_BITS`).
     fn delta(&self, num: u64) -> f64 {
-        self.half * (2.0 * (num as f64 / (1u64 << EDGE_BITS) as f64) - 1.0)
+        self.delta_of(num, 1)
+    }
+    /// The azimuth offset of `num / (2^EDGE_BITS · m)`: one correctly rounded quotient, so
+    /// equal rationals give the same bits.
+    fn delta_of(&self, num: u64, m: u64) -> f64 {
+        self.half * (2.0 * (num as f64 / ((1u64 << EDGE_BITS) * m) as f64) - 1.0)
     }
     /// Numerator (over `den · m`) and angle of bound node `n` of the interval `num`.
     fn node(&self, num: [u64; 2], n: u64) -> (u64, f64) {
@@ -780,10 +785,14 @@ impl ExactSet {
                 0.5 * period / n_cells as f64
             },
         };
-        // Bit-identical results either way; the cache only pays for expensive BRDFs, and
-        // anisotropic cells (many nodes, many intervals) would hold too many values.
-        let cache =
-            isotropic && cache.unwrap_or_else(|| eval_cost_ns(brdf.as_ref()) > CACHE_ABOVE_NS);
+        // Bit-identical results either way; the cache only pays for expensive isotropic
+        // BRDFs. Anisotropic intervals spend most of their evaluations on the normaliser
+        // nodes: on poulin-fournier the cache cut the build's evaluations by 16 % and its CPU
+        // time by 10 %, for a peak of 280 MB instead of 16 MB (it stays off by default).
+        let cache = match cache {
+            Some(forced) => forced,
+            None => isotropic && eval_cost_ns(brdf.as_ref()) > CACHE_ABOVE_NS,
+        };
         let none = Arc::new(Inheritance::default());
         let mut jobs: Vec<Job> = (0..n_cells)
             .flat_map(|cell| {
@@ -1199,17 +1208,15 @@ fn build_interval(
     let map = set
         .disc_map
         .map_for(brdf.as_ref(), theta_b.to_degrees(), set.equal_area_from_deg);
+    // δ nodes as exact rationals (see `Grid::delta_of`): a node a split interval shares with
+    // its child is the same `f64`, whatever the two node counts.
     let deltas = |n: usize| -> Vec<f64> {
         if isotropic {
             vec![0.0]
         } else {
-            // Exact ends (a child's end is its parent's, bit for bit).
-            (0..n)
-                .map(|m| match m {
-                    0 => da,
-                    m if m == n - 1 => db,
-                    m => da + (db - da) * m as f64 / (n - 1) as f64,
-                })
+            let (a, b, m) = (job.dnum[0], job.dnum[1], n as u64 - 1);
+            (0..n as u64)
+                .map(|k| grid.delta_of(a * m + (b - a) * k, m))
                 .collect()
         }
     };

@@ -110,36 +110,44 @@ fn a_moving_cusp_stays_under_the_interval_bounds() {
 
 /// The bound nodes' values kept across a split are the values the BRDF gives: a set built
 /// with the cache is the set built without it (same layout, normaliser and samples, bit for
-/// bit), for fewer evaluations.
+/// bit), for fewer evaluations — isotropic, and anisotropic with splits in θ and in azimuth.
 #[test]
 fn the_node_cache_changes_nothing_but_the_cost() {
-    let (brdf, opts) = small("phong:n=200");
-    let build = |cache| ExactSet::build_with(Arc::clone(&brdf), &opts, None, Some(cache));
-    let (with, without) = (build(true).unwrap(), build(false).unwrap());
-    assert_eq!(with.layout(), without.layout());
-    assert!(
-        with.len() > 6,
-        "no interval was split: the test would show nothing"
-    );
-    let (a, b) = (with.report(), without.report());
-    assert!(
-        a.build_evaluations < b.build_evaluations,
-        "{} vs {}",
-        a.build_evaluations,
-        b.build_evaluations
-    );
-    let (mut r1, mut r2) = (
-        Xoshiro256PlusPlus::seed_from_u64(4),
-        Xoshiro256PlusPlus::seed_from_u64(4),
-    );
-    for k in 0..2000 {
-        let wo = brdf::direction_from_angles(k as f64 * 0.0449, k as f64 * 3.7);
-        let (s, t) = (with.sample(&wo, &mut r1), without.sample(&wo, &mut r2));
-        assert_eq!(
-            (s.wi, s.pdf.to_bits()),
-            (t.wi, t.pdf.to_bits()),
-            "sample {k}"
+    let (phong, phong_opts) = small("phong:n=200");
+    let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.1,alpha_y=0.3").unwrap());
+    let ward_opts = ExactOptions {
+        min_width_deg: 4.0,
+        ..ExactOptions::default()
+    };
+    for (brdf, opts) in [(phong, phong_opts), (ward, ward_opts)] {
+        let build = |cache| ExactSet::build_with(Arc::clone(&brdf), &opts, None, Some(cache));
+        let (with, without) = (build(true).unwrap(), build(false).unwrap());
+        assert_eq!(with.layout(), without.layout());
+        assert!(
+            with.len() > 6,
+            "no interval was split: the test would show nothing"
         );
+        let (a, b) = (with.report(), without.report());
+        assert!(
+            a.build_evaluations < b.build_evaluations,
+            "{} vs {}",
+            a.build_evaluations,
+            b.build_evaluations
+        );
+        let (mut r1, mut r2) = (
+            Xoshiro256PlusPlus::seed_from_u64(4),
+            Xoshiro256PlusPlus::seed_from_u64(4),
+        );
+        for k in 0..2000 {
+            let wo = brdf::direction_from_angles(k as f64 * 0.0449, k as f64 * 3.7);
+            let (s, t) = (with.sample(&wo, &mut r1), without.sample(&wo, &mut r2));
+            assert_eq!(
+                (s.wi, s.pdf.to_bits()),
+                (t.wi, t.pdf.to_bits()),
+                "{} sample {k}",
+                brdf.name()
+            );
+        }
     }
 }
 
