@@ -78,6 +78,7 @@ use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::Turn;
 use crate::normalisation::{Grading, per_leaf_quadrature};
 use crate::options::{OptionsError, SetOptions};
+use crate::set::layout_for;
 
 use chebyshev::{ChebyshevTable, lobatto_nodes};
 use density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryDensity};
@@ -759,21 +760,15 @@ impl ExactSet {
         let isotropic = brdf.is_isotropic();
         let var = table_var(isotropic);
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
-        let half_turn = !isotropic
-            && options.set.symmetries
-            && brdf.is_half_turn_symmetric()
-            && options.initial_phi_cells.is_multiple_of(2);
-        let period = if half_turn {
-            std::f64::consts::PI
-        } else {
-            std::f64::consts::TAU
-        };
-        let n_cells = match (isotropic, half_turn) {
-            (true, _) => 1,
-            (false, true) => options.initial_phi_cells / 2,
-            (false, false) => options.initial_phi_cells,
-        };
-        let phi_of = |k: usize| k as f64 * period / n_cells as f64;
+        let layout = layout_for(
+            brdf.as_ref(),
+            &SetOptions {
+                anisotropic_slices: [1, options.initial_phi_cells],
+                ..options.set
+            },
+        );
+        let (period, n_cells) = (layout.phi_period(), layout.phi);
+        let phi_of = |k: usize| layout.phi_of(k);
         let min_width = options.min_width_deg.to_radians();
         let n0 = options.initial_intervals as u64;
         let grid = Grid {
