@@ -16,7 +16,7 @@
 use std::cell::Cell;
 use std::sync::Arc;
 
-use brdf::{Brdf, Vec3};
+use brdf::{Brdf, Outgoing, Vec3};
 use partition_sampler::{
     Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats,
 };
@@ -153,7 +153,8 @@ pub(crate) fn count_evaluations(n: u64) {
 #[derive(Clone)]
 pub struct DiscBrdf {
     brdf: Arc<dyn Brdf>,
-    wo: Vec3,
+    /// `ωo` as the BRDF prepared it ([`Brdf::prepare`]).
+    wo: Outgoing,
     map: DiscMap,
     zero_floor: f64,
 }
@@ -162,7 +163,7 @@ impl std::fmt::Debug for DiscBrdf {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DiscBrdf")
             .field("brdf", &self.brdf.name())
-            .field("wo", &self.wo)
+            .field("wo", self.wo.wo())
             .field("map", &self.map)
             .field("zero_floor", &self.zero_floor)
             .finish()
@@ -178,8 +179,8 @@ impl DiscBrdf {
     /// The density of `brdf` for `wo` under `map`.
     pub fn with_map(brdf: Arc<dyn Brdf>, wo: Vec3, map: DiscMap) -> Self {
         Self {
+            wo: brdf.prepare(&wo),
             brdf,
-            wo,
             map,
             zero_floor: 0.0,
         }
@@ -208,7 +209,7 @@ impl DiscBrdf {
 
     /// The outgoing direction.
     pub fn wo(&self) -> &Vec3 {
-        &self.wo
+        self.wo.wo()
     }
 
     /// The BRDF.
@@ -228,13 +229,13 @@ impl Density for DiscBrdf {
         let v = match self.map {
             DiscMap::Projected => {
                 let wi = Vec3::new(p[0], p[1], (1.0 - r2).sqrt());
-                self.brdf.eval(&self.wo, &wi)
+                self.brdf.eval_prepared(&self.wo, &wi)
             }
             DiscMap::EqualArea => {
                 let s = (2.0 - r2).sqrt();
                 let z = 1.0 - r2;
                 let wi = Vec3::new(p[0] * s, p[1] * s, z);
-                2.0 * z * self.brdf.eval(&self.wo, &wi)
+                2.0 * z * self.brdf.eval_prepared(&self.wo, &wi)
             }
         };
         if v == 0.0 { self.zero_floor } else { v }

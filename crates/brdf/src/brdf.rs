@@ -32,6 +32,21 @@ pub trait Brdf: Send + Sync {
         [y, y, y]
     }
 
+    /// The values of `f_r(ωo, ·)` that depend on `ωo` alone, computed once for many
+    /// evaluations at one outgoing direction (a sampler's trials at one query). The default
+    /// keeps `ωo` only.
+    fn prepare(&self, wo: &Vec3) -> Outgoing {
+        Outgoing::new(*wo)
+    }
+
+    /// [`eval`](Brdf::eval) at `q.wo()` for `q` from this BRDF's [`prepare`](Brdf::prepare).
+    /// Implementations return the same value as `eval(q.wo(), wi)`, bit for bit (samplers
+    /// evaluate pdfs through both). With an `Outgoing` prepared by another BRDF the value is
+    /// unspecified but finite and `≥ 0`.
+    fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+        self.eval(q.wo(), wi)
+    }
+
     /// True when `f_r` is invariant under a common rotation of `wo` and `wi` about the normal.
     /// Default `false` (the safe answer for samplers).
     fn is_isotropic(&self) -> bool {
@@ -103,6 +118,42 @@ pub trait Brdf: Send + Sync {
     }
 }
 
+/// An outgoing direction `ωo` with up to [`Outgoing::CACHE_LEN`] values a BRDF derived from it
+/// in [`Brdf::prepare`] (their meaning is private to that BRDF). Plain data: `Copy`, no heap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outgoing {
+    wo: Vec3,
+    cache: [f64; Outgoing::CACHE_LEN],
+}
+
+impl Outgoing {
+    /// Number of cached values.
+    pub const CACHE_LEN: usize = 8;
+
+    /// `ωo` with an empty (zero) cache.
+    pub fn new(wo: Vec3) -> Self {
+        Self {
+            wo,
+            cache: [0.0; Self::CACHE_LEN],
+        }
+    }
+
+    /// `ωo` with the values a BRDF computed from it.
+    pub fn with_cache(wo: Vec3, cache: [f64; Self::CACHE_LEN]) -> Self {
+        Self { wo, cache }
+    }
+
+    /// The outgoing direction.
+    pub fn wo(&self) -> &Vec3 {
+        &self.wo
+    }
+
+    /// The cached values.
+    pub fn cache(&self) -> &[f64; Self::CACHE_LEN] {
+        &self.cache
+    }
+}
+
 macro_rules! forward_brdf {
     ($($ty:ty),*) => {$(
         impl<T: Brdf + ?Sized> Brdf for $ty {
@@ -113,6 +164,14 @@ macro_rules! forward_brdf {
             #[inline]
             fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
                 (**self).eval_rgb(wo, wi)
+            }
+            #[inline]
+            fn prepare(&self, wo: &Vec3) -> Outgoing {
+                (**self).prepare(wo)
+            }
+            #[inline]
+            fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+                (**self).eval_prepared(q, wi)
             }
             fn is_isotropic(&self) -> bool {
                 (**self).is_isotropic()

@@ -52,7 +52,7 @@ pub mod special;
 #[cfg(test)]
 mod test_support;
 
-pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, luminance};
+pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, Outgoing, luminance};
 pub use analytic::{AnalyticLobes, SpecularLobe};
 pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,

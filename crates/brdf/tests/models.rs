@@ -108,6 +108,20 @@ proptest! {
         }
     }
 
+    /// `Brdf::eval_prepared` at a prepared `ωo` is `eval`, bit for bit (samplers mix them).
+    #[test]
+    fn prepared_evaluation_is_eval(u1 in 0.0..1.0f64, v1 in 0.0..1.0f64, u2 in 0.0..1.0f64, v2 in 0.0..1.0f64) {
+        let (wo, wi) = (dir(u1, v1), dir(u2, v2));
+        let below = Vec3::new(wi.x, wi.y, -wi.z);
+        for (s, b) in built() {
+            for (o, i) in [(wo, wi), (wo, below), (below, wi)] {
+                let q = b.prepare(&o);
+                prop_assert_eq!(q.wo(), &o);
+                prop_assert_eq!(b.eval_prepared(&q, &i).to_bits(), b.eval(&o, &i).to_bits(), "{}", &s);
+            }
+        }
+    }
+
     #[test]
     fn reciprocal_models_are_symmetric(u1 in 0.0..1.0f64, v1 in 0.0..1.0f64, u2 in 0.0..1.0f64, v2 in 0.0..1.0f64) {
         let (wo, wi) = (dir(u1, v1), dir(u2, v2));

@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex};
 
-use brdf::{Brdf, Vec3, rotate_z};
+use brdf::{Brdf, Outgoing, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
 use rustc_hash::FxHashMap;
 
@@ -21,7 +21,8 @@ use crate::layout::Turn;
 #[derive(Clone, Copy)]
 pub(crate) struct QueryDensity<'a> {
     brdf: &'a dyn Brdf,
-    wo: Vec3,
+    /// `ωo` as the BRDF prepared it ([`Brdf::prepare`]).
+    wo: Outgoing,
     /// `(sin, cos)` of `rot`; `None` for no rotation.
     rot: Option<(f64, f64)>,
     map: DiscMap,
@@ -49,21 +50,21 @@ impl<'a> QueryDensity<'a> {
         if turn == Turn::IDENTITY {
             Self {
                 brdf,
-                wo: *wo,
+                wo: brdf.prepare(wo),
                 rot: None,
                 map,
             }
         } else if isotropic {
             Self {
                 brdf,
-                wo: turn.undo(wo),
+                wo: brdf.prepare(&turn.undo(wo)),
                 rot: None,
                 map,
             }
         } else {
             Self {
                 brdf,
-                wo: *wo,
+                wo: brdf.prepare(wo),
                 rot: Some((turn.sin, turn.cos)),
                 map,
             }
@@ -82,7 +83,7 @@ impl<'a> QueryDensity<'a> {
             None => v,
             Some((s, c)) => Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z),
         };
-        let f = self.brdf.eval(&self.wo, &wi);
+        let f = self.brdf.eval_prepared(&self.wo, &wi);
         match self.map {
             DiscMap::Projected => f,
             DiscMap::EqualArea => 2.0 * v.z * f,
@@ -129,7 +130,8 @@ struct FreshBuffer(Mutex<Vec<([u64; 3], f64)>>);
 /// One bound node of an [`IntervalEnvelope`].
 pub(crate) struct EnvelopeNode {
     pub(crate) key: NodeKey,
-    pub(crate) wo: Vec3,
+    /// The node's `ωo`, prepared by the interval's BRDF.
+    pub(crate) wo: Outgoing,
     pub(crate) delta: f64,
     /// Values this node already had in the interval's parent (same node, same lattice).
     inherited: Option<Arc<NodeValues>>,
@@ -142,7 +144,7 @@ impl EnvelopeNode {
     /// A node at `wo` turned by `delta`; `cache`: keep the values this build evaluates.
     pub(crate) fn new(
         key: NodeKey,
-        wo: Vec3,
+        wo: Outgoing,
         delta: f64,
         inherited: Option<Arc<NodeValues>>,
         cache: bool,
@@ -170,7 +172,7 @@ impl EnvelopeNode {
         } else {
             rotate_z(wi, self.delta)
         };
-        let v = brdf.eval(&self.wo, &w);
+        let v = brdf.eval_prepared(&self.wo, &w);
         if let Some(buffers) = &self.fresh {
             evaluations.fetch_add(1, Relaxed);
             let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
@@ -234,7 +236,10 @@ impl Brdf for IntervalEnvelope {
         // Every node lies in the xz-plane (isotropic layouts): the max of even functions of y
         // is even.
         self.brdf.is_mirror_symmetric()
-            && self.nodes.iter().all(|n| n.wo.y == 0.0 && n.delta == 0.0)
+            && self
+                .nodes
+                .iter()
+                .all(|n| n.wo.wo().y == 0.0 && n.delta == 0.0)
     }
     fn bounded_at_horizon(&self) -> bool {
         self.brdf.bounded_at_horizon()

@@ -1237,7 +1237,13 @@ fn build_interval(
                 .find(|(k, _)| *k == key && cacheable)
                 .map(|(_, v)| Arc::clone(v));
             let wo = direction_from_radians(t, phi_k + d);
-            nodes.push(EnvelopeNode::new(key, wo, d, inherited, cacheable));
+            nodes.push(EnvelopeNode::new(
+                key,
+                brdf.prepare(&wo),
+                d,
+                inherited,
+                cacheable,
+            ));
         }
     }
     let n_nodes = nodes.len() as u64;
@@ -1479,7 +1485,7 @@ fn split_axis(
     let (c, d) = (n_theta / 2, n_delta / 2);
     let g: Vec<QueryDensity> = nodes
         .iter()
-        .map(|n| QueryDensity::new(brdf, n.wo, n.delta, map))
+        .map(|n| QueryDensity::new(brdf, *n.wo.wo(), n.delta, map))
         .collect();
     let (mut centre, mut theta, mut delta) = (0.0, 0.0, 0.0);
     for leaf in tree.leaves() {

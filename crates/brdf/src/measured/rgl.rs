@@ -40,7 +40,7 @@ use thiserror::Error;
 
 use super::tensor::TensorFile;
 use super::warp::{BilinearTable, ParamAxis, Warp2D};
-use crate::brdf::{Brdf, luminance};
+use crate::brdf::{Brdf, Outgoing, luminance};
 use crate::geometry::Vec3;
 
 /// Why an RGL `.bsdf` file could not be read.
@@ -512,18 +512,119 @@ fn sampling_table(
     })
 }
 
+/// What [`RglBrdf::prepare`](Brdf::prepare) keeps of `ωo` (indices into [`Outgoing::cache`]).
+mod prepared {
+    /// 1 when `ωo` is above the horizon, else 0.
+    pub(super) const VALID: usize = 0;
+    /// `(cos φo, sin φo)`: the turn that brings the half vector's azimuth relative to `ωo`.
+    pub(super) const COS_PHI: usize = 1;
+    /// See [`COS_PHI`].
+    pub(super) const SIN_PHI: usize = 2;
+    /// The slice `i` and weight `w` of `θo` on the `theta_i` axis.
+    pub(super) const SLICE: usize = 3;
+    /// See [`SLICE`].
+    pub(super) const WEIGHT: usize = 4;
+    /// `4 σ(u_o)` (1 when the file has no Jacobian factor).
+    pub(super) const FOUR_SIGMA: usize = 5;
+}
+
+impl RglBrdf {
+    /// The slice and weight stored in `q`, made safe to index with whatever `q` holds.
+    fn prepared_slice(&self, q: &Outgoing) -> (usize, f64) {
+        let n = self.tables.theta.values().len();
+        if n < 2 {
+            return (0, 0.0);
+        }
+        let (i, w) = (q.cache()[prepared::SLICE], q.cache()[prepared::WEIGHT]);
+        let w = if (0.0..=1.0).contains(&w) { w } else { 0.0 };
+        ((i.max(0.0) as usize).min(n - 2), w)
+    }
+
+    /// The warped-square position `s`, the slice blend `(i, w)` and the `D/(4σ)` factor of
+    /// `(ωo, ωi)` for a prepared `ωo`; `None` below the horizon or for `ωi = −ωo`.
+    #[inline]
+    fn lookup_prepared(&self, q: &Outgoing, wi: &Vec3) -> Option<([f64; 2], usize, f64, f64)> {
+        let c = q.cache();
+        if !(c[prepared::VALID] == 1.0 && wi.z > 0.0) {
+            return None;
+        }
+        let sum = q.wo() + wi;
+        let norm = sum.norm();
+        if !(norm > 1e-12) {
+            return None;
+        }
+        let m = sum / norm;
+        let (cos_o, sin_o) = (c[prepared::COS_PHI], c[prepared::SIN_PHI]);
+        // Azimuth of m relative to ωo: m turned by −φo.
+        let rel = (cos_o * m.y - sin_o * m.x).atan2(cos_o * m.x + sin_o * m.y);
+        let mut um_y = phi_to_u(rel);
+        um_y -= um_y.floor();
+        let u_m = [theta_to_u(elevation(&m)), um_y];
+        let t = &self.tables;
+        let (i, w) = self.prepared_slice(q);
+        let (s, _) = t.vndf.invert_located(u_m, i, w);
+        let factor = if t.jacobian {
+            t.ndf.eval(u_m, 0, 0, 0.0) / c[prepared::FOUR_SIGMA]
+        } else {
+            1.0
+        };
+        Some((s, i, w, factor))
+    }
+}
+
 impl Brdf for RglBrdf {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        match Self::half_coords(wo, wi) {
-            Some(c) => self.luminance_cos_at(&c) / wi.z,
-            None => 0.0,
-        }
+        self.eval_prepared(&self.prepare(wo), wi)
     }
 
     fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
-        match Self::half_coords(wo, wi) {
-            Some(c) => self.rgb_cos_at(&c).map(|v| v / wi.z),
+        let q = self.prepare(wo);
+        match self.lookup_prepared(&q, wi) {
+            Some((s, i, w, factor)) => {
+                let rgb = &self.tables.rgb;
+                std::array::from_fn(|ch| (rgb.eval(s, 3 * i + ch, 3, w) * factor).max(0.0) / wi.z)
+            }
             None => [0.0; 3],
+        }
+    }
+
+    /// Keeps `θo`'s slice blend, `(cos φo, sin φo)` and `4σ(u_o)`: an evaluation at a prepared
+    /// `ωo` needs one `atan2` and one `asin` (the half vector's angles) instead of two each.
+    fn prepare(&self, wo: &Vec3) -> Outgoing {
+        let mut c = [0.0; Outgoing::CACHE_LEN];
+        if wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite() {
+            let t = &self.tables;
+            let theta_o = elevation(wo);
+            let r = wo.x.hypot(wo.y);
+            let (phi_o, cos_o, sin_o) = if r > 0.0 {
+                (wo.y.atan2(wo.x), wo.x / r, wo.y / r)
+            } else {
+                (0.0, 1.0, 0.0)
+            };
+            let (i, w) = t.theta.locate(theta_o);
+            let four_sigma = if t.jacobian {
+                4.0 * t
+                    .sigma
+                    .eval([theta_to_u(theta_o), phi_to_u(phi_o)], 0, 0, 0.0)
+            } else {
+                1.0
+            };
+            c[prepared::VALID] = 1.0;
+            c[prepared::COS_PHI] = cos_o;
+            c[prepared::SIN_PHI] = sin_o;
+            c[prepared::SLICE] = i as f64;
+            c[prepared::WEIGHT] = w;
+            c[prepared::FOUR_SIGMA] = four_sigma;
+        }
+        Outgoing::with_cache(*wo, c)
+    }
+
+    fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+        match self.lookup_prepared(q, wi) {
+            Some((s, i, w, factor)) => {
+                (self.tables.rgb_luminance.eval(s, i, 1, w) * factor).max(0.0) / wi.z
+            }
+            None => 0.0,
         }
     }
 

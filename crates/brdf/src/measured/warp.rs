@@ -317,6 +317,12 @@ impl Warp2D {
     /// density at `pos`.
     pub fn invert(&self, pos: [f64; 2], param: f64) -> ([f64; 2], f64) {
         let (s, w) = self.axis.locate(param);
+        self.invert_located(pos, s, w)
+    }
+
+    /// [`invert`](Self::invert) for a parameter already located on the axis (`(s, w)` from
+    /// [`ParamAxis::locate`] of this warp's axis).
+    pub(crate) fn invert_located(&self, pos: [f64; 2], s: usize, w: f64) -> ([f64; 2], f64) {
         let nx = self.table.nx;
         let (cx, cy, fx, fy) = self.table.cell(pos);
         let [v00, v10, v01, v11] = self.table.corners(s, 1, w, cx, cy);
