@@ -581,8 +581,8 @@ impl Brdf for RglBrdf {
         let q = self.prepare(wo);
         match self.lookup_prepared(&q, wi) {
             Some((s, i, w, factor)) => {
-                let rgb = &self.tables.rgb;
-                std::array::from_fn(|ch| (rgb.eval(s, 3 * i + ch, 3, w) * factor).max(0.0) / wi.z)
+                let rgb: [f64; 3] = self.tables.rgb.eval_consecutive(s, 3 * i, 3, w);
+                rgb.map(|v| (v * factor).max(0.0) / wi.z)
             }
             None => [0.0; 3],
         }

@@ -113,20 +113,6 @@ impl BilinearTable {
         }
     }
 
-    /// Cell and fractions of `pos` (clamped to `[0,1]²`).
-    #[inline]
-    fn cell(&self, pos: [f64; 2]) -> (usize, usize, f64, f64) {
-        let sx = pos[0].clamp(0.0, 1.0) * (self.nx - 1) as f64;
-        let sy = pos[1].clamp(0.0, 1.0) * (self.ny - 1) as f64;
-        let (sx, sy) = (
-            if sx.is_nan() { 0.0 } else { sx },
-            if sy.is_nan() { 0.0 } else { sy },
-        );
-        let cx = (sx as usize).min(self.nx - 2);
-        let cy = (sy as usize).min(self.ny - 2);
-        (cx, cy, sx - cx as f64, sy - cy as f64)
-    }
-
     /// The four corners `(v00, v10, v01, v11)` of cell `(cx, cy)` of the blended slice.
     #[inline]
     fn corners(&self, s: usize, stride: usize, w: f64, cx: usize, cy: usize) -> [f64; 4] {
@@ -142,9 +128,28 @@ impl BilinearTable {
     /// The bilinear interpolant at `pos` of the blend of slice `s` (weight `1 − w`) and slice
     /// `s + stride` (weight `w`).
     pub fn eval(&self, pos: [f64; 2], s: usize, stride: usize, w: f64) -> f64 {
-        let (cx, cy, fx, fy) = self.cell(pos);
+        let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
         let [v00, v10, v01, v11] = self.corners(s, stride, w, cx, cy);
         (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
+    }
+}
+
+impl BilinearTable {
+    /// [`eval`](Self::eval) of `N` consecutive slices `s, s + 1, …` (e.g. the channels of an
+    /// RGB table), each blended with the slice `stride` further on: the cell of `pos` is found
+    /// once.
+    pub fn eval_consecutive<const N: usize>(
+        &self,
+        pos: [f64; 2],
+        s: usize,
+        stride: usize,
+        w: f64,
+    ) -> [f64; N] {
+        let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
+        std::array::from_fn(|c| {
+            let [v00, v10, v01, v11] = self.corners(s + c, stride, w, cx, cy);
+            (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
+        })
     }
 }
 
@@ -154,14 +159,21 @@ pub(crate) struct ZeroSlice(pub usize);
 
 /// The normalised density of a [`BilinearTable`] conditioned on a [`ParamAxis`], with its
 /// marginal (rows) and conditional (columns) CDFs: eval, exact sampling and inversion.
+///
+/// Layout: what one evaluation reads sits together. Every grid point holds its normalised
+/// value beside the row's CDF there, every row its marginal CDF beside the row's total, so an
+/// inversion reads two lines of grid points and one of rows per slice.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Warp2D {
     axis: ParamAxis,
-    table: BilinearTable,
-    /// Per slice and row: the row's integral so far in `y` (cell units, normalised to end at 1).
-    marginal: Vec<f64>,
-    /// Per slice, row and column: the integral along the row so far in `x` (cell units).
-    conditional: Vec<f64>,
+    nx: usize,
+    ny: usize,
+    /// Per slice and grid point (row-major, `x` fastest): the normalised value, and the
+    /// integral along its row so far in `x` (cell units).
+    cells: Vec<[f64; 2]>,
+    /// Per slice and row: the integral of the rows so far in `y` (cell units, ending at 1),
+    /// and the row's total along `x`.
+    rows: Vec<[f64; 2]>,
 }
 
 impl Warp2D {
@@ -171,46 +183,48 @@ impl Warp2D {
         let (nx, ny) = (table.nx, table.ny);
         let n = nx * ny;
         let slices = table.slices();
-        let mut data = table.data;
-        let mut marginal = vec![0.0; slices * ny];
-        let mut conditional = vec![0.0; slices * n];
+        let data = table.data;
+        let mut cells = vec![[0.0; 2]; slices * n];
+        let mut rows = vec![[0.0; 2]; slices * ny];
         for s in 0..slices {
             let d = &data[s * n..(s + 1) * n];
-            let c = &mut conditional[s * n..(s + 1) * n];
+            let c = &mut cells[s * n..(s + 1) * n];
             for y in 0..ny {
                 let mut sum = 0.0;
                 for x in 0..nx - 1 {
                     sum += 0.5 * (d[y * nx + x] + d[y * nx + x + 1]);
-                    c[y * nx + x + 1] = sum;
+                    c[y * nx + x + 1][1] = sum;
                 }
             }
-            let m = &mut marginal[s * ny..(s + 1) * ny];
+            let r = &mut rows[s * ny..(s + 1) * ny];
             let mut sum = 0.0;
             for y in 0..ny - 1 {
-                sum += 0.5 * (c[y * nx + nx - 1] + c[(y + 1) * nx + nx - 1]);
-                m[y + 1] = sum;
+                sum += 0.5 * (c[y * nx + nx - 1][1] + c[(y + 1) * nx + nx - 1][1]);
+                r[y + 1][0] = sum;
             }
             if !(sum > 0.0 && sum.is_finite()) {
                 return Err(ZeroSlice(s));
             }
             let scale = 1.0 / sum;
-            m.iter_mut().for_each(|v| *v *= scale);
-            c.iter_mut().for_each(|v| *v *= scale);
-            data[s * n..(s + 1) * n]
-                .iter_mut()
-                .for_each(|v| *v *= scale);
+            for (cell, &v) in c.iter_mut().zip(d) {
+                *cell = [v * scale, cell[1] * scale];
+            }
+            for (y, row) in r.iter_mut().enumerate() {
+                *row = [row[0] * scale, c[y * nx + nx - 1][1]];
+            }
         }
         Ok(Self {
             axis,
-            table: BilinearTable::new(nx, ny, data),
-            marginal,
-            conditional,
+            nx,
+            ny,
+            cells,
+            rows,
         })
     }
 
-    /// The normalised table.
-    pub fn table(&self) -> &BilinearTable {
-        &self.table
+    /// The normalised table (a copy).
+    pub fn table(&self) -> BilinearTable {
+        BilinearTable::new(self.nx, self.ny, self.cells.iter().map(|c| c[0]).collect())
     }
 
     /// The parameter axis.
@@ -220,47 +234,51 @@ impl Warp2D {
 
     /// Heap bytes of the structure.
     pub fn bytes_used(&self) -> usize {
-        8 * (self.table.data.len() + self.marginal.len() + self.conditional.len())
-            + 8 * self.axis.values.len()
+        16 * (self.cells.len() + self.rows.len()) + 8 * self.axis.values.len()
     }
 
     fn area_scale(&self) -> f64 {
-        ((self.table.nx - 1) * (self.table.ny - 1)) as f64
+        ((self.nx - 1) * (self.ny - 1)) as f64
     }
 
+    /// Grid point `k` (value, row CDF) of the blend of slices `s` and `s + 1` with weight `w`.
     #[inline]
-    fn blend_m(&self, s: usize, w: f64, y: usize) -> f64 {
-        let ny = self.table.ny;
-        let v0 = self.marginal[s * ny + y];
-        if w == 0.0 {
-            v0
-        } else {
-            (1.0 - w) * v0 + w * self.marginal[(s + 1) * ny + y]
-        }
+    fn cell_at(&self, s: usize, w: f64, k: usize) -> [f64; 2] {
+        blend_pair(&self.cells, self.nx * self.ny, s, w, k)
     }
 
+    /// Row `y` (marginal CDF, row total) of the blend of slices `s` and `s + 1`.
     #[inline]
-    fn blend_c(&self, s: usize, w: f64, k: usize) -> f64 {
-        let n = self.table.slice_len();
-        let v0 = self.conditional[s * n + k];
-        if w == 0.0 {
-            v0
-        } else {
-            (1.0 - w) * v0 + w * self.conditional[(s + 1) * n + k]
-        }
+    fn row_at(&self, s: usize, w: f64, y: usize) -> [f64; 2] {
+        blend_pair(&self.rows, self.ny, s, w, y)
+    }
+
+    /// The four corner values `(v00, v10, v01, v11)` and the row CDFs at `(cx, cy)` and
+    /// `(cx, cy + 1)` of the blended slice.
+    #[inline]
+    fn corners(&self, s: usize, w: f64, cx: usize, cy: usize) -> ([f64; 4], [f64; 2]) {
+        let k = cy * self.nx + cx;
+        let [v00, c0] = self.cell_at(s, w, k);
+        let [v10, _] = self.cell_at(s, w, k + 1);
+        let [v01, c1] = self.cell_at(s, w, k + self.nx);
+        let [v11, _] = self.cell_at(s, w, k + self.nx + 1);
+        ([v00, v10, v01, v11], [c0, c1])
     }
 
     /// Density at `pos ∈ [0,1]²` (w.r.t. area) for parameter `param`.
     pub fn eval(&self, pos: [f64; 2], param: f64) -> f64 {
         let (s, w) = self.axis.locate(param);
-        self.table.eval(pos, s, 1, w) * self.area_scale()
+        let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
+        let ([v00, v10, v01, v11], _) = self.corners(s, w, cx, cy);
+        let v = (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11);
+        v * self.area_scale()
     }
 
     /// The warp: a uniform `u ∈ [0,1]²` to a point with this density; returns the point and its
     /// density.
     pub fn sample(&self, u: [f64; 2], param: f64) -> ([f64; 2], f64) {
         let (s, w) = self.axis.locate(param);
-        let (nx, ny) = (self.table.nx, self.table.ny);
+        let (nx, ny) = (self.nx, self.ny);
         let uy = u[1].clamp(0.0, 1.0);
         let ux = u[0].clamp(0.0, 1.0);
         // Row: largest r in [0, ny−2] with F(r) < uy.
@@ -268,7 +286,7 @@ impl Warp2D {
             let (mut lo, mut hi) = (0usize, ny - 1);
             while hi - lo > 1 {
                 let mid = (lo + hi) / 2;
-                if self.blend_m(s, w, mid) < uy {
+                if self.row_at(s, w, mid)[0] < uy {
                     lo = mid;
                 } else {
                     hi = mid;
@@ -276,14 +294,13 @@ impl Warp2D {
             }
             lo
         };
-        let rest = uy - self.blend_m(s, w, row);
-        let r0 = self.blend_c(s, w, row * nx + nx - 1);
-        let r1 = self.blend_c(s, w, (row + 1) * nx + nx - 1);
-        let ty = solve_linear_density(r0, r1, rest);
+        let [m0, r0] = self.row_at(s, w, row);
+        let [_, r1] = self.row_at(s, w, row + 1);
+        let ty = solve_linear_density(r0, r1, uy - m0);
         // Column, on the row blended at ty.
         let cond = |x: usize| {
-            (1.0 - ty) * self.blend_c(s, w, row * nx + x)
-                + ty * self.blend_c(s, w, (row + 1) * nx + x)
+            (1.0 - ty) * self.cell_at(s, w, row * nx + x)[1]
+                + ty * self.cell_at(s, w, (row + 1) * nx + x)[1]
         };
         let target = ux * ((1.0 - ty) * r0 + ty * r1);
         let col = {
@@ -298,8 +315,8 @@ impl Warp2D {
             }
             lo
         };
-        let rest = target - cond(col);
-        let [v00, v10, v01, v11] = self.table.corners(s, 1, w, col, row);
+        let ([v00, v10, v01, v11], [c0_row, c1_row]) = self.corners(s, w, col, row);
+        let rest = target - ((1.0 - ty) * c0_row + ty * c1_row);
         let c0 = (1.0 - ty) * v00 + ty * v01;
         let c1 = (1.0 - ty) * v10 + ty * v11;
         let tx = solve_linear_density(c0, c1, rest);
@@ -323,26 +340,51 @@ impl Warp2D {
     /// [`invert`](Self::invert) for a parameter already located on the axis (`(s, w)` from
     /// [`ParamAxis::locate`] of this warp's axis).
     pub(crate) fn invert_located(&self, pos: [f64; 2], s: usize, w: f64) -> ([f64; 2], f64) {
-        let nx = self.table.nx;
-        let (cx, cy, fx, fy) = self.table.cell(pos);
-        let [v00, v10, v01, v11] = self.table.corners(s, 1, w, cx, cy);
+        let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
+        let ([v00, v10, v01, v11], [along0, along1]) = self.corners(s, w, cx, cy);
+        let [m0, r0] = self.row_at(s, w, cy);
+        let [_, r1] = self.row_at(s, w, cy + 1);
         let c0 = (1.0 - fy) * v00 + fy * v01;
         let c1 = (1.0 - fy) * v10 + fy * v11;
         let pdf = ((1.0 - fx) * c0 + fx * c1) * self.area_scale();
-        let r0 = self.blend_c(s, w, cy * nx + nx - 1);
-        let r1 = self.blend_c(s, w, (cy + 1) * nx + nx - 1);
         let row_total = (1.0 - fy) * r0 + fy * r1;
-        let along = fx * (c0 + 0.5 * fx * (c1 - c0))
-            + (1.0 - fy) * self.blend_c(s, w, cy * nx + cx)
-            + fy * self.blend_c(s, w, (cy + 1) * nx + cx);
+        let along = fx * (c0 + 0.5 * fx * (c1 - c0)) + (1.0 - fy) * along0 + fy * along1;
         let ux = if row_total > 0.0 {
             along / row_total
         } else {
             0.0
         };
-        let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + self.blend_m(s, w, cy);
+        let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
         ([ux, uy], pdf)
     }
+}
+
+/// Entry `k` of the blend of slices `s` (weight `1 − w`) and `s + 1` (weight `w`) of `data`,
+/// slices of `n` entries.
+#[inline]
+fn blend_pair(data: &[[f64; 2]], n: usize, s: usize, w: f64, k: usize) -> [f64; 2] {
+    let a = data[s * n + k];
+    if w == 0.0 {
+        a
+    } else {
+        let b = data[(s + 1) * n + k];
+        [(1.0 - w) * a[0] + w * b[0], (1.0 - w) * a[1] + w * b[1]]
+    }
+}
+
+/// Cell `(cx, cy)` and fractions `(fx, fy)` of `pos` (clamped to `[0,1]²`, NaN to 0) on a grid
+/// of `nx × ny` points.
+#[inline]
+fn grid_cell(pos: [f64; 2], nx: usize, ny: usize) -> (usize, usize, f64, f64) {
+    let sx = pos[0].clamp(0.0, 1.0) * (nx - 1) as f64;
+    let sy = pos[1].clamp(0.0, 1.0) * (ny - 1) as f64;
+    let (sx, sy) = (
+        if sx.is_nan() { 0.0 } else { sx },
+        if sy.is_nan() { 0.0 } else { sy },
+    );
+    let cx = (sx as usize).min(nx - 2);
+    let cy = (sy as usize).min(ny - 2);
+    (cx, cy, sx - cx as f64, sy - cy as f64)
 }
 
 /// The `t ∈ [0,1]` with `∫₀ᵗ ((1−τ)a + τb) dτ = rest` (a linear density on one cell), or the
