@@ -174,6 +174,17 @@ fn prepared_evaluation_matches_the_pairwise_coordinates() {
         }
     }
     assert!(worst < 1e-9, "worst relative difference {worst}");
+    // An `Outgoing` this BRDF did not prepare gives a finite value ≥ 0, never a panic.
+    let wi = direction_from_angles(30.0, 10.0);
+    for cache in [
+        [1.0; 8],
+        [1.0, 0.0, 0.0, 1e300, f64::NAN, 0.0, 0.0, 0.0],
+        [-5.0; 8],
+    ] {
+        let q = brdf::Outgoing::with_cache(direction_from_angles(20.0, 0.0), cache);
+        let v = b.eval_prepared(&q, &wi);
+        assert!(v.is_finite() && v >= 0.0, "{cache:?}: {v}");
+    }
 }
 
 #[test]

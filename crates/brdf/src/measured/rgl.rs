@@ -545,7 +545,8 @@ impl RglBrdf {
     #[inline]
     fn lookup_prepared(&self, q: &Outgoing, wi: &Vec3) -> Option<([f64; 2], usize, f64, f64)> {
         let c = q.cache();
-        if !(c[prepared::VALID] == 1.0 && wi.z > 0.0) {
+        // A cache from another BRDF may hold anything: only positive 4σ is taken.
+        if !(c[prepared::VALID] == 1.0 && wi.z > 0.0 && c[prepared::FOUR_SIGMA] > 0.0) {
             return None;
         }
         let sum = q.wo() + wi;
