@@ -47,27 +47,18 @@ impl<'a> QueryDensity<'a> {
         turn: Turn,
         map: DiscMap,
     ) -> Self {
-        if turn == Turn::IDENTITY {
-            Self {
-                brdf,
-                wo: brdf.prepare(wo),
-                rot: None,
-                map,
-            }
+        let (wo, rot) = if turn == Turn::IDENTITY {
+            (*wo, None)
         } else if isotropic {
-            Self {
-                brdf,
-                wo: brdf.prepare(&turn.undo(wo)),
-                rot: None,
-                map,
-            }
+            (turn.undo(wo), None)
         } else {
-            Self {
-                brdf,
-                wo: brdf.prepare(wo),
-                rot: Some((turn.sin, turn.cos)),
-                map,
-            }
+            (*wo, Some((turn.sin, turn.cos)))
+        };
+        Self {
+            brdf,
+            wo: brdf.prepare(&wo),
+            rot,
+            map,
         }
     }
 
