@@ -56,6 +56,7 @@ mod builder;
 pub mod contract;
 mod density;
 mod error;
+mod index;
 #[cfg(test)]
 mod layout_tests;
 mod leaf;

@@ -7,6 +7,7 @@ use crate::audit::{Audit, Counters, flush_local, record_one};
 use crate::contract::{Point2, Sample2, Sampler2D, UniformSource};
 use crate::density::{IntegralSource, RegionStats};
 use crate::error::AttachError;
+use crate::index::{floor_index, index_to_f64};
 use crate::leaf::{Frame, Leaf};
 use crate::rect::Domain;
 use crate::tree::{EMPTY, LEAF, LeafChoice, QuadTree, Scheme};
@@ -305,11 +306,11 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     fn alias_index(&self, u0: f64) -> usize {
         let leaves = &self.tree.leaves;
         let n = leaves.len();
-        let s = u0 * n as f64;
-        let i = (s as usize).min(n - 1);
+        let s = u0 * index_to_f64(n);
+        let i = floor_index(s, n - 1);
         let first = &leaves[i];
         let alias = first.alias as usize;
-        if s - (i as f64) < first.prob || alias >= n {
+        if s - index_to_f64(i) < first.prob || alias >= n {
             i
         } else {
             alias

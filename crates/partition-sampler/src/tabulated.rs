@@ -9,6 +9,7 @@ use crate::density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats,
 };
 use crate::error::DensityError;
+use crate::index::floor_index;
 use crate::pyramid::{CellSource, Pyramid, snap};
 use crate::rect::{Domain, Rect};
 
@@ -122,6 +123,8 @@ impl RowFactor for SinPiRows {
 pub struct TabulatedDensity<R: RowFactor = UnitRows> {
     width: usize,
     height: usize,
+    /// `[W, H]` as floats (the bounds test of a point, without a conversion per call).
+    size_f64: [f64; 2],
     values: Vec<f64>,
     domain: Rect,
     factor: R,
@@ -251,6 +254,7 @@ impl<R: RowFactor> TabulatedDensity<R> {
         Ok(Self {
             width,
             height,
+            size_f64: [width as f64, height as f64],
             values,
             domain,
             factor,
@@ -337,11 +341,11 @@ impl<R: RowFactor> TabulatedDensity<R> {
     fn cell_index(&self, p: Point2) -> Option<(usize, f64)> {
         let fx = (p[0] - self.domain.x0) * self.sx;
         let fy = (p[1] - self.domain.y0) * self.sy;
-        if !(fx >= 0.0 && fx <= self.width as f64 && fy >= 0.0 && fy <= self.height as f64) {
+        if !(fx >= 0.0 && fx <= self.size_f64[0] && fy >= 0.0 && fy <= self.size_f64[1]) {
             return None;
         }
-        let i = (fx as usize).min(self.width - 1);
-        let j = (fy as usize).min(self.height - 1);
+        let i = floor_index(fx, self.width - 1);
+        let j = floor_index(fy, self.height - 1);
         Some((j * self.width + i, fy))
     }
 }

@@ -1,6 +1,7 @@
 //! Shared kernels: validation, normalised CDF construction and CDF search.
 
 use super::PiecewiseConstantError;
+use crate::index::{floor_index, index_to_f64};
 
 /// The largest `f64` below 1.
 pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
@@ -119,8 +120,14 @@ pub(crate) fn find_cell_guided_by<T>(
     guide: &[u32],
     u: f64,
 ) -> (usize, f64) {
-    let g = ((u * guide.len() as f64) as usize).min(guide.len() - 1);
+    let g = guide_bucket(u, guide.len());
     scan_by(cdf, key, guide[g] as usize, u)
+}
+
+/// The guide-table bucket `min(⌊u·G⌋, G − 1)` of `u` for a guide of `G ≥ 1` entries.
+#[inline(always)]
+pub(crate) fn guide_bucket(u: f64, g_len: usize) -> usize {
+    floor_index(u * index_to_f64(g_len), g_len - 1)
 }
 
 /// The scan of [`find_cell_guided_by`] from cell `start` (a guide entry) over `[cdf, value]`
@@ -160,8 +167,8 @@ pub(crate) fn invert_in(lo: f64, hi: f64, du: f64) -> f64 {
 /// Index of the cell of `t ∈ [0, n]` (scaled coordinate) and its fractional part, clamped.
 #[inline]
 pub(crate) fn cell_of(t: f64, n: usize) -> (usize, f64) {
-    let i = (t.max(0.0) as usize).min(n - 1);
-    (i, (t - i as f64).clamp(0.0, 1.0))
+    let i = floor_index(t.max(0.0), n - 1);
+    (i, (t - index_to_f64(i)).clamp(0.0, 1.0))
 }
 
 /// The coordinate at fraction `t ∈ [0,1)` of cell `i` of an axis from `lo` to `hi`, nudged
@@ -170,11 +177,16 @@ pub(crate) fn cell_of(t: f64, n: usize) -> (usize, f64) {
 /// the sampled cell and points stay in `[lo, hi)`.
 #[inline]
 pub(crate) fn place(lo: f64, hi: f64, size: f64, inv_size: f64, i: usize, t: f64) -> f64 {
-    let x = lo + (i as f64 + t) * size;
-    if x < hi && ((x - lo) * inv_size).max(0.0) as usize == i {
+    let fi = index_to_f64(i);
+    let x = lo + (fi + t) * size;
+    // `⌊max(s, 0)⌋ == i` for `s = (x − lo)/size` (the cell `cell_of` sees), without the
+    // float-to-integer conversion: `i ≤ s < i + 1`, where for `i = 0` negatives and NaN
+    // count as inside (they floor to 0).
+    let s = (x - lo) * inv_size;
+    if x < hi && !(s >= fi + 1.0) && (i == 0 || s >= fi) {
         x
     } else {
-        lo + (i as f64 + 0.5) * size
+        lo + (fi + 0.5) * size
     }
 }
 
@@ -229,6 +241,56 @@ mod tests {
                         find_cell_guided_by(&cdf, |&c| c, &guide, u),
                         find_cell(&cdf, u),
                         "u = {u}, G = {g_len}, values {values:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn place_keeps_the_cast_based_cell_test() {
+        // The check of `place` written with the float-to-integer cast, as before: the same
+        // coordinate for every axis, cell and fraction tried (edges, their neighbours, NaN).
+        fn place_by_cast(lo: f64, hi: f64, size: f64, inv: f64, i: usize, t: f64) -> f64 {
+            let x = lo + (i as f64 + t) * size;
+            if x < hi && ((x - lo) * inv).max(0.0) as usize == i {
+                x
+            } else {
+                lo + (i as f64 + 0.5) * size
+            }
+        }
+        let ts = [
+            0.0,
+            -0.0,
+            1e-300,
+            0.25,
+            0.5,
+            1.0f64.next_down(),
+            ONE_MINUS_EPSILON,
+            1.0,
+            -1e-17,
+            f64::NAN,
+        ];
+        for (lo, hi, n) in [
+            (0.0, 1.0, 1usize),
+            (0.0, 1.0, 3),
+            (-1.0, 1.0, 7),
+            (0.1, 0.7, 1024),
+            (-3.3, 1e-9, 513),
+            (1e8, 1e8 + 1.0, 4096),
+        ] {
+            let size = (hi - lo) / n as f64;
+            let inv = n as f64 / (hi - lo);
+            for i in (0..n).step_by((n / 64).max(1)).chain([n - 1]) {
+                for &t in &ts {
+                    let (a, b) = (
+                        place(lo, hi, size, inv, i, t),
+                        place_by_cast(lo, hi, size, inv, i, t),
+                    );
+                    assert_eq!(
+                        a.to_bits(),
+                        b.to_bits(),
+                        "lo {lo} hi {hi} n {n} i {i} t {t}"
                     );
                 }
             }

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::PiecewiseConstantError;
 use super::cdf::{
-    cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, invert_cell, invert_in,
-    place, scan_from, validate_values,
+    cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, invert_cell,
+    invert_in, place, scan_from, validate_values,
 };
 
 /// A density on a rectangle proportional to a `width × height` grid of non-negative values,
@@ -250,7 +250,7 @@ impl Sampler2D for PiecewiseConstant2D {
                 let u1 = clamp_unit(u.next_uniform());
                 let (row, dv) =
                     find_cell_guided_by(&self.marginal, |&c| c, &self.marginal_guide, u1);
-                let g = ((u0 * w as f64) as usize).min(w - 1);
+                let g = guide_bucket(u0, w);
                 cols[j] = u0;
                 rows[j] = (row, dv);
                 starts[j] = self.conditional_guide[row * w + g];
