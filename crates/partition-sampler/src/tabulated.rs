@@ -9,7 +9,7 @@ use crate::density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats,
 };
 use crate::error::DensityError;
-use crate::index::floor_index;
+use crate::index::{floor_index, index_to_f64};
 use crate::pyramid::{CellSource, Pyramid, snap};
 use crate::rect::{Domain, Rect};
 
@@ -123,8 +123,6 @@ impl RowFactor for SinPiRows {
 pub struct TabulatedDensity<R: RowFactor = UnitRows> {
     width: usize,
     height: usize,
-    /// `[W, H]` as floats (the bounds test of a point, without a conversion per call).
-    size_f64: [f64; 2],
     values: Vec<f64>,
     domain: Rect,
     factor: R,
@@ -254,7 +252,6 @@ impl<R: RowFactor> TabulatedDensity<R> {
         Ok(Self {
             width,
             height,
-            size_f64: [width as f64, height as f64],
             values,
             domain,
             factor,
@@ -341,7 +338,8 @@ impl<R: RowFactor> TabulatedDensity<R> {
     fn cell_index(&self, p: Point2) -> Option<(usize, f64)> {
         let fx = (p[0] - self.domain.x0) * self.sx;
         let fy = (p[1] - self.domain.y0) * self.sy;
-        if !(fx >= 0.0 && fx <= self.size_f64[0] && fy >= 0.0 && fy <= self.size_f64[1]) {
+        let (w, h) = (index_to_f64(self.width), index_to_f64(self.height));
+        if !(fx >= 0.0 && fx <= w && fy >= 0.0 && fy <= h) {
             return None;
         }
         let i = floor_index(fx, self.width - 1);

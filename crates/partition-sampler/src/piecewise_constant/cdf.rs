@@ -167,7 +167,7 @@ pub(crate) fn invert_in(lo: f64, hi: f64, du: f64) -> f64 {
 /// Index of the cell of `t ∈ [0, n]` (scaled coordinate) and its fractional part, clamped.
 #[inline]
 pub(crate) fn cell_of(t: f64, n: usize) -> (usize, f64) {
-    let i = floor_index(t.max(0.0), n - 1);
+    let i = floor_index(t, n - 1);
     (i, (t - index_to_f64(i)).clamp(0.0, 1.0))
 }
 
