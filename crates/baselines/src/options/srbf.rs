@@ -32,7 +32,8 @@ pub struct SrbfOptions {
     /// Product lobes kept (largest masses) by the product estimator.
     pub product_lobes: usize,
     /// Share of the product estimator's samples given to the BRDF slice's lobes
-    /// (defensive components, `[0, 1)`; see `srbf::estimate_srbf_product`).
+    /// (defensive components, `[0, 1 − γ)` with `γ` = `ProductSettings::DEFAULT_COSINE` the
+    /// cosine component's share; see `srbf::estimate_srbf_product`).
     pub defensive: f64,
 }
 
@@ -71,11 +72,7 @@ impl SrbfOptions {
                 what: "kept product",
             });
         }
-        if !((0.0..1.0).contains(&self.defensive)) {
-            return Err(SrbfError::BadDefensive {
-                value: self.defensive,
-            });
-        }
+        self.product_settings().validate()?;
         for (what, got, min) in [
             ("slices", self.slices, 1),
             ("phi slices", self.phi_slices, 1),
@@ -108,6 +105,7 @@ impl SrbfOptions {
         ProductSettings {
             keep: self.product_lobes,
             defensive: self.defensive,
+            cosine: ProductSettings::DEFAULT_COSINE,
         }
     }
 

@@ -86,4 +86,15 @@ pub enum SrbfError {
         /// The value given.
         value: f64,
     },
+    /// A cosine sample share outside `(0, 1)`, or one that leaves no room beside the defensive
+    /// share (`δ + γ ≥ 1`).
+    #[error(
+        "the cosine share must be in (0, 1) with defensive + cosine < 1 (got cosine {cosine}, defensive {defensive})"
+    )]
+    BadCosineShare {
+        /// The cosine share given.
+        cosine: f64,
+        /// The defensive share given.
+        defensive: f64,
+    },
 }
