@@ -50,7 +50,7 @@ pub use error::SrbfError;
 pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit};
 pub use product::{
     Estimate, LocalFrame, MisHeuristic, ProductScene, ProductSettings, ProductStats, estimate_brdf,
-    estimate_light, estimate_mis, estimate_srbf_product,
+    estimate_light, estimate_mis, estimate_srbf_product, quadrature_reference,
 };
 pub use sampler::{SrbfReport, SrbfSampler};
 pub use vmf::SgLobe;

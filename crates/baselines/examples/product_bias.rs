@@ -1,0 +1,107 @@
+//! Issue 27's scene: a 256 × 128 map of dim noise with a 300-radiance column 3 pixels wide at
+//! `u ≈ U`, GGX `α = 0.15`, normal `(0.3, 0.2, 0.93)`, `θo = 40°`; every estimator with the
+//! default SRBF options against the per-pixel quadrature, optionally writing the map as PFM
+//! (for `brdf-lab product --map`). Figures: docs/validation.md, "Product estimators:
+//! unbiasedness under adversarial maps".
+//!
+//! `cargo run --release -p baselines --example product_bias -- [U [N [OUT.pfm]]]`
+
+use baselines::srbf::{
+    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    estimate_srbf_product, fit_envmap, quadrature_reference,
+};
+use baselines::{SrbfOptions, SrbfSampler};
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+
+/// Dim deterministic noise in `[0.05, 0.25)` (a hash of the pixel index).
+fn noise(i: usize) -> f32 {
+    let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+    x ^= x >> 31;
+    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x ^= x >> 29;
+    (0.05 + 0.2 * ((x >> 11) as f64 / (1u64 << 53) as f64)) as f32
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let uc: f64 = args.get(1).map_or(Ok(0.0), |s| s.parse())?;
+    let n: usize = args.get(2).map_or(Ok(1_000_000), |s| s.parse())?;
+    let (w, h) = (256usize, 128usize);
+    let xc = ((uc * w as f64).round() as usize) % w;
+    let rgb: Vec<[f32; 3]> = (0..w * h)
+        .map(|i| {
+            let dx = (i % w + w - xc) % w;
+            if dx <= 1 || dx == w - 1 {
+                [300.0; 3]
+            } else {
+                [noise(i); 3]
+            }
+        })
+        .collect();
+    let map = EnvMap::new(w, h, rgb)?;
+    if let Some(path) = args.get(3) {
+        // PFM: little-endian (negative scale), rows bottom to top.
+        let mut bytes = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+        for y in (0..h).rev() {
+            for x in 0..w {
+                for c in map.pixel(x, y).ok_or("pixel")? {
+                    bytes.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+        std::fs::write(path, bytes)?;
+    }
+    let brdf = brdf::parse_spec("ggx:alpha=0.15")?;
+    let frame = LocalFrame::new([0.3, 0.2, 0.93], 0.0)?;
+    let scene = ProductScene::new(
+        brdf.as_ref(),
+        &map,
+        frame,
+        brdf::direction_from_angles(40.0, 0.0),
+    )?;
+    let (q, q_err) = quadrature_reference(&scene, 8);
+    println!("column at u = {uc}: quadrature {q:.6} ± {q_err:.1e}");
+    let options = SrbfOptions::default();
+    let brdf_fit = SrbfSampler::build(brdf.as_ref(), &options)?;
+    let map_fit = fit_envmap(&map, &options)?;
+    let adaptive = EnvMapSampler::adaptive(&map, AdaptiveOptions::default())?;
+    let cdf = EnvMapSampler::piecewise_constant(&map)?;
+    let show = |e: &Estimate| {
+        println!(
+            "{:<36} {:.5} ± {:.5}  {:+6.2} %  z = {:+6.2}  {}",
+            e.estimator,
+            e.estimate,
+            e.std_err,
+            100.0 * (e.estimate / q - 1.0),
+            (e.estimate - q) / e.std_err,
+            e.warning().unwrap_or_default()
+        )
+    };
+    let settings = options.product_settings();
+    show(&estimate_srbf_product(&scene, &brdf_fit, &map_fit, &settings, n, 1)?.0);
+    show(&estimate_brdf(&scene, &brdf_fit, "brdf:srbf", n, 2)?);
+    show(&estimate_light(
+        &scene,
+        &adaptive,
+        "light:envmap-adaptive",
+        n,
+        3,
+    )?);
+    show(&estimate_light(&scene, &cdf, "light:envmap-cdf", n, 4)?);
+    for (k, h) in [MisHeuristic::Balance, MisHeuristic::Power]
+        .into_iter()
+        .enumerate()
+    {
+        let name = format!("mis-{h:?}:srbf+envmap-adaptive").to_lowercase();
+        show(&estimate_mis(
+            &scene,
+            &brdf_fit,
+            &adaptive,
+            h,
+            &name,
+            n,
+            5 + k as u64,
+        )?);
+    }
+    Ok(())
+}
