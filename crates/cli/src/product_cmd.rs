@@ -64,7 +64,7 @@ pub(crate) struct ProductArgs {
     /// Write the results as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Write the results as CSV (`estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z`).
+    /// Write the results as CSV (`estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z,reference,reference_std_err,heavy_tailed,tail_share,variance_rel_ci95`).
     #[arg(long)]
     csv: Option<PathBuf>,
     /// Options of the samplers (the srbf fits: --srbf-*).
@@ -94,10 +94,18 @@ struct Row {
     seconds: f64,
     seconds_per_sample: f64,
     variance_time: f64,
-    /// `(estimate − reference) / √(σ² + σ_ref²)`.
+    /// `(estimate − reference) / √(σ² + σ_ref²)`; no yardstick when `heavy_tailed`.
     z: f64,
     reference: f64,
     reference_std_err: f64,
+    /// Largest share of the variance estimate held by one sample.
+    tail_share: f64,
+    /// Relative half-width of the variance estimate's 95 % interval.
+    variance_rel_ci95: f64,
+    /// The standard error (and so `z`) is no yardstick (`Estimate::heavy_tailed`).
+    heavy_tailed: bool,
+    /// Why, when `heavy_tailed`.
+    warning: Option<String>,
 }
 
 /// The fits' quality and cost.
@@ -120,6 +128,8 @@ struct FitSummary {
     product_lobes: usize,
     kept_lobes: usize,
     kept_mass_fraction: f64,
+    /// Samples of the product estimator drawn from its cosine component.
+    cosine_samples: usize,
 }
 
 /// The JSON document.
@@ -144,6 +154,8 @@ struct Estimate2 {
     std_err: f64,
     samples: usize,
     seconds: f64,
+    heavy_tailed: bool,
+    warning: Option<String>,
 }
 
 fn load_map(path: Option<&PathBuf>) -> CliResult<(EnvMap, String)> {
@@ -310,6 +322,10 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
                 / (e.std_err.powi(2) + reference.std_err.powi(2)).sqrt(),
             reference: reference.estimate,
             reference_std_err: reference.std_err,
+            tail_share: e.tail_share,
+            variance_rel_ci95: e.variance_rel_ci95,
+            heavy_tailed: e.heavy_tailed,
+            warning: e.warning(),
         })
         .collect();
 
@@ -328,7 +344,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         br.slices, br.lobes, br.mean_rel_l2, br.max_rel_l2, br.mean_rel_l1, br.seconds, br.bytes
     );
     println!(
-        "           map: {} lobes, rel. L2 {:.3}, rel. L1 {:.3}, {:.2} s, {} bytes; product: {} lobes, kept {} ({:.1} % of the mass)",
+        "           map: {} lobes, rel. L2 {:.3}, rel. L1 {:.3}, {:.2} s, {} bytes; product: {} lobes, kept {} ({:.1} % of the mass), {} cosine samples",
         map_fit.lobes.len(),
         map_fit.report.rel_l2,
         map_fit.report.rel_l1,
@@ -336,7 +352,8 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         map_fit.bytes_used(),
         stats.product_lobes,
         stats.kept,
-        100.0 * stats.kept_mass_fraction
+        100.0 * stats.kept_mass_fraction,
+        stats.cosine_samples
     );
     println!(
         "reference  {:.6e} ± {:.2e} ({}, {} samples, {:.2} s)",
@@ -351,14 +368,34 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         "estimator", "estimate", "std err", "z", "ns/sample", "var×time"
     );
     for r in &rows {
+        // A heavy-tailed estimate's standard error is no yardstick: no bare z for it.
+        let z = if r.heavy_tailed {
+            "heavy".to_string()
+        } else {
+            format!("{:.2}", r.z)
+        };
         println!(
-            "{:<44} {:>13.6e} {:>10.3e} {:>8.2} {:>10.1} {:>10.3e}",
+            "{:<44} {:>13.6e} {:>10.3e} {:>8} {:>10.1} {:>10.3e}",
             r.estimator,
             r.estimate,
             r.std_err,
-            r.z,
+            z,
             1e9 * r.seconds_per_sample,
             r.variance_time
+        );
+    }
+    if let Some(w) = reference.warning() {
+        eprintln!(
+            "brdf-lab: warning: the reference ({}): {w}; every z above rests on its standard error",
+            reference.estimator
+        );
+    }
+    for r in rows.iter().filter(|r| r.heavy_tailed) {
+        eprintln!(
+            "brdf-lab: warning: {}: {}; its standard error is no yardstick (z would be {:.2})",
+            r.estimator,
+            r.warning.as_deref().unwrap_or("heavy tail"),
+            r.z
         );
     }
 
@@ -366,12 +403,12 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         write_atomically(path, |w| {
             writeln!(
                 w,
-                "estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z,reference,reference_std_err"
+                "estimator,estimate,std_err,samples,seconds,seconds_per_sample,variance_time,z,reference,reference_std_err,heavy_tailed,tail_share,variance_rel_ci95"
             )?;
             for r in &rows {
                 writeln!(
                     w,
-                    "{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     r.estimator,
                     num(r.estimate),
                     num(r.std_err),
@@ -381,7 +418,10 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
                     num(r.variance_time),
                     num(r.z),
                     num(r.reference),
-                    num(r.reference_std_err)
+                    num(r.reference_std_err),
+                    r.heavy_tailed,
+                    num(r.tail_share),
+                    num(r.variance_rel_ci95)
                 )?;
             }
             Ok(())
@@ -401,6 +441,8 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
                 std_err: reference.std_err,
                 samples: reference.samples,
                 seconds: reference.seconds,
+                heavy_tailed: reference.heavy_tailed,
+                warning: reference.warning(),
             },
             fits: FitSummary {
                 brdf_slices: br.slices,
@@ -420,6 +462,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
                 product_lobes: stats.product_lobes,
                 kept_lobes: stats.kept,
                 kept_mass_fraction: stats.kept_mass_fraction,
+                cosine_samples: stats.cosine_samples,
             },
             estimators: rows,
         };

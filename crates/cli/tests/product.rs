@@ -118,3 +118,91 @@ fn small_run_writes_json_and_csv() {
     assert!(table.starts_with("estimator,estimate,std_err,"));
     assert_eq!(table.lines().count(), 1 + estimators.len());
 }
+
+/// A `w × h` PFM of radiance `base` with one pixel `(x, y)` (row 0 at the top) of `hot`.
+fn hot_pixel_pfm(path: &std::path::Path, w: usize, h: usize, (x, y): (usize, usize), hot: f32) {
+    let mut bytes = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+    for row in (0..h).rev() {
+        for col in 0..w {
+            let v: f32 = if (col, row) == (x, y) { hot } else { 0.1 };
+            for _ in 0..3 {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn heavy_tailed_estimators_get_a_warning_instead_of_a_bare_z() {
+    // One pixel 1000 times brighter than the rest, holding a third of the map's power: cosine
+    // sampling hits it about 6 times in 4000 draws, each hit holding a large share of the
+    // variance (flagged); light sampling under Lambert has weights f·cos·Φ spread over
+    // thousands of values (not flagged).
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("hot.pfm");
+    hot_pixel_pfm(&map, 64, 32, (10, 8), 100.0);
+    let json = dir.path().join("h.json");
+    let args = [
+        "product",
+        "--brdf",
+        "lambert",
+        "--theta-o",
+        "30",
+        "-n",
+        "4000",
+        "--map",
+        map.to_str().unwrap(),
+        "--srbf-slices",
+        "2",
+        "--srbf-fit-rows",
+        "8",
+        "--srbf-lobes",
+        "2",
+        "--srbf-map-lobes",
+        "4",
+        "--srbf-map-fit-width",
+        "16",
+        "--reference-samples",
+        "200000",
+        "--brdf-sampler",
+        "cosine",
+        "--light-sampler",
+        "envmap-cdf",
+        "--json",
+        json.to_str().unwrap(),
+    ];
+    let o = brdf_lab(&args);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = |name: &str| {
+        doc["estimators"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["estimator"] == name)
+            .unwrap_or_else(|| panic!("{name} missing"))
+            .clone()
+    };
+    let cosine = row("brdf:cosine");
+    assert_eq!(cosine["heavy_tailed"], true, "{cosine}");
+    assert!(cosine["tail_share"].as_f64().unwrap() > 0.05, "{cosine}");
+    assert!(
+        cosine["warning"]
+            .as_str()
+            .unwrap()
+            .starts_with("heavy tail")
+    );
+    let line = out.lines().find(|l| l.starts_with("brdf:cosine ")).unwrap();
+    assert!(line.contains(" heavy "), "{line}");
+    assert!(
+        err.contains("brdf-lab: warning: brdf:cosine: heavy tail"),
+        "{err}"
+    );
+    let light = row("light:envmap-cdf");
+    assert_eq!(light["heavy_tailed"], false, "{light}");
+    assert!(light["warning"].is_null());
+}
