@@ -78,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )
     };
     let settings = options.product_settings();
-    show(&estimate_srbf_product(&scene, &brdf_fit, &map_fit, &settings, n, 1)?.0);
+    show(&estimate_srbf_product(&scene, &brdf_fit, &map_fit, &adaptive, &settings, n, 1)?.0);
     show(&estimate_brdf(&scene, &brdf_fit, "brdf:srbf", n, 2)?);
     show(&estimate_light(
         &scene,

@@ -62,6 +62,7 @@ fn check(
                 &scene,
                 &brdf_fit,
                 &map_fit,
+                &cdf,
                 &options.product_settings(),
                 n,
                 seed + 2,

@@ -32,8 +32,9 @@ pub struct SrbfOptions {
     /// Product lobes kept (largest masses) by the product estimator.
     pub product_lobes: usize,
     /// Share of the product estimator's samples given to the BRDF slice's lobes
-    /// (defensive components, `[0, 1 − γ)` with `γ` = `ProductSettings::DEFAULT_COSINE` the
-    /// cosine component's share; see `srbf::estimate_srbf_product`).
+    /// (defensive components, `[0, 1 − γ − β)` with `γ`, `β` = `ProductSettings::DEFAULT_COSINE`,
+    /// `DEFAULT_LIGHT` the cosine and light components' shares; see
+    /// `srbf::estimate_srbf_product`).
     pub defensive: f64,
 }
 
@@ -106,6 +107,7 @@ impl SrbfOptions {
             keep: self.product_lobes,
             defensive: self.defensive,
             cosine: ProductSettings::DEFAULT_COSINE,
+            light: ProductSettings::DEFAULT_LIGHT,
         }
     }
 

@@ -86,14 +86,16 @@ pub enum SrbfError {
         /// The value given.
         value: f64,
     },
-    /// A cosine sample share outside `(0, 1)`, or one that leaves no room beside the defensive
-    /// share (`δ + γ ≥ 1`).
+    /// A cosine sample share outside `(0, 1)`, a light share outside `[0, 1)`, or shares that
+    /// leave no room for the product lobes (`δ + γ + β ≥ 1`).
     #[error(
-        "the cosine share must be in (0, 1) with defensive + cosine < 1 (got cosine {cosine}, defensive {defensive})"
+        "the cosine share must be in (0, 1), the light share in [0, 1), with defensive + cosine + light < 1 (got cosine {cosine}, light {light}, defensive {defensive})"
     )]
     BadCosineShare {
         /// The cosine share given.
         cosine: f64,
+        /// The light share given.
+        light: f64,
         /// The defensive share given.
         defensive: f64,
     },

@@ -27,9 +27,10 @@
 //! // Reflected radiance under the procedural sky, by SRBF product sampling.
 //! let sky = envmap::procedural_sky(64, 32)?;
 //! let map_fit = fit_envmap(&sky, &options)?;
+//! let light = envmap::EnvMapSampler::piecewise_constant(&sky)?;
 //! let frame = LocalFrame::new([0.0, 0.3, 1.0], 0.0)?;
 //! let scene = ProductScene::new(brdf.as_ref(), &sky, frame, wo)?;
-//! let (estimate, stats) = estimate_srbf_product(&scene, &sampler, &map_fit, &options.product_settings(), 10_000, 7)?;
+//! let (estimate, stats) = estimate_srbf_product(&scene, &sampler, &map_fit, &light, &options.product_settings(), 10_000, 7)?;
 //! assert!(estimate.estimate > 0.0 && estimate.std_err > 0.0 && stats.kept >= 1);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

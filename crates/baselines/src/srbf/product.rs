@@ -550,15 +550,21 @@ pub struct ProductSettings {
     pub defensive: f64,
     /// Share `γ ∈ (0, 1)` of the samples drawn from `cos⁺θ/π` on the local hemisphere, the
     /// component that bounds the mixture's density below wherever the integrand can be
-    /// non-zero (see [`estimate_srbf_product`]); `δ + γ < 1`.
+    /// non-zero (see [`estimate_srbf_product`]).
     pub cosine: f64,
+    /// Share `β ∈ [0, 1)` of the samples drawn from the map sampler given to
+    /// [`estimate_srbf_product`] (light sampling as one more component of the mixture); `δ + γ
+    /// + β < 1`.
+    pub light: f64,
 }
 
 impl ProductSettings {
     /// Default cosine share `γ`.
     pub const DEFAULT_COSINE: f64 = 0.1;
+    /// Default light share `β`.
+    pub const DEFAULT_LIGHT: f64 = 0.1;
 
-    /// Checks `keep ≥ 1`, `δ ∈ [0, 1)`, `γ ∈ (0, 1)` and `δ + γ < 1`.
+    /// Checks `keep ≥ 1`, `δ ∈ [0, 1)`, `γ ∈ (0, 1)`, `β ∈ [0, 1)` and `δ + γ + β < 1`.
     pub fn validate(&self) -> Result<(), SrbfError> {
         if self.keep == 0 {
             return Err(SrbfError::ZeroLobes {
@@ -570,9 +576,14 @@ impl ProductSettings {
                 value: self.defensive,
             });
         }
-        if !(self.cosine > 0.0 && self.cosine < 1.0 && self.defensive + self.cosine < 1.0) {
+        if !(self.cosine > 0.0
+            && self.cosine < 1.0
+            && (0.0..1.0).contains(&self.light)
+            && self.defensive + self.cosine + self.light < 1.0)
+        {
             return Err(SrbfError::BadCosineShare {
                 cosine: self.cosine,
+                light: self.light,
                 defensive: self.defensive,
             });
         }
@@ -586,6 +597,7 @@ impl Default for ProductSettings {
             keep: 32,
             defensive: 0.2,
             cosine: Self::DEFAULT_COSINE,
+            light: Self::DEFAULT_LIGHT,
         }
     }
 }
@@ -619,11 +631,13 @@ enum Component {
     Lobe(SgLobe),
     /// `cos⁺θ/π` on the local upper hemisphere.
     Cosine,
+    /// The map sampler's density of the world direction `frame.to_world(ω)`.
+    Light,
 }
 
 impl Component {
     /// The density w.r.t. solid angle at the unit local direction `wi`.
-    fn pdf(&self, wi: &Vec3) -> f64 {
+    fn pdf(&self, scene: &ProductScene<'_>, light: &EnvMapSampler, wi: &Vec3) -> f64 {
         match self {
             Component::Lobe(l) => vmf_pdf(l.axis.dot(wi), l.lambda),
             Component::Cosine => {
@@ -633,15 +647,34 @@ impl Component {
                     0.0
                 }
             }
+            Component::Light => {
+                let w = scene.frame.to_world(wi);
+                light.pdf_sa([w.x, w.y, w.z])
+            }
         }
     }
 
-    /// A direction from `u ∈ [0, 1)²`; a cosine draw always has `z = √(1 − u₀) > 0`, so its
-    /// own density is positive in floating point too.
-    fn sample(&self, u: [f64; 2]) -> Vec3 {
+    /// A local direction; a cosine draw always has `z = √(1 − u₀) > 0`, so its own density
+    /// is positive in floating point too. The density is evaluated (by [`Self::pdf`]) at the
+    /// returned local direction, the same one the integrand sees.
+    fn sample(
+        &self,
+        scene: &ProductScene<'_>,
+        light: &EnvMapSampler,
+        rng: &mut Xoshiro256PlusPlus,
+    ) -> Vec3 {
         match self {
-            Component::Lobe(l) => vmf_sample(&l.axis, l.lambda, u),
-            Component::Cosine => CosineHemisphere::sample_square(u).wi,
+            Component::Lobe(l) => {
+                let u: [f64; 2] = [rand::RngExt::random(rng), rand::RngExt::random(rng)];
+                vmf_sample(&l.axis, l.lambda, u)
+            }
+            Component::Cosine => {
+                let u: [f64; 2] = [rand::RngExt::random(rng), rand::RngExt::random(rng)];
+                CosineHemisphere::sample_square(u).wi
+            }
+            Component::Light => scene
+                .frame
+                .to_local(&Vec3::from(light.sample(rng).direction)),
         }
     }
 }
@@ -649,10 +682,11 @@ impl Component {
 /// SRBF product importance sampling (module docs) with `n` samples.
 ///
 /// Components: the `settings.keep` product lobes of largest mass, the BRDF slice's lobes
-/// (normalised, mass-weighted; unless `settings.defensive = 0`) and the cosine density
-/// `cos⁺θ/π`. Sample shares: `(1 − δ − γ)·I_m/Σ_kept I`, `δ·I_b/Σ I_b` and `γ`, split by
-/// largest remainders with a floor of 2 per component; the estimate is the multi-sample
-/// balance heuristic with the actual counts,
+/// (normalised, mass-weighted; unless `settings.defensive = 0`), the cosine density
+/// `cos⁺θ/π` and (unless `settings.light = 0`) the map sampler `light`. Sample shares:
+/// `(1 − δ − γ − β)·I_m/Σ_kept I`, `δ·I_b/Σ I_b`, `γ` and `β`, split by largest remainders
+/// with a floor of 2 per component; the estimate is the multi-sample balance heuristic with
+/// the actual counts,
 ///
 /// `F = Σ_k Σ_{j ≤ n_k} g(ω_kj) / q(ω_kj)`, `q(ω) = Σ_k' n_k' p_k'(ω)`,
 ///
@@ -674,6 +708,13 @@ impl Component {
 /// (the only place `g` is non-zero), so every weight is bounded,
 /// `g/q ≤ π·L(ω)·f_r(ωo, ω)/n_cos`, and the variance is finite for any bounded map and BRDF.
 ///
+/// Why the light component: the cosine bound `π L f_r / n_cos` is finite but large when all of
+/// the integrand sits in a small bright region of the BRDF's tail (a hot pixel, or only the
+/// part of a column below the map's horizon): the cosine component reaches it a few times per
+/// run and those few weights carry the variance (flagged by [`Estimate::heavy_tailed`]). A
+/// map sampler's density is proportional to the radiance, so `g/q ≤ f_r cos θ·Φ/n_light`
+/// (`Φ` the map's power in the sampler's measure) wherever the map sampler is exact.
+///
 /// Why the BRDF lobes too: where the map fit misses energy (a dim, wide background behind a few
 /// bright lamps gets no map lobe), the product lobes alone leave the BRDF peak to the cosine
 /// component; the BRDF lobes cover it (measured: half the reference with all 24 product lobes
@@ -682,6 +723,7 @@ pub fn estimate_srbf_product(
     scene: &ProductScene<'_>,
     brdf_fit: &SrbfSampler,
     map_fit: &EnvSrbf,
+    light: &EnvMapSampler,
     settings: &ProductSettings,
     n: usize,
     seed: u64,
@@ -690,6 +732,7 @@ pub fn estimate_srbf_product(
         scene,
         brdf_fit,
         map_fit,
+        light,
         settings,
         n,
         seed,
@@ -697,10 +740,15 @@ pub fn estimate_srbf_product(
     )
 }
 
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the public entry point plus the variant"
+)]
 fn srbf_product(
     scene: &ProductScene<'_>,
     brdf_fit: &SrbfSampler,
     map_fit: &EnvSrbf,
+    light: &EnvMapSampler,
     settings: &ProductSettings,
     n: usize,
     seed: u64,
@@ -725,10 +773,10 @@ fn srbf_product(
         }
     }
     let product_lobes = lobes.len();
-    let gamma = if variant == Variant::WithoutCosine {
-        0.0
+    let (gamma, beta) = if variant == Variant::WithoutCosine {
+        (0.0, 0.0)
     } else {
-        settings.cosine
+        (settings.cosine, settings.light)
     };
     let mut delta = settings.defensive;
     let total_mass: f64 = lobes.iter().map(|l| l.1).sum();
@@ -741,19 +789,23 @@ fn srbf_product(
         .collect();
     if lobes.is_empty() {
         // Every product underflowed: the BRDF lobes take the product lobes' share.
-        delta = 1.0 - gamma;
+        delta = 1.0 - gamma - beta;
     }
     if delta == 0.0 || defensive.is_empty() {
         defensive.clear();
         delta = 0.0;
     }
-    let budget = (n / 2).saturating_sub(defensive.len() + 1).max(1);
+    let budget = (n / 2).saturating_sub(defensive.len() + 2).max(1);
     lobes.truncate(settings.keep.min(budget));
     let kept = lobes.len();
     let kept_mass: f64 = lobes.iter().map(|l| l.1).sum();
     let defensive_mass: f64 = defensive.iter().map(|l| l.1).sum();
-    let product_share = if kept > 0 { 1.0 - delta - gamma } else { 0.0 };
-    let gamma = 1.0 - delta - product_share;
+    let product_share = if kept > 0 {
+        1.0 - delta - gamma - beta
+    } else {
+        0.0
+    };
+    let gamma = 1.0 - delta - beta - product_share;
     // Components and their sample shares (the cosine component last).
     let mut components: Vec<Component> = Vec::with_capacity(kept + defensive.len() + 1);
     let mut shares: Vec<f64> = Vec::with_capacity(kept + defensive.len() + 1);
@@ -764,6 +816,10 @@ fn srbf_product(
     for (l, mass) in &defensive {
         components.push(Component::Lobe(*l));
         shares.push(delta * mass / defensive_mass);
+    }
+    if beta > 0.0 {
+        components.push(Component::Light);
+        shares.push(beta);
     }
     if variant != Variant::WithoutCosine {
         components.push(Component::Cosine);
@@ -794,7 +850,10 @@ fn srbf_product(
     .collect();
     let density_times_n = |wi: &Vec3| -> f64 {
         let sum = |set: &[Component], ns: &[usize]| -> f64 {
-            set.iter().zip(ns).map(|(c, &k)| k as f64 * c.pdf(wi)).sum()
+            set.iter()
+                .zip(ns)
+                .map(|(c, &k)| k as f64 * c.pdf(scene, light, wi))
+                .sum()
         };
         match variant {
             Variant::Correct | Variant::WithoutCosine => sum(&components, &counts),
@@ -815,11 +874,7 @@ fn srbf_product(
     for (c, &k) in components.iter().zip(&counts) {
         let mut m = Moments::default();
         for _ in 0..k {
-            let u: [f64; 2] = [
-                rand::RngExt::random(&mut rng),
-                rand::RngExt::random(&mut rng),
-            ];
-            let wi = c.sample(u);
+            let wi = c.sample(scene, light, &mut rng);
             let g = scene.integrand(&wi);
             m.push(if g > 0.0 {
                 g / density_times_n(&wi)
@@ -940,7 +995,7 @@ mod tests {
             ..ProductSettings::default()
         };
         let (tsai, _) =
-            estimate_srbf_product(&scene, &brdf_fit, &map_fit, &plain, 40_000, 2).unwrap();
+            estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &plain, 40_000, 2).unwrap();
         assert!(z(&tsai, &reference) < 4.0, "{tsai:?} vs {reference:?}");
         for keep in [1, 32] {
             let settings = ProductSettings {
@@ -949,7 +1004,8 @@ mod tests {
                 ..ProductSettings::default()
             };
             let (good, stats) =
-                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &settings, 40_000, 2).unwrap();
+                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &settings, 40_000, 2)
+                    .unwrap();
             assert!(keep > 1 || stats.kept_mass_fraction < 0.8, "{stats:?}");
             assert!(
                 z(&good, &reference) < 4.0,
@@ -965,6 +1021,7 @@ mod tests {
             &scene,
             &brdf_fit,
             &map_fit,
+            &light,
             &settings,
             40_000,
             2,
@@ -1019,11 +1076,13 @@ mod tests {
         .unwrap();
         let (q, q_err) = quadrature_reference(&scene, 4);
         assert!(q_err < 1e-4 * q, "{q} ± {q_err}");
+        let light = EnvMapSampler::piecewise_constant(&map).unwrap();
         let settings = options.product_settings();
         let n = 40_000;
         for seed in 0..8 {
             let (good, stats) =
-                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &settings, n, seed).unwrap();
+                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &settings, n, seed)
+                    .unwrap();
             assert!(stats.cosine_samples >= n / 20, "{stats:?}");
             let zg = (good.estimate - q) / good.std_err;
             assert!(
@@ -1034,6 +1093,7 @@ mod tests {
                 &scene,
                 &brdf_fit,
                 &map_fit,
+                &light,
                 &settings,
                 n,
                 seed,
@@ -1051,21 +1111,24 @@ mod tests {
 
     #[test]
     fn settings_refuse_a_mixture_without_a_positive_cosine_share() {
-        for (cosine, defensive) in [
-            (0.0, 0.2),
-            (-0.1, 0.2),
-            (f64::NAN, 0.2),
-            (0.5, 0.5),
-            (1.0, 0.0),
+        for (cosine, defensive, light) in [
+            (0.0, 0.2, 0.1),
+            (-0.1, 0.2, 0.1),
+            (f64::NAN, 0.2, 0.1),
+            (0.5, 0.5, 0.0),
+            (1.0, 0.0, 0.0),
+            (0.1, 0.2, 0.7),
+            (0.1, 0.2, -0.1),
         ] {
             let s = ProductSettings {
                 keep: 4,
                 defensive,
                 cosine,
+                light,
             };
             assert!(
                 matches!(s.validate(), Err(SrbfError::BadCosineShare { .. })),
-                "{cosine} {defensive}"
+                "{cosine} {defensive} {light}"
             );
         }
         assert!(ProductSettings::default().validate().is_ok());
