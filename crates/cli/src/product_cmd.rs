@@ -258,6 +258,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         &scene,
         &brdf_fit,
         &map_fit,
+        &light_samplers[0].1,
         &srbf_options.product_settings(),
         n,
         stream(args.seed, 1),
