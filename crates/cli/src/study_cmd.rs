@@ -221,8 +221,9 @@ fn shared_root() -> Option<PathBuf> {
 }
 
 /// The output directory of a study, written atomically: checked before any work, filled in a
-/// temporary directory created beside it (in its nearest existing ancestor, so on the same file
-/// system), and moved in by [`Staging::commit`] only when every file is written. A run that
+/// temporary directory (inside it when it exists, else in its nearest existing ancestor: on
+/// the same file system either way), and moved in by [`Staging::commit`] only when every file
+/// is written. A run that
 /// fails (or bad input) leaves neither the output directory nor the temporary one.
 struct Staging {
     dir: tempfile::TempDir,
@@ -242,10 +243,11 @@ impl Staging {
                 .map(drop)
                 .map_err(|e| fail(format!("cannot create files: {e}")))?;
         }
+        // An existing output directory holds its own temporary one (so `--out .` needs no
+        // writable parent); a new one is staged in its nearest existing ancestor.
         let absolute = std::path::absolute(out).map_err(|e| fail(e.to_string()))?;
         let ancestor = absolute
             .ancestors()
-            .skip(1)
             .find(|a| a.is_dir())
             .ok_or_else(|| fail("no existing parent directory".into()))?;
         let dir = tempfile::Builder::new()

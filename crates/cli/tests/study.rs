@@ -84,6 +84,9 @@ fn a_study_writes_its_outputs_and_shards_merge_to_the_same_numbers() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let merged = dir.path().join("merged");
+    // An existing output directory: its other files are kept, no temporary directory is left.
+    std::fs::create_dir(&merged).expect("mkdir");
+    std::fs::write(merged.join("keep.txt"), "mine").expect("write");
     let mut args = vec!["study", "merge"];
     let names: Vec<String> = shards.iter().map(|s| s.display().to_string()).collect();
     args.extend(names.iter().map(String::as_str));
@@ -93,6 +96,19 @@ fn a_study_writes_its_outputs_and_shards_merge_to_the_same_numbers() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(numbers(&merged), numbers(&whole));
     assert!(merged.join("images/reference.png").is_file());
+    assert!(merged.join("keep.txt").is_file());
+    for d in [dir.path(), merged.as_path(), whole.as_path()] {
+        let stray: Vec<_> = std::fs::read_dir(d)
+            .expect("dir")
+            .flatten()
+            .filter(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .starts_with(".brdf-lab-study-")
+            })
+            .collect();
+        assert!(stray.is_empty(), "{stray:?}");
+    }
     // A missing shard is refused, and leaves no output directory.
     let partial = dir.path().join("partial").display().to_string();
     let o = brdf_lab(&["study", "merge", &names[0], &names[1], "--out", &partial]);
