@@ -1,8 +1,10 @@
-//! The report of a run: JSON (design.md §5 schema, plus extra fields) and markdown.
+//! The report of a run: JSON (the schema of docs/validation.md, plus extra fields) and markdown.
 
 use std::fmt::Write as _;
 
 use serde::Serialize;
+
+use crate::case::names;
 use stats::TestOutcome;
 
 /// One test of one case.
@@ -88,7 +90,8 @@ pub struct MutantRecord {
 pub struct ValidationReport {
     /// Family-wise significance level.
     pub alpha: f64,
-    /// Every test passed (and, with mutants, every mutant was caught and every control passed).
+    /// Every test passed (and, with mutants, every mutant was caught and every control passed),
+    /// and at least one test ran: a run whose every case was skipped did not pass.
     pub passed: bool,
     /// Every test of every case, in a fixed order.
     pub tests: Vec<TestRecord>,
@@ -145,12 +148,28 @@ impl ValidationReport {
         self.passed
     }
 
+    /// The records of the cases skipped because the sampler does not apply to the target (one
+    /// per case, with the reason in its `detail`).
+    pub fn skipped(&self) -> impl Iterator<Item = &TestRecord> {
+        self.tests.iter().filter(|t| t.test == names::SKIPPED)
+    }
+
+    /// The number of skipped cases ([`Self::skipped`]).
+    pub fn skipped_cases(&self) -> usize {
+        self.skipped().count()
+    }
+
+    /// The number of tests that ran (every record but the skipped cases').
+    pub fn tests_run(&self) -> usize {
+        self.tests.len() - self.skipped_cases()
+    }
+
     /// The failed tests of the correct samplers.
     pub fn failures(&self) -> impl Iterator<Item = &TestRecord> {
         self.tests.iter().filter(|t| !t.passed)
     }
 
-    /// JSON with the schema of design.md §5
+    /// JSON with the schema of docs/validation.md
     /// (`{"alpha", "passed", "tests": [{"brdf", "sampler", "theta_o", "test", "statistic",
     /// "p_value", "passed"}], "mutants": [{"name", "detected"}]}`) plus extra fields
     /// (`domain`, `detail`, `caught_by`, `control_passed`, the tier and sample counts).
@@ -166,11 +185,27 @@ impl ValidationReport {
         let mut s = String::new();
         let _ = writeln!(s, "# brdf-lab validate — {} tier\n", self.tier);
         let failed = self.tests.iter().filter(|t| !t.passed).count();
+        let run = self.tests_run();
+        let skipped = match self.skipped_cases() {
+            0 => String::new(),
+            1 => ", 1 case skipped (the sampler does not apply)".to_string(),
+            k => format!(", {k} cases skipped (the sampler does not apply)"),
+        };
         let _ = writeln!(
             s,
-            "**Result: {}** — {} tests, {} failed; family-wise α = {}, Šidák per-test level {:.3e} over m = {} p-valued tests; seed {}, {} one-sample draws per case plus {} batches of {}.\n",
-            if self.passed { "PASSED" } else { "FAILED" },
-            self.tests.len(),
+            "**Result: {}** — {} run{skipped}, {} failed; family-wise α = {}, Šidák per-test level {:.3e} over m = {} p-valued tests; seed {}, {} one-sample draws per case plus {} batches of {}.\n",
+            if run == 0 {
+                "NO TEST RAN"
+            } else if self.passed {
+                "PASSED"
+            } else {
+                "FAILED"
+            },
+            if run == 1 {
+                "1 test".to_string()
+            } else {
+                format!("{run} tests")
+            },
             failed,
             self.alpha,
             self.per_test_level,

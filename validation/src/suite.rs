@@ -659,8 +659,11 @@ fn assemble(
             }
         })
         .collect();
-    let passed =
-        tests.iter().all(|t| t.passed) && mutants.iter().all(|m| m.detected && m.control_passed);
+    // A run in which every case was skipped (or that had no case) tested nothing: not a pass.
+    let ran = tests.iter().any(|t| t.test != names::SKIPPED);
+    let passed = ran
+        && tests.iter().all(|t| t.passed)
+        && mutants.iter().all(|m| m.detected && m.control_passed);
     ValidationReport {
         alpha: config.alpha,
         passed,
@@ -746,5 +749,29 @@ mod tests {
             vec![(caught(), bad_control)],
         );
         assert!(!r.passed() && !r.mutants[0].control_passed);
+    }
+
+    #[test]
+    fn a_run_whose_every_case_was_skipped_did_not_pass() {
+        let skipped = || case("analytic", vec![skipped_outcome("no analytic sampler")]);
+        let r = assembled(vec![skipped()], Vec::new());
+        assert!(!r.passed() && r.tests.iter().all(|t| t.passed));
+        assert_eq!((r.tests_run(), r.skipped_cases()), (0, 1));
+        assert!(
+            r.to_markdown().contains("**Result: NO TEST RAN**"),
+            "{}",
+            r.to_markdown()
+        );
+        let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+        assert_eq!(json["passed"], false);
+        let r = assembled(vec![skipped(), case("b", vec![p("x", 0.5)])], Vec::new());
+        assert!(r.passed());
+        assert_eq!((r.tests_run(), r.skipped_cases()), (1, 1));
+        assert!(
+            r.to_markdown().contains("1 test run, 1 case skipped"),
+            "{}",
+            r.to_markdown()
+        );
+        assert!(!assembled(Vec::new(), Vec::new()).passed());
     }
 }

@@ -2,15 +2,17 @@
 
 use std::path::Path;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirectionSampler, DiscMapPolicy, QuadTreeSet, SetOptions};
 use clap::Args;
 use partition_sampler::TreeParams;
 
-use crate::baseline_args::BaselineArgs;
+use crate::baseline_args::{APPLIES_TO, BaselineArgs, ProductBaselineArgs};
 use crate::error::{CliError, CliResult};
 use crate::progress;
+use crate::values::{self, End, display_path};
 
 /// The BRDF and the outgoing direction.
 #[derive(Debug, Args)]
@@ -20,48 +22,95 @@ pub(crate) struct BrdfArgs {
     #[arg(long = "brdf", required_unless_present = "set_file")]
     pub(crate) spec: Option<String>,
     /// Outgoing polar angle θo in degrees, in [0, 90).
-    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    #[arg(long = "theta-o", value_parser = values::theta_o, allow_hyphen_values = true)]
     pub(crate) theta_o: f64,
-    /// Outgoing azimuth φo in degrees.
-    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Outgoing azimuth φo in degrees, in [−360, 360].
+    #[arg(long = "phi-o", default_value_t = 0.0, value_parser = values::azimuth, allow_hyphen_values = true)]
     pub(crate) phi_o: f64,
 }
 
-/// Options of the adaptive quadtree sets.
+/// Options of the adaptive quadtree sets (and `adaptive-exact`).
 #[derive(Debug, Args, Clone)]
-pub(crate) struct SetArgs {
+#[command(next_help_heading = "Options of the adaptive samplers")]
+pub(crate) struct AdaptiveArgs {
     /// Outgoing-angle slices of an isotropic BRDF's set.
-    #[arg(long, default_value_t = SetOptions::DEFAULT_SLICES)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_SLICES,
+          value_parser = values::int(1, SetOptions::MAX_SLICES), allow_negative_numbers = true)]
     pub(crate) slices: usize,
     /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
-    #[arg(long, default_value_t = SetOptions::DEFAULT_N_MAX)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_N_MAX,
+          value_parser = values::real(End::Closed(1.0), End::None), allow_hyphen_values = true)]
     pub(crate) n_max: f64,
     /// Maximum quadtree depth; the image map must be finer than the deepest leaf:
     /// 2^(max_depth+1) ≤ grid, so at most 7 at the default --grid 256 (8 needs --grid 512).
-    #[arg(long, default_value_t = SetOptions::DEFAULT_MAX_DEPTH)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_MAX_DEPTH,
+          value_parser = values::int(0u32, partition_sampler::MAX_DEPTH_LIMIT), allow_negative_numbers = true)]
     pub(crate) max_depth: u32,
     /// Cells per axis of each slice's sampled image map over [-1, 1]²: a power of two; the
     /// slices refined for grazing lobes use up to 4 times as many.
-    #[arg(long, default_value_t = SetOptions::DEFAULT_GRID)]
+    #[arg(long, default_value_t = SetOptions::DEFAULT_GRID,
+          value_parser = values::int(4, SetOptions::MAX_GRID), allow_negative_numbers = true)]
     pub(crate) grid: usize,
     /// Hemisphere-to-disc map of the slices: `auto` (projected disc; equal-area from
     /// --equal-area-from degrees and for BRDFs unbounded at the horizon), `projected`
     /// (the papers') or `equal-area`.
     #[arg(long, default_value = "auto", value_parser = parse_disc_map)]
     pub(crate) disc_map: DiscMapPolicy,
-    /// Outgoing polar angle (degrees) from which `--disc-map auto` uses the equal-area map.
-    #[arg(long, default_value_t = SetOptions::DEFAULT_EQUAL_AREA_FROM_DEG)]
+    /// Outgoing polar angle (degrees, in [0, 90]) from which `--disc-map auto` uses the
+    /// equal-area map.
+    #[arg(long, default_value_t = SetOptions::DEFAULT_EQUAL_AREA_FROM_DEG,
+          value_parser = values::real(End::Closed(0.0), End::Closed(90.0)), allow_hyphen_values = true)]
     pub(crate) equal_area_from: f64,
-    /// Options of the baseline samplers (ignored by the adaptive sets).
+}
+
+/// The sampler options of `sample`, `eval` and `build`: the adaptive sets' and the baseline
+/// samplers'. Each applies to some samplers only ([`APPLIES_TO`]).
+#[derive(Debug, Args, Clone)]
+pub(crate) struct SamplerArgs {
+    #[command(flatten)]
+    pub(crate) adaptive: AdaptiveArgs,
     #[command(flatten)]
     pub(crate) baselines: BaselineArgs,
+}
+
+/// The options of `product`: every sampler option (its `--brdf-sampler`s may be any direction
+/// sampler) and the SRBF product estimator's.
+#[derive(Debug, Args, Clone)]
+pub(crate) struct ProductSamplerArgs {
+    #[command(flatten)]
+    pub(crate) adaptive: AdaptiveArgs,
+    #[command(flatten)]
+    pub(crate) baselines: ProductBaselineArgs,
+}
+
+/// The name `product_cmd` knows `product`'s sampler options by.
+pub(crate) type SetArgs = ProductSamplerArgs;
+
+impl ProductSamplerArgs {
+    /// The adaptive sets' options.
+    pub(crate) fn options(&self) -> SetOptions {
+        self.adaptive.options()
+    }
+}
+
+impl SamplerArgs {
+    /// The adaptive sets' options.
+    pub(crate) fn options(&self) -> SetOptions {
+        self.adaptive.options()
+    }
+
+    /// [`AdaptiveArgs::check`].
+    pub(crate) fn check(&self) -> CliResult<()> {
+        self.adaptive.check()
+    }
 }
 
 fn parse_disc_map(s: &str) -> Result<DiscMapPolicy, String> {
     DiscMapPolicy::parse(s).ok_or_else(|| format!("`{s}`: expected auto, projected or equal-area"))
 }
 
-impl SetArgs {
+impl AdaptiveArgs {
+    /// The adaptive sets' options these flags select.
     pub(crate) fn options(&self) -> SetOptions {
         let defaults = SetOptions::default();
         SetOptions {
@@ -79,7 +128,7 @@ impl SetArgs {
     }
 }
 
-impl SetArgs {
+impl AdaptiveArgs {
     /// Checks `--grid` and `--max-depth` with messages in terms of the options (exit 2), e.g.
     /// which `--grid` a `--max-depth` needs.
     pub(crate) fn check(&self) -> CliResult<()> {
@@ -135,7 +184,7 @@ pub(crate) fn load_set(
     given_spec: Option<&str>,
     given_sampler: Option<&str>,
 ) -> CliResult<(String, Arc<dyn Brdf>, Built, &'static str)> {
-    let fail = |why: String| CliError::input(format!("--set {}: {why}", path.display()));
+    let fail = |why: String| CliError::input(format!("--set {}: {why}", display_path(path)));
     let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
     let spec = QuadTreeSet::stored_spec(&bytes).map_err(|e| fail(e.to_string()))?;
     if let Some(given) = given_spec
@@ -220,13 +269,15 @@ impl From<samplers::BuiltDirection> for Built {
     }
 }
 
-/// Builds sampler `name` for `brdf` (spec recorded), with a progress bar over the slices.
+/// Builds sampler `name` for `brdf` (spec recorded), with a progress bar over the slices;
+/// returns it with the wall time of the build. Prints the build's warnings
+/// ([`print_build_warnings`]).
 pub(crate) fn build(
     name: &str,
     spec: &str,
     brdf: Arc<dyn Brdf>,
-    set: &SetArgs,
-) -> CliResult<Built> {
+    set: &SamplerArgs,
+) -> CliResult<(Built, Duration)> {
     let options = set.options();
     let baselines = set.baselines.options()?;
     let pb = progress::bar(0, "building");
@@ -236,13 +287,98 @@ pub(crate) fn build(
     };
     let request = samplers::DirectionRequest::new(brdf, &options)
         .with_baselines(baselines)
-        .with_spec(spec)
-        .with_progress(&tick);
+        .with_spec(spec);
+    let request = request.with_progress(&tick);
+    let started = Instant::now();
     let built = samplers::build_direction(name, &request)
         .map(Built::from)
         .map_err(CliError::input);
+    let elapsed = started.elapsed();
     pb.finish_and_clear();
-    built
+    let built = built?;
+    print_build_warnings(name, built.sampler());
+    Ok((built, elapsed))
+}
+
+/// The warnings of a built sampler: the lines `warning: …` of its
+/// [`DirectionSampler::build_report`] (e.g. `srbf` fits that hit the L-BFGS iteration cap),
+/// without that prefix.
+pub(crate) fn build_warnings(sampler: &dyn DirectionSampler) -> Vec<String> {
+    sampler
+        .build_report()
+        .map(|r| {
+            r.lines()
+                .filter_map(|l| l.strip_prefix("warning: ").map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Prints `brdf-lab: warning: --sampler NAME: …` on stderr for each of [`build_warnings`].
+pub(crate) fn print_build_warnings(name: &str, sampler: &dyn DirectionSampler) {
+    for w in build_warnings(sampler) {
+        eprintln!("brdf-lab: warning: --sampler {name}: {w}");
+    }
+}
+
+/// The lines of a built sampler's report without its warnings (printed apart).
+pub(crate) fn report_lines(sampler: &dyn DirectionSampler) -> Vec<String> {
+    sampler
+        .build_report()
+        .map(|r| {
+            r.lines()
+                .filter(|l| !l.starts_with("warning: "))
+                .map(str::to_string)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The ids of the options given on the command line (clap ids: the field names).
+#[derive(Debug, Default)]
+pub(crate) struct Given(pub(crate) Vec<String>);
+
+impl Given {
+    /// The options given on the command line among `matches`' (not their defaults).
+    pub(crate) fn of(matches: &clap::ArgMatches) -> Self {
+        Self(
+            matches
+                .ids()
+                .filter(|id| {
+                    matches.value_source(id.as_str())
+                        == Some(clap::parser::ValueSource::CommandLine)
+                })
+                .map(|id| id.as_str().to_string())
+                .collect(),
+        )
+    }
+}
+
+/// Refuses sampler options given for a sampler they do not configure ([`APPLIES_TO`]): exit
+/// 2 with `--epsilon applies to sampler cascade-cdf, not adaptive`. `sampler` is the sampler
+/// in use; `None` when the command builds none (`eval` without `--sampler`).
+pub(crate) fn check_options_apply(given: &Given, sampler: Option<&str>) -> CliResult<()> {
+    for (ids, names) in APPLIES_TO {
+        if sampler.is_some_and(|s| names.contains(&s.trim())) {
+            continue;
+        }
+        if let Some(id) = ids.iter().find(|id| given.0.iter().any(|g| g == *id)) {
+            let flag = format!("--{}", id.replace('_', "-"));
+            let list = if names.len() == 1 {
+                format!("sampler {}", names[0])
+            } else {
+                format!("samplers {}", names.join(", "))
+            };
+            let used = match sampler {
+                Some(s) => s.trim().to_string(),
+                None => "none (no --sampler given)".to_string(),
+            };
+            return Err(CliError::input(format!(
+                "{flag} applies to {list}, not {used}"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Prints the build report of an adaptive set to stdout (nothing for other samplers).

@@ -4,8 +4,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::brdf_args::{self, Built, SetArgs};
+use crate::brdf_args::{self, Built, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
+use crate::values::display_path;
 
 /// Arguments of `brdf-lab build`.
 #[derive(Debug, Args)]
@@ -21,11 +22,11 @@ pub(crate) struct BuildArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
-    set: SetArgs,
+    set: SamplerArgs,
 }
 
 /// Runs `brdf-lab build`.
-pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
+pub(crate) fn run(args: &BuildArgs, given: &Given) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
@@ -44,17 +45,26 @@ pub(crate) fn run(args: &BuildArgs) -> CliResult<()> {
             sets.join(", ")
         )));
     }
+    brdf_args::check_options_apply(given, Some(entry.name))?;
     let brdf = brdf_args::parse_brdf(&args.spec)?;
-    let built = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set)?;
+    let (built, elapsed) = brdf_args::build(&args.sampler, &args.spec, brdf, &args.set)?;
     println!("brdf       {}", args.spec);
+    // Every sampler: the build's wall time and memory; then its own report (fit quality, …).
+    println!(
+        "sampler    {} built in {:.3} s, {} bytes ({:.1} KiB)",
+        entry.name,
+        elapsed.as_secs_f64(),
+        built.sampler().bytes_used(),
+        built.sampler().bytes_used() as f64 / 1024.0
+    );
     brdf_args::print_set_report(&built);
-    if let Some(report) = built.sampler().build_report() {
-        println!("{report}");
+    for line in brdf_args::report_lines(built.sampler()) {
+        println!("{line}");
     }
     if let (Some(path), Built::Set(set)) = (&args.out, &built) {
         let bytes = set.to_bytes();
         crate::output::write_atomically(path, |w| w.write_all(&bytes))?;
-        println!("wrote      {} ({} bytes)", path.display(), bytes.len());
+        println!("wrote      {} ({} bytes)", display_path(path), bytes.len());
     }
     Ok(())
 }

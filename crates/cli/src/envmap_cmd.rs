@@ -12,6 +12,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 use crate::error::{CliError, CliResult};
 use crate::output::{num, write_atomically};
 use crate::progress;
+use crate::values::{self, counted, display_path};
 
 /// Width and height of the built-in procedural sky.
 const SKY_SIZE: (usize, usize) = (1024, 512);
@@ -25,10 +26,10 @@ pub(crate) struct EnvmapArgs {
     #[arg(long)]
     map: Option<PathBuf>,
     /// Number of samples to draw.
-    #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(short = 'n', long = "samples", value_parser = values::at_least(1u64), allow_negative_numbers = true)]
     n: u64,
     /// Seed of the random streams (the samples depend only on it, not on the thread count).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed, allow_negative_numbers = true)]
     seed: u64,
     /// Write the samples as CSV `u,v,pdf_uv,pdf_sa` (written atomically).
     #[arg(long)]
@@ -40,10 +41,12 @@ pub(crate) struct EnvmapArgs {
     #[arg(long, default_value = "envmap-adaptive", value_parser = envmap_sampler_names())]
     sampler: String,
     /// Split threshold n_max ≥ 1 of the adaptive samplers (mean trials per sample ≤ n_max).
-    #[arg(long, default_value_t = AdaptiveOptions::DEFAULT_N_MAX)]
+    #[arg(long, default_value_t = AdaptiveOptions::DEFAULT_N_MAX,
+          value_parser = values::real(values::End::Closed(1.0), values::End::None), allow_hyphen_values = true)]
     n_max: f64,
     /// Maximum quadtree depth of the adaptive samplers.
-    #[arg(long, default_value_t = TreeParams::DEFAULT_MAX_DEPTH)]
+    #[arg(long, default_value_t = TreeParams::DEFAULT_MAX_DEPTH,
+          value_parser = values::int(0u32, partition_sampler::MAX_DEPTH_LIMIT), allow_negative_numbers = true)]
     max_depth: u32,
     /// Leaf choice of the adaptive sampler.
     #[arg(long, value_enum, default_value_t = LeafChoiceName::Alias)]
@@ -93,8 +96,8 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     let (map, map_name) = match &args.map {
         Some(path) => {
             let map = EnvMap::load(path)
-                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-            (map, path.display().to_string())
+                .map_err(|e| CliError::input(format!("{}: {e}", display_path(path))))?;
+            (map, display_path(path))
         }
         None => {
             let map = envmap::procedural_sky(SKY_SIZE.0, SKY_SIZE.1).map_err(CliError::input)?;
@@ -135,10 +138,10 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     pb.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
     println!(
-        "samples    {n} in {:.3} s ({:.2} M samples/s on {} threads, incl. the estimator)",
+        "samples    {n} in {:.3} s ({:.2} M samples/s on {}, incl. the estimator)",
         elapsed,
         n as f64 / elapsed / 1e6,
-        rayon::current_num_threads()
+        counted(rayon::current_num_threads(), "thread")
     );
     if let Some(stats) = sampler.stats() {
         let measured = stats
@@ -158,8 +161,9 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     if let Some(path) = &args.out {
         write_samples(path, &blocks)?;
         println!(
-            "wrote      {} ({n} rows: u,v,pdf_uv,pdf_sa)",
-            path.display()
+            "wrote      {} ({}: u,v,pdf_uv,pdf_sa)",
+            display_path(path),
+            counted(n, "row")
         );
     }
     if args.compare {
@@ -311,7 +315,8 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
     let threads = rayon::current_num_threads();
     println!();
     println!(
-        "compare    {n} samples per variant, median of 5 builds; M/s on 1 and {threads} threads, 'one' = one sample_uv call per sample, 'blk' = sample_into on buffers of {CONSUMER_BATCH} (same samples; consumed, not stored)"
+        "compare    {n} samples per variant (--samples clamped to [10^5, 4·10^6] for the timings), median of 5 builds; M/s on 1 thread and on {}, 'one' = one sample_uv call per sample, 'blk' = sample_into on buffers of {CONSUMER_BATCH} (same samples; consumed, not stored)",
+        counted(threads, "thread")
     );
     println!(
         "{:<24} {:<8} {:>10} {:>12} {:>10} {:>11} {:>11} {:>11} {:>11}",

@@ -1,4 +1,4 @@
-//! The CLI's error type and its mapping to exit codes (design.md §5).
+//! The CLI's error type and its mapping to exit codes (README.md, "Exit codes").
 
 use std::fmt;
 
@@ -9,6 +9,9 @@ pub(crate) enum CliError {
     Input(String),
     /// A statistical test failed: exit code 1.
     TestFailed(String),
+    /// `validate` ran no test: every case was skipped (no sampler applied to the targets):
+    /// exit code 3, so a run that checked nothing is never taken for a pass.
+    NothingTested(String),
 }
 
 impl CliError {
@@ -17,6 +20,7 @@ impl CliError {
         match self {
             CliError::Input(_) => 2,
             CliError::TestFailed(_) => 1,
+            CliError::NothingTested(_) => 3,
         }
     }
 
@@ -30,7 +34,9 @@ impl CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Input(m) | CliError::TestFailed(m) => f.write_str(m),
+            CliError::Input(m) | CliError::TestFailed(m) | CliError::NothingTested(m) => {
+                f.write_str(m)
+            }
         }
     }
 }

@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 use brdf::Vec3;
 use clap::Args;
 
-use crate::brdf_args::{self, BrdfArgs, SetArgs};
+use crate::brdf_args::{self, BrdfArgs, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
 use crate::output::{num, write_atomically};
+use crate::values::{counted, display_path};
 
 /// Arguments of `brdf-lab eval`.
 #[derive(Debug, Args)]
@@ -31,14 +32,14 @@ pub(crate) struct EvalArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
-    set: SetArgs,
+    set: SamplerArgs,
 }
 
 /// Reads the directions of a CSV file, each normalised to a unit vector (exit 2 naming the bad
 /// line). The one rule for every sampler: f and every pdf see the same unit vector.
 fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        .map_err(|e| CliError::input(format!("{}: {e}", display_path(path))))?;
     let mut dirs = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
@@ -66,7 +67,7 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
                 {
                     return Err(CliError::input(format!(
                         "{}:{}: direction must be finite, non-zero and normalisable",
-                        path.display(),
+                        display_path(path),
                         i + 1
                     )));
                 }
@@ -79,7 +80,7 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
             _ => {
                 return Err(CliError::input(format!(
                     "{}:{}: expected three numbers `x,y,z`, got `{line}`",
-                    path.display(),
+                    display_path(path),
                     i + 1
                 )));
             }
@@ -88,29 +89,31 @@ fn read_directions(path: &Path) -> CliResult<Vec<Vec3>> {
     if dirs.is_empty() {
         return Err(CliError::input(format!(
             "{}: no directions",
-            path.display()
+            display_path(path)
         )));
     }
     Ok(dirs)
 }
 
 /// Runs `brdf-lab eval`.
-pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
+pub(crate) fn run(args: &EvalArgs, given: &Given) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
     let dirs = read_directions(&args.dirs)?;
     let (brdf, built) = match &args.set_file {
         Some(path) => {
-            let (_, brdf, set, _) =
+            let (_, brdf, set, name) =
                 brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?;
+            brdf_args::check_options_apply(given, Some(name))?;
             (brdf, Some(set))
         }
         None => {
+            brdf_args::check_options_apply(given, args.sampler.as_deref())?;
             let spec = brdf_args::required_spec(&args.brdf)?;
             let brdf = brdf_args::parse_brdf(spec)?;
             let built = match &args.sampler {
-                Some(name) => Some(brdf_args::build(name, spec, brdf.clone(), &args.set)?),
+                Some(name) => Some(brdf_args::build(name, spec, brdf.clone(), &args.set)?.0),
                 None => None,
             };
             (brdf, built)
@@ -147,7 +150,11 @@ pub(crate) fn run(args: &EvalArgs) -> CliResult<()> {
     match &args.out {
         Some(path) => {
             write_atomically(path, write)?;
-            eprintln!("wrote {} ({} rows)", path.display(), rows.len());
+            eprintln!(
+                "wrote {} ({})",
+                display_path(path),
+                counted(rows.len(), "row")
+            );
         }
         None => crate::output::write_stdout(write)?,
     }

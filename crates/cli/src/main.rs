@@ -1,6 +1,7 @@
-//! `brdf-lab`: the command line of the brdf-lab research framework (design.md §5).
+//! `brdf-lab`: the command line of the brdf-lab research framework (README.md).
 //!
-//! Exit codes: 0 success (all tests passed), 1 a statistical test failed, 2 bad usage or input.
+//! Exit codes: 0 success (all tests passed), 1 a statistical test failed, 2 bad usage or input,
+//! 3 `validate` ran no test (every case skipped).
 
 mod baseline_args;
 mod brdf_args;
@@ -15,8 +16,9 @@ mod progress;
 mod sample_cmd;
 mod study_cmd;
 mod validate_cmd;
+mod values;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
 
 /// Importance sampling of reflectance functions: samplers, validation and studies.
@@ -37,7 +39,7 @@ enum Command {
     Eval(eval_cmd::EvalArgs),
     /// Build (and save) a BRDF's set of adaptive quadtrees, with its report.
     Build(build_cmd::BuildArgs),
-    /// Run the statistical validation suite (exit 1 if a test fails).
+    /// Run the statistical validation suite (exit 1 if a test fails, 3 if no test ran).
     Validate(validate_cmd::ValidateArgs),
     /// Sample an environment map (directions ∝ luminance per solid angle) and print a summary.
     Envmap(envmap_cmd::EnvmapArgs),
@@ -51,12 +53,22 @@ fn main() {
     // Usage errors: clap's full message (missing arguments by name, possible values, "similar
     // argument" tips, the usage line) on stderr, exit 2. No subcommand: the help on stderr,
     // exit 2 (`arg_required_else_help`). `--help` / `--version`: stdout, exit 0.
-    let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
+    let matches = Cli::command()
+        .try_get_matches()
+        .unwrap_or_else(|e| e.exit());
+    let cli =
+        Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.format(&mut Cli::command()).exit());
+    // The options given on the command line (not defaulted): a sampler option given for a
+    // sampler it does not configure is refused.
+    let given = matches
+        .subcommand()
+        .map(|(_, m)| brdf_args::Given::of(m))
+        .unwrap_or_default();
     let result = match cli.command {
         Command::List => list_cmd::run(),
-        Command::Sample(args) => sample_cmd::run(&args),
-        Command::Eval(args) => eval_cmd::run(&args),
-        Command::Build(args) => build_cmd::run(&args),
+        Command::Sample(args) => sample_cmd::run(&args, &given),
+        Command::Eval(args) => eval_cmd::run(&args, &given),
+        Command::Build(args) => build_cmd::run(&args, &given),
         Command::Validate(args) => validate_cmd::run(&args),
         Command::Envmap(args) => envmap_cmd::run(&args),
         Command::Study(args) => study_cmd::run(&args),

@@ -8,6 +8,7 @@
 //! the umask, e.g. 0644), an existing one keeps its mode.
 
 use crate::error::{CliError, CliResult};
+use crate::values::display_path;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -72,11 +73,11 @@ fn target(path: &Path) -> Result<Target, String> {
     let dir = parent_dir(&file);
     match std::fs::metadata(dir) {
         Ok(m) if m.is_dir() => Ok(Target::File(file)),
-        Ok(_) => Err(format!("{} is not a directory", dir.display())),
+        Ok(_) => Err(format!("{} is not a directory", display_path(dir))),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            Err(format!("directory {} does not exist", dir.display()))
+            Err(format!("directory {} does not exist", display_path(dir)))
         }
-        Err(e) => Err(format!("directory {}: {}", dir.display(), reason(&e))),
+        Err(e) => Err(format!("directory {}: {}", display_path(dir), reason(&e))),
     }
 }
 
@@ -84,7 +85,7 @@ fn target(path: &Path) -> Result<Target, String> {
 /// not a directory, its directory exists, and a file can be created there (probed with a
 /// temporary file that is removed at once). Exit 2 with a one-line reason otherwise.
 pub(crate) fn check_writable(flag: &str, path: &Path) -> CliResult<()> {
-    let fail = |why: String| CliError::input(format!("{flag} {}: {why}", path.display()));
+    let fail = |why: String| CliError::input(format!("{flag} {}: {why}", display_path(path)));
     match target(path).map_err(fail)? {
         // Opening a FIFO here would block or signal end of file to its reader.
         Target::Stream => Ok(()),
@@ -93,7 +94,7 @@ pub(crate) fn check_writable(flag: &str, path: &Path) -> CliResult<()> {
             tempfile::NamedTempFile::new_in(dir).map(drop).map_err(|e| {
                 fail(format!(
                     "cannot create files in {}: {}",
-                    dir.display(),
+                    display_path(dir),
                     reason(&e)
                 ))
             })
@@ -129,7 +130,7 @@ pub(crate) fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> CliResult<()> {
-    let fail = |why: String| CliError::input(format!("cannot write {}: {why}", path.display()));
+    let fail = |why: String| CliError::input(format!("cannot write {}: {why}", display_path(path)));
     let file = match target(path).map_err(fail)? {
         Target::Stream => {
             let out = std::fs::OpenOptions::new()

@@ -13,10 +13,11 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
-use crate::brdf_args::{self, BrdfArgs, SetArgs};
+use crate::brdf_args::{self, BrdfArgs, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
 use crate::output::{num, write_atomically};
 use crate::progress;
+use crate::values::{self, counted, display_path};
 
 /// Samples per independently seeded chunk (output depends on the seed only, not on threads).
 const CHUNK: usize = 4096;
@@ -34,33 +35,37 @@ pub(crate) struct SampleArgs {
     #[arg(long = "set", value_name = "FILE", conflicts_with_all = brdf_args::SET_OPTION_IDS)]
     set_file: Option<PathBuf>,
     /// Number of samples.
-    #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
+    #[arg(short = 'n', long = "samples", value_parser = values::int(1u64, 1_000_000_000), allow_negative_numbers = true)]
     n: u64,
     /// Seed of the random streams.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed, allow_negative_numbers = true)]
     seed: u64,
     /// Write the samples as CSV `x,y,z,pdf` (pdf w.r.t. solid angle) here, atomically, instead
     /// of to standard output. The summary always goes to standard error.
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
-    set: SetArgs,
+    set: SamplerArgs,
 }
 
 /// Runs `brdf-lab sample`.
-pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
+pub(crate) fn run(args: &SampleArgs, given: &Given) -> CliResult<()> {
     crate::output::check_all([("--out", args.out.as_deref())])?;
     args.set.check()?;
     let wo = brdf_args::outgoing(&args.brdf)?;
     let (spec, brdf, built, name) = match &args.set_file {
         Some(path) => {
-            brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?
+            let loaded =
+                brdf_args::load_set(path, args.brdf.spec.as_deref(), args.sampler.as_deref())?;
+            brdf_args::check_options_apply(given, Some(loaded.3))?;
+            loaded
         }
         None => {
+            let name = args.sampler.as_deref().unwrap_or("adaptive");
+            brdf_args::check_options_apply(given, Some(name))?;
             let spec = brdf_args::required_spec(&args.brdf)?;
             let brdf = brdf_args::parse_brdf(spec)?;
-            let name = args.sampler.as_deref().unwrap_or("adaptive");
-            let built = brdf_args::build(name, spec, brdf.clone(), &args.set)?;
+            let (built, _) = brdf_args::build(name, spec, brdf.clone(), &args.set)?;
             (spec.to_string(), brdf, built, name)
         }
     };
@@ -70,7 +75,7 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
         args.brdf.theta_o, args.brdf.phi_o
     );
     if let Some(path) = &args.set_file {
-        eprintln!("set file   {}", path.display());
+        eprintln!("set file   {}", display_path(path));
     }
     eprintln!(
         "sampler    {} ({} bytes)",
@@ -95,9 +100,9 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     pb.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
     eprintln!(
-        "samples    {n} in {elapsed:.3} s ({:.2} M samples/s on {} threads)",
+        "samples    {n} in {elapsed:.3} s ({:.2} M samples/s on {})",
         n as f64 / elapsed / 1e6,
-        rayon::current_num_threads()
+        counted(rayon::current_num_threads(), "thread")
     );
 
     // The directional albedo ∫ f cos dω, estimated by (1/N) Σ f cos / p and by the adaptive
@@ -127,6 +132,11 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     for line in brdf_args::set_report_lines(&built) {
         eprintln!("{line}");
     }
+    if let brdf_args::Built::Other(s) = &built {
+        for line in brdf_args::report_lines(s.as_ref()) {
+            eprintln!("{line}");
+        }
+    }
 
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
         writeln!(w, "x,y,z,pdf")?;
@@ -145,7 +155,11 @@ pub(crate) fn run(args: &SampleArgs) -> CliResult<()> {
     match &args.out {
         Some(path) => {
             write_atomically(path, write)?;
-            eprintln!("wrote      {} ({n} rows: x,y,z,pdf)", path.display());
+            eprintln!(
+                "wrote      {} ({}: x,y,z,pdf)",
+                display_path(path),
+                counted(n, "row")
+            );
         }
         None => crate::output::write_stdout(write)?,
     }

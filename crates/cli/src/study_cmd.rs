@@ -9,6 +9,7 @@ use study::{Shard, StudyConfig, StudyPlan, StudyResults};
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
 use crate::progress;
+use crate::values::{self, counted, display_path};
 
 /// Arguments of `brdf-lab study`.
 #[derive(Debug, Args)]
@@ -23,8 +24,8 @@ pub(crate) struct StudyArgs {
     /// preferred list (uniform, cosine, the lobe/CDF/factored baselines, the adaptive ones).
     #[arg(long = "sampler")]
     samplers: Vec<String>,
-    /// Outgoing polar angle θo in degrees (repeatable); default 30 and 60.
-    #[arg(long = "theta-o")]
+    /// Outgoing polar angle θo in degrees, in [0, 90) (repeatable); default 30 and 60.
+    #[arg(long = "theta-o", allow_hyphen_values = true)]
     theta_o: Vec<f64>,
     /// Light (repeatable): `sky` (default, built in), `envmap:PATH`,
     /// `area[:theta=DEG,phi=DEG,radius=DEG,radiance=L]`, `constant[:radiance=L]`.
@@ -39,13 +40,13 @@ pub(crate) struct StudyArgs {
     paper: bool,
     /// Sample counts N of the error curves, comma-separated, strictly increasing
     /// (default 1,25,100,225,400,900,1600,2500).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = values::at_least(1usize), allow_hyphen_values = true)]
     n_grid: Option<Vec<usize>>,
     /// Independent estimates per N (≥ 2).
-    #[arg(long)]
+    #[arg(long, value_parser = values::at_least(2usize), allow_negative_numbers = true)]
     repetitions: Option<usize>,
     /// Seed of the study; cell i uses a stream seeded from (seed, i).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed, allow_negative_numbers = true)]
     seed: u64,
     /// Run only every N-th cell, starting at the K-th (K/N, 1 ≤ K ≤ N); merge the shards'
     /// directories with `brdf-lab study merge`.
@@ -54,10 +55,11 @@ pub(crate) struct StudyArgs {
     /// Skip the sphere images (always skipped for a shard; `study merge` renders them).
     #[arg(long)]
     no_images: bool,
-    /// Samples per pixel of the equal-samples sphere images.
-    #[arg(long, default_value_t = 64)]
+    /// Samples per pixel of the equal-samples sphere images, in 1 ..= 65536.
+    #[arg(long, default_value_t = 64, value_parser = values::int(1usize, MAX_SPP), allow_negative_numbers = true)]
     spp: usize,
-    /// Output directory (created if missing; checked before any work).
+    /// Output directory (checked before any work; the outputs are written to a temporary
+    /// directory beside it and moved in at the end, so a failed run leaves nothing).
     #[arg(long, default_value = "study-out")]
     out: PathBuf,
 }
@@ -75,16 +77,19 @@ struct MergeArgs {
     /// Shard output directories (each with a results.json).
     #[arg(required = true)]
     dirs: Vec<PathBuf>,
-    /// Output directory of the merged study.
+    /// Output directory of the merged study (written as `study --out` is).
     #[arg(long)]
     out: PathBuf,
     /// Skip the sphere images.
     #[arg(long)]
     no_images: bool,
-    /// Samples per pixel of the equal-samples sphere images.
-    #[arg(long, default_value_t = 64)]
+    /// Samples per pixel of the equal-samples sphere images, in 1 ..= 65536.
+    #[arg(long, default_value_t = 64, value_parser = values::int(1usize, MAX_SPP), allow_negative_numbers = true)]
     spp: usize,
 }
+
+/// Largest `--spp` (the equal-samples images take `spp` samples per pixel and sampler).
+const MAX_SPP: usize = 65_536;
 
 /// Runs `brdf-lab study`.
 pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
@@ -129,7 +134,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         .transpose()
         .map_err(CliError::input)?;
     let plan = StudyPlan::new(config, notes).map_err(CliError::input)?;
-    prepare_dir(&args.out)?;
+    let staging = Staging::new(&args.out)?;
     let images = !args.no_images && shard.is_none();
     let render_steps = if images {
         1 + 2 * plan.config().samplers.len() as u64
@@ -142,7 +147,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     let render = images
         .then(|| {
             let cfg = study::RenderConfig {
-                spp: args.spp.max(1),
+                spp: args.spp,
                 seed: args.seed,
                 ..study::RenderConfig::default()
             };
@@ -156,32 +161,35 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         None
     };
     bar.finish_and_clear();
-    write_outputs(&args.out, &results, render.as_ref(), tables.as_deref())?;
+    write_outputs(staging.path(), &results, render.as_ref(), tables.as_deref())?;
+    staging.commit()?;
     summary(&args.out, &results);
     Ok(())
 }
 
 /// `brdf-lab study merge DIR… --out DIR`.
 fn merge(args: &MergeArgs) -> CliResult<()> {
-    prepare_dir(&args.out)?;
+    // The inputs are read and merged before the output is touched: bad input leaves nothing.
     let parts = args
         .dirs
         .iter()
         .map(|d| {
             let path = d.join("results.json");
-            let text = std::fs::read_to_string(&path)
-                .map_err(|e| CliError::input(format!("cannot read {}: {e}", path.display())))?;
-            StudyResults::from_json(&text, &path.display().to_string()).map_err(CliError::input)
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                CliError::input(format!("cannot read {}: {e}", display_path(&path)))
+            })?;
+            StudyResults::from_json(&text, &display_path(&path)).map_err(CliError::input)
         })
         .collect::<CliResult<Vec<_>>>()?;
     let merged = StudyResults::merge(parts).map_err(CliError::input)?;
+    let staging = Staging::new(&args.out)?;
     let render = if args.no_images {
         None
     } else {
         let plan =
             StudyPlan::new(merged.config.clone(), merged.notes.clone()).map_err(CliError::input)?;
         let cfg = study::RenderConfig {
-            spp: args.spp.max(1),
+            spp: args.spp,
             seed: merged.config.seed,
             ..study::RenderConfig::default()
         };
@@ -192,7 +200,8 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
         bar.finish_and_clear();
         Some(r)
     };
-    write_outputs(&args.out, &merged, render.as_ref(), None)?;
+    write_outputs(staging.path(), &merged, render.as_ref(), None)?;
+    staging.commit()?;
     summary(&args.out, &merged);
     Ok(())
 }
@@ -208,22 +217,88 @@ fn shared_root() -> Option<PathBuf> {
         .into_iter()
         .flatten()
         .find(|d| d.join("../shared").is_dir())
+        .map(|d| std::fs::canonicalize(&d).unwrap_or(d))
 }
 
-/// Creates the output directory if needed and checks that files can be created in it, before
-/// any work (exit 2, one line, otherwise).
-fn prepare_dir(dir: &Path) -> CliResult<()> {
-    let fail = |why: String| CliError::input(format!("--out {}: {why}", dir.display()));
-    if dir.exists() && !dir.is_dir() {
-        return Err(fail("exists and is not a directory".into()));
+/// The output directory of a study, written atomically: checked before any work, filled in a
+/// temporary directory (inside it when it exists, else in its nearest existing ancestor: on
+/// the same file system either way), and moved in by [`Staging::commit`] only when every file
+/// is written. A run that
+/// fails (or bad input) leaves neither the output directory nor the temporary one.
+struct Staging {
+    dir: tempfile::TempDir,
+    out: PathBuf,
+}
+
+impl Staging {
+    /// Checks `out` (a directory or nothing yet, writable) and creates the temporary
+    /// directory with `plots/` and `images/` (exit 2, one line, otherwise).
+    fn new(out: &Path) -> CliResult<Self> {
+        let fail = |why: String| CliError::input(format!("--out {}: {why}", display_path(out)));
+        if out.exists() && !out.is_dir() {
+            return Err(fail("exists and is not a directory".into()));
+        }
+        if out.is_dir() {
+            tempfile::NamedTempFile::new_in(out)
+                .map(drop)
+                .map_err(|e| fail(format!("cannot create files: {e}")))?;
+        }
+        // An existing output directory holds its own temporary one (so `--out .` needs no
+        // writable parent); a new one is staged in its nearest existing ancestor.
+        let absolute = std::path::absolute(out).map_err(|e| fail(e.to_string()))?;
+        let ancestor = absolute
+            .ancestors()
+            .find(|a| a.is_dir())
+            .ok_or_else(|| fail("no existing parent directory".into()))?;
+        let dir = tempfile::Builder::new()
+            .prefix(".brdf-lab-study-")
+            .tempdir_in(ancestor)
+            .map_err(|e| {
+                fail(format!(
+                    "cannot create files in {}: {e}",
+                    display_path(ancestor)
+                ))
+            })?;
+        for sub in ["plots", "images"] {
+            std::fs::create_dir(dir.path().join(sub))
+                .map_err(|e| fail(format!("cannot create {sub}/: {e}")))?;
+        }
+        Ok(Self {
+            dir,
+            out: out.to_path_buf(),
+        })
     }
-    for sub in [dir.to_path_buf(), dir.join("plots"), dir.join("images")] {
-        std::fs::create_dir_all(&sub)
-            .map_err(|e| fail(format!("cannot create {}: {e}", sub.display())))?;
+
+    /// Where the outputs are written until [`Self::commit`].
+    fn path(&self) -> &Path {
+        self.dir.path()
     }
-    tempfile::NamedTempFile::new_in(dir)
-        .map(drop)
-        .map_err(|e| fail(format!("cannot create files: {e}")))
+
+    /// Moves every written file into the output directory (created if missing; files of
+    /// the same names are replaced, others kept), each by an atomic rename.
+    fn commit(self) -> CliResult<()> {
+        let fail =
+            |why: String| CliError::input(format!("--out {}: {why}", display_path(&self.out)));
+        let mut stack = vec![PathBuf::new()];
+        while let Some(rel) = stack.pop() {
+            let target = self.out.join(&rel);
+            std::fs::create_dir_all(&target)
+                .map_err(|e| fail(format!("cannot create {}: {e}", display_path(&target))))?;
+            let entries =
+                std::fs::read_dir(self.dir.path().join(&rel)).map_err(|e| fail(e.to_string()))?;
+            for entry in entries {
+                let entry = entry.map_err(|e| fail(e.to_string()))?;
+                let name = rel.join(entry.file_name());
+                if entry.path().is_dir() {
+                    stack.push(name);
+                } else {
+                    std::fs::rename(entry.path(), self.out.join(&name))
+                        .map_err(|e| fail(format!("cannot move {} in: {e}", name.display())))?;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Writes `results.json`, `results.csv`, the plots (`plots/*.png`, `plots/*.svg`) and
@@ -307,8 +382,8 @@ fn write_text(path: &Path, text: &str) -> CliResult<()> {
 fn summary(dir: &Path, results: &StudyResults) {
     let failed = results.cells.iter().filter(|c| !c.ok()).count();
     eprintln!(
-        "study: {} cells{}{} → {}",
-        results.cells.len(),
+        "study: {}{}{} → {}",
+        counted(results.cells.len(), "cell"),
         results.shard.map_or(String::new(), |s| format!(
             " (shard {}/{})",
             s.index, s.count
@@ -318,6 +393,6 @@ fn summary(dir: &Path, results: &StudyResults) {
         } else {
             String::new()
         },
-        dir.join("report.md").display()
+        display_path(&dir.join("report.md"))
     );
 }

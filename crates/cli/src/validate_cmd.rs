@@ -8,6 +8,7 @@ use validation::{ProgressEvent, ValidateConfig};
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
 use crate::progress;
+use crate::values::{self, End, count, counted};
 
 /// Arguments of `brdf-lab validate`.
 #[derive(Debug, Args)]
@@ -18,14 +19,14 @@ pub(crate) struct ValidateArgs {
     /// Sampler to test (repeatable); default: every sampler of the project.
     #[arg(long = "sampler")]
     samplers: Vec<String>,
-    /// Outgoing polar angle in degrees (repeatable); default: the tier's list.
-    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    /// Outgoing polar angle in degrees, in [0, 90) (repeatable); default: the tier's list.
+    #[arg(long = "theta-o", value_parser = values::theta_o, allow_hyphen_values = true)]
     theta_o: Vec<f64>,
-    /// Samples per case; default: the tier's count.
-    #[arg(long)]
+    /// Samples per case (at least 2000); default: the tier's count.
+    #[arg(long, value_parser = values::at_least(validation::MIN_SAMPLES), allow_negative_numbers = true)]
     samples: Option<usize>,
     /// Master seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed, allow_negative_numbers = true)]
     seed: u64,
     /// The quick tier (what CI runs) instead of the full tier.
     #[arg(long)]
@@ -33,10 +34,10 @@ pub(crate) struct ValidateArgs {
     /// Also run the deliberately broken samplers; every one must be caught.
     #[arg(long)]
     mutants: bool,
-    /// Family-wise significance level (Šidák-corrected over the run's tests).
-    #[arg(long, default_value_t = 0.01)]
+    /// Family-wise significance level in (0, 1) (Šidák-corrected over the run's tests).
+    #[arg(long, default_value_t = 0.01, value_parser = values::real(End::Open(0.0), End::Open(1.0)), allow_hyphen_values = true)]
     alpha: f64,
-    /// Write the report as JSON (schema in design.md §5).
+    /// Write the report as JSON (schema in docs/validation.md).
     #[arg(long)]
     json: Option<PathBuf>,
     /// Write a readable markdown report of every test.
@@ -49,7 +50,7 @@ pub(crate) struct ValidateArgs {
 }
 
 /// Runs `brdf-lab validate`: exit 0 when everything passed, 1 when a test failed (or a mutant
-/// escaped), 2 on bad input.
+/// escaped), 2 on bad input, 3 when no test ran (every case skipped: no sampler applied).
 pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
     crate::output::check_all([
         ("--json", args.json.as_deref()),
@@ -109,24 +110,25 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
         write_atomically(path, |w| w.write_all(md.as_bytes()))?;
     }
     let failed: Vec<_> = report.tests.iter().filter(|t| !t.passed).collect();
+    let skipped: Vec<_> = report.skipped().collect();
+    let run = report.tests_run();
+    let skipped_note = match skipped.len() {
+        0 => String::new(),
+        k => format!(" ({} skipped)", count(k, "case", "cases")),
+    };
     println!(
-        "validate   {} tests, {} failed, α = {} (Šidák-corrected per test)",
-        report.tests.len(),
+        "validate   {}{skipped_note}, {} failed, α = {} (Šidák-corrected per test)",
+        counted(run, "test"),
         failed.len(),
         report.alpha
     );
-    let skipped: Vec<_> = report
-        .tests
-        .iter()
-        .filter(|t| t.test == validation::names::SKIPPED)
-        .collect();
     if let Some(first) = skipped.first() {
         println!(
-            "skipped    {} cases where the sampler does not apply, e.g. {} | {}: {}",
-            skipped.len(),
+            "skipped    {} where the sampler does not apply, e.g. {} | {}: {}",
+            count(skipped.len(), "case", "cases"),
             first.sampler,
             first.brdf,
-            first.detail
+            why(first)
         );
     }
     for t in failed.iter().take(20) {
@@ -156,7 +158,17 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
             );
         }
     }
-    if report.passed() {
+    if run == 0 {
+        println!("result     NO TEST RAN");
+        let reason = skipped.first().map_or_else(
+            || "no case matched the selection".to_string(),
+            |t| format!("{} | {}: {}", t.sampler, t.brdf, why(t)),
+        );
+        Err(CliError::NothingTested(format!(
+            "no test ran: {} skipped ({reason})",
+            count(skipped.len(), "case", "cases")
+        )))
+    } else if report.passed() {
         println!("result     PASSED");
         Ok(())
     } else {
@@ -164,4 +176,9 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
             "validation failed (see the lines above)".to_string(),
         ))
     }
+}
+
+/// The reason of a skipped case (its detail without the `skipped: ` prefix).
+fn why(t: &validation::TestRecord) -> &str {
+    t.detail.strip_prefix("skipped: ").unwrap_or(&t.detail)
 }

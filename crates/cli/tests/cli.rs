@@ -1,4 +1,4 @@
-//! End-to-end tests of the `brdf-lab` binary: the CLI contract of design.md §5 (columns, pdf
+//! End-to-end tests of the `brdf-lab` binary: the CLI contract of the README (columns, pdf
 //! conventions, exit codes, one-line errors, atomic outputs).
 
 use std::path::Path;
@@ -74,8 +74,8 @@ fn bad_inputs_exit_2_with_one_line() {
     );
     assert_input_error(&["envmap", "-n", "10", "--map", "map.png"], "map.png");
     assert_usage_error(&["envmap", "-n", "0"], "--samples");
-    assert_input_error(&["envmap", "-n", "10", "--n-max", "0.5"], "--n-max");
-    assert_input_error(&["envmap", "-n", "10", "--n-max", "NaN"], "--n-max");
+    assert_usage_error(&["envmap", "-n", "10", "--n-max", "0.5"], "--n-max");
+    assert_usage_error(&["envmap", "-n", "10", "--n-max", "NaN"], "--n-max");
     assert_input_error(
         &[
             "sample",
@@ -112,9 +112,9 @@ fn bad_inputs_exit_2_with_one_line() {
         ],
         "nosuchmodel",
     );
-    assert_input_error(
+    assert_usage_error(
         &["sample", "--brdf", "lambert", "--theta-o", "95", "-n", "10"],
-        "--theta-o",
+        "[0, 90)",
     );
     assert_input_error(
         &[
@@ -159,12 +159,12 @@ fn bad_inputs_exit_2_with_one_line() {
             value,
         ]
     };
-    assert_input_error(
+    assert_usage_error(
         &lobe("--lobe-exponent=-1", "--lobe-slices=4"),
         "[0, 1000000]",
     );
-    assert_input_error(&lobe("--lobe-exponent", "NaN"), "--lobe-exponent");
-    assert_input_error(&lobe("--lobe-slices", "0"), "[1, 1024]");
+    assert_usage_error(&lobe("--lobe-exponent", "NaN"), "--lobe-exponent");
+    assert_usage_error(&lobe("--lobe-slices", "0"), "1 ..= 1024");
     assert_input_error(
         &[
             "sample",
@@ -373,21 +373,24 @@ fn eval_normalises_directions_once_for_f_and_every_pdf() {
     .expect("write");
     for sampler in ["adaptive", "adaptive-paper", "cosine", "uniform"] {
         let out = dir.path().join(format!("{sampler}.csv"));
-        let o = brdf_lab(&[
+        let mut args = vec![
             "eval",
             "--brdf",
             "phong:n=50",
             "--theta-o",
             "45",
-            "--slices",
-            "9",
             "--sampler",
             sampler,
             "--dirs",
             dirs.to_str().expect("p"),
             "--out",
             out.to_str().expect("p"),
-        ]);
+        ];
+        // `--slices` configures the adaptive sets only (refused with the others).
+        if sampler.starts_with("adaptive") {
+            args.extend(["--slices", "9"]);
+        }
+        let o = brdf_lab(&args);
         assert!(o.status.success(), "{}", stderr(&o));
         let (header, rows) = read_csv(&out);
         assert_eq!(header, "x,y,z,f,pdf");
@@ -761,12 +764,16 @@ fn long_runs_print_progress_lines_when_stderr_is_not_a_terminal() {
         .filter(|l| l.starts_with("building: "))
         .collect();
     assert!(!lines.is_empty(), "{err}");
+    // Before the build reports its slice count (on a loaded machine a line can come first),
+    // a line says `building: 0 done, 0 s elapsed`; then `building: 12/90 (13 %), 1 s elapsed`.
     for l in &lines {
         assert!(
-            l.ends_with("s elapsed") && l.contains('/') && l.contains(" %)"),
+            l.ends_with("s elapsed")
+                && (l.contains('/') && l.contains(" %)") || l.contains(" done, ")),
             "{l}"
         );
     }
+    assert!(lines.iter().any(|l| l.contains(" %)")), "{err}");
     // Stdout keeps only the report.
     assert!(!String::from_utf8_lossy(&o.stdout).contains("building:"));
 }
@@ -946,4 +953,446 @@ fn list_into_a_closed_pipe_ends_quietly() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "exit {:?}: {err}", out.status);
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// A numeric value out of its range: clap's usage error naming the option, the value and the
+/// range (exit 2), never a clamp, a run or "unexpected argument".
+fn assert_out_of_range(args: &[&str], flag: &str, range: &str) {
+    let o = brdf_lab(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.contains("invalid value") && err.contains(flag) && err.contains(range),
+        "{args:?}: `{flag}`, `{range}` not in {err}"
+    );
+    assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    assert!(
+        o.stdout.is_empty(),
+        "{args:?} ran: {}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+}
+
+#[test]
+fn numeric_options_are_range_checked_by_name() {
+    let sample = |extra: &[&'static str]| {
+        let mut a = vec!["sample", "--brdf", "lambert", "--theta-o", "30", "-n", "5"];
+        a.extend_from_slice(extra);
+        a
+    };
+    assert_out_of_range(
+        &["sample", "--brdf", "lambert", "--theta-o", "30", "-n", "-5"],
+        "--samples",
+        "must be an integer in 1 ..= 1000000000",
+    );
+    assert_out_of_range(
+        &["envmap", "-n", "-5"],
+        "--samples",
+        "must be an integer ≥ 1",
+    );
+    for phi in ["1e308", "NaN", "inf", "-inf", "400"] {
+        assert_out_of_range(&sample(&["--phi-o", phi]), "--phi-o", "[-360, 360]");
+    }
+    for theta in ["90", "-1", "NaN", "inf"] {
+        assert_out_of_range(
+            &["sample", "--brdf", "lambert", "--theta-o", theta, "-n", "5"],
+            "--theta-o",
+            "[0, 90)",
+        );
+    }
+    assert_out_of_range(
+        &sample(&["--seed", "-1"]),
+        "--seed",
+        "0 ..= 18446744073709551615",
+    );
+    assert_out_of_range(&sample(&["--n-max", "NaN"]), "--n-max", "≥ 1");
+    assert_out_of_range(
+        &sample(&["--equal-area-from", "inf"]),
+        "--equal-area-from",
+        "[0, 90]",
+    );
+    assert_out_of_range(&sample(&["--slices", "0"]), "--slices", "1 ..= 4096");
+    assert_out_of_range(&sample(&["--max-depth", "-1"]), "--max-depth", "0 ..= ");
+    assert_out_of_range(
+        &sample(&["--sampler", "cascade-cdf", "--epsilon", "NaN"]),
+        "--epsilon",
+        "(0, 1)",
+    );
+    assert_out_of_range(
+        &sample(&["--sampler", "factored", "--factored-alpha", "2"]),
+        "--factored-alpha",
+        "[0, 1]",
+    );
+    assert_out_of_range(
+        &sample(&["--sampler", "factored", "--factored-j", "-3"]),
+        "--factored-j",
+        "1 ..= 16",
+    );
+    assert_out_of_range(
+        &["validate", "--quick", "--alpha", "0"],
+        "--alpha",
+        "(0, 1)",
+    );
+    assert_out_of_range(
+        &["validate", "--quick", "--theta-o", "NaN"],
+        "--theta-o",
+        "[0, 90)",
+    );
+    assert_out_of_range(
+        &["validate", "--quick", "--samples", "10"],
+        "--samples",
+        "≥ 2000",
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("o");
+    let out_s = out.to_str().expect("path");
+    // `study --spp 0` ran at 1 spp and exited 0; now refused before any work.
+    assert_out_of_range(
+        &["study", "--spp", "0", "--out", out_s],
+        "--spp",
+        "1 ..= 65536",
+    );
+    assert_out_of_range(
+        &["study", "merge", "x", "--spp", "-4", "--out", out_s],
+        "--spp",
+        "1 ..= 65536",
+    );
+    assert_out_of_range(
+        &["study", "--repetitions", "1", "--out", out_s],
+        "--repetitions",
+        "≥ 2",
+    );
+    assert_out_of_range(
+        &["study", "--n-grid", "-1,4", "--out", out_s],
+        "--n-grid",
+        "≥ 1",
+    );
+    assert!(!out.exists());
+    // The srbf options keep the library's one-line reason (`product` relies on it).
+    assert_input_error(
+        &sample(&["--sampler", "srbf", "--srbf-max-iter", "0"]),
+        "--srbf-max-iter 0",
+    );
+}
+
+#[test]
+fn sampler_options_are_refused_where_they_do_nothing() {
+    let base = ["sample", "--brdf", "phong", "--theta-o", "30", "-n", "5"];
+    let with = |extra: &[&'static str]| {
+        let mut a = base.to_vec();
+        a.extend_from_slice(extra);
+        a
+    };
+    assert_input_error(
+        &with(&["--epsilon", "0.01"]),
+        "--epsilon applies to sampler cascade-cdf, not adaptive",
+    );
+    assert_input_error(
+        &with(&["--sampler", "tabulated-cdf", "--epsilon", "0.01"]),
+        "--epsilon applies to sampler cascade-cdf, not tabulated-cdf",
+    );
+    assert_input_error(
+        &with(&["--sampler", "cosine", "--factored-j", "2"]),
+        "--factored-j applies to sampler factored, not cosine",
+    );
+    assert_input_error(
+        &with(&["--sampler", "cosine", "--n-max", "2"]),
+        "--n-max applies to samplers adaptive, adaptive-paper",
+    );
+    assert_input_error(
+        &with(&["--sampler", "lobe-sphere", "--cdf-slices", "4"]),
+        "--cdf-slices applies to samplers tabulated-cdf, cascade-cdf, not lobe-sphere",
+    );
+    assert_input_error(
+        &[
+            "build",
+            "--brdf",
+            "phong",
+            "--sampler",
+            "srbf",
+            "--lobe-slices",
+            "4",
+        ],
+        "--lobe-slices applies to samplers lobe-sphere, lobe-hemisphere, not srbf",
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    std::fs::write(&dirs, "0,0,1\n").expect("write");
+    assert_input_error(
+        &[
+            "eval",
+            "--brdf",
+            "phong",
+            "--theta-o",
+            "30",
+            "--dirs",
+            dirs.to_str().expect("path"),
+            "--srbf-lobes",
+            "3",
+        ],
+        "--srbf-lobes applies to sampler srbf, not none (no --sampler given)",
+    );
+    // The product-only options are not options of sample, eval or build.
+    assert_usage_error(&with(&["--srbf-keep", "3"]), "--srbf-keep");
+    for cmd in ["sample", "eval", "build"] {
+        let help = String::from_utf8_lossy(&brdf_lab(&[cmd, "--help"]).stdout).to_string();
+        for product_only in [
+            "--srbf-keep",
+            "--srbf-map-lobes",
+            "--srbf-defensive ",
+            "--srbf-map-fit-width",
+        ] {
+            assert!(
+                !help.contains(product_only),
+                "{cmd} --help lists {product_only}"
+            );
+        }
+        assert!(
+            help.contains("--srbf-lobes") && help.contains("--epsilon"),
+            "{help}"
+        );
+    }
+    let help = String::from_utf8_lossy(&brdf_lab(&["product", "--help"]).stdout).to_string();
+    assert!(
+        help.contains("--srbf-keep") && help.contains("--srbf-map-lobes"),
+        "{help}"
+    );
+    // An option given with the sampler it configures is accepted.
+    let o = brdf_lab(&with(&[
+        "--sampler",
+        "cascade-cdf",
+        "--epsilon",
+        "0.01",
+        "--cdf-slices",
+        "2",
+        "--cdf-grid",
+        "16x32",
+    ]));
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn every_built_sampler_reports_time_memory_and_its_fit() {
+    for (sampler, extra, fit) in [
+        (
+            "tabulated-cdf",
+            vec!["--cdf-slices", "2", "--cdf-grid", "16x32"],
+            "CDF points stored",
+        ),
+        ("lobe-sphere", vec!["--lobe-slices", "4"], "exponent n in ["),
+        (
+            "factored",
+            vec!["--factored-grid", "4,4,8,4", "--factored-iterations", "50"],
+            "relative error",
+        ),
+        (
+            "srbf",
+            vec!["--srbf-slices", "2", "--srbf-fit-rows", "8"],
+            "fit rel. L2 mean",
+        ),
+    ] {
+        let mut args = vec!["build", "--brdf", "phong:n=20", "--sampler", sampler];
+        args.extend(extra);
+        let o = brdf_lab(&args);
+        assert!(o.status.success(), "{sampler}: {}", stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("sampler "))
+            .unwrap_or_else(|| panic!("{sampler}: no sampler line in {out}"));
+        assert!(
+            line.contains(&format!("{sampler} built in")) && line.contains(" bytes"),
+            "{sampler}: {line}"
+        );
+        assert!(out.contains(fit), "{sampler}: `{fit}` not in {out}");
+    }
+}
+
+#[test]
+fn srbf_fits_at_the_iteration_cap_are_warned_about_everywhere() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let dirs = dir.path().join("d.csv");
+    std::fs::write(&dirs, "0,0,1\n").expect("write");
+    let capped = [
+        "--sampler",
+        "srbf",
+        "--srbf-slices",
+        "2",
+        "--srbf-max-iter",
+        "1",
+    ];
+    let warning = "brdf-lab: warning: --sampler srbf: 2 of 2 BRDF slice fits hit the L-BFGS cap";
+    let runs: [Vec<&str>; 3] = [
+        vec!["build", "--brdf", "phong:n=200"],
+        vec![
+            "sample",
+            "--brdf",
+            "phong:n=200",
+            "--theta-o",
+            "30",
+            "-n",
+            "10",
+            "--out",
+            "/dev/null",
+        ],
+        vec![
+            "eval",
+            "--brdf",
+            "phong:n=200",
+            "--theta-o",
+            "30",
+            "--dirs",
+            dirs.to_str().expect("path"),
+            "--out",
+            "/dev/null",
+        ],
+    ];
+    for mut args in runs {
+        args.extend(capped);
+        let o = brdf_lab(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(warning), "{args:?}: {}", stderr(&o));
+    }
+    // Converged fits (a cap high enough for lambert's two slices): no warning.
+    let o = brdf_lab(&[
+        "build",
+        "--brdf",
+        "lambert",
+        "--sampler",
+        "srbf",
+        "--srbf-slices",
+        "2",
+        "--srbf-max-iter",
+        "1000",
+    ]);
+    assert!(
+        o.status.success() && !stderr(&o).contains("warning"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn validate_that_runs_no_test_does_not_pass() {
+    // Every case skipped: no PASSED, exit 3 with the reason.
+    let o = brdf_lab(&[
+        "validate",
+        "--quick",
+        "--sampler",
+        "analytic",
+        "--brdf",
+        "oren-nayar",
+        "--theta-o",
+        "30",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(3), "{out}{err}");
+    assert!(!out.contains("PASSED"), "{out}");
+    assert!(
+        out.contains("0 tests (1 case skipped)") && out.contains("NO TEST RAN"),
+        "{out}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("no test ran: 1 case skipped (analytic | oren-nayar: BRDF model `oren-nayar` has no analytic sampler"),
+        "{err}"
+    );
+    // Partly skipped: the run passes and says how many cases were skipped.
+    let o = brdf_lab(&[
+        "validate",
+        "--quick",
+        "--sampler",
+        "analytic",
+        "--brdf",
+        "oren-nayar",
+        "--brdf",
+        "lambert",
+        "--theta-o",
+        "30",
+        "--samples",
+        "2000",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert_eq!(o.status.code(), Some(0), "{out}{}", stderr(&o));
+    assert!(
+        out.contains("(1 case skipped)") && out.contains("result     PASSED"),
+        "{out}"
+    );
+}
+
+#[test]
+fn help_texts_point_inside_the_repository() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for cmd in [
+        "list", "sample", "eval", "build", "validate", "envmap", "study", "product",
+    ] {
+        let help = String::from_utf8_lossy(&brdf_lab(&[cmd, "--help"]).stdout).to_string();
+        assert!(!help.is_empty(), "{cmd}");
+        assert!(
+            !help.contains("design.md") && !help.contains("../shared/docs"),
+            "{cmd}: {help}"
+        );
+        for doc in help.split_whitespace().filter(|w| w.contains("docs/")) {
+            let doc = doc.trim_matches(|c: char| !(c.is_alphanumeric() || "/._-".contains(c)));
+            assert!(
+                root.join(doc).is_file(),
+                "{cmd} --help points to {doc}, not in the repository"
+            );
+        }
+    }
+    let help = String::from_utf8_lossy(&brdf_lab(&["validate", "--help"]).stdout).to_string();
+    assert!(help.contains("docs/validation.md"), "{help}");
+}
+
+#[test]
+fn paths_counts_and_nouns_are_printed_as_a_reader_expects() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    std::fs::create_dir(dir.path().join("sub")).expect("mkdir");
+    let o = Command::new(env!("CARGO_BIN_EXE_brdf-lab"))
+        .current_dir(dir.path())
+        .env("RAYON_NUM_THREADS", "1")
+        .args([
+            "sample",
+            "--brdf",
+            "lambert",
+            "--theta-o",
+            "30",
+            "-n",
+            "1",
+            "--sampler",
+            "cosine",
+            "--out",
+            "sub/.././sub/../s.csv",
+        ])
+        .output()
+        .expect("run brdf-lab");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("on 1 thread)"), "{err}");
+    assert!(err.contains("wrote      s.csv (1 row: x,y,z,pdf)"), "{err}");
+    assert!(dir.path().join("s.csv").is_file());
+    // A path outside the working directory: absolute and canonical, without `..`.
+    let o = brdf_lab(&[
+        "sample",
+        "--brdf",
+        "lambert",
+        "--theta-o",
+        "30",
+        "-n",
+        "2",
+        "--sampler",
+        "cosine",
+        "--out",
+        dir.path().join("sub/../t.csv").to_str().expect("path"),
+    ]);
+    let err = stderr(&o);
+    let canonical = std::fs::canonicalize(dir.path())
+        .expect("canonical")
+        .join("t.csv");
+    assert!(
+        err.contains(&format!("wrote      {} (2 rows", canonical.display())),
+        "{err}"
+    );
+    assert!(!err.contains(".."), "{err}");
 }

@@ -72,3 +72,14 @@ fn docs_do_not_point_outside_the_repository() {
         );
     }
 }
+
+#[test]
+fn default_outputs_are_ignored_by_git() {
+    let ignore = read(".gitignore");
+    for default in ["study-out/", "/target"] {
+        assert!(
+            ignore.lines().any(|l| l.trim() == default),
+            ".gitignore lacks {default}"
+        );
+    }
+}

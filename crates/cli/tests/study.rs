@@ -84,6 +84,9 @@ fn a_study_writes_its_outputs_and_shards_merge_to_the_same_numbers() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let merged = dir.path().join("merged");
+    // An existing output directory: its other files are kept, no temporary directory is left.
+    std::fs::create_dir(&merged).expect("mkdir");
+    std::fs::write(merged.join("keep.txt"), "mine").expect("write");
     let mut args = vec!["study", "merge"];
     let names: Vec<String> = shards.iter().map(|s| s.display().to_string()).collect();
     args.extend(names.iter().map(String::as_str));
@@ -93,10 +96,52 @@ fn a_study_writes_its_outputs_and_shards_merge_to_the_same_numbers() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(numbers(&merged), numbers(&whole));
     assert!(merged.join("images/reference.png").is_file());
-    // A missing shard is refused.
-    let o = brdf_lab(&["study", "merge", &names[0], &names[1], "--out", &merged_str]);
+    assert!(merged.join("keep.txt").is_file());
+    for d in [dir.path(), merged.as_path(), whole.as_path()] {
+        let stray: Vec<_> = std::fs::read_dir(d)
+            .expect("dir")
+            .flatten()
+            .filter(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .starts_with(".brdf-lab-study-")
+            })
+            .collect();
+        assert!(stray.is_empty(), "{stray:?}");
+    }
+    // A missing shard is refused, and leaves no output directory.
+    let partial = dir.path().join("partial").display().to_string();
+    let o = brdf_lab(&["study", "merge", &names[0], &names[1], "--out", &partial]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing shards: 3/3"));
+    assert!(
+        !Path::new(&partial).exists(),
+        "a failed merge left {partial}"
+    );
+}
+
+#[test]
+fn a_failed_merge_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x");
+    let o = brdf_lab(&[
+        "study",
+        "merge",
+        dir.path().join("nonexist").to_str().expect("path"),
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("nonexist/results.json"), "{err}");
+    assert!(!out.exists(), "a failed merge created {}", out.display());
+    // Nor a temporary directory beside it.
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .flatten()
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }
 
 #[test]

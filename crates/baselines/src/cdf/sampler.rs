@@ -313,4 +313,9 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
     fn bytes_used(&self) -> usize {
         self.report.bytes
     }
+
+    /// [`CdfReport::summary`]: layout, grid, build time, memory and compression.
+    fn build_report(&self) -> Option<String> {
+        Some(self.report.summary())
+    }
 }

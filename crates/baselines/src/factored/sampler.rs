@@ -220,6 +220,18 @@ impl DirectionSampler for FactoredSampler {
             + self.theta_p.measure.len();
         std::mem::size_of::<Self>() + floats * std::mem::size_of::<f64>()
     }
+
+    /// [`FactoredReport`]'s lines (fit, convergence, time, memory), and a line `warning: …`
+    /// when a factorisation stopped at its iteration cap.
+    fn build_report(&self) -> Option<String> {
+        let mut s = self.report.to_string();
+        if !self.report.converged() {
+            s.push_str(
+                "\nwarning: factored: a factorisation hit its iteration cap (--factored-iterations) before the tolerance; the residuals above are not converged",
+            );
+        }
+        Some(s)
+    }
 }
 
 #[cfg(test)]

@@ -267,6 +267,31 @@ impl DirectionSampler for LobeSampler {
         std::mem::size_of::<Self>() + self.fits.len() * std::mem::size_of::<LobeFit>()
     }
 
+    /// The fitted exponents and cosine weights over the slices (the fit), and the memory.
+    fn build_report(&self) -> Option<String> {
+        let range = |f: fn(&LobeFit) -> f64| {
+            self.fits
+                .iter()
+                .map(f)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x), hi.max(x))
+                })
+        };
+        let (n_lo, n_hi) = range(|f| f.exponent);
+        let (w_lo, w_hi) = range(|f| f.defensive);
+        Some(format!(
+            "lobe       {} slices ({} θo × {} φo), {}; exponent n in [{n_lo:.4}, {n_hi:.4}], cosine weight in [{w_lo:.3}, {w_hi:.3}]; {} bytes",
+            self.fits.len(),
+            self.theta_slices,
+            self.phi_slices,
+            match self.support {
+                LobeSupport::Sphere => "on the sphere",
+                LobeSupport::Hemisphere => "truncated to the hemisphere",
+            },
+            self.bytes_used()
+        ))
+    }
+
     /// The mirror direction, where the lobe `max(0, ω_r·ωi)^n` peaks (narrowly for a large
     /// fitted exponent `n`: width `≈ 1/√n`).
     fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {

@@ -150,6 +150,19 @@ pub struct SrbfReport {
     pub bytes: usize,
 }
 
+impl SrbfReport {
+    /// `Some(message)` when slice fits hit the L-BFGS iteration cap: how many, and the
+    /// largest residual (what the command line prints as a warning).
+    pub fn lbfgs_cap_warning(&self) -> Option<String> {
+        (self.not_converged > 0).then(|| {
+            format!(
+                "{} of {} BRDF slice fits hit the L-BFGS cap (--srbf-max-iter); largest residual (rel. L2) {:.3e}",
+                self.not_converged, self.slices, self.max_rel_l2
+            )
+        })
+    }
+}
+
 /// The `srbf` sampler (see the module docs). Immutable and `Sync` once built.
 #[derive(Debug, Clone)]
 pub struct SrbfSampler {
@@ -370,6 +383,29 @@ impl DirectionSampler for SrbfSampler {
                 .map(SliceMixture::bytes_used)
                 .sum::<usize>()
             + self.fits.capacity() * std::mem::size_of::<FitReport>()
+    }
+
+    /// The fits' quality and cost, and a line `warning: …` ([`SrbfReport::lbfgs_cap_warning`])
+    /// when some slice fits hit the L-BFGS iteration cap (the command line prints such lines
+    /// as warnings).
+    fn build_report(&self) -> Option<String> {
+        let r = &self.report;
+        let mut s = format!(
+            "srbf       {} slices, {} lobes; fit rel. L2 mean {:.3e} max {:.3e}, rel. L1 mean {:.3e}; {} black slices; built in {:.3} s, {} bytes",
+            r.slices,
+            r.lobes,
+            r.mean_rel_l2,
+            r.max_rel_l2,
+            r.mean_rel_l1,
+            r.black_slices,
+            r.seconds,
+            r.bytes
+        );
+        if let Some(w) = r.lbfgs_cap_warning() {
+            s.push_str("\nwarning: ");
+            s.push_str(&w);
+        }
+        Some(s)
     }
 }
 

@@ -4,12 +4,15 @@ use baselines::{CdfOptions, CdfOptionsError};
 use clap::Args;
 
 use crate::error::{CliError, CliResult};
+use crate::values::{End, int, real};
 
 /// Flags of the tabulated and cascade CDFs (`tabulated-cdf`, `cascade-cdf`).
 #[derive(Debug, Args, Clone)]
+#[command(next_help_heading = "Options of the tabulated-cdf and cascade-cdf samplers")]
 pub(crate) struct CdfArgs {
     /// CDF baselines: outgoing θ slices of an isotropic BRDF (1 ..= 1024).
-    #[arg(long, default_value_t = CdfOptions::DEFAULT_SLICES)]
+    #[arg(long, default_value_t = CdfOptions::DEFAULT_SLICES,
+          value_parser = int(1, CdfOptions::MAX_SLICES), allow_negative_numbers = true)]
     pub(crate) cdf_slices: usize,
     /// CDF baselines: outgoing slices THETAxPHI of an anisotropic BRDF (each 1 ..= 1024).
     #[arg(long, value_name = "THETAxPHI", value_parser = parse_pair,
@@ -20,10 +23,12 @@ pub(crate) struct CdfArgs {
           default_value_t = Pair([CdfOptions::DEFAULT_N_Z, CdfOptions::DEFAULT_N_PHI]))]
     pub(crate) cdf_grid: Pair,
     /// CDF baselines: BRDF evaluations per cell and axis (1 ..= 16).
-    #[arg(long, default_value_t = CdfOptions::DEFAULT_SUPERSAMPLING)]
+    #[arg(long, default_value_t = CdfOptions::DEFAULT_SUPERSAMPLING,
+          value_parser = int(1, CdfOptions::MAX_SUPERSAMPLING), allow_negative_numbers = true)]
     pub(crate) cdf_supersampling: usize,
     /// cascade-cdf: Douglas–Peucker tolerance ε in CDF units, in (0, 1).
-    #[arg(long, default_value_t = CdfOptions::DEFAULT_EPSILON)]
+    #[arg(long, default_value_t = CdfOptions::DEFAULT_EPSILON,
+          value_parser = real(End::Open(0.0), End::Open(1.0)), allow_hyphen_values = true)]
     pub(crate) epsilon: f64,
 }
 

@@ -4,16 +4,18 @@ use baselines::{FactoredOptions, NmfCost, Reparam};
 use clap::{Args, ValueEnum};
 
 use crate::error::{CliError, CliResult};
+use crate::values::{End, int, real, seed};
 
 /// Flags of the Lawrence 2004 factorisation (`--sampler factored`); unset flags keep
 /// `FactoredOptions`' defaults.
 #[derive(Debug, Args, Clone, Default)]
+#[command(next_help_heading = "Options of the factored sampler")]
 pub(crate) struct FactoredArgs {
     /// Factored: outer terms J, in 1..=16 (default 3).
-    #[arg(long = "factored-j", value_name = "J")]
+    #[arg(long = "factored-j", value_name = "J", value_parser = int(FactoredOptions::TERMS_RANGE.0, FactoredOptions::TERMS_RANGE.1), allow_negative_numbers = true)]
     factored_j: Option<usize>,
     /// Factored: inner terms K per outer term, in 1..=16 (default 2).
-    #[arg(long = "factored-k", value_name = "K")]
+    #[arg(long = "factored-k", value_name = "K", value_parser = int(FactoredOptions::TERMS_RANGE.0, FactoredOptions::TERMS_RANGE.1), allow_negative_numbers = true)]
     factored_k: Option<usize>,
     /// Factored: NMF cost (default euclidean).
     #[arg(long = "factored-cost", value_enum)]
@@ -25,17 +27,17 @@ pub(crate) struct FactoredArgs {
     #[arg(long = "factored-grid", value_name = "THO,PHO,THP,PHP", value_parser = parse_grid)]
     factored_grid: Option<[usize; 4]>,
     /// Factored: iteration cap of each factorisation, in 1..=1000000 (default 2000).
-    #[arg(long = "factored-iterations", value_name = "N")]
+    #[arg(long = "factored-iterations", value_name = "N", value_parser = int(FactoredOptions::MAX_ITERATIONS_RANGE.0, FactoredOptions::MAX_ITERATIONS_RANGE.1), allow_negative_numbers = true)]
     factored_iterations: Option<usize>,
     /// Factored: stop at this relative cost change, in (0, 1) (default 1e-6).
-    #[arg(long = "factored-tolerance", value_name = "TOL")]
+    #[arg(long = "factored-tolerance", value_name = "TOL", value_parser = real(End::Open(0.0), End::Open(1.0)), allow_hyphen_values = true)]
     factored_tolerance: Option<f64>,
     /// Factored: seed of the initial factors (default 2004).
-    #[arg(long = "factored-seed", value_name = "S")]
+    #[arg(long = "factored-seed", value_name = "S", value_parser = seed, allow_negative_numbers = true)]
     factored_seed: Option<u64>,
     /// Factored: weight α of the defensive cosine component, in [0, 1] (default 0.05; 0 is
     /// the paper-pure sampler, which may leave support holes).
-    #[arg(long = "factored-alpha", value_name = "ALPHA")]
+    #[arg(long = "factored-alpha", value_name = "ALPHA", value_parser = real(End::Closed(0.0), End::Closed(1.0)), allow_hyphen_values = true)]
     factored_alpha: Option<f64>,
     /// Factored: tabulate θo × φo rows even for isotropic BRDFs (default: θo only, turned by φo).
     #[arg(long = "factored-full-rows")]

@@ -4,16 +4,20 @@ use baselines::LobeOptions;
 use clap::Args;
 
 use crate::error::{CliError, CliResult};
+use crate::values::{End, int, real};
 
 /// Flags of the cosine-lobe and analytic samplers.
 #[derive(Debug, Args, Clone, Default)]
+#[command(next_help_heading = "Options of the lobe-sphere and lobe-hemisphere samplers")]
 pub(crate) struct LobeArgs {
     /// Fixed exponent of the lobe-sphere / lobe-hemisphere samplers, in [0, 1e6] (default:
     /// fitted per outgoing slice by minimising the estimator's second moment).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true,
+          value_parser = real(End::Closed(0.0), End::Closed(LobeOptions::MAX_EXPONENT)))]
     pub(crate) lobe_exponent: Option<f64>,
     /// Number of outgoing θo slices of the lobe fit, in [1, 1024] (default 16).
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true,
+          value_parser = int(1, LobeOptions::MAX_SLICES))]
     pub(crate) lobe_slices: Option<usize>,
 }
 
