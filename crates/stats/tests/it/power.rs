@@ -2,7 +2,7 @@
 //!
 //! Fixed seeds; significance level α = 0.01 per test unless stated.
 
-mod common;
+use crate::common;
 
 use common::*;
 use stats::{

@@ -1,7 +1,7 @@
 //! Batch allocation: Σ n_i = N always (proptest), E[n_i] = N p_i for the randomised remainder
 //! (z-tests with Bonferroni correction, α = 0.01) and the documented bias of Hamilton's split.
 
-mod common;
+use crate::common;
 
 use common::ALPHA;
 use partition_sampler::{AllocationMode, UniformSequence, allocate, stratum_weights};

@@ -2,7 +2,7 @@
 //! project's shared data beside the repository, which has no licence to be copied into it) at
 //! θo = 45°, for every direction sampler that applies to it at a CI-sized cost: the adaptive
 //! sets (`adaptive`, `adaptive-mixture`) and the baselines (`uniform`, `cosine`, the two cosine
-//! lobes, `tabulated-cdf`, `cascade-cdf`, `factored`, `srbf`); 105 tests, ≈ 150 s wall on 2
+//! lobes, `tabulated-cdf`, `cascade-cdf`, `factored`, `srbf`); 105 tests, ≈ 150 s wall (299 CPU-s) on 2
 //! cores, most of it the adaptive sets' builds on the interpolant.
 //! Left out, with the figures in docs/validation.md: `adaptive-paper` (normalisation 1.6e-3
 //! against the tier's 1e-3: its leaf probabilities need per-leaf integrals that the leaf
@@ -12,6 +12,12 @@
 //! the interpolant peaks between grid points), `adaptive-exact` (28 s build, normaliser error
 //! 6e-3 on it); `analytic` and `rgl-native` do not apply (no model sampler, not an RGL file).
 //! Without the shared data (a user's clone) the test says so and does nothing; CI has it.
+//!
+//! Not in the README's test command: CI runs the same configuration with the binary the tests
+//! built (`brdf-lab validate --quick --theta-o 45 --brdf cornell:… --sampler …` in `.ci/run`,
+//! the ten samplers below); run this test with `cargo test --release -p validation --test it
+//! quick_cornell -- --ignored` (docs/validation.md, "What the test command runs and what moved
+//! to validate runs").
 
 use validation::{QUICK_CORNELL, ValidateConfig, run};
 
@@ -30,10 +36,7 @@ const SAMPLERS: [&str; 10] = [
 ];
 
 #[test]
-#[cfg_attr(
-    debug_assertions,
-    ignore = "heavy: run with `cargo test --release` (CI does)"
-)]
+#[ignore = "≈ 300 CPU-s: CI runs it as `brdf-lab validate` (.ci/run); run with --release -- --ignored"]
 fn quick_tier_cornell_material_passes_for_every_applicable_sampler() {
     let path = QUICK_CORNELL.trim_start_matches("cornell:");
     if !std::path::Path::new(path).is_file() {

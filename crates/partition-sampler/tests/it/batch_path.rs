@@ -3,7 +3,7 @@
 //! count the same trials, violations and exhausted samples — on identity and mapped frames,
 //! with wrong bounds and with samples abandoned at the trial cap.
 
-mod common;
+use crate::common;
 
 use common::*;
 use partition_sampler::{

@@ -1,11 +1,11 @@
 //! False-rejection rates of the tests on correct samplers.
 //!
 //! The quick test runs in CI with few seeds and a wide tolerance; the `#[ignore]`d ones are
-//! the real calibration (run with `cargo test -p stats --release --test calibration -- --ignored
+//! the real calibration (run with `cargo test -p stats --release --test it calibration -- --ignored
 //! --nocapture`), checking that the observed rejection rate is consistent with the nominal
 //! level (two-sided binomial p-value > 1e-3) and that the p-values look uniform.
 
-mod common;
+use crate::common;
 
 use common::*;
 use stats::{

@@ -1,6 +1,6 @@
 //! KS p-values against reference values, independent exact formulas, statrs, and simulation.
 
-mod common;
+use crate::common;
 
 use common::*;
 use statrs::distribution::Uniform;

@@ -1,7 +1,7 @@
 //! Goodness of fit of the samples against independently computed bin masses
 //! (α = 0.01, fixed seeds), for both schemes and both leaf choices.
 
-mod common;
+use crate::common;
 
 use common::*;
 use partition_sampler::{

@@ -1,6 +1,6 @@
 //! Accuracy of the bin quadrature against analytic bin masses, and its determinism.
 
-mod common;
+use crate::common;
 
 use common::*;
 use stats::{

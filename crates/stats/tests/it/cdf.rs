@@ -1,6 +1,6 @@
 //! Tabulated projection CDFs against closed forms.
 
-mod common;
+use crate::common;
 
 use common::*;
 use stats::{

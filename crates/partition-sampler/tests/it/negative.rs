@@ -2,7 +2,7 @@
 //! (α = 0.01, fixed seeds). Also shows the envelope scheme staying exact where the papers'
 //! scheme is biased by wrong integrals.
 
-mod common;
+use crate::common;
 
 use common::*;
 use partition_sampler::{
