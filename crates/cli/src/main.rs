@@ -4,6 +4,7 @@
 //! 3 `validate` ran no test (every case skipped).
 
 mod baseline_args;
+mod bench_cmd;
 mod brdf_args;
 mod build_cmd;
 mod envmap_cmd;
@@ -47,6 +48,8 @@ enum Command {
     Study(study_cmd::StudyArgs),
     /// Reflected radiance under an environment map: SRBF product, BRDF, light and MIS estimators.
     Product(product_cmd::ProductArgs),
+    /// Time per sample (with the estimator's f) and BRDF evaluations per sample of several samplers.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() {
@@ -73,6 +76,7 @@ fn main() {
         Command::Envmap(args) => envmap_cmd::run(&args),
         Command::Study(args) => study_cmd::run(&args),
         Command::Product(args) => product_cmd::run(&args),
+        Command::Bench(args) => bench_cmd::run(&args),
     };
     if let Err(e) = result {
         report_and_exit(&e);

@@ -1,0 +1,466 @@
+//! `brdf-lab bench`: the cost of one sample, as an estimator pays it, for several samplers of
+//! one BRDF in one run — "which sampler is fastest for my material".
+//!
+//! One sample is `sample(ωo, u) -> (ωi, pdf)` **plus the one evaluation `f_r(ωo, ωi)`** the
+//! estimator `f cos / pdf` needs. Queries are either one fixed `ωo` (`--theta-o/--phi-o`) or a
+//! fresh `ωo` per query (`--queries random`: uniform in solid angle over θo ∈ [0°, 89°], as
+//! when ωo changes from pixel to pixel). Samples are split into fixed chunks, each with its own
+//! generator seeded from `(seed, chunk)`, so the samples do not depend on the thread count.
+//!
+//! Wall time is measured `--repeat` times per sampler, interleaved across samplers (so a change
+//! of machine load spreads over all of them), and the median is reported with the spread.
+//! BRDF evaluations per sample (including the estimator's one) are counted in a separate,
+//! untimed pass through a counting wrapper; they do not depend on the load.
+
+use std::cell::Cell;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use brdf::{Brdf, Outgoing, Vec3};
+use brdf_sampling::DirectionSampler;
+use clap::{Args, ValueEnum};
+use partition_sampler::chunk_seed;
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::brdf_args::{self, SetArgs};
+use crate::error::{CliError, CliResult};
+use crate::output::write_atomically;
+use crate::progress;
+
+/// Samples per independently seeded chunk.
+const CHUNK: usize = 4096;
+
+/// Largest θo of a random query, degrees (grazing, but not at the horizon).
+const RANDOM_THETA_MAX_DEG: f64 = 89.0;
+
+/// Samples of the untimed counting pass (at most).
+const COUNT_SAMPLES: usize = 200_000;
+
+/// How the outgoing directions of the queries are chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum Queries {
+    /// One ωo for every query (`--theta-o`, `--phi-o`).
+    Fixed,
+    /// A fresh ωo per query, uniform in solid angle over θo ∈ [0°, 89°].
+    Random,
+}
+
+/// Arguments of `brdf-lab bench`.
+#[derive(Debug, Args)]
+pub(crate) struct BenchArgs {
+    /// BRDF: `name` or `name:key=value,...` (e.g. `ggx:alpha=0.2`), `merl:PATH`, `rgl:PATH`, ….
+    #[arg(long = "brdf")]
+    spec: String,
+    /// Samplers to compare (registry names, see `brdf-lab list`); several in one run.
+    #[arg(long = "sampler", num_args = 1.., required = true)]
+    samplers: Vec<String>,
+    /// Outgoing directions: `fixed` (one ωo) or `random` (a fresh ωo per query).
+    #[arg(long, value_enum, default_value_t = Queries::Random)]
+    queries: Queries,
+    /// Outgoing polar angle θo in degrees, in [0, 90) (with `--queries fixed`).
+    #[arg(
+        long = "theta-o",
+        default_value_t = 30.0,
+        allow_negative_numbers = true
+    )]
+    theta_o: f64,
+    /// Outgoing azimuth φo in degrees, finite (with `--queries fixed`).
+    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    phi_o: f64,
+    /// Samples per timed run.
+    #[arg(short = 'n', long = "samples", default_value_t = 1_000_000,
+          value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
+    n: u64,
+    /// Timed runs per sampler (interleaved across samplers); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeat: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Also write the results as JSON (a list, one object per sampler) here, atomically.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    #[command(flatten)]
+    set: SetArgs,
+}
+
+/// One sampler's figures.
+#[derive(Debug, Clone, Serialize)]
+struct BenchRecord {
+    /// The sampler's registry name.
+    sampler: String,
+    /// Median wall time per sample (incl. the estimator's `f`), ns, on `threads` threads.
+    ns_per_sample: f64,
+    /// Fastest and slowest of the timed runs, ns per sample.
+    ns_per_sample_min: f64,
+    ns_per_sample_max: f64,
+    /// Every timed run, ns per sample, in the order run.
+    ns_per_sample_runs: Vec<f64>,
+    /// BRDF evaluations per sample, the estimator's one included (counted, not timed).
+    evals_per_sample: f64,
+    /// Samples per timed run.
+    samples: usize,
+    /// Threads of the timed runs.
+    threads: usize,
+    /// `fixed` or `random`.
+    queries: Queries,
+    /// Build time, seconds (wall).
+    build_seconds: f64,
+    /// Bytes of the sampler's precomputed structures.
+    bytes_used: usize,
+    /// Mean of `f cos / pdf` over the timed run's samples: the directional albedo (fixed ωo) or
+    /// its average over the queries' ωo; a checksum that the work was done.
+    mean_weight: f64,
+}
+
+thread_local! {
+    static EVALS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Forwards everything to the wrapped BRDF (its `prepare` too, so the sampler keeps its fast
+/// path) and counts `eval`, `eval_rgb` and `eval_prepared` calls on the calling thread.
+struct Counted(Arc<dyn Brdf>);
+
+fn count() {
+    EVALS.with(|c| c.set(c.get() + 1));
+}
+
+impl Brdf for Counted {
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        count();
+        self.0.eval(wo, wi)
+    }
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        count();
+        self.0.eval_rgb(wo, wi)
+    }
+    fn prepare(&self, wo: &Vec3) -> Outgoing {
+        self.0.prepare(wo)
+    }
+    fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+        count();
+        self.0.eval_prepared(q, wi)
+    }
+    fn is_isotropic(&self) -> bool {
+        self.0.is_isotropic()
+    }
+    fn is_mirror_symmetric(&self) -> bool {
+        self.0.is_mirror_symmetric()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        self.0.is_half_turn_symmetric()
+    }
+    fn is_reciprocal(&self) -> bool {
+        self.0.is_reciprocal()
+    }
+    fn conserves_energy(&self) -> bool {
+        self.0.conserves_energy()
+    }
+    fn bounded_at_horizon(&self) -> bool {
+        self.0.bounded_at_horizon()
+    }
+    fn analytic_lobes(&self) -> Option<brdf::AnalyticLobes> {
+        self.0.analytic_lobes()
+    }
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        self.0.as_any()
+    }
+}
+
+/// The outgoing direction of query `i` of a chunk.
+fn query(queries: Queries, fixed: &Vec3, rng: &mut Xoshiro256PlusPlus) -> Vec3 {
+    match queries {
+        Queries::Fixed => *fixed,
+        Queries::Random => {
+            // Uniform in solid angle over the cap θ ≤ θmax: cos θ uniform on [cos θmax, 1].
+            let cos_max = RANDOM_THETA_MAX_DEG.to_radians().cos();
+            let c = 1.0 - rng.random::<f64>() * (1.0 - cos_max);
+            let s = (1.0 - c * c).max(0.0).sqrt();
+            let phi = std::f64::consts::TAU * rng.random::<f64>();
+            Vec3::new(s * phi.cos(), s * phi.sin(), c)
+        }
+    }
+}
+
+/// Draws `n` samples (and their `f`) in seeded chunks; returns Σ f cos / pdf and the
+/// evaluations counted on the worker threads.
+fn run_samples(
+    sampler: &dyn DirectionSampler,
+    brdf: &dyn Brdf,
+    queries: Queries,
+    fixed: &Vec3,
+    n: usize,
+    seed: u64,
+) -> (f64, u64) {
+    let chunks = n.div_ceil(CHUNK);
+    (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let len = CHUNK.min(n - c * CHUNK);
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
+            let before = EVALS.with(Cell::get);
+            let mut sum = 0.0;
+            for _ in 0..len {
+                let wo = query(queries, fixed, &mut rng);
+                let s = sampler.sample(&wo, &mut rng);
+                if s.pdf > 0.0 && s.wi.z > 0.0 {
+                    sum += brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf;
+                }
+            }
+            (sum, EVALS.with(Cell::get) - before)
+        })
+        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let m = s.len() / 2;
+    if s.len() % 2 == 1 {
+        s[m]
+    } else {
+        0.5 * (s[m - 1] + s[m])
+    }
+}
+
+/// A built sampler of the benchmark and its build figures.
+struct Subject {
+    name: String,
+    sampler: Arc<dyn DirectionSampler>,
+    build_seconds: f64,
+}
+
+fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject> {
+    let started = Instant::now();
+    let built = brdf_args::build(name, &args.spec, brdf, &args.set)?;
+    let build_seconds = started.elapsed().as_secs_f64();
+    let sampler: Arc<dyn DirectionSampler> = match built {
+        brdf_args::Built::Set(s) => s,
+        brdf_args::Built::Other(s) => s,
+    };
+    Ok(Subject {
+        name: name.to_string(),
+        sampler,
+        build_seconds,
+    })
+}
+
+/// Runs `brdf-lab bench`.
+pub(crate) fn run(args: &BenchArgs) -> CliResult<()> {
+    crate::output::check_all([("--json", args.json.as_deref())])?;
+    args.set.check()?;
+    if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
+        return Err(CliError::input(format!(
+            "--theta-o must be in [0, 90) degrees, got {}",
+            args.theta_o
+        )));
+    }
+    if !args.phi_o.is_finite() {
+        return Err(CliError::input(format!(
+            "--phi-o must be finite, got {}",
+            args.phi_o
+        )));
+    }
+    let n = usize::try_from(args.n).map_err(CliError::input)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.map_or(0, |t| t as usize))
+        .build()
+        .map_err(CliError::input)?;
+    let threads = pool.current_num_threads();
+    let fixed = brdf::direction_from_angles(args.theta_o, args.phi_o);
+    let plain = brdf_args::parse_brdf(&args.spec)?;
+    let counted: Arc<dyn Brdf> = Arc::new(Counted(plain.clone()));
+
+    // Built over the counting wrapper: one build serves both passes (a build can take seconds).
+    let mut subjects = Vec::with_capacity(args.samplers.len());
+    for name in &args.samplers {
+        subjects.push(build(name, args, counted.clone())?);
+    }
+
+    // Evaluations per sample: an untimed pass on the worker threads.
+    let count_n = n.min(COUNT_SAMPLES);
+    let evals: Vec<f64> = pool.install(|| {
+        subjects
+            .iter()
+            .map(|s| {
+                let (_, e) = run_samples(
+                    s.sampler.as_ref(),
+                    counted.as_ref(),
+                    args.queries,
+                    &fixed,
+                    count_n,
+                    args.seed,
+                );
+                e as f64 / count_n as f64
+            })
+            .collect()
+    });
+
+    // Timed runs, interleaved: run r of every sampler before run r + 1 of any.
+    let pb = progress::bar(u64::from(args.repeat) * subjects.len() as u64, "timing");
+    let mut runs = vec![Vec::with_capacity(args.repeat as usize); subjects.len()];
+    let mut means = vec![0.0; subjects.len()];
+    pool.install(|| {
+        for _ in 0..args.repeat {
+            for (k, s) in subjects.iter().enumerate() {
+                let started = Instant::now();
+                let (sum, _) = run_samples(
+                    s.sampler.as_ref(),
+                    counted.as_ref(),
+                    args.queries,
+                    &fixed,
+                    n,
+                    args.seed,
+                );
+                let ns = started.elapsed().as_secs_f64() * 1e9 / n as f64;
+                runs[k].push(ns);
+                means[k] = sum / n as f64;
+                pb.inc(1);
+            }
+        }
+    });
+    pb.finish_and_clear();
+
+    let records: Vec<BenchRecord> = subjects
+        .iter()
+        .enumerate()
+        .map(|(k, s)| BenchRecord {
+            sampler: s.name.clone(),
+            ns_per_sample: median(&runs[k]),
+            ns_per_sample_min: runs[k].iter().copied().fold(f64::INFINITY, f64::min),
+            ns_per_sample_max: runs[k].iter().copied().fold(0.0, f64::max),
+            ns_per_sample_runs: runs[k].clone(),
+            evals_per_sample: evals[k],
+            samples: n,
+            threads,
+            queries: args.queries,
+            build_seconds: s.build_seconds,
+            bytes_used: s.sampler.bytes_used(),
+            mean_weight: means[k],
+        })
+        .collect();
+    print_table(args, &records, threads);
+    if let Some(path) = &args.json {
+        write_atomically(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &records).map_err(std::io::Error::other)?;
+            writeln!(w)
+        })?;
+        eprintln!("wrote      {}", path.display());
+    }
+    Ok(())
+}
+
+fn print_table(args: &BenchArgs, records: &[BenchRecord], threads: usize) {
+    let queries = match args.queries {
+        Queries::Fixed => format!("fixed ωo (θo = {}°, φo = {}°)", args.theta_o, args.phi_o),
+        Queries::Random => {
+            format!("a random ωo per query (uniform in solid angle, θo ≤ {RANDOM_THETA_MAX_DEG}°)")
+        }
+    };
+    println!("brdf       {}", args.spec);
+    println!("queries    {queries}");
+    println!(
+        "timing     {} samples per run, median of {} interleaved run{}, {threads} thread{}; \
+         a sample = sample(ωo, u) + the estimator's f(ωo, ωi)",
+        args.n,
+        args.repeat,
+        if args.repeat == 1 { "" } else { "s" },
+        if threads == 1 { "" } else { "s" },
+    );
+    let fastest = records
+        .iter()
+        .map(|r| r.ns_per_sample)
+        .fold(f64::INFINITY, f64::min);
+    println!(
+        "{:<24} {:>10} {:>17} {:>9} {:>10} {:>10} {:>12} {:>11}",
+        "sampler",
+        "ns/sample",
+        "min–max",
+        "× fastest",
+        "evals/smp",
+        "build s",
+        "memory KiB",
+        "mean f·c/p"
+    );
+    for r in records {
+        println!(
+            "{:<24} {:>10.1} {:>17} {:>9.2} {:>10.3} {:>10.3} {:>12.1} {:>11.5}",
+            r.sampler,
+            r.ns_per_sample,
+            format!("{:.1}–{:.1}", r.ns_per_sample_min, r.ns_per_sample_max),
+            r.ns_per_sample / fastest,
+            r.evals_per_sample,
+            r.build_seconds,
+            r.bytes_used as f64 / 1024.0,
+            r.mean_weight,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn random_queries_lie_in_the_cap_and_are_seeded() {
+        let mut a = Xoshiro256PlusPlus::seed_from_u64(7);
+        let mut b = Xoshiro256PlusPlus::seed_from_u64(7);
+        let cos_max = RANDOM_THETA_MAX_DEG.to_radians().cos();
+        let z = Vec3::new(0.0, 0.0, 1.0);
+        for _ in 0..10_000 {
+            let w = query(Queries::Random, &z, &mut a);
+            assert!((w.norm() - 1.0).abs() < 1e-12);
+            assert!(w.z >= cos_max - 1e-12 && w.z <= 1.0);
+            assert_eq!(w, query(Queries::Random, &z, &mut b));
+        }
+        assert_eq!(query(Queries::Fixed, &z, &mut a), z);
+    }
+
+    #[test]
+    fn counting_wrapper_counts_every_evaluation_route() {
+        let inner: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("phong:n=20").unwrap());
+        let c = Counted(inner.clone());
+        let wo = brdf::direction_from_angles(20.0, 0.0);
+        let wi = brdf::direction_from_angles(25.0, 180.0);
+        let before = EVALS.with(Cell::get);
+        let q = c.prepare(&wo);
+        assert_eq!(c.eval_prepared(&q, &wi), inner.eval(&wo, &wi));
+        assert_eq!(c.eval(&wo, &wi), inner.eval(&wo, &wi));
+        let _ = c.eval_rgb(&wo, &wi);
+        assert_eq!(EVALS.with(Cell::get) - before, 3);
+    }
+
+    #[test]
+    fn samples_and_counts_do_not_depend_on_the_thread_count() {
+        let brdf: Arc<dyn Brdf> =
+            Arc::new(Counted(Arc::from(brdf::parse_spec("phong:n=20").unwrap())));
+        let sampler = baselines::CosineHemisphere;
+        let wo = brdf::direction_from_angles(30.0, 0.0);
+        let on = |t: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .unwrap()
+                .install(|| run_samples(&sampler, brdf.as_ref(), Queries::Random, &wo, 20_000, 3))
+        };
+        let (s1, e1) = on(1);
+        let (s2, e2) = on(2);
+        // Chunk sums are added in a fixed tree order by rayon's reduce only up to
+        // associativity: compare to rounding.
+        approx::assert_relative_eq!(s1, s2, max_relative = 1e-12);
+        assert_eq!(e1, e2);
+        // Cosine sampling evaluates f once per sample above the horizon: the estimator's.
+        assert!(e1 <= 20_000 && e1 > 19_000, "{e1}");
+    }
+}
