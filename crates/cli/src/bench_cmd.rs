@@ -30,6 +30,7 @@ use crate::brdf_args::{self, SetArgs};
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
 use crate::progress;
+use crate::values;
 
 /// Samples per independently seeded chunk.
 const CHUNK: usize = 4096;
@@ -63,27 +64,23 @@ pub(crate) struct BenchArgs {
     #[arg(long, value_enum, default_value_t = Queries::Random)]
     queries: Queries,
     /// Outgoing polar angle θo in degrees, in [0, 90) (with `--queries fixed`).
-    #[arg(
-        long = "theta-o",
-        default_value_t = 30.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "theta-o", default_value_t = 30.0, value_parser = values::theta_o, allow_hyphen_values = true)]
     theta_o: f64,
-    /// Outgoing azimuth φo in degrees, finite (with `--queries fixed`).
-    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Outgoing azimuth φo in degrees, in [−360, 360] (with `--queries fixed`).
+    #[arg(long = "phi-o", default_value_t = 0.0, value_parser = values::azimuth, allow_hyphen_values = true)]
     phi_o: f64,
     /// Samples per timed run.
     #[arg(short = 'n', long = "samples", default_value_t = 1_000_000,
-          value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
+          value_parser = values::int(1u64, 1_000_000_000), allow_negative_numbers = true)]
     n: u64,
     /// Timed runs per sampler (interleaved across samplers); the median is reported.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 5, value_parser = values::int(1u32, 1000), allow_negative_numbers = true)]
     repeat: u32,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = values::int(1u32, 1024), allow_negative_numbers = true)]
     threads: Option<u32>,
     /// Seed of the random streams.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed)]
     seed: u64,
     /// Also write the results as JSON (a list, one object per sampler) here, atomically.
     #[arg(long, value_name = "FILE")]

@@ -21,6 +21,7 @@ use serde::Serialize;
 use crate::brdf_args::{SetArgs, parse_brdf};
 use crate::error::{CliError, CliResult};
 use crate::output::{check_all, num, write_atomically};
+use crate::values;
 
 /// Width and height of the built-in procedural sky.
 const SKY_SIZE: (usize, usize) = (1024, 512);
@@ -37,20 +38,20 @@ pub(crate) struct ProductArgs {
     /// World-space surface normal `X,Y,Z` (normalised here; the zero vector is refused).
     #[arg(long, default_value = "0,0,1", value_parser = parse_vec3, allow_hyphen_values = true)]
     normal: [f64; 3],
-    /// Rotation of the tangent frame about the normal, in degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Rotation of the tangent frame about the normal, in degrees, in [−360, 360].
+    #[arg(long, default_value_t = 0.0, value_parser = values::azimuth, allow_hyphen_values = true)]
     rotation: f64,
     /// Outgoing polar angle θo in the local frame, degrees in [0, 90).
-    #[arg(long = "theta-o", allow_negative_numbers = true)]
+    #[arg(long = "theta-o", value_parser = values::theta_o, allow_hyphen_values = true)]
     theta_o: f64,
-    /// Outgoing azimuth φo in the local frame, degrees.
-    #[arg(long = "phi-o", default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Outgoing azimuth φo in the local frame, degrees in [−360, 360].
+    #[arg(long = "phi-o", default_value_t = 0.0, value_parser = values::azimuth, allow_hyphen_values = true)]
     phi_o: f64,
     /// Samples per estimator.
-    #[arg(short = 'n', long = "samples", value_parser = clap::value_parser!(u64).range(16..))]
+    #[arg(short = 'n', long = "samples", value_parser = values::int(16u64, 1_000_000_000), allow_negative_numbers = true)]
     n: u64,
     /// Seed (each estimator gets its own stream derived from it).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = values::seed)]
     seed: u64,
     /// BRDF direction samplers for the `brdf` and `mis` estimators (repeatable; registry names).
     #[arg(long = "brdf-sampler", default_values_t = ["srbf".to_string(), "cosine".to_string()])]
@@ -59,7 +60,7 @@ pub(crate) struct ProductArgs {
     #[arg(long = "light-sampler", default_values_t = ["envmap-adaptive".to_string(), "envmap-cdf".to_string()])]
     light_samplers: Vec<String>,
     /// Samples of the reference (MIS, balance heuristic, of the first BRDF and light samplers).
-    #[arg(long = "reference-samples", default_value_t = 4_000_000, value_parser = clap::value_parser!(u64).range(16..))]
+    #[arg(long = "reference-samples", default_value_t = 4_000_000, value_parser = values::int(16u64, 1_000_000_000), allow_negative_numbers = true)]
     reference_samples: u64,
     /// Write the results as JSON.
     #[arg(long)]

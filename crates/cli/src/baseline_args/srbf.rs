@@ -52,7 +52,7 @@ pub(crate) struct SrbfProductArgs {
     /// product: product lobes kept (largest masses).
     #[arg(long = "srbf-keep", default_value_t = SrbfOptions::default().product_lobes, allow_negative_numbers = true)]
     pub(crate) srbf_keep: usize,
-    /// product: share of srbf-product's samples given to the BRDF slice's lobes, in [0, 1)
+    /// product: share of srbf-product's samples given to the BRDF slice's lobes, in [0, 0.8)
     /// (0 = Tsai's estimator as published).
     #[arg(long = "srbf-defensive", default_value_t = SrbfOptions::default().defensive, allow_hyphen_values = true)]
     pub(crate) srbf_defensive: f64,
