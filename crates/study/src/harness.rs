@@ -31,6 +31,7 @@ use samplers::{DirectionRequest, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
+use crate::machine::RunClock;
 use crate::results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
 use crate::{CellSpec, Light, Mode, Reference, Shard, StudyConfig, StudyError, reference};
 
@@ -245,6 +246,7 @@ impl StudyPlan {
 
     /// Runs the cells of `shard` (all when `None`); see the module docs.
     pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
+        let clock = RunClock::start();
         let cells = self.selected(shard);
         // Builds: one at a time, so build times are not inflated by each other.
         let built: Vec<((usize, usize), BuildOutcome)> = self
@@ -295,17 +297,32 @@ impl StudyPlan {
                 r
             })
             .collect();
-        // Timings: one cell at a time on this thread.
-        for (c, r) in cells.iter().zip(results.iter_mut()) {
-            if let (Some(Ok((built, seconds))), true) = (find_build(c), r.ok()) {
-                // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
-                // sampler's rounding-level value counts as 0 (no efficiency).
-                let mse = if r.zero_variance { 0.0 } else { r.mse.value };
-                r.timing = Some(self.time_cell(c, built.sampler.as_ref(), *seconds, mse));
+        // Timings on this thread, interleaved: repeat 1 of every cell, then repeat 2, … so that a
+        // change of the machine's load during the timing phase shows in every cell's spread.
+        let mut timers: Vec<(usize, CellTimer<'_>)> = cells
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match (find_build(c), results[i].ok()) {
+                (Some(Ok((built, seconds))), true) => {
+                    Some((i, self.cell_timer(c, built.sampler.as_ref(), *seconds)))
+                }
+                _ => None,
+            })
+            .collect();
+        for _ in 0..self.config.timing_repeats {
+            for (_, t) in timers.iter_mut() {
+                t.repeat(self.config.timing_samples);
             }
-            progress(1);
         }
-        StudyResults {
+        for (i, t) in timers {
+            let r = &mut results[i];
+            // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
+            // sampler's rounding-level value counts as 0 (no efficiency).
+            let mse = if r.zero_variance { 0.0 } else { r.mse.value };
+            r.timing = Some(t.finish(mse));
+        }
+        progress(cells.len() as u64);
+        let mut out = StudyResults {
             schema: SCHEMA.to_string(),
             config: self.config.clone(),
             shard,
@@ -322,7 +339,13 @@ impl StudyPlan {
                 })
                 .collect(),
             cells: results,
+            runs: vec![clock.finish()],
+            rankings: Vec::new(),
+        };
+        if shard.is_none() {
+            out.rankings = crate::ranking::rankings(&out);
         }
+        out
     }
 
     /// The statistics of one cell (deterministic).
@@ -348,13 +371,17 @@ impl StudyPlan {
         let mut counter = EvalCounter::default();
         let ref_value = reference.value;
         let mut errors = Vec::with_capacity(cfg.n_grid.len());
-        let mut values = Vec::with_capacity(cfg.repetitions);
+        let reps = match c.spec.mode {
+            Mode::OneSample => cfg.repetitions,
+            Mode::Batch => cfg.repetitions.max(cfg.batch_repetitions),
+        };
+        let mut values = Vec::with_capacity(reps);
         // Every one-sample value of the cell (independent draws): the variance and the MSE
         // at the budget are measured on all of them.
         let mut all_values: Vec<f64> = Vec::new();
         for &n in &cfg.n_grid {
             values.clear();
-            for _ in 0..cfg.repetitions {
+            for _ in 0..reps {
                 let samples = est.draw(n, &mut rng, &mut counter);
                 let ys = samples.iter().map(|s| est.value(s));
                 let sum: f64 = if c.spec.mode == Mode::OneSample {
@@ -410,7 +437,7 @@ impl StudyPlan {
                 // estimates.
                 let variance = WithCi {
                     value: last,
-                    ci95: finite(Z95 * last * (2.0 / (cfg.repetitions as f64 - 1.0)).sqrt()),
+                    ci95: finite(Z95 * last * (2.0 / (reps as f64 - 1.0)).sqrt()),
                 };
                 let (mse, tail_share) =
                     dispersion::batch_mse(&values, ref_value, reference.abs_err, budget);
@@ -456,52 +483,94 @@ impl StudyPlan {
         }
     }
 
-    /// The timings of one cell, on the calling thread.
-    fn time_cell(
-        &self,
+    /// The timer of one cell (its own stream, seeded apart from the statistics').
+    fn cell_timer<'a>(
+        &'a self,
         c: &PlanCell,
-        sampler: &dyn DirectionSampler,
+        sampler: &'a dyn DirectionSampler,
         build_seconds: f64,
-        mse: f64,
-    ) -> Timing {
+    ) -> CellTimer<'a> {
         let cfg = &self.config;
-        let est = Estimator {
-            brdf: self.brdfs[c.brdf].raw.as_ref(),
-            light: &self.lights[c.light],
-            sampler,
-            mode: c.spec.mode,
-            wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
-        };
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
-            cfg.seed ^ 0x7469_6d65,
-            c.spec.index as u64,
-        ));
-        let mut counter = EvalCounter::default();
-        let n = cfg.timing_samples;
-        let mut sample_ns = Vec::with_capacity(cfg.timing_repeats);
-        let mut estimator_ns = Vec::with_capacity(cfg.timing_repeats);
-        let mut sink = 0.0;
-        for _ in 0..cfg.timing_repeats {
-            let start = Instant::now();
-            let samples = est.draw(n, &mut rng, &mut counter);
-            sample_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
-            sink += samples.len() as f64;
-            let start = Instant::now();
-            let samples = est.draw(n, &mut rng, &mut counter);
-            let sum: f64 = samples.iter().map(|s| est.value(s)).sum();
-            estimator_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
-            sink += sum;
-        }
-        std::hint::black_box(sink);
-        let estimator = median(&mut estimator_ns);
-        Timing {
+        CellTimer {
+            est: Estimator {
+                brdf: self.brdfs[c.brdf].raw.as_ref(),
+                light: &self.lights[c.light],
+                sampler,
+                mode: c.spec.mode,
+                wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
+            },
+            rng: Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+                cfg.seed ^ 0x7469_6d65,
+                c.spec.index as u64,
+            )),
             build_seconds: if self.entries[c.sampler].capabilities.needs_build {
                 build_seconds
             } else {
                 0.0
             },
-            sample_ns: median(&mut sample_ns),
+            sample_ns: Vec::with_capacity(cfg.timing_repeats),
+            estimator_ns: Vec::with_capacity(cfg.timing_repeats),
+            sink: 0.0,
+        }
+    }
+}
+
+/// The timing runs of one cell.
+struct CellTimer<'a> {
+    est: Estimator<'a>,
+    rng: Xoshiro256PlusPlus,
+    build_seconds: f64,
+    sample_ns: Vec<f64>,
+    estimator_ns: Vec<f64>,
+    sink: f64,
+}
+
+impl CellTimer<'_> {
+    /// One timing run of `n` samples: the sampler alone, then the whole estimator.
+    fn repeat(&mut self, n: usize) {
+        let mut counter = EvalCounter::default();
+        let start = Instant::now();
+        let samples = self.est.draw(n, &mut self.rng, &mut counter);
+        self.sample_ns
+            .push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+        self.sink += samples.len() as f64;
+        let start = Instant::now();
+        let samples = self.est.draw(n, &mut self.rng, &mut counter);
+        let sum: f64 = samples.iter().map(|s| self.est.value(s)).sum();
+        self.estimator_ns
+            .push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+        self.sink += sum;
+    }
+
+    /// The cell's [`Timing`], efficiency from `mse`.
+    fn finish(mut self, mse: f64) -> Timing {
+        std::hint::black_box(self.sink);
+        let logs: Vec<f64> = self
+            .estimator_ns
+            .iter()
+            .filter(|t| **t > 0.0)
+            .map(|t| t.ln())
+            .collect();
+        let log_sd = if logs.len() >= 2 {
+            mean_var(&logs).1.sqrt()
+        } else {
+            0.0
+        };
+        let (lo, hi) = self
+            .estimator_ns
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &t| {
+                (lo.min(t), hi.max(t))
+            });
+        let estimator = median(&mut self.estimator_ns);
+        Timing {
+            build_seconds: self.build_seconds,
+            sample_ns: median(&mut self.sample_ns),
             estimator_ns: estimator,
+            estimator_ns_min: finite(lo),
+            estimator_ns_max: hi,
+            estimator_log_sd: finite(log_sd),
+            repeats: self.estimator_ns.len(),
             efficiency: (mse > 0.0 && estimator > 0.0).then(|| 1.0 / (mse * estimator * 1e-9)),
         }
     }

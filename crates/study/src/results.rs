@@ -48,10 +48,12 @@ use std::collections::BTreeSet;
 use serde::{Deserialize, Serialize};
 
 use crate::dispersion::BudgetMse;
+use crate::machine::RunInfo;
+use crate::ranking::Ranking;
 use crate::{Mode, Reference, Shard, StudyConfig, StudyError};
 
 /// Version tag of [`StudyResults`]' JSON form.
-pub const SCHEMA: &str = "brdf-lab-study/2";
+pub const SCHEMA: &str = "brdf-lab-study/3";
 
 /// A value with the half-width of its 95 % confidence interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -85,8 +87,18 @@ pub struct Timing {
     pub build_seconds: f64,
     /// Time per sample of the sampler alone (ns), single-threaded, median of the repeats.
     pub sample_ns: f64,
-    /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns).
+    /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns), median
+    /// of the repeats.
     pub estimator_ns: f64,
+    /// Fastest repeat of the estimator (ns per sample).
+    pub estimator_ns_min: f64,
+    /// Slowest repeat of the estimator (ns per sample).
+    pub estimator_ns_max: f64,
+    /// Sample standard deviation of `ln(estimator ns)` over the repeats (the timing spread
+    /// the rankings carry; 0 with one repeat).
+    pub estimator_log_sd: f64,
+    /// Timing repeats (interleaved with the other cells').
+    pub repeats: usize,
     /// `1 / (MSE per sample at the budget N × estimator time per sample in s)` (the cell's
     /// [`CellResult::mse`]); `None` when it is 0.
     pub efficiency: Option<f64>,
@@ -190,6 +202,11 @@ pub struct StudyResults {
     pub lights: Vec<LightInfo>,
     /// The cells run, by index.
     pub cells: Vec<CellResult>,
+    /// Where and how it ran (one per run; a merged study lists its shards').
+    pub runs: Vec<RunInfo>,
+    /// One ranking per comparison (module [`crate::ranking`]); empty for a shard (`study
+    /// merge` ranks the whole grid).
+    pub rankings: Vec<Ranking>,
 }
 
 impl StudyResults {
@@ -219,6 +236,8 @@ impl StudyResults {
     pub fn without_timing(&self) -> Self {
         Self {
             cells: self.cells.iter().map(CellResult::without_timing).collect(),
+            runs: Vec::new(),
+            rankings: Vec::new(),
             ..self.clone()
         }
     }
@@ -227,7 +246,7 @@ impl StudyResults {
     /// header. Fields are quoted where needed (BRDF specs contain commas).
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
-            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],efficiency[timing]\n",
+            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],efficiency[timing]\n",
         );
         for c in &self.cells {
             let t = c.timing;
@@ -235,6 +254,9 @@ impl StudyResults {
                 t.map(|t| t.build_seconds),
                 t.map(|t| t.sample_ns),
                 t.map(|t| t.estimator_ns),
+                t.map(|t| t.estimator_ns_min),
+                t.map(|t| t.estimator_ns_max),
+                t.map(|t| t.estimator_log_sd),
                 t.and_then(|t| t.efficiency),
             ]
             .map(opt);
@@ -332,7 +354,7 @@ impl StudyResults {
                 "the shards do not cover every cell once (missing shards: {missing})"
             ));
         }
-        Ok(Self {
+        let mut merged = Self {
             schema: SCHEMA.to_string(),
             config: first.config.clone(),
             shard: None,
@@ -340,7 +362,11 @@ impl StudyResults {
             notes: first.notes.clone(),
             lights: first.lights.clone(),
             cells,
-        })
+            runs: parts.iter().flat_map(|p| p.runs.iter().cloned()).collect(),
+            rankings: Vec::new(),
+        };
+        merged.rankings = crate::ranking::rankings(&merged);
+        Ok(merged)
     }
 }
 
