@@ -132,7 +132,7 @@ impl StudyConfig {
             batch_repetitions: BATCH_REPETITIONS,
             variance_samples: 20_000,
             timing_samples: 4096,
-            timing_repeats: 5,
+            timing_repeats: 9,
             slices: brdf_sampling::SetOptions::default().slices,
             seed: 1,
         }

@@ -12,8 +12,12 @@
 //! * per-sample MSE at the budget (largest) N against the reference, its tail share and
 //!   warnings ([`crate::dispersion`]): efficiency divides by it;
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
-//! * timings: after the statistics, cell by cell on the calling thread with nothing else
-//!   running, median of `timing_repeats` runs of `timing_samples` samples.
+//! * relative errors and MSE in batch mode rest on `max(repetitions, batch_repetitions)`
+//!   estimates per N;
+//! * timings: after the statistics, on the calling thread with nothing else of the study
+//!   running, `timing_repeats` runs of `timing_samples` samples per cell, interleaved across
+//!   cells (run 1 of every cell, then run 2, …), on the thread's CPU clock where the platform
+//!   has one (and the wall clock beside); the median and the spread are kept.
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
 //! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
@@ -31,8 +35,10 @@ use samplers::{DirectionRequest, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
-use crate::machine::RunClock;
-use crate::results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+use crate::machine::{RunClock, thread_cpu_seconds};
+use crate::results::{
+    CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi,
+};
 use crate::{CellSpec, Light, Mode, Reference, Shard, StudyConfig, StudyError, reference};
 
 /// Relative size (to the reference squared) below which a variance counts as zero.
@@ -510,6 +516,7 @@ impl StudyPlan {
             },
             sample_ns: Vec::with_capacity(cfg.timing_repeats),
             estimator_ns: Vec::with_capacity(cfg.timing_repeats),
+            estimator_wall_ns: Vec::with_capacity(cfg.timing_repeats),
             sink: 0.0,
         }
     }
@@ -522,57 +529,80 @@ struct CellTimer<'a> {
     build_seconds: f64,
     sample_ns: Vec<f64>,
     estimator_ns: Vec<f64>,
+    estimator_wall_ns: Vec<f64>,
     sink: f64,
 }
 
 impl CellTimer<'_> {
-    /// One timing run of `n` samples: the sampler alone, then the whole estimator.
+    /// One timing run of `n` samples: the sampler alone, then the whole estimator, each on
+    /// the thread's CPU clock (where the platform gives it) and on the wall clock.
     fn repeat(&mut self, n: usize) {
         let mut counter = EvalCounter::default();
-        let start = Instant::now();
+        let per = 1e9 / n as f64;
+        let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
         let samples = self.est.draw(n, &mut self.rng, &mut counter);
+        let wall_s = wall.elapsed().as_secs_f64();
         self.sample_ns
-            .push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+            .push(cpu_or_wall(cpu, thread_cpu_seconds(), wall_s) * per);
         self.sink += samples.len() as f64;
-        let start = Instant::now();
+        let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
         let samples = self.est.draw(n, &mut self.rng, &mut counter);
         let sum: f64 = samples.iter().map(|s| self.est.value(s)).sum();
+        let wall_s = wall.elapsed().as_secs_f64();
         self.estimator_ns
-            .push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+            .push(cpu_or_wall(cpu, thread_cpu_seconds(), wall_s) * per);
+        self.estimator_wall_ns.push(wall_s * per);
         self.sink += sum;
     }
 
     /// The cell's [`Timing`], efficiency from `mse`.
     fn finish(mut self, mse: f64) -> Timing {
         std::hint::black_box(self.sink);
-        let logs: Vec<f64> = self
-            .estimator_ns
-            .iter()
-            .filter(|t| **t > 0.0)
-            .map(|t| t.ln())
-            .collect();
-        let log_sd = if logs.len() >= 2 {
-            mean_var(&logs).1.sqrt()
-        } else {
-            0.0
-        };
         let (lo, hi) = self
             .estimator_ns
             .iter()
             .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &t| {
                 (lo.min(t), hi.max(t))
             });
+        let log_sd = log_sd_of(&self.estimator_ns);
+        let wall_log_sd = log_sd_of(&self.estimator_wall_ns);
         let estimator = median(&mut self.estimator_ns);
         Timing {
+            clock: if thread_cpu_seconds().is_some() {
+                Clock::ThreadCpu
+            } else {
+                Clock::Wall
+            },
             build_seconds: self.build_seconds,
             sample_ns: median(&mut self.sample_ns),
             estimator_ns: estimator,
             estimator_ns_min: finite(lo),
             estimator_ns_max: hi,
             estimator_log_sd: finite(log_sd),
+            estimator_wall_ns: median(&mut self.estimator_wall_ns),
+            estimator_wall_log_sd: finite(wall_log_sd),
             repeats: self.estimator_ns.len(),
             efficiency: (mse > 0.0 && estimator > 0.0).then(|| 1.0 / (mse * estimator * 1e-9)),
         }
+    }
+}
+
+/// Elapsed thread CPU time between two readings, or `wall` when the platform has no thread
+/// clock.
+fn cpu_or_wall(start: Option<f64>, end: Option<f64>, wall: f64) -> f64 {
+    match (start, end) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    }
+}
+
+/// Sample standard deviation of `ln t` over the positive `t` (0 with fewer than two).
+fn log_sd_of(t: &[f64]) -> f64 {
+    let logs: Vec<f64> = t.iter().filter(|t| **t > 0.0).map(|t| t.ln()).collect();
+    if logs.len() >= 2 {
+        mean_var(&logs).1.sqrt()
+    } else {
+        0.0
     }
 }
 

@@ -74,4 +74,4 @@ pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
 pub use report::{ReportAssets, report_markdown};
-pub use results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};

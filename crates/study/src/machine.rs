@@ -70,6 +70,21 @@ pub(crate) fn process_cpu_seconds() -> Option<f64> {
     Some((utime + stime) / 100.0)
 }
 
+/// CPU time of the calling thread (s): `clock_gettime(CLOCK_THREAD_CPUTIME_ID)` on Unix,
+/// `None` elsewhere. Unlike wall time it does not count the time the thread waits while other
+/// processes run, so the timings of a loaded machine stay comparable.
+pub(crate) fn thread_cpu_seconds() -> Option<f64> {
+    #[cfg(unix)]
+    {
+        let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+        Some(t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9)
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
+}
+
 /// Started at the beginning of a run; [`RunClock::finish`] gives its [`RunInfo`].
 #[derive(Debug)]
 pub(crate) struct RunClock {

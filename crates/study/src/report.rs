@@ -147,22 +147,41 @@ fn run_section(s: &mut String, results: &StudyResults) {
                 .map_or("unknown".to_string(), |c| format!("{c:.0} s")),
         );
     }
-    let spreads: Vec<f64> = results
+    let spread = |f: &dyn Fn(&crate::Timing) -> f64| {
+        let mut v: Vec<f64> = results
+            .cells
+            .iter()
+            .filter_map(|c| c.timing.as_ref().map(f))
+            .collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        let q = |p: f64| 100.0 * v[((v.len() - 1) as f64 * p).round() as usize];
+        Some(format!(
+            "median {:.1} %, 90th percentile {:.1} %, largest {:.1} %",
+            q(0.5),
+            q(0.9),
+            q(1.0)
+        ))
+    };
+    let clock = results
         .cells
         .iter()
-        .filter_map(|c| c.timing.map(|t| t.estimator_log_sd))
-        .collect();
-    if !spreads.is_empty() {
-        let mut v = spreads.clone();
-        v.sort_by(f64::total_cmp);
-        let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+        .find_map(|c| c.timing.map(|t| t.clock))
+        .unwrap_or(crate::Clock::Wall);
+    if let (Some(cpu), Some(wall)) = (
+        spread(&|t| t.estimator_log_sd),
+        spread(&|t| t.estimator_wall_log_sd),
+    ) {
         let _ = writeln!(
             s,
-            "* timing spread (standard deviation of ln t over the {} repeats of a cell): median {:.1} %, 90th percentile {:.1} %, largest {:.1} %.",
+            "* timings on the {} clock; their spread (standard deviation of ln t over the {} interleaved repeats of a cell): {cpu}; on the wall clock: {wall}.",
+            match clock {
+                crate::Clock::ThreadCpu => "timing thread's CPU-time",
+                crate::Clock::Wall => "wall",
+            },
             results.config.timing_repeats,
-            100.0 * q(0.5),
-            100.0 * q(0.9),
-            100.0 * q(1.0)
         );
     }
 }
@@ -177,7 +196,7 @@ fn outcome(s: &mut String, results: &StudyResults) {
     } else {
         let _ = writeln!(
             s,
-            "Each comparison (BRDF, θo, light; estimator: BRDF sampling alone) names the most efficient sampler (lowest MSE × time at the budget N), the samplers **statistically tied** with it and the ones **significantly worse**: the ratio of efficiencies best / x has an interval that carries the MSE's uncertainty (its 95 % interval and the reference's error) and the time's (the spread of {} interleaved timing repeats), at the Šidák-corrected level 1 − (1 − α)^(1/m) for the m comparisons with the best, family-wise α = {}; x is tied when the interval contains 1. `(rows …)` are the `index` values of results.csv (one row per N) the sentence rests on. † marks a verdict that the MSEs alone would not give (it rests on the measured times); ⚠ a cell whose spread estimate is unreliable (its interval is optimistic).\n",
+            "Each comparison (BRDF, θo, light; estimator: BRDF sampling alone) names the most efficient sampler (lowest MSE × time at the budget N), the samplers **statistically tied** with it and the ones **significantly worse**: the ratio of efficiencies best / x has an interval that carries the MSE's uncertainty (its 95 % interval and the reference's error) and the time's (the spread of {} interleaved timing repeats, on the timing thread's CPU clock where the platform has one), at the Šidák-corrected level 1 − (1 − α)^(1/m) for the m comparisons with the best, family-wise α = {}; x is tied when the interval contains 1. `(rows …)` are the `index` values of results.csv (one row per N) the sentence rests on. † marks a verdict that the MSEs alone would not give (it rests on the measured times); ⚠ a cell whose spread estimate is unreliable (its interval is optimistic).\n",
             results.config.timing_repeats,
             crate::ranking::ALPHA,
         );
