@@ -12,8 +12,12 @@
 //! * per-sample MSE at the budget (largest) N against the reference, its tail share and
 //!   warnings ([`crate::dispersion`]): efficiency divides by it;
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
-//! * timings: after the statistics, cell by cell on the calling thread with nothing else
-//!   running, median of `timing_repeats` runs of `timing_samples` samples.
+//! * relative errors and MSE in batch mode rest on `max(repetitions, batch_repetitions)`
+//!   estimates per N;
+//! * timings: after the statistics, on the calling thread with nothing else of the study
+//!   running, `timing_repeats` runs of `timing_samples` samples per cell, interleaved across
+//!   cells (run 1 of every cell, then run 2, …), on the thread's CPU clock where the platform
+//!   has one (and the wall clock beside); the median and the spread are kept.
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
 //! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
@@ -31,7 +35,10 @@ use samplers::{DirectionRequest, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
-use crate::results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+use crate::machine::{RunClock, thread_cpu_seconds};
+use crate::results::{
+    CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi,
+};
 use crate::{CellSpec, Light, Mode, Reference, Shard, StudyConfig, StudyError, reference};
 
 /// Relative size (to the reference squared) below which a variance counts as zero.
@@ -245,6 +252,7 @@ impl StudyPlan {
 
     /// Runs the cells of `shard` (all when `None`); see the module docs.
     pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
+        let clock = RunClock::start();
         let cells = self.selected(shard);
         // Builds: one at a time, so build times are not inflated by each other.
         let built: Vec<((usize, usize), BuildOutcome)> = self
@@ -295,17 +303,32 @@ impl StudyPlan {
                 r
             })
             .collect();
-        // Timings: one cell at a time on this thread.
-        for (c, r) in cells.iter().zip(results.iter_mut()) {
-            if let (Some(Ok((built, seconds))), true) = (find_build(c), r.ok()) {
-                // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
-                // sampler's rounding-level value counts as 0 (no efficiency).
-                let mse = if r.zero_variance { 0.0 } else { r.mse.value };
-                r.timing = Some(self.time_cell(c, built.sampler.as_ref(), *seconds, mse));
+        // Timings on this thread, interleaved: repeat 1 of every cell, then repeat 2, … so that a
+        // change of the machine's load during the timing phase shows in every cell's spread.
+        let mut timers: Vec<(usize, CellTimer<'_>)> = cells
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match (find_build(c), results[i].ok()) {
+                (Some(Ok((built, seconds))), true) => {
+                    Some((i, self.cell_timer(c, built.sampler.as_ref(), *seconds)))
+                }
+                _ => None,
+            })
+            .collect();
+        for _ in 0..self.config.timing_repeats {
+            for (_, t) in timers.iter_mut() {
+                t.repeat(self.config.timing_samples);
             }
-            progress(1);
         }
-        StudyResults {
+        for (i, t) in timers {
+            let r = &mut results[i];
+            // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
+            // sampler's rounding-level value counts as 0 (no efficiency).
+            let mse = if r.zero_variance { 0.0 } else { r.mse.value };
+            r.timing = Some(t.finish(mse));
+        }
+        progress(cells.len() as u64);
+        let mut out = StudyResults {
             schema: SCHEMA.to_string(),
             config: self.config.clone(),
             shard,
@@ -322,7 +345,13 @@ impl StudyPlan {
                 })
                 .collect(),
             cells: results,
+            runs: vec![clock.finish()],
+            rankings: Vec::new(),
+        };
+        if shard.is_none() {
+            out.rankings = crate::ranking::rankings(&out);
         }
+        out
     }
 
     /// The statistics of one cell (deterministic).
@@ -348,13 +377,17 @@ impl StudyPlan {
         let mut counter = EvalCounter::default();
         let ref_value = reference.value;
         let mut errors = Vec::with_capacity(cfg.n_grid.len());
-        let mut values = Vec::with_capacity(cfg.repetitions);
+        let reps = match c.spec.mode {
+            Mode::OneSample => cfg.repetitions,
+            Mode::Batch => cfg.repetitions.max(cfg.batch_repetitions),
+        };
+        let mut values = Vec::with_capacity(reps);
         // Every one-sample value of the cell (independent draws): the variance and the MSE
         // at the budget are measured on all of them.
         let mut all_values: Vec<f64> = Vec::new();
         for &n in &cfg.n_grid {
             values.clear();
-            for _ in 0..cfg.repetitions {
+            for _ in 0..reps {
                 let samples = est.draw(n, &mut rng, &mut counter);
                 let ys = samples.iter().map(|s| est.value(s));
                 let sum: f64 = if c.spec.mode == Mode::OneSample {
@@ -410,7 +443,7 @@ impl StudyPlan {
                 // estimates.
                 let variance = WithCi {
                     value: last,
-                    ci95: finite(Z95 * last * (2.0 / (cfg.repetitions as f64 - 1.0)).sqrt()),
+                    ci95: finite(Z95 * last * (2.0 / (reps as f64 - 1.0)).sqrt()),
                 };
                 let (mse, tail_share) =
                     dispersion::batch_mse(&values, ref_value, reference.abs_err, budget);
@@ -456,54 +489,120 @@ impl StudyPlan {
         }
     }
 
-    /// The timings of one cell, on the calling thread.
-    fn time_cell(
-        &self,
+    /// The timer of one cell (its own stream, seeded apart from the statistics').
+    fn cell_timer<'a>(
+        &'a self,
         c: &PlanCell,
-        sampler: &dyn DirectionSampler,
+        sampler: &'a dyn DirectionSampler,
         build_seconds: f64,
-        mse: f64,
-    ) -> Timing {
+    ) -> CellTimer<'a> {
         let cfg = &self.config;
-        let est = Estimator {
-            brdf: self.brdfs[c.brdf].raw.as_ref(),
-            light: &self.lights[c.light],
-            sampler,
-            mode: c.spec.mode,
-            wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
-        };
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
-            cfg.seed ^ 0x7469_6d65,
-            c.spec.index as u64,
-        ));
-        let mut counter = EvalCounter::default();
-        let n = cfg.timing_samples;
-        let mut sample_ns = Vec::with_capacity(cfg.timing_repeats);
-        let mut estimator_ns = Vec::with_capacity(cfg.timing_repeats);
-        let mut sink = 0.0;
-        for _ in 0..cfg.timing_repeats {
-            let start = Instant::now();
-            let samples = est.draw(n, &mut rng, &mut counter);
-            sample_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
-            sink += samples.len() as f64;
-            let start = Instant::now();
-            let samples = est.draw(n, &mut rng, &mut counter);
-            let sum: f64 = samples.iter().map(|s| est.value(s)).sum();
-            estimator_ns.push(start.elapsed().as_secs_f64() * 1e9 / n as f64);
-            sink += sum;
-        }
-        std::hint::black_box(sink);
-        let estimator = median(&mut estimator_ns);
-        Timing {
+        CellTimer {
+            est: Estimator {
+                brdf: self.brdfs[c.brdf].raw.as_ref(),
+                light: &self.lights[c.light],
+                sampler,
+                mode: c.spec.mode,
+                wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
+            },
+            rng: Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+                cfg.seed ^ 0x7469_6d65,
+                c.spec.index as u64,
+            )),
             build_seconds: if self.entries[c.sampler].capabilities.needs_build {
                 build_seconds
             } else {
                 0.0
             },
-            sample_ns: median(&mut sample_ns),
+            sample_ns: Vec::with_capacity(cfg.timing_repeats),
+            estimator_ns: Vec::with_capacity(cfg.timing_repeats),
+            estimator_wall_ns: Vec::with_capacity(cfg.timing_repeats),
+            sink: 0.0,
+        }
+    }
+}
+
+/// The timing runs of one cell.
+struct CellTimer<'a> {
+    est: Estimator<'a>,
+    rng: Xoshiro256PlusPlus,
+    build_seconds: f64,
+    sample_ns: Vec<f64>,
+    estimator_ns: Vec<f64>,
+    estimator_wall_ns: Vec<f64>,
+    sink: f64,
+}
+
+impl CellTimer<'_> {
+    /// One timing run of `n` samples: the sampler alone, then the whole estimator, each on
+    /// the thread's CPU clock (where the platform gives it) and on the wall clock.
+    fn repeat(&mut self, n: usize) {
+        let mut counter = EvalCounter::default();
+        let per = 1e9 / n as f64;
+        let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
+        let samples = self.est.draw(n, &mut self.rng, &mut counter);
+        let wall_s = wall.elapsed().as_secs_f64();
+        self.sample_ns
+            .push(cpu_or_wall(cpu, thread_cpu_seconds(), wall_s) * per);
+        self.sink += samples.len() as f64;
+        let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
+        let samples = self.est.draw(n, &mut self.rng, &mut counter);
+        let sum: f64 = samples.iter().map(|s| self.est.value(s)).sum();
+        let wall_s = wall.elapsed().as_secs_f64();
+        self.estimator_ns
+            .push(cpu_or_wall(cpu, thread_cpu_seconds(), wall_s) * per);
+        self.estimator_wall_ns.push(wall_s * per);
+        self.sink += sum;
+    }
+
+    /// The cell's [`Timing`], efficiency from `mse`.
+    fn finish(mut self, mse: f64) -> Timing {
+        std::hint::black_box(self.sink);
+        let (lo, hi) = self
+            .estimator_ns
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &t| {
+                (lo.min(t), hi.max(t))
+            });
+        let log_sd = log_sd_of(&self.estimator_ns);
+        let wall_log_sd = log_sd_of(&self.estimator_wall_ns);
+        let estimator = median(&mut self.estimator_ns);
+        Timing {
+            clock: if thread_cpu_seconds().is_some() {
+                Clock::ThreadCpu
+            } else {
+                Clock::Wall
+            },
+            build_seconds: self.build_seconds,
+            sample_ns: median(&mut self.sample_ns),
             estimator_ns: estimator,
+            estimator_ns_min: finite(lo),
+            estimator_ns_max: hi,
+            estimator_log_sd: finite(log_sd),
+            estimator_wall_ns: median(&mut self.estimator_wall_ns),
+            estimator_wall_log_sd: finite(wall_log_sd),
+            repeats: self.estimator_ns.len(),
             efficiency: (mse > 0.0 && estimator > 0.0).then(|| 1.0 / (mse * estimator * 1e-9)),
         }
+    }
+}
+
+/// Elapsed thread CPU time between two readings, or `wall` when the platform has no thread
+/// clock.
+fn cpu_or_wall(start: Option<f64>, end: Option<f64>, wall: f64) -> f64 {
+    match (start, end) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    }
+}
+
+/// Sample standard deviation of `ln t` over the positive `t` (0 with fewer than two).
+fn log_sd_of(t: &[f64]) -> f64 {
+    let logs: Vec<f64> = t.iter().filter(|t| **t > 0.0).map(|t| t.ln()).collect();
+    if logs.len() >= 2 {
+        mean_var(&logs).1.sqrt()
+    } else {
+        0.0
     }
 }
 

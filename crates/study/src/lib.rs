@@ -45,16 +45,18 @@ mod error;
 mod groups;
 mod harness;
 mod light;
+mod machine;
 mod paper;
 mod plot;
+pub mod ranking;
 mod reference;
 mod render;
 mod report;
 mod results;
 
 pub use config::{
-    CellSpec, MAP_CANDIDATES, MEASURED_CANDIDATES, Mode, PAPER_N_GRID, PREFERRED_SAMPLERS,
-    QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
+    BATCH_REPETITIONS, CellSpec, MAP_CANDIDATES, MEASURED_CANDIDATES, Mode, PAPER_N_GRID,
+    PREFERRED_SAMPLERS, QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
@@ -62,12 +64,14 @@ pub use error::StudyError;
 pub use groups::{Group, groups, is_adaptive, short_light};
 pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
+pub use machine::{COMMIT, RunInfo};
 pub use paper::{
     MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
     paper_tables,
 };
 pub use plot::{Figure, PLOT_SIZE, PlotFile, Series, group_figures, study_plots};
+pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
 pub use report::{ReportAssets, report_markdown};
-pub use results::{CellResult, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};

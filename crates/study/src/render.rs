@@ -657,14 +657,14 @@ impl Render {
                 if crate::is_adaptive(&b.sampler) {
                     let _ = writeln!(
                         s,
-                        "At {kind}, **{}** has the lowest image error ({:.2} %).",
+                        "At {kind}, **{}** has the lowest image error ({:.2} %) (one image per sampler, no interval: an observation, not a ranking).",
                         b.sampler,
                         100.0 * eb
                     );
                 } else {
                     let _ = writeln!(
                         s,
-                        "At {kind}, **{}** has the lowest image error ({:.2} %); the best adaptive sampler, {}, loses with {:.2} % ({:.2}× the error).",
+                        "At {kind}, **{}** has the lowest image error ({:.2} %); the best adaptive sampler, {}, has {:.2} % ({:.2}× the error) (one image per sampler, no interval: an observation, not a ranking).",
                         b.sampler,
                         100.0 * eb,
                         a.sampler,

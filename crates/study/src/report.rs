@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use crate::groups::{Group, groups, is_adaptive, short_light};
+use crate::ranking::{Entry, Ranking, Verdict};
 use crate::{CellResult, StudyResults};
 
 /// Files beside `report.md` that the report embeds (paths relative to the report).
@@ -62,6 +63,7 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     for l in &results.lights {
         let _ = writeln!(s, "* `{}`: {}", short_light(&l.spec), l.description);
     }
+    run_section(&mut s, results);
     s.push_str(concat!(
         "\n## What is measured\n\n",
         "For each cell the estimator of L_r(ωo) = ∫ f_r L cosθ dσ is (1/N) Σ Y(f_r ⊙ L) cosθ / p_σ with the sampler's ",
@@ -90,7 +92,11 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     }
     s.push_str("## Results\n\n");
     for g in groups(results) {
-        group_table(&mut s, &g, cfg.n_grid.last().copied().unwrap_or(0));
+        let ranking = results
+            .rankings
+            .iter()
+            .find(|r| r.brdf == g.brdf && r.theta_o == g.theta_o_deg && r.light == g.light);
+        group_table(&mut s, &g, cfg.n_grid.last().copied().unwrap_or(0), ranking);
         for (slug, caption, path) in &assets.plots {
             if *slug == g.slug {
                 let _ = writeln!(s, "![{caption}]({path})\n");
@@ -110,61 +116,91 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     s
 }
 
-/// The outcome in words: the most efficient sampler per group, and where the adaptive family
-/// loses, by how much.
-fn outcome(s: &mut String, results: &StudyResults) {
-    s.push_str("## Outcome\n\n");
-    let mut wins = 0;
-    let mut losses = Vec::new();
-    let mut exact = Vec::new();
-    for g in groups(results) {
-        for c in g.cells.iter().filter(|c| c.ok() && c.zero_variance) {
-            exact.push(format!("{} ({})", c.label(), g.title()));
-        }
-        let ranked = g.by_efficiency();
-        let Some((best, best_eff)) = ranked.first() else {
-            continue;
-        };
-        let best_adaptive = ranked.iter().find(|(c, _)| is_adaptive(&c.sampler));
-        match best_adaptive {
-            Some(_) if is_adaptive(&best.sampler) => wins += 1,
-            Some((a, eff)) => losses.push(format!(
-                "* {}: **{}**{} is the most efficient; the best adaptive sampler, {}{}, is {:.2}× less efficient{} (relative error at N = {}: {} vs {}).",
-                g.title(),
-                best.label(),
-                flag(best),
-                a.label(),
-                flag(a),
-                best_eff / eff,
-                if significant(best, a, best_eff / eff) {
-                    ""
-                } else {
-                    ", within the 95 % intervals of their MSEs"
-                },
-                a.final_error().map_or(0, |e| e.n),
-                pct(a.final_error().map(|e| e.mean_rel_err)),
-                pct(best.final_error().map(|e| e.mean_rel_err)),
-            )),
-            None => {}
-        }
+/// Where and how the study ran.
+fn run_section(s: &mut String, results: &StudyResults) {
+    if results.runs.is_empty() {
+        return;
     }
-    let total = wins + losses.len();
-    if total > 0 {
+    s.push_str("\n## Run\n\n");
+    let fmt_load = |l: &[f64]| {
+        if l.is_empty() {
+            "unknown".to_string()
+        } else {
+            l.iter()
+                .map(|x| format!("{x:.2}"))
+                .collect::<Vec<_>>()
+                .join(" / ")
+        }
+    };
+    for r in &results.runs {
         let _ = writeln!(
             s,
-            "An adaptive sampler is the most efficient (lowest MSE × time at the budget N) in **{wins} of {total}** comparisons.{}\n",
-            if losses.is_empty() {
-                ""
-            } else {
-                " Where it loses:"
-            }
+            "* commit `{}`, CPU {} ({} logical CPUs), {} threads for the statistics (one for the timings); load average (1 / 5 / 15 min) {} at the start, {} at the end; {:.0} s wall, {} CPU.",
+            r.commit,
+            r.cpu_model,
+            r.logical_cpus,
+            r.threads,
+            fmt_load(&r.load_start),
+            fmt_load(&r.load_end),
+            r.wall_seconds,
+            r.cpu_seconds
+                .map_or("unknown".to_string(), |c| format!("{c:.0} s")),
         );
-        for l in &losses {
-            let _ = writeln!(s, "{l}");
+    }
+    let spread = |f: &dyn Fn(&crate::Timing) -> f64| {
+        let mut v: Vec<f64> = results
+            .cells
+            .iter()
+            .filter_map(|c| c.timing.as_ref().map(f))
+            .collect();
+        if v.is_empty() {
+            return None;
         }
-        if !losses.is_empty() {
-            s.push('\n');
-        }
+        v.sort_by(f64::total_cmp);
+        let q = |p: f64| 100.0 * v[((v.len() - 1) as f64 * p).round() as usize];
+        Some(format!(
+            "median {:.1} %, 90th percentile {:.1} %, largest {:.1} %",
+            q(0.5),
+            q(0.9),
+            q(1.0)
+        ))
+    };
+    let clock = results
+        .cells
+        .iter()
+        .find_map(|c| c.timing.map(|t| t.clock))
+        .unwrap_or(crate::Clock::Wall);
+    if let (Some(cpu), Some(wall)) = (
+        spread(&|t| t.estimator_log_sd),
+        spread(&|t| t.estimator_wall_log_sd),
+    ) {
+        let _ = writeln!(
+            s,
+            "* timings on the {} clock; their spread (standard deviation of ln t over the {} interleaved repeats of a cell): {cpu}; on the wall clock: {wall}.",
+            match clock {
+                crate::Clock::ThreadCpu => "timing thread's CPU-time",
+                crate::Clock::Wall => "wall",
+            },
+            results.config.timing_repeats,
+        );
+    }
+}
+
+/// The outcome in words, from the rankings: how often an adaptive sampler is significantly
+/// the most efficient, tied for best, significantly worse; one sentence per comparison naming
+/// the results.csv rows (`index`) it rests on.
+fn outcome(s: &mut String, results: &StudyResults) {
+    s.push_str("## Outcome\n\n");
+    if results.shard.is_some() {
+        s.push_str("This is one shard: the rankings are made on the whole grid by `brdf-lab study merge`.\n\n");
+    } else {
+        let _ = writeln!(
+            s,
+            "Each comparison (BRDF, θo, light; estimator: BRDF sampling alone) names the most efficient sampler (lowest MSE × time at the budget N), the samplers **statistically tied** with it and the ones **significantly worse**: the ratio of efficiencies best / x has an interval that carries the MSE's uncertainty (its 95 % interval and the reference's error) and the time's (the spread of {} interleaved timing repeats, on the timing thread's CPU clock where the platform has one), at the Šidák-corrected level 1 − (1 − α)^(1/m) for the m comparisons with the best, family-wise α = {}; x is tied when the interval contains 1. `(rows …)` are the `index` values of results.csv (one row per N) the sentence rests on. † marks a verdict that the MSEs alone would not give (it rests on the measured times); ⚠ a cell whose spread estimate is unreliable (its interval is optimistic).\n",
+            results.config.timing_repeats,
+            crate::ranking::ALPHA,
+        );
+        verdicts(s, &results.rankings);
     }
     let flagged: Vec<&CellResult> = results
         .cells
@@ -179,6 +215,16 @@ fn outcome(s: &mut String, results: &StudyResults) {
             results.cells.iter().filter(|c| c.ok()).count()
         );
     }
+    let exact: Vec<String> = groups(results)
+        .iter()
+        .flat_map(|g| {
+            g.cells
+                .iter()
+                .filter(|c| c.ok() && c.zero_variance)
+                .map(|c| format!("{} ({}, row {})", c.label(), g.title(), c.index))
+                .collect::<Vec<_>>()
+        })
+        .collect();
     if !exact.is_empty() {
         let _ = writeln!(
             s,
@@ -188,7 +234,152 @@ fn outcome(s: &mut String, results: &StudyResults) {
     }
 }
 
-fn group_table(s: &mut String, g: &Group<'_>, n_max: usize) {
+/// How an adaptive sampler fares in one ranking.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum AdaptiveOutcome {
+    /// An adaptive sampler is best and no other family is tied with it.
+    SignificantlyBest,
+    /// An adaptive sampler is best or tied, and so is another family's.
+    TiedForBest,
+    /// Every adaptive sampler is significantly worse than the best.
+    SignificantlyWorse,
+}
+
+/// The adaptive family's outcome in `r`; `None` when no adaptive sampler was ranked.
+pub(crate) fn adaptive_outcome(r: &Ranking) -> Option<AdaptiveOutcome> {
+    if !r.entries.iter().any(|e| is_adaptive(&e.sampler)) {
+        return None;
+    }
+    let top: Vec<&str> = std::iter::once(r.best.as_str())
+        .chain(r.tied.iter().map(String::as_str))
+        .collect();
+    Some(if !top.iter().any(|t| is_adaptive(t)) {
+        AdaptiveOutcome::SignificantlyWorse
+    } else if top.iter().all(|t| is_adaptive(t)) {
+        AdaptiveOutcome::SignificantlyBest
+    } else {
+        AdaptiveOutcome::TiedForBest
+    })
+}
+
+/// `r× [lo, hi]` of an entry's ratio to the best.
+fn ratio_text(e: &Entry) -> String {
+    match (e.ratio, e.ratio_lo, e.ratio_hi) {
+        (Some(r), Some(lo), Some(hi)) => format!("{r:.2}× [{lo:.2}, {hi:.2}]"),
+        _ => "∞× (the best is exact)".into(),
+    }
+}
+
+/// ` ⚠` and ` †` marks of an entry.
+fn marks(e: &Entry) -> String {
+    format!(
+        "{}{}",
+        if e.unreliable { " ⚠" } else { "" },
+        if e.by_time { " †" } else { "" }
+    )
+}
+
+/// The headline counts and one sentence per comparison.
+pub(crate) fn verdicts(s: &mut String, rankings: &[Ranking]) {
+    let outcomes: Vec<Option<AdaptiveOutcome>> = rankings.iter().map(adaptive_outcome).collect();
+    let count = |o: AdaptiveOutcome| outcomes.iter().filter(|x| **x == Some(o)).count();
+    let with = outcomes.iter().filter(|o| o.is_some()).count();
+    let (wins, ties, losses) = (
+        count(AdaptiveOutcome::SignificantlyBest),
+        count(AdaptiveOutcome::TiedForBest),
+        count(AdaptiveOutcome::SignificantlyWorse),
+    );
+    if with > 0 {
+        let _ = writeln!(
+            s,
+            "**Headline** (significant results only): of {with} comparisons with an adaptive sampler, one is **significantly the most efficient in {wins}**, **tied for best in {ties}** (with another family's sampler inside the interval) and **significantly less efficient than the best in {losses}**.\n"
+        );
+    } else if !rankings.is_empty() {
+        s.push_str("No comparison has a ranked adaptive sampler.\n\n");
+    }
+    for (r, o) in rankings.iter().zip(&outcomes) {
+        let title = format!(
+            "{} at θo = {}° under {}",
+            r.brdf,
+            r.theta_o,
+            short_light(&r.light)
+        );
+        let Some(best) = r.entries.first() else {
+            continue;
+        };
+        let tied: Vec<String> = r
+            .entries
+            .iter()
+            .filter(|e| e.verdict == Verdict::Tied)
+            .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
+            .collect();
+        let tied = if tied.is_empty() {
+            "none tied".to_string()
+        } else {
+            format!("tied: {}", tied.join(", "))
+        };
+        let best_adaptive = r.entries.iter().find(|e| is_adaptive(&e.sampler));
+        let runner_up = r.entries.get(1);
+        let (sentence, rows) = match (o, best_adaptive) {
+            (Some(AdaptiveOutcome::SignificantlyWorse), Some(a)) => (
+                format!(
+                    "**{}**{} is the most efficient ({tied}); the best adaptive sampler, {}{}, is {} less efficient",
+                    best.sampler,
+                    marks(best),
+                    a.sampler,
+                    marks(a),
+                    ratio_text(a)
+                ),
+                vec![best.cell, a.cell],
+            ),
+            (Some(AdaptiveOutcome::SignificantlyBest), _) => (
+                match runner_up {
+                    Some(x) => format!(
+                        "**{}**{} is significantly the most efficient ({tied}); the runner-up, {}{}, is {} less efficient",
+                        best.sampler,
+                        marks(best),
+                        x.sampler,
+                        marks(x),
+                        ratio_text(x)
+                    ),
+                    None => format!(
+                        "**{}**{} is the only sampler ranked",
+                        best.sampler,
+                        marks(best)
+                    ),
+                },
+                std::iter::once(best.cell)
+                    .chain(runner_up.map(|x| x.cell))
+                    .collect(),
+            ),
+            _ => (
+                format!(
+                    "**{}**{} is the most efficient; {tied}",
+                    best.sampler,
+                    marks(best)
+                ),
+                r.entries
+                    .iter()
+                    .filter(|e| e.verdict != Verdict::Worse)
+                    .map(|e| e.cell)
+                    .collect(),
+            ),
+        };
+        let rows: Vec<String> = rows.iter().map(usize::to_string).collect();
+        let _ = writeln!(
+            s,
+            "* {title}: {sentence} (rows {}; {} comparisons, intervals at {:.2} %).",
+            rows.join(", "),
+            r.comparisons,
+            100.0 * r.level
+        );
+    }
+    if !rankings.is_empty() {
+        s.push('\n');
+    }
+}
+
+fn group_table(s: &mut String, g: &Group<'_>, n_max: usize, ranking: Option<&Ranking>) {
     let _ = writeln!(s, "### {}\n", g.title());
     if let Some(c) = g.cells.first() {
         let _ = writeln!(
@@ -197,16 +388,24 @@ fn group_table(s: &mut String, g: &Group<'_>, n_max: usize) {
             c.reference.value, c.reference.abs_err, c.reference.method
         );
     }
-    let best = g.by_efficiency().first().map(|b| b.1);
     let _ = writeln!(
         s,
-        "| sampler | rel. error at N = {n_max} | variance / sample | MSE / sample at N = {n_max} | evals / sample | memory | build † | ns / sample † (sampler / estimator) | efficiency † | vs best |"
+        "| row | sampler | rel. error at N = {n_max} | variance / sample | MSE / sample at N = {n_max} | evals / sample | memory | build † | ns / sample † (sampler / estimator [min–max]) | efficiency † | verdict | best / this [interval] |"
     );
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for c in &g.cells {
-        row(s, c, best);
+        row(s, c, ranking.and_then(|r| r.entry(&c.label())));
     }
     s.push('\n');
+    if let Some(r) = ranking {
+        let _ = writeln!(
+            s,
+            "Verdicts: {} comparisons with the best, intervals at {:.2} % each (Šidák, family-wise {:.0} %).\n",
+            r.comparisons,
+            100.0 * r.level,
+            100.0 * (1.0 - r.alpha)
+        );
+    }
     for c in g.cells.iter().filter(|c| c.ok() && !c.warnings.is_empty()) {
         let _ = writeln!(s, "* ⚠ {}: {}.", c.label(), c.warnings.join("; "));
     }
@@ -215,27 +414,19 @@ fn group_table(s: &mut String, g: &Group<'_>, n_max: usize) {
     }
 }
 
-/// Whether an efficiency ratio `ratio` ≥ 1 between cells `a` and `b` exceeds the combined
-/// 95 % half-width of their MSEs (relative, in quadrature; timings taken as exact).
-fn significant(a: &CellResult, b: &CellResult, ratio: f64) -> bool {
-    let rel = |c: &CellResult| {
-        if c.mse.value > 0.0 {
-            c.mse.ci95 / c.mse.value
-        } else {
-            0.0
-        }
-    };
-    ratio - 1.0 > (rel(a).powi(2) + rel(b).powi(2)).sqrt()
-}
-
 /// ` ⚠` for a cell whose spread estimate is unreliable.
 fn flag(c: &CellResult) -> &'static str {
     if c.warnings.is_empty() { "" } else { " ⚠" }
 }
 
-fn row(s: &mut String, c: &CellResult, best: Option<f64>) {
+fn row(s: &mut String, c: &CellResult, entry: Option<&Entry>) {
     if let Some(why) = &c.status {
-        let _ = writeln!(s, "| {} | — {why} | | | | | | | | |", c.label());
+        let _ = writeln!(
+            s,
+            "| {} | {} | — {why} | | | | | | | | | |",
+            c.index,
+            c.label()
+        );
         return;
     }
     let e = c.final_error();
@@ -243,7 +434,8 @@ fn row(s: &mut String, c: &CellResult, best: Option<f64>) {
     let eff = t.and_then(|t| t.efficiency);
     let _ = writeln!(
         s,
-        "| {}{} | {} ± {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |",
+        "| {} | {}{} | {} ± {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
+        c.index,
         c.label(),
         flag(c),
         pct(e.map(|e| e.mean_rel_err)),
@@ -265,14 +457,19 @@ fn row(s: &mut String, c: &CellResult, best: Option<f64>) {
         bytes(c.bytes),
         t.map_or("—".into(), |t| format!("{:.3} s", t.build_seconds)),
         t.map_or("—".into(), |t| format!(
-            "{:.0} / {:.0}",
-            t.sample_ns, t.estimator_ns
+            "{:.0} / {:.0} [{:.0}–{:.0}]",
+            t.sample_ns, t.estimator_ns, t.estimator_ns_min, t.estimator_ns_max
         )),
         eff.map_or("∞ (exact)".into(), |e| format!("{e:.3e}")),
-        match (eff, best) {
-            (Some(e), Some(b)) if e > 0.0 => format!("{:.2}×", b / e),
-            _ => "—".into(),
-        },
+        entry.map_or("—".into(), |e| format!(
+            "{}{}",
+            e.verdict.as_str(),
+            if e.by_time { " †" } else { "" }
+        )),
+        entry.map_or("—".into(), |e| match e.verdict {
+            Verdict::Best => "1".into(),
+            _ => ratio_text(e),
+        }),
     );
 }
 
@@ -290,5 +487,81 @@ pub(crate) fn bytes(b: usize) -> String {
         format!("{:.1} KiB", b / 1024.0)
     } else {
         format!("{:.2} MiB", b / 1024.0 / 1024.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ranking::synthetic::cell;
+    use crate::ranking::{ALPHA, ESTIMATOR_BRDF, rank_cells};
+
+    /// Four comparisons in which an adaptive sampler has the best point estimate in three:
+    /// a clear win, a win inside the intervals of another family's sampler (a tie), a tie in
+    /// which another family leads, and a clear loss. The headline counts 1 win, 2 ties,
+    /// 1 loss — not 3 wins of 4 — and every sentence names its rows.
+    #[test]
+    fn the_headline_counts_only_significant_wins_and_losses() {
+        let comparisons = [
+            // Clear win.
+            vec![
+                cell(0, "adaptive", "ggx", 1.0, 0.05, 100.0, 0.02),
+                cell(1, "cosine", "ggx", 4.0, 0.2, 100.0, 0.02),
+            ],
+            // Point-estimate win, tied with analytic.
+            vec![
+                cell(2, "adaptive-paper (batch)", "phong", 1.0, 0.4, 100.0, 0.02),
+                cell(3, "analytic", "phong", 1.2, 0.3, 100.0, 0.02),
+                cell(4, "uniform", "phong", 40.0, 2.0, 100.0, 0.02),
+            ],
+            // Analytic leads, adaptive tied.
+            vec![
+                cell(5, "analytic", "ward", 1.0, 0.3, 100.0, 0.02),
+                cell(6, "adaptive", "ward", 1.1, 0.3, 100.0, 0.02),
+            ],
+            // Clear loss.
+            vec![
+                cell(7, "lobe-sphere", "cook-torrance", 1.0, 0.05, 100.0, 0.02),
+                cell(
+                    8,
+                    "adaptive-mixture",
+                    "cook-torrance",
+                    2.0,
+                    0.1,
+                    100.0,
+                    0.02,
+                ),
+            ],
+        ];
+        let rankings: Vec<Ranking> = comparisons
+            .iter()
+            .map(|cells| {
+                let refs: Vec<&CellResult> = cells.iter().collect();
+                rank_cells(&refs, ESTIMATOR_BRDF, ALPHA, true).unwrap()
+            })
+            .collect();
+        let outcomes: Vec<_> = rankings.iter().map(adaptive_outcome).collect();
+        assert_eq!(
+            outcomes,
+            [
+                Some(AdaptiveOutcome::SignificantlyBest),
+                Some(AdaptiveOutcome::TiedForBest),
+                Some(AdaptiveOutcome::TiedForBest),
+                Some(AdaptiveOutcome::SignificantlyWorse),
+            ]
+        );
+        let mut s = String::new();
+        verdicts(&mut s, &rankings);
+        assert!(
+            s.contains("of 4 comparisons with an adaptive sampler, one is **significantly the most efficient in 1**, **tied for best in 2**")
+                && s.contains("**significantly less efficient than the best in 1**"),
+            "{s}"
+        );
+        let sentences: Vec<&str> = s.lines().filter(|l| l.starts_with("* ")).collect();
+        assert_eq!(sentences.len(), 4);
+        assert!(sentences[0].contains("(rows 0, 1;"), "{}", sentences[0]);
+        assert!(sentences[1].contains("(rows 2, 3;"), "{}", sentences[1]);
+        assert!(sentences[3].contains("(rows 7, 8;"), "{}", sentences[3]);
+        assert!(sentences[3].contains("the best adaptive sampler, adaptive-mixture, is 2.00× ["));
     }
 }

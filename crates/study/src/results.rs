@@ -1,12 +1,13 @@
 //! A study's results: per-cell numbers, the JSON and CSV forms, and merging shards.
 //!
-//! # `results.json` schema (`"schema": "brdf-lab-study/2"`)
+//! # `results.json` schema (`"schema": "brdf-lab-study/3"`)
 //!
 //! ```text
 //! {
-//!   "schema": "brdf-lab-study/2",
+//!   "schema": "brdf-lab-study/3",
 //!   "config": { preset, samplers[], brdfs[], theta_o_deg[], lights[], n_grid[], repetitions,
-//!               variance_samples, timing_samples, timing_repeats, slices, seed },
+//!               batch_repetitions, variance_samples, timing_samples, timing_repeats, slices,
+//!               seed },
 //!   "shard": null | { "index": K, "count": N },      // K from 1
 //!   "total_cells": number of cells of the whole grid,
 //!   "notes": [ "…" ],                                 // e.g. a missing map file
@@ -23,16 +24,39 @@
 //!       "tail_share": largest share of Σ(y − ȳ)² held by one value,
 //!       "warnings": [ "…" ],               // why the spread estimate is unreliable
 //!       "errors": [ { "n", "mean_rel_err", "ci95", "rms_rel_err", "variance_per_sample" } ],
-//!       "timing": { "build_seconds", "sample_ns", "estimator_ns", "efficiency" }  // TIMINGS
+//!       "timing": { "clock" ("thread-cpu" | "wall"), "build_seconds", "sample_ns",
+//!                   "estimator_ns", "estimator_ns_min", "estimator_ns_max",
+//!                   "estimator_log_sd", "estimator_wall_ns", "estimator_wall_log_sd",
+//!                   "repeats", "efficiency" }                           // TIMINGS
+//!   } ],
+//!   "runs": [ { "commit", "cpu_model", "logical_cpus", "threads", "load_start": [1, 5, 15 min],
+//!               "load_end", "wall_seconds", "cpu_seconds" } ],        // one per run / shard
+//!   "rankings": [ {                                   // empty for a shard; module `ranking`
+//!       "brdf", "theta_o", "light", "estimator" ("brdf"),
+//!       "best": label, "tied": [label], "worse": [label],   // label: `sampler` or `sampler (batch)`
+//!       "alpha", "rule" ("sidak"), "comparisons" (m), "level" (of each interval),
+//!       "entries": [ { "sampler", "cell" (the cell's index), "verdict", "efficiency",
+//!                      "se_log_efficiency", "se_log_mse", "se_log_time", "ratio", "ratio_lo",
+//!                      "ratio_hi", "by_time", "unreliable", "evaluations_per_sample" } ],
+//!       "excluded": [ { "sampler", "cell", "reason" } ]
 //!   } ]
 //! }
 //! ```
 //!
-//! Everything outside `timing` depends only on the config (seed included): equal on rerun, for
+//! Everything outside `timing`, `runs` and `rankings` depends only on the config (seed included): equal on rerun, for
 //! any thread count, and between one run and merged shards. `timing` holds the only measured
 //! times: build time, time per sample of the sampler alone and of the whole estimator
 //! (single-threaded, median of the repeats) and the efficiency 1 / (variance × estimator time
 //! per sample in seconds), the MSE at the budget N standing in for the variance.
+//!
+//! ## Changes from `brdf-lab-study/2`
+//!
+//! * new `rankings` and `runs`; `config.batch_repetitions` (batch-mode cells use
+//!   `max(repetitions, batch_repetitions)` estimates per N);
+//! * `timing`: times are on the timing thread's CPU clock where the platform has one (`clock`),
+//!   the wall-clock median beside; the repeats are interleaved across cells and their spread
+//!   recorded (`estimator_ns_min`, `estimator_ns_max`, `estimator_log_sd`, …, `repeats`).
+//!   Version 2 files are refused by `study merge`.
 //!
 //! ## Changes from `brdf-lab-study/1`
 //!
@@ -48,10 +72,12 @@ use std::collections::BTreeSet;
 use serde::{Deserialize, Serialize};
 
 use crate::dispersion::BudgetMse;
+use crate::machine::RunInfo;
+use crate::ranking::Ranking;
 use crate::{Mode, Reference, Shard, StudyConfig, StudyError};
 
 /// Version tag of [`StudyResults`]' JSON form.
-pub const SCHEMA: &str = "brdf-lab-study/2";
+pub const SCHEMA: &str = "brdf-lab-study/3";
 
 /// A value with the half-width of its 95 % confidence interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -78,15 +104,44 @@ pub struct ErrorAtN {
     pub variance_per_sample: f64,
 }
 
+/// The clock of a cell's per-sample times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Clock {
+    /// The timing thread's CPU time (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`).
+    ThreadCpu,
+    /// Wall time (platforms without a thread CPU clock).
+    Wall,
+}
+
 /// Measured times of a cell (the only time-dependent numbers of a study).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
+    /// The clock of the per-sample times: `thread-cpu` (the timing thread's CPU time, which
+    /// does not count the time other processes hold the core) where the platform gives it,
+    /// else `wall`.
+    pub clock: Clock,
     /// Time to build the sampler for this BRDF (s); 0 for samplers without a structure.
     pub build_seconds: f64,
     /// Time per sample of the sampler alone (ns), single-threaded, median of the repeats.
     pub sample_ns: f64,
-    /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns).
+    /// Time per sample of the whole estimator: sampling, `f_r`, `L`, `cos / pdf` (ns), median
+    /// of the repeats.
     pub estimator_ns: f64,
+    /// Fastest repeat of the estimator (ns per sample).
+    pub estimator_ns_min: f64,
+    /// Slowest repeat of the estimator (ns per sample).
+    pub estimator_ns_max: f64,
+    /// Sample standard deviation of `ln(estimator ns)` over the repeats (the timing spread
+    /// the rankings carry; 0 with one repeat).
+    pub estimator_log_sd: f64,
+    /// Wall-clock time per sample of the whole estimator (ns), median of the repeats (equal to
+    /// [`Self::estimator_ns`] when `clock` is `wall`).
+    pub estimator_wall_ns: f64,
+    /// Sample standard deviation of `ln(wall ns)` over the repeats.
+    pub estimator_wall_log_sd: f64,
+    /// Timing repeats (interleaved with the other cells').
+    pub repeats: usize,
     /// `1 / (MSE per sample at the budget N × estimator time per sample in s)` (the cell's
     /// [`CellResult::mse`]); `None` when it is 0.
     pub efficiency: Option<f64>,
@@ -190,6 +245,11 @@ pub struct StudyResults {
     pub lights: Vec<LightInfo>,
     /// The cells run, by index.
     pub cells: Vec<CellResult>,
+    /// Where and how it ran (one per run; a merged study lists its shards').
+    pub runs: Vec<RunInfo>,
+    /// One ranking per comparison (module [`crate::ranking`]); empty for a shard (`study
+    /// merge` ranks the whole grid).
+    pub rankings: Vec<Ranking>,
 }
 
 impl StudyResults {
@@ -219,6 +279,8 @@ impl StudyResults {
     pub fn without_timing(&self) -> Self {
         Self {
             cells: self.cells.iter().map(CellResult::without_timing).collect(),
+            runs: Vec::new(),
+            rankings: Vec::new(),
             ..self.clone()
         }
     }
@@ -227,7 +289,7 @@ impl StudyResults {
     /// header. Fields are quoted where needed (BRDF specs contain commas).
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
-            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],efficiency[timing]\n",
+            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],estimator_wall_ns[timing],efficiency[timing]\n",
         );
         for c in &self.cells {
             let t = c.timing;
@@ -235,6 +297,10 @@ impl StudyResults {
                 t.map(|t| t.build_seconds),
                 t.map(|t| t.sample_ns),
                 t.map(|t| t.estimator_ns),
+                t.map(|t| t.estimator_ns_min),
+                t.map(|t| t.estimator_ns_max),
+                t.map(|t| t.estimator_log_sd),
+                t.map(|t| t.estimator_wall_ns),
                 t.and_then(|t| t.efficiency),
             ]
             .map(opt);
@@ -332,7 +398,7 @@ impl StudyResults {
                 "the shards do not cover every cell once (missing shards: {missing})"
             ));
         }
-        Ok(Self {
+        let mut merged = Self {
             schema: SCHEMA.to_string(),
             config: first.config.clone(),
             shard: None,
@@ -340,7 +406,11 @@ impl StudyResults {
             notes: first.notes.clone(),
             lights: first.lights.clone(),
             cells,
-        })
+            runs: parts.iter().flat_map(|p| p.runs.iter().cloned()).collect(),
+            rankings: Vec::new(),
+        };
+        merged.rankings = crate::ranking::rankings(&merged);
+        Ok(merged)
     }
 }
 

@@ -55,6 +55,27 @@ fn one_run_equals_three_merged_shards_and_any_thread_count() {
         whole.without_timing().to_json()
     );
     assert_eq!(run(None, 1).without_timing(), whole.without_timing());
+    // Rankings: one per comparison (BRDF × θo), made on the whole grid only.
+    assert!(shards.iter().all(|s| s.rankings.is_empty()));
+    assert_eq!(whole.rankings.len(), 4);
+    assert_eq!(merged.rankings.len(), 4);
+    assert_eq!(merged.runs.len(), 3);
+    let json: serde_json::Value = serde_json::from_str(&whole.to_json()).unwrap();
+    for r in json["rankings"].as_array().unwrap() {
+        for key in [
+            "brdf",
+            "theta_o",
+            "light",
+            "estimator",
+            "best",
+            "tied",
+            "worse",
+        ] {
+            assert!(r.get(key).is_some(), "missing {key}");
+        }
+        let named = 1 + r["tied"].as_array().unwrap().len() + r["worse"].as_array().unwrap().len();
+        assert_eq!(named, r["entries"].as_array().unwrap().len());
+    }
     // Timings are the only difference a rerun may show.
     assert_ne!(whole.cells[2].timing, None);
 }
