@@ -273,7 +273,7 @@ impl Interval {
 ///
 /// Isotropic BRDFs use `v = cos θo`: `A` is then an even function of `θo` (`ωo` at `−θo` is
 /// `ωo` at `θo` turned by π), hence a smooth function of `cos θo` up to normal incidence, and
-/// a query needs no `acos`. Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
+/// a query needs no `acos` — unless the BRDF is a table linear in θo (see [`table_var`]). Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
 /// is not even in `θo` at a fixed azimuth, and `cos θo` would put a square-root singularity at
 /// normal incidence).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -838,7 +838,12 @@ impl ExactSet {
         options.validate()?;
         let start = Instant::now();
         let isotropic = brdf.is_isotropic();
-        let var = table_var(isotropic);
+        let kinks = if follow_kinks {
+            theta_kinks(brdf.as_ref())
+        } else {
+            Vec::new()
+        };
+        let var = table_var(isotropic, !kinks.is_empty());
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
         let layout = layout_for(
             brdf.as_ref(),
@@ -850,11 +855,6 @@ impl ExactSet {
         let (period, n_cells) = (layout.phi_period(), layout.phi);
         let phi_of = |k: usize| layout.phi_of(k);
         let min_width = options.min_width_deg.to_radians();
-        let kinks = if follow_kinks {
-            theta_kinks(brdf.as_ref())
-        } else {
-            Vec::new()
-        };
         let breaks = initial_breaks(options.initial_intervals, &kinks).map(|b| {
             let mut a = [std::f64::consts::FRAC_PI_2; MAX_BREAKS + 1];
             a[..b.len()].copy_from_slice(&b);
@@ -1267,9 +1267,12 @@ struct Built {
     axis: Option<bool>,
 }
 
-/// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell).
-fn table_var(isotropic: bool) -> TableVar {
-    if isotropic {
+/// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell; `tabulated`:
+/// the BRDF has kinks in θo, [`theta_kinks`]). A table interpolated linearly in θo (RGL) makes
+/// `A` a function of `|θo|` with a kink at normal incidence, i.e. a square root of `1 − cos θo`:
+/// its sets keep `v = θo` (on `cc_ibiza_sunset` the `cos θo` table was 4e-4 off at 1.1°).
+fn table_var(isotropic: bool, tabulated: bool) -> TableVar {
+    if isotropic && !tabulated {
         TableVar::Cos
     } else {
         TableVar::Theta
