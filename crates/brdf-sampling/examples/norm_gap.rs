@@ -3,7 +3,7 @@
 //! item 4).
 //!
 //! `cargo run --release -p brdf-sampling --example norm_gap -- --spec SPEC [--angles 180]
-//!   [--n 1024] [--check-n 2048] [--adaptive] [--at θ,θ,…]`
+//!   [--n 1024] [--check-n 2048] [--adaptive] [--at θ,θ,…] [--write-merl PATH]`
 //!
 //! `SPEC` is a model spec (`rgl:PATH`, `cornell:PATH`, `merl:PATH`, …) or `merl(SPEC)`: the
 //! model `SPEC` tabulated in the MERL layout (nearest-bin lookup, `MerlBrdf::tabulate`).
@@ -105,6 +105,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|t| format!("{:.2}", t.to_degrees()))
             .collect();
         println!("θo slices of the table (°): {}", deg.join(", "));
+    }
+    if let Some(path) = arg::<String>(&args, "--write-merl") {
+        // The MERL layout of `merl(SPEC)` as a file (for `brdf-lab sample --brdf merl:PATH`).
+        let inner = spec
+            .strip_prefix("merl(")
+            .and_then(|s| s.strip_suffix(')'))
+            .ok_or("--write-merl needs --spec 'merl(SPEC)'")?;
+        MerlBrdf::tabulate(&*parse_spec(inner)?).write(std::path::Path::new(&path))?;
+        println!("wrote {path}");
+        return Ok(());
     }
     let opts = ExactOptions::with_set(SetOptions::default());
     let (c0, t0) = (cpu_seconds(), Instant::now());
