@@ -20,7 +20,7 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout, SliceLocator};
-use crate::normalisation::{Grading, leaf_quadrature, per_leaf_quadrature};
+use crate::normalisation::{Grading, per_leaf_quadrature};
 use crate::options::SetOptions;
 use crate::report::{CostMeasurement, SetReport};
 
@@ -268,8 +268,14 @@ fn build_slice(
                 f: &f,
                 counter: &counter,
             };
-            let (i_leaves, rel_err) =
-                leaf_quadrature(&counted, tree.leaves(), tree.integral(), mirror_y);
+            let q = per_leaf_quadrature(
+                &counted,
+                tree.leaves(),
+                tree.integral(),
+                mirror_y,
+                Grading::Fixed,
+            );
+            let (i_leaves, rel_err) = (q.total, q.rel_err);
             // Keep the grid's Î when its own error estimate is the smaller one and is not
             // contradicted by the leaf rule: when the two integrals differ by more than the
             // grid claims, the grid's estimate is wrong and the (higher-order, adaptive) leaf
@@ -284,7 +290,9 @@ fn build_slice(
             {
                 SliceNorm {
                     factor: tree.integral() / i_leaves,
-                    rel_err: Some(rel_err),
+                    // The choice above uses the worst-case estimate; the pdf declares the
+                    // tighter one (`LeafIntegrals::declared_rel_err`, issue 27).
+                    rel_err: Some(q.declared_rel_err()),
                 }
             } else {
                 SliceNorm {

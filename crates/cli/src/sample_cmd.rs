@@ -119,12 +119,11 @@ pub(crate) fn run(args: &SampleArgs, given: &Given) -> CliResult<()> {
     }
     let mean = sum / n as f64;
     let std_err = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-    // An adaptive set's pdf is normalised by a quadrature whose relative error it estimates:
-    // a systematic error of the estimate that no number of samples averages away.
-    let normalisation = match &built {
-        brdf_args::Built::Set(set) => set.report().max_integral_rel_err.map(|e| e * mean.abs()),
-        brdf_args::Built::Other(_) => None,
-    };
+    // A sampler whose pdf is normalised by a quadrature declares that quadrature's relative
+    // error at ωo: a systematic error of the estimate that no number of samples averages
+    // away. The error at this ωo, not the largest over the set's slices (issue 27: a grazing
+    // slice's 7.9e-2 made the check unable to fail at θo = 40°).
+    let normalisation = sampler.normaliser_rel_err(&wo).map(|e| e * mean.abs());
     eprintln!(
         "albedo     {}",
         albedo_summary(brdf.as_ref(), &wo, mean, std_err, normalisation)

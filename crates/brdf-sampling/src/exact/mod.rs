@@ -41,7 +41,11 @@
 //! θ (δ) interpolation tail exceeds [`ExactOptions::normaliser_tol`] (or the quadrature's own
 //! error estimate, if larger: below it the tail is quadrature noise), down to
 //! [`ExactOptions::min_width_deg`]: sharp lobes and grazing angles get narrow intervals, smooth
-//! models keep the initial ones. Too many trials halve θ, or δ when the bound nodes'
+//! models keep the initial ones. The initial intervals are also cut at the BRDF's known
+//! **kinks in θo** ([`theta_kinks`]: the θo slices of an RGL table, linear in θo between
+//! them), so that no interval's Chebyshev table has to follow a kink of `A(θo)` (on the RGL
+//! fixture `|A/Â − 1|` went from 2.1e-3 next to a slice to below 1e-4 up to 85°, issue 27).
+//! Too many trials halve θ, or δ when the bound nodes'
 //! densities overlap clearly less along δ than along θ and the azimuth loss alone explains the
 //! excess (`split_axis`): an anisotropic lobe far from the normal gets narrow azimuth cells, the
 //! rest of the hemisphere wide ones. The layout is reported by [`ExactSet::report`].
@@ -269,7 +273,7 @@ impl Interval {
 ///
 /// Isotropic BRDFs use `v = cos θo`: `A` is then an even function of `θo` (`ωo` at `−θo` is
 /// `ωo` at `θo` turned by π), hence a smooth function of `cos θo` up to normal incidence, and
-/// a query needs no `acos`. Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
+/// a query needs no `acos` — unless the BRDF is a table linear in θo (see [`table_var`]). Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
 /// is not even in `θo` at a fixed azimuth, and `cos θo` would put a square-root singularity at
 /// normal incidence).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -659,28 +663,56 @@ impl Job {
     }
 }
 
-/// Exact interval edges and bound nodes: `θ = (π/2) · num / den` with one denominator for the
-/// whole set, so that a node shared by a split interval and its children is the same rational,
-/// hence the same `f64` (a correctly rounded quotient) and the same `ωo` bits.
+/// Exact interval edges and bound nodes: a θ numerator `num` over `2^EDGE_BITS` (or a node's
+/// `k` over `m · 2^EDGE_BITS`) names a point of the initial interval `i = ⌊num / 2^EDGE_BITS⌋`,
+/// at the fraction `rem / 2^EDGE_BITS` of it. One rational for every point of the set, so that
+/// a node shared by a split interval and its children is the same rational, hence the same
+/// `f64` (one correctly rounded quotient) and the same `ωo` bits.
+///
+/// The initial intervals are uniform (`θ = (π/2) · num / den`, `den = n0 · 2^EDGE_BITS`), or,
+/// when the BRDF has kinks in θo ([`theta_kinks`]), cut at those kinks as well
+/// (`θ = b_i + (b_{i+1} − b_i) · rem / 2^EDGE_BITS` over the breaks `b`): every interval is then
+/// a range where `A(θo)` is smooth, and its Chebyshev table converges.
 #[derive(Debug, Clone, Copy)]
 struct Grid {
-    /// Denominator of the interval edges: `initial_intervals · 2^EDGE_BITS`.
+    /// Denominator of the interval edges: `initial intervals · 2^EDGE_BITS`.
     den: u64,
     /// `bound_nodes − 1`: node `n` of `[a, b]` is `(a·m + (b − a)·n) / (den·m)`.
     m: u64,
     /// Half-width of the azimuth cells (0: isotropic); `δ = h · (2 · num / 2^EDGE_BITS − 1)`.
     half: f64,
+    /// The initial intervals' edges (radians, `breaks[0..=n0]`) when they are not uniform.
+    breaks: Option<[f64; MAX_BREAKS + 1]>,
 }
 
 /// Halvings an initial interval can take (far below any useful `min_width_deg`).
 const EDGE_BITS: u32 = 40;
 
+/// Most initial intervals a set can start from when they are cut at the BRDF's kinks (a BRDF
+/// with more kinks than fit keeps the uniform intervals).
+const MAX_BREAKS: usize = 128;
+
 impl Grid {
-    fn theta(num: u64, den: u64) -> f64 {
-        std::f64::consts::FRAC_PI_2 * (num as f64 / den as f64)
+    /// The θ of the rational `k / (m · 2^EDGE_BITS)` (in initial intervals).
+    fn angle(&self, k: u64, m: u64) -> f64 {
+        match &self.breaks {
+            None => std::f64::consts::FRAC_PI_2 * (k as f64 / (self.den * m) as f64),
+            Some(b) => {
+                let unit = m << EDGE_BITS;
+                let n0 = (self.den >> EDGE_BITS) as usize;
+                let (i, rem) = ((k / unit) as usize, k % unit);
+                if i >= n0 {
+                    b[n0]
+                } else if rem == 0 {
+                    b[i]
+                } else {
+                    b[i] + (b[i + 1] - b[i]) * (rem as f64 / unit as f64)
+                }
+            }
+        }
     }
     fn edge(&self, num: u64) -> f64 {
-        Self::theta(num, self.den)
+        self.angle(num, 1)
     }
     /// The azimuth offset of the numerator `num` (over `2^EDGE_BITS`).
     fn delta(&self, num: u64) -> f64 {
@@ -694,8 +726,54 @@ impl Grid {
     /// Numerator (over `den · m`) and angle of bound node `n` of the interval `num`.
     fn node(&self, num: [u64; 2], n: u64) -> (u64, f64) {
         let k = num[0] * self.m + (num[1] - num[0]) * n;
-        (k, Self::theta(k, self.den * self.m))
+        (k, self.angle(k, self.m))
     }
+}
+
+/// Outgoing polar angles (radians, inside `(0, π/2)`, increasing) where `A(θo)` is known to
+/// have a kink: the θo slices of an RGL table, which is linear in θo between them
+/// ([`brdf::RglBrdf::theta_slices`]). Empty for every other BRDF.
+pub(crate) fn theta_kinks(brdf: &dyn Brdf) -> Vec<f64> {
+    let Some(rgl) = brdf
+        .as_any()
+        .and_then(|a| a.downcast_ref::<brdf::RglBrdf>())
+    else {
+        return Vec::new();
+    };
+    let eps = 1e-6;
+    let mut k: Vec<f64> = rgl
+        .theta_slices()
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite() && *t > eps && *t < std::f64::consts::FRAC_PI_2 - eps)
+        .collect();
+    k.sort_by(f64::total_cmp);
+    k.dedup_by(|a, b| (*a - *b).abs() <= eps);
+    k
+}
+
+/// Uniform edges closer to a kink than this (degrees) are dropped: the kink replaces them.
+const KINK_MERGE_DEG: f64 = 2.0;
+
+/// The initial intervals' edges: `n0` uniform ones, cut at the `kinks` too (a uniform edge
+/// within [`KINK_MERGE_DEG`] of a kink gives way to it); `None` without kinks, or with more
+/// than [`MAX_BREAKS`] intervals.
+fn initial_breaks(n0: usize, kinks: &[f64]) -> Option<Vec<f64>> {
+    if kinks.is_empty() {
+        return None;
+    }
+    let merge = KINK_MERGE_DEG.to_radians();
+    let mut b: Vec<f64> = (0..=n0)
+        .map(|i| std::f64::consts::FRAC_PI_2 * (i as f64 / n0 as f64))
+        .filter(|&t| {
+            let end = t == 0.0 || t == std::f64::consts::FRAC_PI_2;
+            end || kinks.iter().all(|k| (k - t).abs() >= merge)
+        })
+        .collect();
+    b.extend_from_slice(kinks);
+    b.sort_by(f64::total_cmp);
+    b.dedup();
+    (b.len() <= MAX_BREAKS + 1).then_some(b)
 }
 
 /// BRDFs slower than this per evaluation (nanoseconds) keep their bound nodes' values for the
@@ -743,22 +821,29 @@ impl ExactSet {
         options: &ExactOptions,
         progress: Option<crate::Progress<'_>>,
     ) -> Result<Self, ExactError> {
-        Self::build_with(brdf, options, progress, None)
+        Self::build_with(brdf, options, progress, None, true)
     }
 
     /// [`ExactSet::build`]; `cache` forces the node-value cache on or off (`None`: on for
     /// isotropic BRDFs slower than [`CACHE_ABOVE_NS`] per evaluation). The set is the same
-    /// either way.
+    /// either way. `follow_kinks: false` keeps the uniform initial intervals also for a BRDF
+    /// with kinks in θo (the behaviour before issue 27, for comparisons).
     fn build_with(
         brdf: Arc<dyn Brdf>,
         options: &ExactOptions,
         progress: Option<crate::Progress<'_>>,
         cache: Option<bool>,
+        follow_kinks: bool,
     ) -> Result<Self, ExactError> {
         options.validate()?;
         let start = Instant::now();
         let isotropic = brdf.is_isotropic();
-        let var = table_var(isotropic);
+        let kinks = if follow_kinks {
+            theta_kinks(brdf.as_ref())
+        } else {
+            Vec::new()
+        };
+        let var = table_var(isotropic, !kinks.is_empty());
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
         let layout = layout_for(
             brdf.as_ref(),
@@ -770,7 +855,12 @@ impl ExactSet {
         let (period, n_cells) = (layout.phi_period(), layout.phi);
         let phi_of = |k: usize| layout.phi_of(k);
         let min_width = options.min_width_deg.to_radians();
-        let n0 = options.initial_intervals as u64;
+        let breaks = initial_breaks(options.initial_intervals, &kinks).map(|b| {
+            let mut a = [std::f64::consts::FRAC_PI_2; MAX_BREAKS + 1];
+            a[..b.len()].copy_from_slice(&b);
+            (b.len() - 1, a)
+        });
+        let n0 = breaks.map_or(options.initial_intervals, |(n, _)| n) as u64;
         let grid = Grid {
             den: n0 << EDGE_BITS,
             m: options.bound_nodes as u64 - 1,
@@ -779,6 +869,7 @@ impl ExactSet {
             } else {
                 0.5 * period / n_cells as f64
             },
+            breaks: breaks.map(|(_, a)| a),
         };
         // Bit-identical results either way; the cache only pays for expensive isotropic
         // BRDFs. Anisotropic intervals spend most of their evaluations on the normaliser
@@ -1176,9 +1267,12 @@ struct Built {
     axis: Option<bool>,
 }
 
-/// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell).
-fn table_var(isotropic: bool) -> TableVar {
-    if isotropic {
+/// The table variable of a set (`isotropic`: the BRDF's, i.e. one azimuth cell; `tabulated`:
+/// the BRDF has kinks in θo, [`theta_kinks`]). A table interpolated linearly in θo (RGL) makes
+/// `A` a function of `|θo|` with a kink at normal incidence, i.e. a square root of `1 − cos θo`:
+/// its sets keep `v = θo` (on `cc_ibiza_sunset` the `cos θo` table was 4e-4 off at 1.1°).
+fn table_var(isotropic: bool, tabulated: bool) -> TableVar {
+    if isotropic && !tabulated {
         TableVar::Cos
     } else {
         TableVar::Theta
