@@ -190,3 +190,25 @@ mod bytes {
         }
     }
 }
+
+/// A saved set found by `fuzz_readers set 1000000 1` (execution 687685): one edit leaves it
+/// decodable, but its stored tree no longer fits the density, and each sample ran the full
+/// `MAX_TRIALS_PER_SAMPLE` rejection trials (1.5 s for 10 draws). It is refused at load time.
+/// (Saved with format version 5 from the fuzzer's seed: `phong:n=50`, 3 slices, grid 32,
+/// depth 4; regenerate with `FUZZ_DUMP=687685` if the format changes.)
+#[test]
+fn a_set_whose_tree_does_not_fit_its_density_is_refused() {
+    let bytes = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz-slow-set.brqs"),
+    )
+    .expect("fixture");
+    assert_eq!(bytes[4..8], SET_FORMAT_VERSION.to_le_bytes());
+    let t = std::time::Instant::now();
+    let r = QuadTreeSet::from_bytes(&bytes, brdf("phong:n=50"), "phong:n=50");
+    assert!(
+        matches!(r, Err(SetFileError::Corrupt(ref m)) if m.contains("does not fit")),
+        "{:?}",
+        r.err()
+    );
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+}
