@@ -212,3 +212,13 @@ fn a_set_whose_tree_does_not_fit_its_density_is_refused() {
     );
     assert!(t.elapsed().as_secs_f64() < 0.5);
 }
+
+/// The load-time fit check accepts built sets of sharp and grazing lobes (no false refusal).
+#[test]
+fn sets_of_sharp_lobes_reload() {
+    for spec in ["ggx:alpha=0.02", "phong:n=5000", "blinn:n=150"] {
+        let set = build(spec, Variant::Adaptive, &test_options());
+        let back = QuadTreeSet::from_bytes(&set.to_bytes(), brdf(spec), spec);
+        assert!(back.is_ok(), "{spec}: {:?}", back.err());
+    }
+}
