@@ -111,7 +111,7 @@ pub use exact::{CellLayout, ExactError, ExactOptions, ExactReport, ExactSet};
 pub use layout::{SliceChoice, SliceLayout, SliceLocator, Turn};
 pub use options::{DiscMapPolicy, OptionsError, SetOptions};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};
-pub use persist::SET_FORMAT_VERSION;
+pub use persist::{MAX_LOADED_MEAN_TRIALS, SET_FORMAT_VERSION};
 pub use reference::{
     AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,
     reference_albedo_with_budget,

@@ -29,6 +29,14 @@ const MAGIC: &[u8; 4] = b"BRQS";
 /// Relative tolerance of the BRDF probe check on load.
 const PROBE_TOLERANCE: f64 = 1e-9;
 
+/// Largest accepted estimate of a loaded slice's mean rejection trials per sample (its leaves'
+/// summed envelope volume over the density at the leaf centres times the leaf areas). Built
+/// sets stay in the single digits (a few hundred for slices of absurd BRDFs, e.g. a MERL
+/// table with 1e38 spikes); a stored tree that does not fit the density (edited bounds, map or
+/// floor) goes far beyond and would make each sample run up to
+/// `partition_sampler::MAX_TRIALS_PER_SAMPLE` trials.
+pub const MAX_LOADED_MEAN_TRIALS: f64 = 1e4;
+
 #[derive(Serialize, Deserialize)]
 struct Stored {
     spec: String,
@@ -80,6 +88,22 @@ fn decode(bytes: &[u8]) -> Result<Stored, SetFileError> {
         postcard::Error::DeserializeUnexpectedEnd => SetFileError::Truncated,
         other => SetFileError::Decode(other.to_string()),
     })
+}
+
+/// `Σ volume / Σ f(centre) · area` over the leaves: the mean trials per sample if the density
+/// were its value at each leaf's centre (infinite when it vanishes at every centre).
+fn estimated_mean_trials(s: &QuadTreeSampler<SliceDensity>) -> f64 {
+    use partition_sampler::Density;
+    let (mut volume, mut mass) = (0.0, 0.0);
+    for leaf in s.tree().leaves() {
+        volume += leaf.volume;
+        mass += s.density().eval(leaf.rect.center()).max(0.0) * leaf.rect.area();
+    }
+    if mass > 0.0 {
+        volume / mass
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl QuadTreeSet {
@@ -200,6 +224,14 @@ impl QuadTreeSet {
                 .with_zero_floor(floor);
             let sampler = QuadTreeSampler::from_parts(tree, SliceDensity { f, shape })
                 .map_err(|source| SetFileError::Attach { slice, source })?;
+            let trials = estimated_mean_trials(&sampler);
+            if !(trials <= MAX_LOADED_MEAN_TRIALS) {
+                return Err(SetFileError::Corrupt(format!(
+                    "slice {slice}: the stored bounds are {trials:.3e} times the density at the \
+                     leaf centres (more than {MAX_LOADED_MEAN_TRIALS:e}): the tree does not fit \
+                     the BRDF, its disc map or its floor"
+                )));
+            }
             trees.push(sampler);
         }
         Ok(QuadTreeSet {

@@ -96,3 +96,129 @@ fn corrupted_bytes_never_panic() {
     }
     assert!(errors > 0);
 }
+
+/// A header followed by a length claiming 2^40 elements (postcard varint) gets a typed error at
+/// once: nothing of that size is allocated (serde preallocates at most 1 MiB per sequence).
+#[test]
+fn huge_claims_are_refused_before_allocating() {
+    let bytes = small_set(Variant::Adaptive).to_bytes();
+    let tree = small_set(Variant::Adaptive)
+        .tree(0)
+        .expect("a slice")
+        .tree()
+        .to_bytes();
+    // LEB128 of 2^40, then a few bytes.
+    let huge = [0x80u8, 0x80, 0x80, 0x80, 0x80, 0x20, 1, 2, 3];
+    let t = std::time::Instant::now();
+    let mut v = bytes[..8].to_vec();
+    v.extend(huge);
+    let r = QuadTreeSet::from_bytes(&v, brdf("phong:n=50"), "phong:n=50");
+    assert!(
+        matches!(r, Err(SetFileError::Truncated | SetFileError::Decode(_))),
+        "{:?}",
+        r.err()
+    );
+    let mut v = tree[..8].to_vec();
+    v.extend(huge);
+    assert!(partition_sampler::QuadTree::from_bytes(&v).is_err());
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+}
+
+mod bytes {
+    use super::*;
+    use proptest::prelude::*;
+    use std::sync::OnceLock;
+
+    fn seeds() -> &'static (Vec<u8>, Vec<u8>) {
+        static SEEDS: OnceLock<(Vec<u8>, Vec<u8>)> = OnceLock::new();
+        SEEDS.get_or_init(|| {
+            let set = small_set(Variant::Adaptive);
+            let tree = set.tree(4).expect("a slice").tree().to_bytes();
+            (set.to_bytes(), tree)
+        })
+    }
+
+    const SPECIAL: [f64; 7] = [f64::NAN, f64::INFINITY, -1.0, 1e308, 1e38, 0.0, -0.0];
+
+    fn edit(
+        mut b: Vec<u8>,
+        edits: Vec<(proptest::sample::Index, u8)>,
+        words: Vec<(proptest::sample::Index, usize)>,
+        cut: Option<proptest::sample::Index>,
+    ) -> Vec<u8> {
+        for (at, v) in edits {
+            let i = at.index(b.len());
+            b[i] = v;
+        }
+        for (at, k) in words {
+            let i = at.index(b.len() - 7);
+            b[i..i + 8].copy_from_slice(&SPECIAL[k].to_le_bytes());
+        }
+        if let Some(c) = cut {
+            let n = c.index(b.len());
+            b.truncate(n);
+        }
+        b
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+        /// Edited saved sets and trees: a typed error, or a set that draws directions with
+        /// finite pdfs and a tree that validates with a finite integral.
+        #[test]
+        fn edits_give_a_typed_error_or_a_usable_sampler(
+            edits in proptest::collection::vec((any::<proptest::sample::Index>(), any::<u8>()), 0..5),
+            words in proptest::collection::vec((any::<proptest::sample::Index>(), 0usize..7), 0..4),
+            cut in proptest::option::of(any::<proptest::sample::Index>()),
+            tree in any::<bool>(),
+        ) {
+            let (set_bytes, tree_bytes) = seeds();
+            if tree {
+                let b = edit(tree_bytes.clone(), edits, words, cut);
+                if let Ok(t) = partition_sampler::QuadTree::from_bytes(&b) {
+                    prop_assert!(t.integral().is_finite());
+                }
+            } else {
+                let b = edit(set_bytes.clone(), edits, words, cut);
+                if let Ok(s) = QuadTreeSet::from_bytes(&b, brdf("phong:n=50"), "phong:n=50") {
+                    let wo = wo_at(30.0);
+                    for d in draw(&s, &wo, 10, 1) {
+                        prop_assert!(d.pdf.is_finite() && d.pdf >= 0.0, "{:?}", d);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A saved set found by `fuzz_readers set 1000000 1` (execution 687685): one edit leaves it
+/// decodable, but its stored tree no longer fits the density, and each sample ran the full
+/// `MAX_TRIALS_PER_SAMPLE` rejection trials (1.5 s for 10 draws). It is refused at load time.
+/// (Saved with format version 5 from the fuzzer's seed: `phong:n=50`, 3 slices, grid 32,
+/// depth 4; regenerate with `FUZZ_DUMP=687685` if the format changes.)
+#[test]
+fn a_set_whose_tree_does_not_fit_its_density_is_refused() {
+    let bytes = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz-slow-set.brqs"),
+    )
+    .expect("fixture");
+    assert_eq!(bytes[4..8], SET_FORMAT_VERSION.to_le_bytes());
+    let t = std::time::Instant::now();
+    let r = QuadTreeSet::from_bytes(&bytes, brdf("phong:n=50"), "phong:n=50");
+    assert!(
+        matches!(r, Err(SetFileError::Corrupt(ref m)) if m.contains("does not fit")),
+        "{:?}",
+        r.err()
+    );
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+}
+
+/// The load-time fit check accepts built sets of sharp and grazing lobes (no false refusal).
+#[test]
+fn sets_of_sharp_lobes_reload() {
+    for spec in ["ggx:alpha=0.02", "phong:n=5000", "blinn:n=150"] {
+        let set = build(spec, Variant::Adaptive, &test_options());
+        let back = QuadTreeSet::from_bytes(&set.to_bytes(), brdf(spec), spec);
+        assert!(back.is_ok(), "{spec}: {:?}", back.err());
+    }
+}

@@ -259,3 +259,66 @@ proptest! {
         let _ = CornellBrdf::parse(&String::from_utf8_lossy(&bytes));
     }
 }
+
+/// A count line claiming 2^40 wavelengths (or samples) gets a typed error at once: the count is
+/// bounded by 10,000 and the samples are only those the text holds.
+#[test]
+fn huge_claims_are_refused_before_allocating() {
+    let t = std::time::Instant::now();
+    let r = CornellBrdf::parse("1099511627776\n400 500\n0 0 0 0 1 1\n");
+    assert!(
+        matches!(r, Err(CornellError::BadCount { line: 1, .. })),
+        "{r:?}"
+    );
+    let r = CornellBrdf::parse("10000\n400 500\n");
+    assert!(
+        matches!(
+            r,
+            Err(CornellError::MissingWavelengths {
+                found: 2,
+                expected: 10_000
+            })
+        ),
+        "{r:?}"
+    );
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    /// Tokens of a valid file replaced by huge, negative, non-finite or non-numeric ones, lines
+    /// dropped or duplicated: a typed error or a material whose values are finite and
+    /// non-negative.
+    #[test]
+    fn token_edits_give_a_typed_error_or_a_valid_material(
+        edits in proptest::collection::vec((any::<proptest::sample::Index>(), 0usize..10), 1..6),
+        dup in proptest::option::of(any::<proptest::sample::Index>()),
+    ) {
+        let tokens = ["1e38", "-1e38", "nan", "inf", "-5", "0", "1099511627776", "x", "", "3.2"];
+        let text = synthetic(|ti, _, _| 0.1 + ti);
+        let mut lines: Vec<Vec<String>> = text
+            .lines()
+            .map(|l| l.split(' ').map(str::to_string).collect())
+            .collect();
+        for (at, k) in edits {
+            let line = at.index(lines.len());
+            let n = lines[line].len();
+            let tok = at.index(n.max(1)).min(n.saturating_sub(1));
+            if n > 0 {
+                lines[line][tok] = tokens[k].to_string();
+            }
+        }
+        if let Some(d) = dup {
+            let i = d.index(lines.len());
+            let copy = lines[i].clone();
+            lines.insert(i, copy);
+        }
+        let edited: Vec<String> = lines.iter().map(|l| l.join(" ")).collect();
+        if let Ok(b) = CornellBrdf::parse(&edited.join("\n")) {
+            for (wo, wi) in pairs(4, 10) {
+                let v = b.eval(&wo, &wi);
+                prop_assert!(v.is_finite() && v >= 0.0, "{}", v);
+            }
+        }
+    }
+}

@@ -353,3 +353,77 @@ fn half_diff_round_trip() {
         assert!((rotate_z(&i2, phi_h) - wi).norm() < 1e-9);
     }
 }
+
+/// A 12-byte header claiming 2^40 cells (or the legal dims without data) gets a typed error
+/// before any allocation: the dims are checked first, then the file size.
+#[test]
+fn huge_claims_are_refused_before_allocating() {
+    let header = |d: [i32; 3]| d.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
+    let t = std::time::Instant::now();
+    let r = MerlBrdf::from_bytes(&header([1 << 20, 1 << 20, 1]));
+    assert!(matches!(r, Err(MerlError::DimsProduct { .. })), "{r:?}");
+    let r = MerlBrdf::from_bytes(&header([90, 90, 180]));
+    assert!(
+        matches!(r, Err(MerlError::Truncated { actual: 12, .. })),
+        "{r:?}"
+    );
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+}
+
+mod bytes {
+    use super::*;
+    use proptest::prelude::*;
+    use std::sync::OnceLock;
+
+    fn good() -> &'static [u8] {
+        static GOOD: OnceLock<Vec<u8>> = OnceLock::new();
+        GOOD.get_or_init(|| MerlBrdf::from_fn(|th, _, _| [1.0 + th, 2.0, 0.5]).to_bytes())
+    }
+
+    fn check(bytes: &[u8]) {
+        if let Ok(m) = MerlBrdf::from_bytes(bytes) {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+            for _ in 0..10 {
+                let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
+                let v = m.eval(&wo, &wi);
+                assert!(v.is_finite() && v >= 0.0, "{v}");
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+        /// Header edits and any length: a typed error (or, at the legal size with legal dims,
+        /// a valid table), never a panic.
+        #[test]
+        fn header_and_size_edits(edits in proptest::collection::vec((0usize..12, any::<u8>()), 0..6),
+                                 len in 0usize..FILE_BYTES + 64) {
+            let good = good();
+            let mut head = good[..12].to_vec();
+            for (i, v) in edits {
+                head[i] = v;
+            }
+            let mut b = head;
+            b.extend_from_slice(&good[12..len.clamp(12, FILE_BYTES)]);
+            b.resize(len.max(12), 0);
+            b.truncate(len);
+            check(&b);
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+        /// Special doubles anywhere in the data at the legal size: a typed error for NaN/inf,
+        /// otherwise finite non-negative values (negative = unmeasured, read as 0).
+        #[test]
+        fn special_values(words in proptest::collection::vec((0usize..3 * CELLS, 0usize..6), 1..30)) {
+            let special = [f64::NAN, f64::INFINITY, -1.0, 1e300, 1e38, -1e-300];
+            let mut b = good().to_vec();
+            for (w, k) in words {
+                let at = 12 + 8 * w;
+                b[at..at + 8].copy_from_slice(&special[k].to_le_bytes());
+            }
+            check(&b);
+        }
+    }
+}

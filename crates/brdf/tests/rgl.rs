@@ -422,3 +422,142 @@ proptest! {
         let _ = RglBrdf::from_bytes(&bytes);
     }
 }
+
+// ---- absurd but finite tables (issue 27), memory bounded by the file -------------------
+
+/// `f·cos` at a few direction pairs: finite and non-negative for any file that reads.
+fn evaluations_are_finite(b: &RglBrdf) {
+    for (wo, wi) in random_pairs(21, 12) {
+        let v = b.eval(&wo, &wi);
+        assert!(v.is_finite() && v >= 0.0, "eval {v}");
+        for c in b.eval_rgb(&wo, &wi) {
+            assert!(c.is_finite() && c >= 0.0, "eval_rgb {c}");
+        }
+    }
+}
+
+fn is_implausible(r: &Result<RglBrdf, RglError>, name: &str) -> bool {
+    matches!(r, Err(RglError::Implausible { field, .. }) if field == name)
+}
+
+/// Single values set to 1e38 (or σ to 1e-30) in each table: each breaks one of the physical
+/// rules and gets a typed error at read time instead of a build running for minutes.
+#[test]
+fn absurd_but_finite_values_are_refused() {
+    let r = edited(|f| set_f32(field(f, "rgb"), 5, 1e38));
+    assert!(is_implausible(&r, "rgb"), "{:?}", r.as_ref().err());
+    let r = edited(|f| set_f32(field(f, "ndf"), 3, 1e38));
+    assert!(is_implausible(&r, "ndf"), "{:?}", r.as_ref().err());
+    let r = edited(|f| set_f32(field(f, "sigma"), 5, 1e38));
+    assert!(is_implausible(&r, "sigma"), "{:?}", r.as_ref().err());
+    let r = edited(|f| set_f32(field(f, "sigma"), 200, 1e-30));
+    assert!(is_implausible(&r, "sigma"), "{:?}", r.as_ref().err());
+    for name in ["vndf", "luminance"] {
+        let r = edited(|f| {
+            for i in 0..4 {
+                set_f32(field(f, name), 17 * i, 1e38);
+            }
+        });
+        assert!(is_implausible(&r, name), "{name}: {:?}", r.as_ref().err());
+    }
+    // Large but plausible values still read (an rgb spike of 1000 in one cell keeps every
+    // slice's albedo below the limit) and evaluate to finite values.
+    let b = edited(|f| set_f32(field(f, "rgb"), 5, 1000.0)).expect("a plausible spike reads");
+    evaluations_are_finite(&b);
+}
+
+/// The mutants of issue 27: 200 of the fixture's 4-byte words set to 1e38 (fixed seeds).
+/// Before the physical checks most of them were accepted and `sample --sampler adaptive`
+/// on them ran for minutes (anisotropic layout from a spiked `ndf`/`sigma`, trees at full
+/// depth around every spike); now every one gets a typed error at read time.
+#[test]
+fn words_set_to_1e38_are_refused_at_read_time() {
+    let original = fixture_bytes();
+    let mut implausible = 0;
+    for seed in 0..12 {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut bytes = original.clone();
+        for _ in 0..200 {
+            let i = 4 * rng.random_range(0..bytes.len() / 4);
+            bytes[i..i + 4].copy_from_slice(&1e38f32.to_le_bytes());
+        }
+        let r = RglBrdf::from_bytes(&bytes);
+        assert!(r.is_err(), "seed {seed}: a 1e38 mutant was accepted");
+        implausible += usize::from(matches!(r, Err(RglError::Implausible { .. })));
+    }
+    // Most words land in the tables (the header is 0.05 % of the file).
+    assert!(
+        implausible >= 10,
+        "{implausible} of 12 refused by the physical rules"
+    );
+}
+
+/// A tiny file whose one field claims 2^40 elements gets a typed error without allocating.
+#[test]
+fn a_claim_of_2_pow_40_elements_is_refused_before_allocating() {
+    let huge = Raw {
+        name: "rgb".into(),
+        dtype: DTYPE_F32,
+        shape: vec![1 << 20, 1 << 20],
+        data: vec![0; 64],
+    };
+    let bytes = write_tensor(&[huge], (1, 0));
+    let t = std::time::Instant::now();
+    let r = RglBrdf::from_bytes(&bytes);
+    assert!(matches!(r, Err(RglError::Truncated { .. })), "{r:?}");
+    assert!(t.elapsed().as_secs_f64() < 0.5);
+    // Many distinct field names: the duplicate check stays linear (65,536 fields, 1 MB).
+    let fields: Vec<Raw> = (0..65_536u32)
+        .map(|k| Raw {
+            name: format!("{:04x}", k),
+            dtype: 1,
+            shape: vec![0],
+            data: Vec::new(),
+        })
+        .collect();
+    let bytes = write_tensor(&fields, (1, 0));
+    let t = std::time::Instant::now();
+    assert!(matches!(
+        TensorFile::parse(&bytes),
+        Ok(ref tf) if tf.fields().len() == 65_536
+    ));
+    assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
+}
+
+/// Special values in every kind of position of the fixture (fixed seeds): no panic, and a file
+/// that reads evaluates to finite non-negative values.
+const SPECIAL: [f32; 9] = [
+    f32::NAN,
+    f32::INFINITY,
+    -1.0,
+    1e38,
+    -1e38,
+    f32::MAX,
+    0.0,
+    1e-38,
+    7.5,
+];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #[test]
+    fn special_words_and_bytes_give_a_typed_error_or_a_valid_material(
+        words in proptest::collection::vec((0usize..164_732, 0usize..SPECIAL.len()), 0..40),
+        bytes in proptest::collection::vec((0usize..658_928, any::<u8>()), 0..4),
+        cut in proptest::option::of(0usize..658_928),
+    ) {
+        let mut b = fixture_bytes();
+        for (w, k) in words {
+            b[4 * w..4 * w + 4].copy_from_slice(&SPECIAL[k].to_le_bytes());
+        }
+        for (i, v) in bytes {
+            b[i] = v;
+        }
+        if let Some(c) = cut {
+            b.truncate(c);
+        }
+        if let Ok(m) = RglBrdf::from_bytes(&b) {
+            evaluations_are_finite(&m);
+        }
+    }
+}

@@ -65,6 +65,26 @@ pub enum EnvMapError {
         /// The limit, in pixels.
         max: usize,
     },
+    /// The header claims more pixels than the file's bytes can encode (checked before any
+    /// allocation, so that memory stays bounded by the file's size).
+    #[error(
+        "{format} header claims {width}×{height} pixels, more than {bytes} bytes can encode \
+         (at most {per_byte} pixels per byte of {what})"
+    )]
+    ClaimExceedsFile {
+        /// The file format.
+        format: MapFormat,
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+        /// The bytes available.
+        bytes: usize,
+        /// The most pixels a byte can encode in this format (as accepted here).
+        per_byte: usize,
+        /// What the bytes are (pixel data, the whole file).
+        what: &'static str,
+    },
     /// `rgb.len()` differs from `width · height`.
     #[error("size mismatch: a {width}×{height} map needs {expected} pixels, got {got}")]
     SizeMismatch {

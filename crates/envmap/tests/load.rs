@@ -574,3 +574,160 @@ fn real_maps_load() {
     }
     eprintln!("loaded {loaded} real maps");
 }
+
+// ---------------------------------------------------------------- memory bounded by the file
+
+/// The offset of the `dataWindow` box (`xmin, ymin, xmax, ymax` as `i32`) in an EXR header.
+fn exr_data_window(bytes: &[u8]) -> usize {
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("dataWindow attribute");
+    at + key.len() + 4
+}
+
+/// The offset of the value of the EXR header attribute `key` (name, type, then a 4-byte size).
+fn exr_attribute(bytes: &[u8], key: &[u8]) -> usize {
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .unwrap_or_else(|| panic!("attribute {}", String::from_utf8_lossy(key)));
+    at + key.len() + 4
+}
+
+/// Headers claiming the most pixels allowed (2^25) or 2^40 pixels over a few bytes of data get
+/// a typed error before the decoder allocates the image (before the fix, a 20 KB Radiance file
+/// made the decoder allocate 400 MB before finding the data short).
+#[test]
+fn huge_claims_are_refused_before_allocating() {
+    let t = std::time::Instant::now();
+    // Radiance: 8192 × 4096 with 4 bytes per scanline (enough for the old per-line check).
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n".to_vec();
+    hdr.extend(std::iter::repeat_n([2u8, 2, 32, 0], 4096).flatten());
+    let r = EnvMap::from_bytes(&hdr, MapFormat::Hdr);
+    assert!(
+        matches!(
+            r,
+            Err(EnvMapError::ClaimExceedsFile {
+                width: 8192,
+                height: 4096,
+                ..
+            })
+        ),
+        "{r:?}"
+    );
+    let r = EnvMap::from_bytes(
+        b"#?RADIANCE\n\n-Y 1048576 +X 1048576\n\x02\x02\x00\x10",
+        MapFormat::Hdr,
+    );
+    assert!(matches!(r, Err(EnvMapError::TooLarge { .. })), "{r:?}");
+    // OpenEXR: a valid 9×5 file whose data window is widened to 8192 × 4096.
+    let src = test_pixels(9, 5);
+    let mut exr = exr_file(9, 5, &src);
+    let at = exr_data_window(&exr);
+    exr[at + 8..at + 12].copy_from_slice(&8191i32.to_le_bytes());
+    exr[at + 12..at + 16].copy_from_slice(&4095i32.to_le_bytes());
+    // The writer tiles the image in 64×64 tiles; one tile of the whole window makes the chunk
+    // count 1, so that the offset table (checked by the decoder) stays one entry long. The
+    // decoder's own checks of the chunk table refuse it (before the image is allocated); the
+    // reader's pixels-per-byte bound is the backstop for claims that pass them.
+    let tiles = exr_attribute(&exr, b"tiles\0tiledesc\0");
+    exr[tiles..tiles + 4].copy_from_slice(&8192u32.to_le_bytes());
+    exr[tiles + 4..tiles + 8].copy_from_slice(&4096u32.to_le_bytes());
+    let cc = exr_attribute(&exr, b"chunkCount\0int\0");
+    exr[cc..cc + 4].copy_from_slice(&1i32.to_le_bytes());
+    let r = EnvMap::from_bytes(&exr, MapFormat::Exr);
+    assert!(
+        matches!(
+            r,
+            Err(EnvMapError::ClaimExceedsFile { .. } | EnvMapError::Decode { .. })
+        ),
+        "{r:?}"
+    );
+    // PFM: the exact size is checked before the pixels are read.
+    let r = EnvMap::from_bytes(b"PF\n8192 4096\n-1.0\n\0\0\0\0", MapFormat::Pfm);
+    assert!(matches!(r, Err(EnvMapError::Truncated { .. })), "{r:?}");
+    let r = EnvMap::from_bytes(b"PF\n1048576 1048576\n-1.0\n\0\0\0\0", MapFormat::Pfm);
+    assert!(matches!(r, Err(EnvMapError::TooLarge { .. })), "{r:?}");
+    assert!(t.elapsed().as_secs_f64() < 1.0, "{:?}", t.elapsed());
+}
+
+mod bytes {
+    use super::*;
+    use envmap::{AdaptiveOptions, EnvMapSampler, SamplerKind};
+    use proptest::prelude::*;
+    use rand::SeedableRng;
+    use rand::rngs::Xoshiro256PlusPlus;
+
+    const SPECIAL: [f32; 8] = [
+        f32::NAN,
+        f32::INFINITY,
+        -1.0,
+        1e38,
+        f32::MAX,
+        0.0,
+        1e-38,
+        65504.0,
+    ];
+
+    fn seeds() -> Vec<(MapFormat, Vec<u8>)> {
+        let src = test_pixels(12, 6);
+        let quads: Vec<[u8; 4]> = src.iter().map(|&c| rgbe(c)).collect();
+        vec![
+            (
+                MapFormat::Hdr,
+                hdr_file("#?RADIANCE", 12, 6, &quads, Scanlines::Rle),
+            ),
+            (
+                MapFormat::Hdr,
+                hdr_file("#?RGBE", 12, 6, &quads, Scanlines::OldRle),
+            ),
+            (MapFormat::Exr, exr_file(12, 6, &src)),
+            (MapFormat::Pfm, pfm_file(false, true, 12, 6, &src, 1.0)),
+            (MapFormat::Pfm, pfm_file(true, false, 12, 6, &src, 2.0)),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+        /// Byte edits, special floats in either byte order, truncation: a typed error, or a map
+        /// whose pixels are finite and non-negative and whose samplers build or fail typed.
+        #[test]
+        fn edits_give_a_typed_error_or_a_valid_map(
+            which in 0usize..5,
+            edits in proptest::collection::vec((any::<proptest::sample::Index>(), any::<u8>()), 0..6),
+            words in proptest::collection::vec((any::<proptest::sample::Index>(), 0usize..8, any::<bool>()), 0..6),
+            cut in proptest::option::of(any::<proptest::sample::Index>()),
+        ) {
+            let (format, mut b) = seeds().swap_remove(which);
+            for (at, v) in edits {
+                let i = at.index(b.len());
+                b[i] = v;
+            }
+            for (at, k, le) in words {
+                let i = at.index(b.len() - 3);
+                let w = if le { SPECIAL[k].to_le_bytes() } else { SPECIAL[k].to_be_bytes() };
+                b[i..i + 4].copy_from_slice(&w);
+            }
+            if let Some(c) = cut {
+                let n = c.index(b.len());
+                b.truncate(n);
+            }
+            if let Ok(map) = EnvMap::from_bytes(&b, format) {
+                let (w, h) = (map.width(), map.height());
+                prop_assert!(w > 0 && h > 0 && w * h == map.rgb().len());
+                prop_assert!(map.rgb().iter().flatten().all(|c| c.is_finite() && *c >= 0.0));
+                for kind in [SamplerKind::PiecewiseConstant, SamplerKind::Adaptive(AdaptiveOptions::default())] {
+                    if let Ok(s) = EnvMapSampler::new(&map, kind) {
+                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+                        for _ in 0..4 {
+                            let e = s.sample(&mut rng);
+                            prop_assert!(e.pdf_uv.is_finite() && e.pdf_uv > 0.0, "{:?}", e);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -141,6 +141,16 @@ pub enum RglError {
         /// Number of `phi_i` values.
         n_phi: usize,
     },
+    /// A table breaks a physical rule of the format that no single value breaks: the NDF's
+    /// normalisation, the bounds of `sigma` implied by the NDF, an albedo far above 1, or a
+    /// product or sum that overflows the format's `f32` (see [`RglBrdf::from_bytes`]).
+    #[error("field `{field}`: {detail}")]
+    Implausible {
+        /// The field.
+        field: String,
+        /// The rule broken and the offending value.
+        detail: String,
+    },
     /// A sampling table slice integrates to zero.
     #[error("field `{field}`: slice {slice} integrates to zero")]
     ZeroSlice {
@@ -209,6 +219,16 @@ struct Tables {
     mirror_symmetric: bool,
 }
 
+/// Accepted range of the NDF's normalisation `∫ D(m) cos θm dm` (1 for a microfacet
+/// distribution; 1.008 in the four RGL files of `../shared`, whose tables are bilinear
+/// resamplings).
+pub const NDF_NORMALISATION_RANGE: (f64, f64) = (0.5, 2.0);
+
+/// Largest accepted directional albedo of an `rgb` slice (its mean over the warped square when
+/// `jacobian = 1`): 10 times the energy received is no measurement (the four RGL files of
+/// `../shared` stay below 1.61, reached at grazing angles).
+pub const MAX_SLICE_ALBEDO: f64 = 10.0;
+
 /// Relative tolerance of the symmetry checks made when a file is read.
 pub const SYMMETRY_TOLERANCE: f64 = 1e-6;
 
@@ -242,6 +262,16 @@ impl RglBrdf {
     }
 
     /// Reads and validates an RGL `.bsdf` file's bytes.
+    ///
+    /// Besides the per-value rules of the [module docs](self), the tables must obey the
+    /// physics the format encodes (each a typed [`RglError::Implausible`]): the NDF's
+    /// normalisation `∫ D cos θm dm` lies in [`NDF_NORMALISATION_RANGE`]; `sigma`, the
+    /// projected area `∫ D ⟨ω·m⟩ dm`, lies between `cos θ / 2` and twice `∫ D dm`; with the
+    /// Jacobian factor, each `rgb` slice's mean (the directional albedo) is at most
+    /// [`MAX_SLICE_ALBEDO`]; the largest value `rgb · D / (4σ)` can take and each sampling
+    /// slice's sum are finite in `f32` (the precision Mitsuba evaluates the format in). These
+    /// reject absurd-but-finite files (e.g. words set to 1e38) whose dynamic range would make a
+    /// sampler's build run for minutes.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, RglError> {
         let tf = TensorFile::parse(bytes)?;
         let description = String::from_utf8_lossy(tf.u8_data("description")?).into_owned();
@@ -303,6 +333,13 @@ impl RglBrdf {
             c.min = c.min.min(*v);
             *v = 0.0;
         }
+        let jac_field = tf.field("jacobian")?;
+        if jac_field.shape != [1] {
+            return Err(shape_error("jacobian", &jac_field.shape, "[1]"));
+        }
+        let jacobian = tf.u8_data("jacobian")?[0] != 0;
+        check_physics(&ndf, &sigma, &rgb, (lum_shape[3], lum_shape[2]), jacobian)?;
+
         let cell = lum_shape[2] * lum_shape[3];
         let mut y = Vec::with_capacity(n_theta * cell);
         for t in 0..n_theta {
@@ -311,12 +348,6 @@ impl RglBrdf {
         }
         let rgb_luminance = BilinearTable::new(lum_shape[3], lum_shape[2], y);
         let rgb = BilinearTable::new(lum_shape[3], lum_shape[2], rgb);
-
-        let jac_field = tf.field("jacobian")?;
-        if jac_field.shape != [1] {
-            return Err(shape_error("jacobian", &jac_field.shape, "[1]"));
-        }
-        let jacobian = tf.u8_data("jacobian")?[0] != 0;
 
         let tol = SYMMETRY_TOLERANCE;
         let isotropic = ndf.is_y_constant(tol) && sigma.is_y_constant(tol);
@@ -487,6 +518,143 @@ fn check_min(name: &str, data: &[f64], min: f64, strict: bool) -> Result<(), Rgl
     Ok(())
 }
 
+/// Trapezoid weights of the mean over `[0, 1]` of the linear interpolant on `n ≥ 2` equally
+/// spaced nodes.
+fn trapezoid_weight(k: usize, n: usize) -> f64 {
+    let h = 1.0 / (n - 1) as f64;
+    if k == 0 || k == n - 1 { 0.5 * h } else { h }
+}
+
+/// `∫₀¹ p(u) g(u) du` for the linear interpolant `p` of `profile` (nodes `k/(n−1)`), with 8
+/// midpoints per cell.
+fn integrate_profile(profile: &[f64], g: impl Fn(f64) -> f64) -> f64 {
+    const SUB: usize = 8;
+    let cells = profile.len() - 1;
+    let h = 1.0 / (cells * SUB) as f64;
+    let mut sum = 0.0;
+    for c in 0..cells {
+        for k in 0..SUB {
+            let t = (k as f64 + 0.5) / SUB as f64;
+            let u = (c as f64 + t) / cells as f64;
+            sum += ((1.0 - t) * profile[c] + t * profile[c + 1]) * g(u) * h;
+        }
+    }
+    sum
+}
+
+fn implausible(field: &str, detail: String) -> RglError {
+    RglError::Implausible {
+        field: field.to_string(),
+        detail,
+    }
+}
+
+/// The rules between `ndf`, `sigma` and `rgb` listed in [`RglBrdf::from_bytes`]. `rgb` is
+/// clamped (non-negative); `rgb_grid` is its `(nx, ny)`.
+fn check_physics(
+    ndf: &BilinearTable,
+    sigma: &BilinearTable,
+    rgb: &[f64],
+    rgb_grid: (usize, usize),
+    jacobian: bool,
+) -> Result<(), RglError> {
+    let (nx, ny) = ndf.size();
+    let d = ndf.values();
+    // Mean of D over the azimuth (exact for the bilinear interpolant), per θ node.
+    let profile: Vec<f64> = (0..nx)
+        .map(|i| {
+            (0..ny)
+                .map(|j| trapezoid_weight(j, ny) * d[j * nx + i])
+                .sum()
+        })
+        .collect();
+    // dω = sin θ dθ dφ with θ = u₀²π/2, φ = 2πu₁ − π: sin θ · πu₀ du₀ · 2π du₁.
+    let jac = |u: f64| 2.0 * PI * PI * u;
+    let theta = u_to_theta;
+    let norm = integrate_profile(&profile, |u| theta(u).cos() * theta(u).sin() * jac(u));
+    let (lo, hi) = NDF_NORMALISATION_RANGE;
+    if !(lo..=hi).contains(&norm) {
+        return Err(implausible(
+            "ndf",
+            format!(
+                "∫ D cos θm dm = {norm:.4e}, outside [{lo}, {hi}] (a microfacet distribution has 1)"
+            ),
+        ));
+    }
+    let total = integrate_profile(&profile, |u| theta(u).sin() * jac(u));
+    let (sx, sy) = sigma.size();
+    let s = sigma.values();
+    for j in 0..sy {
+        for i in 0..sx {
+            let v = s[j * sx + i];
+            let cos = theta(i as f64 / (sx - 1) as f64).cos();
+            if !(v >= 0.5 * cos && v <= 2.0 * total) {
+                return Err(implausible(
+                    "sigma",
+                    format!(
+                        "value {v:e} at index {} is outside [cos θ / 2, 2 ∫ D dm] = [{:.4e}, {:.4e}] (the projected area ∫ D ⟨ω·m⟩ dm)",
+                        j * sx + i,
+                        0.5 * cos,
+                        2.0 * total
+                    ),
+                ));
+            }
+        }
+    }
+    let (mx, my) = rgb_grid;
+    let cell = mx * my;
+    if jacobian {
+        for (k, slice) in rgb.chunks_exact(cell).enumerate() {
+            let mean: f64 = (0..my)
+                .map(|j| {
+                    let row: f64 = (0..mx)
+                        .map(|i| trapezoid_weight(i, mx) * slice[j * mx + i])
+                        .sum();
+                    trapezoid_weight(j, my) * row
+                })
+                .sum();
+            if !(mean <= MAX_SLICE_ALBEDO) {
+                return Err(implausible(
+                    "rgb",
+                    format!(
+                        "slice {} channel {} has albedo {mean:.4e} > {MAX_SLICE_ALBEDO}",
+                        k / 3,
+                        k % 3
+                    ),
+                ));
+            }
+        }
+    }
+    let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    let min_sigma = s.iter().copied().fold(f64::INFINITY, f64::min);
+    let peak = if jacobian {
+        max(rgb) * max(d) / (4.0 * min_sigma)
+    } else {
+        max(rgb)
+    };
+    if !(peak <= f64::from(f32::MAX)) {
+        return Err(implausible(
+            "rgb",
+            format!("max rgb · max D / (4 min σ) = {peak:e} overflows f32"),
+        ));
+    }
+    Ok(())
+}
+
+/// Each slice of a sampling table sums to a finite `f32` (Mitsuba builds its CDFs in `f32`).
+fn check_f32_sums(name: &str, values: &[f64], slice_len: usize) -> Result<(), RglError> {
+    for (k, slice) in values.chunks_exact(slice_len).enumerate() {
+        let sum: f64 = slice.iter().sum();
+        if !(sum <= f64::from(f32::MAX)) {
+            return Err(implausible(
+                name,
+                format!("slice {k} sums to {sum:e}, which overflows f32"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A rank-4 sampling table `[1, T, Ny, Nx]` (non-negative, every slice positive).
 fn sampling_table(
     tf: &TensorFile<'_>,
@@ -504,6 +672,7 @@ fn sampling_table(
     }
     let data = tf.f32_data(name)?;
     check_min(name, &data, 0.0, false)?;
+    check_f32_sums(name, &data, shape[2] * shape[3])?;
     Warp2D::new(axis.clone(), BilinearTable::new(shape[3], shape[2], data)).map_err(|z| {
         RglError::ZeroSlice {
             field: name.to_string(),

@@ -112,6 +112,9 @@ impl<'a> TensorFile<'a> {
         }
         let count = c.u32("field count")?;
         let mut fields: Vec<Field> = Vec::new();
+        // Names seen so far: a hash set keeps the duplicate check linear (a file of 65,536
+        // short distinct names is 1 MB and would cost 2·10⁹ comparisons pairwise).
+        let mut names = std::collections::HashSet::new();
         for _ in 0..count {
             let len = usize::from(c.u16("field name length")?);
             let name = String::from_utf8_lossy(c.take(len, "field name")?).into_owned();
@@ -123,7 +126,7 @@ impl<'a> TensorFile<'a> {
                 let e = c.u64("field shape")?;
                 shape.push(usize::try_from(e).unwrap_or(usize::MAX));
             }
-            if fields.iter().any(|f| f.name == name) {
+            if !names.insert(name.clone()) {
                 return Err(RglError::DuplicateField { name });
             }
             let Some(size) = dtype_size(dtype) else {

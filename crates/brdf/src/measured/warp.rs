@@ -62,6 +62,11 @@ impl BilinearTable {
         Self { nx, ny, data }
     }
 
+    /// The values, slice after slice (row-major, `x` fastest).
+    pub fn values(&self) -> &[f64] {
+        &self.data
+    }
+
     /// Number of slices.
     pub fn slices(&self) -> usize {
         self.data.len() / (self.nx * self.ny)

@@ -15,6 +15,13 @@ use crate::{EnvMap, EnvMapError};
 
 const FORMAT: MapFormat = MapFormat::Hdr;
 
+/// The most pixels one byte of pixel data may encode. Flat scanlines hold 1/4 pixel per byte,
+/// new-style RLE at most 127 pixels per 8 bytes (a run per channel), old-style run markers
+/// 255 pixels per 4 bytes unless chained (`(1,1,1,n)` markers in a row multiply by 256, so a
+/// few bytes could claim millions of pixels): claims beyond this are refused before the
+/// decoder allocates the image, keeping memory within about 2 KiB per byte of file.
+const MAX_PIXELS_PER_BYTE: usize = 64;
+
 fn malformed(detail: impl Into<String>) -> EnvMapError {
     EnvMapError::MalformedHeader {
         format: FORMAT,
@@ -116,6 +123,17 @@ fn parse_header(bytes: &[u8]) -> Result<Header, EnvMapError> {
             "{} bytes of pixel data cannot hold {height} scanlines",
             bytes.len() - pos
         )));
+    }
+    let data = bytes.len() - pos;
+    if width * height > MAX_PIXELS_PER_BYTE * data {
+        return Err(EnvMapError::ClaimExceedsFile {
+            format: FORMAT,
+            width,
+            height,
+            bytes: data,
+            per_byte: MAX_PIXELS_PER_BYTE,
+            what: "pixel data",
+        });
     }
     Ok(Header {
         after_signature,
