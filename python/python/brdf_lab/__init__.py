@@ -100,6 +100,8 @@ def _names(x: Any, what: str) -> list:
         return []
     if isinstance(x, (str, Brdf)):
         x = [x]
+    if not isinstance(x, (list, tuple)):
+        x = [x]
     out = []
     for item in x:
         if isinstance(item, Brdf):
