@@ -1,12 +1,17 @@
 //! NumPy inputs (any array-like, converted to float64) checked into Rust vectors, and Rust
 //! vectors handed back to NumPy without a copy.
 
+use std::borrow::Cow;
+
 use brdf::Vec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn};
 use pyo3::prelude::*;
 
+use rayon::prelude::*;
+
 use crate::errors::invalid;
+use crate::threads::install;
 
 /// An array-like argument, converted to float64 by numpy when needed.
 pub(crate) type ArrayIn<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
@@ -32,36 +37,47 @@ impl Dirs {
     }
 }
 
-/// Reads directions of shape `(3,)` or `(N, 3)`: finite, non-zero, normalised here.
+/// The values of an array in C order: borrowed when it is C-contiguous, else copied.
+fn c_order<'a>(view: &'a numpy::ndarray::ArrayViewD<'a, f64>) -> Cow<'a, [f64]> {
+    match view.as_slice() {
+        Some(s) => Cow::Borrowed(s),
+        None => Cow::Owned(view.as_standard_layout().iter().copied().collect()),
+    }
+}
+
+/// Reads directions of shape `(3,)` or `(N, 3)`: finite, non-zero, normalised here (in
+/// parallel).
 pub(crate) fn dirs(a: &ArrayIn<'_>, name: &str) -> PyResult<Dirs> {
     let view = a.as_array();
-    let (n, single) = match view.shape() {
-        [3] => (1, true),
-        [n, 3] => (*n, false),
+    let single = match view.shape() {
+        [3] => true,
+        [_, 3] => false,
         other => {
             return Err(invalid(format!(
                 "{name} must have shape (3,) or (N, 3), got {other:?}"
             )));
         }
     };
-    let flat: Vec<f64> = match view.as_slice() {
-        Some(s) => s.to_vec(),
-        None => view.iter().copied().collect(),
+    let flat = c_order(&view);
+    let bad = |c: &[f64]| {
+        let finite = c.iter().all(|x| x.is_finite());
+        let norm = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        !finite || norm <= 0.0
     };
-    let mut v = Vec::with_capacity(n);
-    for (row, c) in flat.chunks_exact(3).enumerate() {
-        let d = Vec3::new(c[0], c[1], c[2]);
-        if !(d.x.is_finite() && d.y.is_finite() && d.z.is_finite()) {
-            return Err(invalid(format!(
-                "{name} has a non-finite value (NaN or ±inf) in row {row}: {c:?}"
-            )));
-        }
-        let norm = d.norm();
-        if norm.is_nan() || norm <= 0.0 {
-            return Err(invalid(format!("{name} row {row} is the zero vector")));
-        }
-        v.push(d / norm);
+    if let Some(row) = install(|| flat.par_chunks_exact(3).position_first(bad)) {
+        let c = &flat[3 * row..3 * row + 3];
+        return Err(invalid(if c.iter().all(|x| x.is_finite()) {
+            format!("{name} row {row} is the zero vector")
+        } else {
+            format!("{name} has a non-finite value (NaN or ±inf) in row {row}: {c:?}")
+        }));
     }
+    let v: Vec<Vec3> = install(|| {
+        flat.par_chunks_exact(3)
+            .with_min_len(4096)
+            .map(|c| Vec3::new(c[0], c[1], c[2]).normalize())
+            .collect()
+    });
     Ok(Dirs { v, single })
 }
 
@@ -80,36 +96,30 @@ pub(crate) fn pair_len(a: &Dirs, an: &str, b: &Dirs, bn: &str) -> PyResult<usize
     }
 }
 
-/// Uniforms of shape `(N, 2)` in `[0, 1]` (1 is mapped to the largest double below 1).
-pub(crate) fn uniforms(a: &ArrayIn<'_>, name: &str) -> PyResult<Vec<[f64; 2]>> {
-    let view = a.as_array();
+/// Uniforms of shape `(N, 2)` in `[0, 1]`, flat (2 per row), checked in parallel and borrowed
+/// when the array is C-contiguous.
+pub(crate) fn uniforms<'a>(
+    view: &'a numpy::ndarray::ArrayViewD<'a, f64>,
+    name: &str,
+) -> PyResult<Cow<'a, [f64]>> {
     if !matches!(view.shape(), [_, 2]) {
         return Err(invalid(format!(
             "{name} must have shape (N, 2), got {:?}",
             view.shape()
         )));
     }
-    let flat: Vec<f64> = match view.as_slice() {
-        Some(s) => s.to_vec(),
-        None => view.iter().copied().collect(),
-    };
-    let below_one = 1.0 - f64::EPSILON / 2.0;
-    flat.chunks_exact(2)
-        .enumerate()
-        .map(|(row, c)| {
-            let mut out = [0.0; 2];
-            for k in 0..2 {
-                let x = c[k];
-                if !(0.0..=1.0).contains(&x) {
-                    return Err(invalid(format!(
-                        "{name} must lie in [0, 1): row {row} is {c:?}"
-                    )));
-                }
-                out[k] = x.min(below_one);
-            }
-            Ok(out)
-        })
-        .collect()
+    let flat = c_order(view);
+    let bad = install(|| {
+        flat.par_chunks_exact(2)
+            .position_first(|c| !((0.0..=1.0).contains(&c[0]) && (0.0..=1.0).contains(&c[1])))
+    });
+    if let Some(row) = bad {
+        return Err(invalid(format!(
+            "{name} must lie in [0, 1): row {row} is {:?}",
+            &flat[2 * row..2 * row + 2]
+        )));
+    }
+    Ok(flat)
 }
 
 /// Points of shape `(N, 2)`, finite.
@@ -141,7 +151,15 @@ pub(crate) fn vec1(py: Python<'_>, v: Vec<f64>) -> Bound<'_, PyArray1<f64>> {
     Array1::from_vec(v).into_pyarray(py)
 }
 
-/// `(N, k)` float64 array from `N` rows of `k` (no copy).
+/// `(N, k)` float64 array from a flat row-major vector of `N · k` values (no copy).
+pub(crate) fn flat_rows(py: Python<'_>, v: Vec<f64>, k: usize) -> Bound<'_, PyArray2<f64>> {
+    let n = v.len() / k;
+    Array2::from_shape_vec((n, k), v)
+        .expect("n rows of k values")
+        .into_pyarray(py)
+}
+
+/// `(N, k)` float64 array from `N` rows of `k` (one copy).
 pub(crate) fn rows<const K: usize>(py: Python<'_>, v: Vec<[f64; K]>) -> Bound<'_, PyArray2<f64>> {
     let n = v.len();
     let flat: Vec<f64> = v.into_iter().flatten().collect();

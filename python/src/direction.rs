@@ -1,5 +1,6 @@
 //! `brdf_lab.DirectionSampler`: any direction sampler of the registry, built for a BRDF.
 
+use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -14,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
-use crate::arrays::{ArrayIn, dirs, pair_len, rows, uniforms, vec1};
+use crate::arrays::{ArrayIn, dirs, flat_rows, pair_len, uniforms, vec1};
 use crate::brdf_py::Brdf;
 use crate::errors::{invalid, value_error};
 use crate::options::{BASELINE_KEYS, direction_options, set_keys};
@@ -51,43 +52,80 @@ impl<R: UniformSource> UniformSource for Lead<'_, R> {
     }
 }
 
-/// The uniforms argument of `sample`: a count (all uniforms from the generator) or `(N, 2)`.
-pub(crate) enum UArg {
+/// The uniforms argument of `sample`: a count (all uniforms from the generator) or `(N, 2)`
+/// values (borrowed from the NumPy array when it is C-contiguous float64).
+pub(crate) enum UArg<'a> {
     /// Draw this many samples.
     Count(usize),
-    /// One query per row; the row gives its first two uniforms.
-    Given(Vec<[f64; 2]>),
+    /// One query per row (flat, 2 per row); the row gives its first two uniforms.
+    Given(Cow<'a, [f64]>),
 }
 
-impl UArg {
+/// The Python value of `u`: an int or an array-like (kept alive while its values are read).
+pub(crate) enum UIn<'py> {
+    /// A sample count.
+    Count(usize),
+    /// An array-like.
+    Array(ArrayIn<'py>),
+}
+
+impl<'py> UIn<'py> {
     /// Reads `u`: a non-negative int or an `(N, 2)` array-like.
-    pub(crate) fn read(u: &Bound<'_, PyAny>) -> PyResult<Self> {
+    pub(crate) fn read(u: &Bound<'py, PyAny>) -> PyResult<Self> {
         if u.is_instance_of::<pyo3::types::PyInt>() {
             let n: i64 = u.extract()?;
             return usize::try_from(n)
-                .map(UArg::Count)
+                .map(UIn::Count)
                 .map_err(|_| invalid(format!("the sample count must be ≥ 0, got {n}")));
         }
-        let arr: ArrayIn<'_> = u.extract().map_err(|e| {
+        u.extract().map(UIn::Array).map_err(|e| {
             invalid(format!(
                 "u must be an (N, 2) array of floats or an int: {e}"
             ))
-        })?;
-        Ok(UArg::Given(uniforms(&arr, "u")?))
+        })
+    }
+}
+
+impl<'a> UArg<'a> {
+    /// The checked uniforms of `u` (values in [0, 1]).
+    pub(crate) fn of(
+        u: &'a UIn<'_>,
+        view: &'a Option<numpy::ndarray::ArrayViewD<'a, f64>>,
+    ) -> PyResult<Self> {
+        match (u, view) {
+            (UIn::Count(n), _) => Ok(UArg::Count(*n)),
+            (UIn::Array(_), Some(v)) => Ok(UArg::Given(uniforms(v, "u")?)),
+            (UIn::Array(_), None) => Err(invalid("internal: u without its view")),
+        }
     }
 
     /// Number of queries.
     pub(crate) fn len(&self) -> usize {
         match self {
             UArg::Count(n) => *n,
-            UArg::Given(v) => v.len(),
+            UArg::Given(v) => v.len() / 2,
         }
+    }
+
+    /// Query `k`'s two uniforms (1 mapped below 1).
+    #[inline]
+    pub(crate) fn row(v: &[f64], k: usize) -> [f64; 2] {
+        const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+        [v[2 * k].min(BELOW_ONE), v[2 * k + 1].min(BELOW_ONE)]
+    }
+}
+
+/// The view of an array argument (None for a count).
+pub(crate) fn view_of<'a>(u: &'a UIn<'_>) -> Option<numpy::ndarray::ArrayViewD<'a, f64>> {
+    match u {
+        UIn::Count(_) => None,
+        UIn::Array(a) => Some(a.as_array()),
     }
 }
 
 /// Runs `one(k, source)` for every query `k < n` in fixed chunks of `PAR_CHUNK`, chunk `c`'s
 /// generator seeded from `(seed, c)`, so the output depends on `seed` only.
-pub(crate) fn chunked<T, F>(n: usize, u: &UArg, seed: u64, one: F) -> Vec<T>
+pub(crate) fn chunked<T, F>(n: usize, u: &UArg<'_>, seed: u64, one: F) -> Vec<T>
 where
     T: Default + Clone + Send,
     F: Fn(usize, &mut dyn UniformSource) -> T + Sync,
@@ -102,7 +140,7 @@ where
                     let k = c * PAR_CHUNK + j;
                     *slot = match u {
                         UArg::Count(_) => one(k, &mut rng),
-                        UArg::Given(v) => one(k, &mut Lead::new(v[k], &mut rng)),
+                        UArg::Given(v) => one(k, &mut Lead::new(UArg::row(v, k), &mut rng)),
                     };
                 }
             });
@@ -220,7 +258,9 @@ impl DirectionSampler {
         Bound<'py, PyAny>,
     )> {
         let wo = dirs(&wo, "wo")?;
-        let u = UArg::read(u)?;
+        let u_in = UIn::read(u)?;
+        let u_view = view_of(&u_in);
+        let u = UArg::of(&u_in, &u_view)?;
         let n = u.len();
         if !wo.single && wo.len() != n {
             return Err(invalid(format!(
@@ -231,34 +271,50 @@ impl DirectionSampler {
         let seed = self.next_seed(seed);
         let sampler = Arc::clone(&self.built.sampler);
         let brdf = Arc::clone(&self.brdf);
-        type Row = ([f64; 3], f64, [f64; 3]);
-        let out: Vec<Row> = py.detach(|| {
-            chunked(n, &u, seed, |k, src| {
-                let o = wo.get(k);
-                if !above(o) {
-                    return Row::default();
-                }
-                let s = sampler.sample(o, src);
-                let f = if s.pdf > 0.0 && s.wi.z > 0.0 {
-                    if rgb {
-                        brdf.eval_rgb(o, &s.wi)
-                    } else {
-                        [brdf.eval(o, &s.wi), 0.0, 0.0]
-                    }
-                } else {
-                    [0.0; 3]
-                };
-                ([s.wi.x, s.wi.y, s.wi.z], s.pdf, f)
+        let fw = if rgb { 3 } else { 1 };
+        let mut wi = vec![0.0; 3 * n];
+        let mut pdf = vec![0.0; n];
+        let mut f = vec![0.0; fw * n];
+        // One pass, in parallel, straight into the output buffers (no per-row temporaries).
+        py.detach(|| {
+            install(|| {
+                wi.par_chunks_mut(3 * PAR_CHUNK)
+                    .zip(pdf.par_chunks_mut(PAR_CHUNK))
+                    .zip(f.par_chunks_mut(fw * PAR_CHUNK))
+                    .enumerate()
+                    .for_each(|(c, ((wi_c, pdf_c), f_c))| {
+                        let mut rng = chunk_rng(seed, c as u64);
+                        for j in 0..pdf_c.len() {
+                            let k = c * PAR_CHUNK + j;
+                            let o = wo.get(k);
+                            if !above(o) {
+                                continue; // zeros
+                            }
+                            let s = match &u {
+                                UArg::Count(_) => sampler.sample(o, &mut rng),
+                                UArg::Given(v) => {
+                                    sampler.sample(o, &mut Lead::new(UArg::row(v, k), &mut rng))
+                                }
+                            };
+                            wi_c[3 * j..3 * j + 3].copy_from_slice(&[s.wi.x, s.wi.y, s.wi.z]);
+                            pdf_c[j] = s.pdf;
+                            if s.pdf > 0.0 && s.wi.z > 0.0 {
+                                if rgb {
+                                    f_c[3 * j..3 * j + 3].copy_from_slice(&brdf.eval_rgb(o, &s.wi));
+                                } else {
+                                    f_c[j] = brdf.eval(o, &s.wi);
+                                }
+                            }
+                        }
+                    });
             })
         });
-        let wi: Vec<[f64; 3]> = out.iter().map(|r| r.0).collect();
-        let pdf: Vec<f64> = out.iter().map(|r| r.1).collect();
         let f = if rgb {
-            rows(py, out.iter().map(|r| r.2).collect()).into_any()
+            flat_rows(py, f, 3).into_any()
         } else {
-            vec1(py, out.iter().map(|r| r.2[0]).collect()).into_any()
+            vec1(py, f).into_any()
         };
-        Ok((rows(py, wi), vec1(py, pdf), f))
+        Ok((flat_rows(py, wi, 3), vec1(py, pdf), f))
     }
 
     /// The sampler's density of `wi` given `wo`, per unit solid angle, shape (N,). `wo`, `wi`:

@@ -17,7 +17,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 
 use crate::arrays::{ArrayIn, dirs, points, rows, vec1};
-use crate::direction::{UArg, chunked};
+use crate::direction::{UArg, UIn, chunked, view_of};
 use crate::errors::{invalid, value_error};
 use crate::threads::{call_seed, install};
 
@@ -55,13 +55,20 @@ fn tree_params(
 fn sample_planar<S: Sampler2D + Sync + ?Sized>(
     s: &S,
     warp: Option<&(dyn Fn([f64; 2]) -> Sample2 + Sync)>,
-    u: &UArg,
+    u: &UArg<'_>,
     seed: u64,
 ) -> Vec<Sample2> {
     match (u, warp) {
         (UArg::Count(n), _) => install(|| partition_sampler::sample_par(s, *n, seed)),
         (UArg::Given(v), Some(w)) => {
-            install(|| v.par_iter().with_min_len(1024).map(|p| w(*p)).collect())
+            let v: &[f64] = v;
+            install(|| {
+                (0..v.len() / 2)
+                    .into_par_iter()
+                    .with_min_len(1024)
+                    .map(|k| w(UArg::row(v, k)))
+                    .collect()
+            })
         }
         (UArg::Given(_), None) => chunked(u.len(), u, seed, |_, src: &mut dyn UniformSource| {
             let x = s.sample(src);
@@ -194,7 +201,9 @@ impl EnvMapSampler {
         Bound<'py, PyArray2<f64>>,
         Bound<'py, PyArray1<f64>>,
     )> {
-        let u = UArg::read(u)?;
+        let u_in = UIn::read(u)?;
+        let u_view = view_of(&u_in);
+        let u = UArg::of(&u_in, &u_view)?;
         let seed = seed
             .unwrap_or_else(|| call_seed(self.seed, self.calls.fetch_add(1, Ordering::Relaxed)));
         let inner = Arc::clone(&self.inner);
@@ -413,7 +422,9 @@ impl PartitionSampler {
         u: &Bound<'py, PyAny>,
         seed: Option<u64>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
-        let u = UArg::read(u)?;
+        let u_in = UIn::read(u)?;
+        let u_view = view_of(&u_in);
+        let u = UArg::of(&u_in, &u_view)?;
         let seed = seed
             .unwrap_or_else(|| call_seed(self.seed, self.calls.fetch_add(1, Ordering::Relaxed)));
         let inner = Arc::clone(&self.inner);
