@@ -26,7 +26,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::brdf_args::{self, SetArgs};
+use crate::brdf_args::{self, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
 use crate::progress;
@@ -86,7 +86,7 @@ pub(crate) struct BenchArgs {
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
     #[command(flatten)]
-    set: SetArgs,
+    set: SamplerArgs,
 }
 
 /// One sampler's figures.
@@ -239,9 +239,8 @@ struct Subject {
 }
 
 fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject> {
-    let started = Instant::now();
-    let built = brdf_args::build(name, &args.spec, brdf, &args.set)?;
-    let build_seconds = started.elapsed().as_secs_f64();
+    let (built, elapsed) = brdf_args::build(name, &args.spec, brdf, &args.set)?;
+    let build_seconds = elapsed.as_secs_f64();
     let sampler: Arc<dyn DirectionSampler> = match built {
         brdf_args::Built::Set(s) => s,
         brdf_args::Built::Other(s) => s,
@@ -254,9 +253,21 @@ fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject
 }
 
 /// Runs `brdf-lab bench`.
-pub(crate) fn run(args: &BenchArgs) -> CliResult<()> {
+pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
     crate::output::check_all([("--json", args.json.as_deref())])?;
     args.set.check()?;
+    // Each sampler option given must configure at least one of the samplers compared.
+    for option in &given.0 {
+        let one = Given(vec![option.clone()]);
+        let checks: Vec<CliResult<()>> = args
+            .samplers
+            .iter()
+            .map(|s| brdf_args::check_options_apply(&one, Some(s)))
+            .collect();
+        if checks.iter().all(Result::is_err) {
+            return checks.into_iter().next().unwrap_or(Ok(()));
+        }
+    }
     if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
         return Err(CliError::input(format!(
             "--theta-o must be in [0, 90) degrees, got {}",

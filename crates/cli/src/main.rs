@@ -76,7 +76,7 @@ fn main() {
         Command::Envmap(args) => envmap_cmd::run(&args),
         Command::Study(args) => study_cmd::run(&args),
         Command::Product(args) => product_cmd::run(&args),
-        Command::Bench(args) => bench_cmd::run(&args),
+        Command::Bench(args) => bench_cmd::run(&args, &given),
     };
     if let Err(e) = result {
         report_and_exit(&e);
