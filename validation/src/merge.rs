@@ -89,3 +89,87 @@ pub fn merge(parts: Vec<(String, ValidationReport)>) -> Result<ValidationReport,
     header.shard = None;
     Ok(header.judged())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::TestRecord;
+    use stats::{TestOutcome, sidak_level};
+
+    fn record(case: usize, p: f64) -> TestRecord {
+        let o = TestOutcome::with_p_value("chi-square", 1.0, p, 0.01, String::new());
+        TestRecord {
+            case,
+            ..TestRecord::new("lambert", "s", Some(0.0), "hemisphere", &o)
+        }
+    }
+
+    fn part(index: usize, tests: Vec<TestRecord>) -> (String, ValidationReport) {
+        let cases = tests.iter().map(|t| t.case).collect::<BTreeSet<_>>().len();
+        let r = ValidationReport {
+            alpha: 0.01,
+            passed: false,
+            tests,
+            mutants: Vec::new(),
+            tier: "quick".into(),
+            seed: 1,
+            samples: 2000,
+            batches: [50, 256],
+            m: 0,
+            per_test_level: 0.0,
+            shard: Some(ShardInfo {
+                index,
+                count: 2,
+                total_cases: 3,
+                cases,
+                fingerprint: "f".into(),
+            }),
+        };
+        (format!("part{index}"), r.judged())
+    }
+
+    #[test]
+    fn the_merge_judges_the_union_at_its_sidak_level() {
+        // Alone, shard 1 judges p = 0.003 at the level of m = 1 (0.01): failed. Over the
+        // union (m = 4, level ≈ 0.0025) it passes, as in the single run.
+        let p1 = part(1, vec![record(0, 0.003), record(2, 0.5)]);
+        assert!(!p1.1.passed && !p1.1.tests[0].passed);
+        let p2 = part(2, vec![record(1, 0.5), record(1, 0.6)]);
+        let merged = merge(vec![p2.clone(), p1.clone()]).unwrap();
+        assert_eq!(merged.m, 4);
+        assert_eq!(merged.per_test_level, sidak_level(0.01, 4));
+        assert!(merged.passed && merged.tests.iter().all(|t| t.passed));
+        assert_eq!(
+            merged.tests.iter().map(|t| t.case).collect::<Vec<_>>(),
+            [0, 1, 1, 2]
+        );
+        assert!(merged.shard.is_none());
+
+        assert!(matches!(merge(Vec::new()), Err(MergeError::NoParts)));
+        assert!(matches!(
+            merge(vec![p1.clone()]),
+            Err(MergeError::Missing { missing, count: 2 }) if missing == [2]
+        ));
+        let mut truncated = p2.clone();
+        truncated.1.tests.clear();
+        assert!(matches!(
+            merge(vec![p1.clone(), truncated]),
+            Err(MergeError::Incomplete {
+                got: 2,
+                expected: 3
+            })
+        ));
+        let mut other = p2.clone();
+        other.1.shard.as_mut().unwrap().fingerprint = "g".into();
+        assert!(matches!(
+            merge(vec![p1.clone(), other]),
+            Err(MergeError::ConfigMismatch { .. })
+        ));
+        let mut whole = p2;
+        whole.1.shard = None;
+        assert!(matches!(
+            merge(vec![p1, whole]),
+            Err(MergeError::NotAShard(_))
+        ));
+    }
+}
