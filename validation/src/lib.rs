@@ -10,7 +10,9 @@
 //! * the `samplers` crate is the registry (one entry per sampler; [`builds`] maps each kind to
 //!   a subject under test); [`mutants()`] are the broken ones.
 //! * [`run`] executes a [`ValidateConfig`] (quick or full tier) and returns a
-//!   [`ValidationReport`] ([`ValidationReport::to_json`], [`ValidationReport::to_markdown`]).
+//!   [`ValidationReport`] ([`ValidationReport::to_json`], [`ValidationReport::to_markdown`]);
+//!   [`run_shard`] runs one [`Shard`] of it and [`merge`] recombines the shards' reports into
+//!   the single run's.
 //!
 //! Tests per case (sampler, target, `θo`): `chi-square` and `batch-chi-square` (expected counts
 //! by adaptive quadrature with accuracy tied to N, pooling below 5), `ks-cos-theta`/`ks-phi`
@@ -46,6 +48,7 @@ mod case;
 pub mod cells;
 mod domain;
 mod error;
+mod merge;
 pub mod mutants;
 mod plan;
 pub mod references;
@@ -61,15 +64,16 @@ pub use builds::{
 };
 pub use case::{DECLARED_ERROR_FACTOR, DRAW_CHUNK, draw, draw_batches, names, run_case, z_test};
 pub use domain::{Domain, Resolution};
-pub use error::ValidationError;
+pub use error::{MergeError, ValidationError};
+pub use merge::merge;
 pub use mutants::{Mutant, mutants};
 pub use plan::{
     DEFAULT_MEASURED_DIR, DEFAULT_MERL_DIR, FULL_PRESET_MODELS, FULL_SAMPLES, FULL_THETA_O,
     MIN_SAMPLES, PRESET_THETA_O, Plan, QUICK_BRDFS, QUICK_CORNELL, QUICK_RGL, QUICK_SAMPLES,
-    QUICK_THETA_O, Tier, ValidateConfig,
+    QUICK_THETA_O, Shard, Tier, ValidateConfig,
 };
-pub use report::{MutantRecord, TestRecord, ValidationReport};
+pub use report::{MutantRecord, ShardInfo, TestRecord, ValidationReport};
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };
-pub use suite::{ProgressEvent, run};
+pub use suite::{ProgressEvent, run, run_shard};

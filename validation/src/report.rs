@@ -2,14 +2,22 @@
 
 use std::fmt::Write as _;
 
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::case::names;
-use stats::TestOutcome;
+use stats::{TestOutcome, sidak_level};
+
+/// A number written as `null` when not finite (serde_json's way) read back as NaN.
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
 
 /// One test of one case.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TestRecord {
+    /// Index of the case in the run's full plan (fixed order; the unit of `--shard K/N`).
+    #[serde(default)]
+    pub case: usize,
     /// BRDF spec, or the target of a standalone sampler (e.g. `map:procedural-sky-128x64`).
     pub brdf: String,
     /// Sampler name.
@@ -18,7 +26,8 @@ pub struct TestRecord {
     pub theta_o: Option<f64>,
     /// Test name (`chi-square`, `ks-phi`, `unbiasedness`, ...).
     pub test: String,
-    /// The statistic (`null` in JSON when not finite).
+    /// The statistic (`null` in JSON when not finite; read back as NaN).
+    #[serde(deserialize_with = "nan_if_null")]
     pub statistic: f64,
     /// p-value of statistical tests; `null` for deterministic checks.
     pub p_value: Option<f64>,
@@ -40,6 +49,7 @@ impl TestRecord {
         o: &TestOutcome,
     ) -> Self {
         Self {
+            case: 0,
             brdf: brdf.to_owned(),
             sampler: sampler.to_owned(),
             theta_o,
@@ -61,8 +71,11 @@ impl TestRecord {
 }
 
 /// The outcome of one mutant and its control.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MutantRecord {
+    /// Index of the mutant's case in the run's full plan (the mutants come last).
+    #[serde(default)]
+    pub case: usize,
     /// Mutant name.
     pub name: String,
     /// Whether at least one test rejected the mutant.
@@ -85,8 +98,24 @@ pub struct MutantRecord {
     pub control_tests: Vec<TestRecord>,
 }
 
+/// What a shard's report (`validate --shard K/N --json`) says about the run it is part of.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    /// `K` of `K/N`, from 1.
+    pub index: usize,
+    /// `N` of `K/N`.
+    pub count: usize,
+    /// Cases of the full plan (every shard's, mutants included).
+    pub total_cases: usize,
+    /// Cases of this shard.
+    pub cases: usize,
+    /// Hash (hex FNV-1a) of the configuration and of the full plan's case labels: shards of
+    /// different runs (or that found different data files) do not merge.
+    pub fingerprint: String,
+}
+
 /// The report of a validation run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ValidationReport {
     /// Family-wise significance level.
     pub alpha: f64,
@@ -109,6 +138,11 @@ pub struct ValidationReport {
     pub m: usize,
     /// Šidák per-test level `1 − (1 − α)^{1/m}`.
     pub per_test_level: f64,
+    /// Set in a shard's report only (absent from a whole run's and a merged report's JSON).
+    /// A shard's `passed`, `m` and `per_test_level` cover its own tests only: the run's
+    /// verdict is the merge's ([`crate::merge`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardInfo>,
 }
 
 fn fmt_num(x: f64) -> String {
@@ -142,7 +176,53 @@ fn fmt_theta(t: Option<f64>) -> String {
     t.map_or_else(|| "—".into(), |t| format!("{t}°"))
 }
 
+impl MutantRecord {
+    /// Re-judges the mutant's and its control's tests at `level` and derives the verdicts
+    /// (`detected`, `caught_by`, `min_p_value`, `control_passed`) from them.
+    fn judge(&mut self, level: f64) {
+        self.tests.iter_mut().for_each(|t| t.judge(level));
+        self.control_tests.iter_mut().for_each(|t| t.judge(level));
+        self.caught_by = self
+            .tests
+            .iter()
+            .filter(|t| !t.passed && t.test != names::BUILD)
+            .map(|t| t.test.clone())
+            .collect();
+        self.detected = !self.caught_by.is_empty();
+        self.min_p_value = self
+            .tests
+            .iter()
+            .filter_map(|t| t.p_value)
+            .min_by(f64::total_cmp);
+        self.control_passed = self.control_tests.iter().all(|t| t.passed);
+    }
+}
+
 impl ValidationReport {
+    /// Judges the report's tests together: `m` = the p-valued tests of the cases and of the
+    /// mutants' controls, every p-value at the Šidák level `1 − (1 − α)^{1/m}`, the mutants'
+    /// verdicts, and `passed` (every test passed, every mutant caught with its control
+    /// passing, and at least one test ran). A single run and [`crate::merge`] both end here.
+    pub(crate) fn judged(mut self) -> Self {
+        self.m = self
+            .tests
+            .iter()
+            .chain(self.mutants.iter().flat_map(|m| m.control_tests.iter()))
+            .filter(|t| t.p_value.is_some())
+            .count();
+        let level = sidak_level(self.alpha, self.m);
+        self.per_test_level = level;
+        self.tests.iter_mut().for_each(|t| t.judge(level));
+        self.mutants.iter_mut().for_each(|m| m.judge(level));
+        // A run in which every case was skipped (or that had no case) tested nothing: not a
+        // pass.
+        let ran = self.tests.iter().any(|t| t.test != names::SKIPPED);
+        self.passed = ran
+            && self.tests.iter().all(|t| t.passed)
+            && self.mutants.iter().all(|m| m.detected && m.control_passed);
+        self
+    }
+
     /// Whether the run passed: every test, and with mutants every detection and control.
     pub fn passed(&self) -> bool {
         self.passed

@@ -8,7 +8,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use brdf::{Brdf, Vec3, direction_from_angles};
 use brdf_sampling::DirectionSampler;
 use rayon::prelude::*;
-use stats::{TestOutcome, sidak_level};
+use stats::TestOutcome;
+#[cfg(test)]
+use stats::sidak_level;
 
 use crate::adapters::DirectionAtWo;
 use crate::builds::{
@@ -17,14 +19,14 @@ use crate::builds::{
 use crate::case::{error_outcome, names, run_case, skipped_outcome};
 use crate::domain::Domain;
 use crate::error::ValidationError;
-use crate::mutants::mutants;
+use crate::mutants::{Mutant, mutants};
 use crate::plan::{
     DEFAULT_MEASURED_DIR, FULL_PRESET_MODELS, FULL_THETA_O, MIN_SAMPLES, PRESET_THETA_O, Plan,
-    QUICK_BRDFS, QUICK_THETA_O, Tier, ValidateConfig,
+    QUICK_BRDFS, QUICK_THETA_O, Shard, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
-use crate::report::{MutantRecord, TestRecord, ValidationReport};
-use crate::seeding::case_seed;
+use crate::report::{MutantRecord, ShardInfo, TestRecord, ValidationReport};
+use crate::seeding::{case_seed, label_hash};
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
 use samplers::SamplerEntry;
@@ -202,6 +204,8 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
 
 /// The outcomes of one case.
 struct CaseResult {
+    /// Index in the run's full plan.
+    index: usize,
     sampler: String,
     target: String,
     theta_o: Option<f64>,
@@ -244,19 +248,25 @@ fn case_label(sampler: &str, target: &str, theta: Option<f64>) -> String {
     format!("{sampler}|{target}|{theta:?}")
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_brdf_job(
     entry: &SamplerEntry,
     r: &Resolved,
     bi: usize,
     refs: &[Result<BrdfReferences, String>],
     seed: u64,
+    cases: Cases<'_>,
     on_done: &(dyn Fn(&CaseResult) + Sync),
 ) -> Vec<CaseResult> {
     let (spec, brdf) = &r.brdfs[bi];
+    // Nothing of this job in the shard: not built.
+    if !(0..cases_at(r, spec)).any(|k| (cases.keep)(cases.base + k)) {
+        return Vec::new();
+    }
     // A sampler that does not apply to this BRDF (the registry says why) is skipped and
     // reported, never built.
     if let Err(na) = entry.applicability(brdf.as_ref()) {
-        return skipped_angles(entry.name, spec, r, &na.reason, on_done);
+        return skipped_angles(entry.name, spec, r, &na.reason, cases, on_done);
     }
     // Direction samplers are built once per BRDF; disc samplers per angle.
     let built = direction_domain(entry).map(|domain| {
@@ -276,7 +286,19 @@ fn run_brdf_job(
             refs,
         ))),
     };
-    run_angles(entry.name, spec, r, refs, seed, on_done, &subject_at)
+    run_angles(entry.name, spec, r, refs, seed, cases, on_done, &subject_at)
+}
+
+/// The first case index of a job and the shard's selection of case indices.
+#[derive(Clone, Copy)]
+struct Cases<'a> {
+    base: usize,
+    keep: &'a (dyn Fn(usize) -> bool + Sync),
+}
+
+/// The number of cases of `spec` in the run: the angles it runs at.
+fn cases_at(r: &Resolved, spec: &str) -> usize {
+    r.angles.iter().filter(|&&t| r.runs(spec, t)).count()
 }
 
 /// The cases of a sampler that does not apply to a BRDF: one skipped outcome per angle the
@@ -286,13 +308,17 @@ fn skipped_angles(
     spec: &str,
     r: &Resolved,
     reason: &str,
+    cases: Cases<'_>,
     on_done: &(dyn Fn(&CaseResult) + Sync),
 ) -> Vec<CaseResult> {
     r.angles
         .iter()
         .filter(|&&theta| r.runs(spec, theta))
-        .map(|&theta| {
+        .enumerate()
+        .filter(|(k, _)| (cases.keep)(cases.base + k))
+        .map(|(k, &theta)| {
             let c = CaseResult {
+                index: cases.base + k,
                 sampler: sampler.to_owned(),
                 target: spec.to_owned(),
                 theta_o: Some(theta),
@@ -330,12 +356,19 @@ fn run_angles(
     r: &Resolved,
     refs: &[Result<BrdfReferences, String>],
     seed: u64,
+    cases: Cases<'_>,
     on_done: &(dyn Fn(&CaseResult) + Sync),
     subject_at: &(dyn Fn(Vec3, &BrdfReferences) -> Result<AnySubject, String> + Sync),
 ) -> Vec<CaseResult> {
     let mut out = Vec::with_capacity(r.angles.len());
+    let mut k = 0;
     for (ai, &theta) in r.angles.iter().enumerate() {
         if !r.runs(spec, theta) {
+            continue;
+        }
+        let index = cases.base + k;
+        k += 1;
+        if !(cases.keep)(index) {
             continue;
         }
         let wo = direction_from_angles(theta, 0.0);
@@ -356,6 +389,7 @@ fn run_angles(
             Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
         };
         let c = CaseResult {
+            index,
             sampler: sampler.to_owned(),
             target: spec.to_owned(),
             theta_o: Some(theta),
@@ -421,6 +455,26 @@ pub fn run(
     config: &ValidateConfig,
     progress: &(dyn Fn(ProgressEvent) + Sync),
 ) -> Result<ValidationReport, ValidationError> {
+    run_shard(config, None, progress)
+}
+
+/// Runs the cases of one shard of a validation (all of them with `None`, as [`run`] does).
+///
+/// The run's cases are numbered in a fixed order (the standalone samplers whose targets could
+/// not be built, then every sampler × BRDF × angle, the standalone samplers' targets and the
+/// saved sets' angles in job order, then the mutants); `shard` keeps the cases `i` with
+/// `i mod N = K − 1` ([`Shard::contains`]). Each case is seeded from the master seed and its
+/// own label, so its records equal the single run's; a sampler is built only when the shard
+/// holds one of its cases. The shard's report carries a [`ShardInfo`] (its `passed` judges its
+/// own tests only); [`crate::merge`] recombines the parts into the single run's report.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_shard(
+    config: &ValidateConfig,
+    shard: Option<Shard>,
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
     let r = resolve(config)?;
     let seed = config.seed;
 
@@ -443,35 +497,52 @@ pub fn run(
             jobs.push(Job::Brdf { entry, brdf: bi });
         }
     }
-    let mut failed_builds: Vec<CaseResult> = Vec::new();
+    // The plan's case labels in the fixed order (their index is the case's number).
+    let mut labels: Vec<String> = Vec::new();
+    let mut failed_builds: Vec<(&'static SamplerEntry, &String)> = Vec::new();
     for (entry, cases) in &standalone {
         match cases {
             Ok(cases) => jobs.extend(cases.iter().map(|case| Job::Standalone { entry, case })),
-            Err(e) => failed_builds.push(CaseResult {
-                sampler: entry.name.to_owned(),
-                target: "—".into(),
-                theta_o: None,
-                domain: "—".into(),
-                outcomes: vec![error_outcome(names::BUILD, e)],
-            }),
+            Err(e) => {
+                labels.push(case_label(entry.name, "—", None));
+                failed_builds.push((entry, e));
+            }
         }
     }
     jobs.extend((0..r.sets.len()).map(Job::Set));
+    let mut bases: Vec<usize> = Vec::with_capacity(jobs.len());
+    for job in &jobs {
+        bases.push(labels.len());
+        match job {
+            Job::Brdf { entry, brdf } => {
+                let spec = &r.brdfs[*brdf].0;
+                labels.extend(
+                    r.angles
+                        .iter()
+                        .filter(|&&t| r.runs(spec, t))
+                        .map(|&t| case_label(entry.name, spec, Some(t))),
+                );
+            }
+            Job::Standalone { entry, case } => {
+                labels.push(case_label(entry.name, &case.target, None));
+            }
+            Job::Set(i) => {
+                let set = &r.sets[*i];
+                labels.extend(
+                    r.angles
+                        .iter()
+                        .filter(|&&t| r.runs(&set.spec, t))
+                        .map(|&t| case_label(&set.label, &set.spec, Some(t))),
+                );
+            }
+        }
+    }
     let mutant_list = if config.mutants { mutants() } else { &[] };
-    let angles_of = |spec: &str| r.angles.iter().filter(|&&t| r.runs(spec, t)).count();
-    let total = jobs
-        .iter()
-        .map(|j| match j {
-            Job::Brdf { brdf, .. } => angles_of(&r.brdfs[*brdf].0),
-            _ => 0,
-        })
-        .sum::<usize>()
-        + r.sets.len() * r.angles.len()
-        + jobs
-            .iter()
-            .filter(|j| matches!(j, Job::Standalone { .. }))
-            .count()
-        + mutant_list.len();
+    let mutant_base = labels.len();
+    labels.extend(mutant_list.iter().map(|m| format!("mutant:{}", m.name)));
+    let total_cases = labels.len();
+    let keep = |i: usize| shard.is_none_or(|s| s.contains(i));
+    let total = (0..total_cases).filter(|&i| keep(i)).count();
     progress(ProgressEvent::Started { total });
     let done = AtomicUsize::new(0);
     let notify = |label: String, passed: bool| {
@@ -485,79 +556,120 @@ pub fn run(
     };
     let on_done = |c: &CaseResult| notify(c.label(), c.outcomes.iter().all(|o| o.passed));
 
-    // References of every (BRDF, angle), shared by the samplers.
-    let refs: Vec<Vec<Result<BrdfReferences, String>>> = if brdf_entries.is_empty() {
-        Vec::new()
-    } else {
-        r.brdfs
-            .par_iter()
-            .map(|(spec, b)| {
-                r.angles
-                    .par_iter()
-                    .map(|&t| {
-                        if r.runs(spec, t) {
-                            references_for(b.as_ref(), &direction_from_angles(t, 0.0))
-                        } else {
-                            Err("not run at this angle".to_owned())
-                        }
-                    })
-                    .collect()
-            })
-            .collect()
-    };
+    // References of every (BRDF, angle) that a case of the shard needs, shared by the
+    // samplers.
+    let mut needed = vec![vec![false; r.angles.len()]; r.brdfs.len()];
+    for (job, &base) in jobs.iter().zip(&bases) {
+        if let Job::Brdf { brdf, .. } = job {
+            let spec = &r.brdfs[*brdf].0;
+            let running = r
+                .angles
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| r.runs(spec, **t));
+            for (k, (ai, _)) in running.enumerate() {
+                needed[*brdf][ai] |= keep(base + k);
+            }
+        }
+    }
+    let refs: Vec<Vec<Result<BrdfReferences, String>>> = r
+        .brdfs
+        .par_iter()
+        .zip(&needed)
+        .map(|((_, b), need)| {
+            r.angles
+                .par_iter()
+                .zip(need)
+                .map(|(&t, &need)| {
+                    if need {
+                        references_for(b.as_ref(), &direction_from_angles(t, 0.0))
+                    } else {
+                        Err("not run at this angle in this shard".to_owned())
+                    }
+                })
+                .collect()
+        })
+        .collect();
 
+    let failed_builds: Vec<CaseResult> = failed_builds
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| keep(*i))
+        .map(|(index, (entry, e))| CaseResult {
+            index,
+            sampler: entry.name.to_owned(),
+            target: "—".into(),
+            theta_o: None,
+            domain: "—".into(),
+            outcomes: vec![error_outcome(names::BUILD, e)],
+        })
+        .collect();
     let results: Vec<Vec<CaseResult>> = jobs
         .par_iter()
-        .map(|job| match job {
-            Job::Brdf { entry, brdf } => {
-                run_brdf_job(entry, &r, *brdf, &refs[*brdf], seed, &on_done)
-            }
-            Job::Standalone { entry, case } => {
-                let c = CaseResult {
-                    sampler: entry.name.to_owned(),
-                    target: case.target.clone(),
-                    theta_o: None,
-                    domain: case.subject.domain.name().to_owned(),
-                    outcomes: run_case(
-                        &AnySubject::Planar(case.subject.clone()),
-                        &r.plan,
-                        case_seed(seed, &case_label(entry.name, &case.target, None)),
-                    ),
-                };
-                on_done(&c);
-                vec![c]
-            }
-            Job::Set(i) => {
-                let set = &r.sets[*i];
-                let refs: Vec<Result<BrdfReferences, String>> = r
-                    .angles
-                    .iter()
-                    .map(|&t| references_for(set.brdf.as_ref(), &direction_from_angles(t, 0.0)))
-                    .collect();
-                let subject_at = |wo: Vec3, refs: &BrdfReferences| {
-                    Ok(direction_subject(
-                        &set.sampler,
-                        Domain::Hemisphere,
-                        &set.brdf,
-                        wo,
-                        refs,
-                    ))
-                };
-                run_angles(
-                    &set.label,
-                    &set.spec,
-                    &r,
-                    &refs,
-                    seed,
-                    &on_done,
-                    &subject_at,
-                )
+        .zip(&bases)
+        .map(|(job, &base)| {
+            let cases = Cases { base, keep: &keep };
+            match job {
+                Job::Brdf { entry, brdf } => {
+                    run_brdf_job(entry, &r, *brdf, &refs[*brdf], seed, cases, &on_done)
+                }
+                Job::Standalone { .. } if !keep(base) => Vec::new(),
+                Job::Standalone { entry, case } => {
+                    let c = CaseResult {
+                        index: base,
+                        sampler: entry.name.to_owned(),
+                        target: case.target.clone(),
+                        theta_o: None,
+                        domain: case.subject.domain.name().to_owned(),
+                        outcomes: run_case(
+                            &AnySubject::Planar(case.subject.clone()),
+                            &r.plan,
+                            case_seed(seed, &case_label(entry.name, &case.target, None)),
+                        ),
+                    };
+                    on_done(&c);
+                    vec![c]
+                }
+                Job::Set(i) => {
+                    let set = &r.sets[*i];
+                    let running = || r.angles.iter().filter(|&&t| r.runs(&set.spec, t));
+                    if !(0..running().count()).any(|k| keep(base + k)) {
+                        return Vec::new();
+                    }
+                    let refs: Vec<Result<BrdfReferences, String>> = r
+                        .angles
+                        .iter()
+                        .map(|&t| references_for(set.brdf.as_ref(), &direction_from_angles(t, 0.0)))
+                        .collect();
+                    let subject_at = |wo: Vec3, refs: &BrdfReferences| {
+                        Ok(direction_subject(
+                            &set.sampler,
+                            Domain::Hemisphere,
+                            &set.brdf,
+                            wo,
+                            refs,
+                        ))
+                    };
+                    run_angles(
+                        &set.label,
+                        &set.spec,
+                        &r,
+                        &refs,
+                        seed,
+                        cases,
+                        &on_done,
+                        &subject_at,
+                    )
+                }
             }
         })
         .collect();
-    let mutant_results: Vec<(CaseResult, CaseResult)> = mutant_list
+    let mutant_results: Vec<MutantCase> = mutant_list
         .par_iter()
-        .map(|m| {
+        .enumerate()
+        .filter(|(j, _)| keep(mutant_base + j))
+        .map(|(j, m)| {
+            let index = mutant_base + j;
             let label = |kind: &str| format!("{kind}:{}", m.name);
             let wo = direction_from_angles(m.theta_o, 0.0);
             let built = brdf::parse_spec(m.brdf)
@@ -576,6 +688,7 @@ pub fn run(
                     Err(e) => ("—".to_owned(), vec![error_outcome(names::BUILD, e)]),
                 };
                 CaseResult {
+                    index,
                     sampler: label(kind),
                     target: m.brdf.to_owned(),
                     theta_o: Some(m.theta_o),
@@ -591,10 +704,17 @@ pub fn run(
                 Err(e) => (run_one(Err(e), "mutant"), run_one(Err(e), "control")),
             };
             notify(label("mutant"), mc.outcomes.iter().any(|o| !o.passed));
-            (mc, cc)
+            (m, mc, cc)
         })
         .collect();
 
+    let shard_info = shard.map(|s| ShardInfo {
+        index: s.index,
+        count: s.count,
+        total_cases,
+        cases: total,
+        fingerprint: fingerprint(config, &labels),
+    });
     Ok(assemble(
         config,
         &r.plan,
@@ -603,13 +723,30 @@ pub fn run(
             .chain(results.into_iter().flatten())
             .collect(),
         mutant_results,
+        shard_info,
     ))
+}
+
+/// A mutant with its case and its control's.
+type MutantCase = (&'static Mutant, CaseResult, CaseResult);
+
+/// FNV-1a (hex) of the configuration (as JSON) and of the plan's case labels in order.
+fn fingerprint(config: &ValidateConfig, labels: &[String]) -> String {
+    let mut text = serde_json::to_string(config).unwrap_or_default();
+    for l in labels {
+        text.push('\n');
+        text.push_str(l);
+    }
+    format!("{:016x}", label_hash(&text))
 }
 
 fn records(c: &CaseResult) -> Vec<TestRecord> {
     c.outcomes
         .iter()
-        .map(|o| TestRecord::new(&c.target, &c.sampler, c.theta_o, &c.domain, o))
+        .map(|o| TestRecord {
+            case: c.index,
+            ..TestRecord::new(&c.target, &c.sampler, c.theta_o, &c.domain, o)
+        })
         .collect()
 }
 
@@ -617,65 +754,40 @@ fn assemble(
     config: &ValidateConfig,
     plan: &Plan,
     cases: Vec<CaseResult>,
-    mutant_results: Vec<(CaseResult, CaseResult)>,
+    mutant_results: Vec<MutantCase>,
+    shard: Option<ShardInfo>,
 ) -> ValidationReport {
-    let mut tests: Vec<TestRecord> = cases.iter().flat_map(records).collect();
-    let mut controls: Vec<Vec<TestRecord>> =
-        mutant_results.iter().map(|(_, c)| records(c)).collect();
-    let m = tests
-        .iter()
-        .chain(controls.iter().flatten())
-        .filter(|t| t.p_value.is_some())
-        .count();
-    let level = sidak_level(config.alpha, m);
-    tests.iter_mut().for_each(|t| t.judge(level));
-    controls.iter_mut().flatten().for_each(|t| t.judge(level));
     let mutants: Vec<MutantRecord> = mutant_results
         .iter()
-        .zip(controls)
-        .zip(mutants())
-        .map(|(((mc, _), control_tests), m)| {
-            let mut mtests = records(mc);
-            mtests.iter_mut().for_each(|t| t.judge(level));
-            let caught_by: Vec<String> = mtests
-                .iter()
-                .filter(|t| !t.passed && t.test != names::BUILD)
-                .map(|t| t.test.clone())
-                .collect();
-            MutantRecord {
-                name: m.name.to_owned(),
-                detected: !caught_by.is_empty(),
-                caught_by,
-                min_p_value: mtests
-                    .iter()
-                    .filter_map(|t| t.p_value)
-                    .min_by(f64::total_cmp),
-                control_passed: control_tests.iter().all(|t| t.passed),
-                description: m.description.to_owned(),
-                brdf: m.brdf.to_owned(),
-                theta_o: m.theta_o,
-                tests: mtests,
-                control_tests,
-            }
+        .map(|(m, mc, cc)| MutantRecord {
+            case: mc.index,
+            name: m.name.to_owned(),
+            // Derived from the tests by `judged`.
+            detected: false,
+            caught_by: Vec::new(),
+            min_p_value: None,
+            control_passed: false,
+            description: m.description.to_owned(),
+            brdf: m.brdf.to_owned(),
+            theta_o: m.theta_o,
+            tests: records(mc),
+            control_tests: records(cc),
         })
         .collect();
-    // A run in which every case was skipped (or that had no case) tested nothing: not a pass.
-    let ran = tests.iter().any(|t| t.test != names::SKIPPED);
-    let passed = ran
-        && tests.iter().all(|t| t.passed)
-        && mutants.iter().all(|m| m.detected && m.control_passed);
     ValidationReport {
         alpha: config.alpha,
-        passed,
-        tests,
+        passed: false,
+        tests: cases.iter().flat_map(records).collect(),
         mutants,
         tier: plan.tier.name().to_owned(),
         seed: config.seed,
         samples: plan.samples,
         batches: [plan.batches, plan.batch_size],
-        m,
-        per_test_level: level,
+        m: 0,
+        per_test_level: 0.0,
+        shard,
     }
+    .judged()
 }
 
 #[cfg(test)]
@@ -684,6 +796,7 @@ mod tests {
 
     fn case(sampler: &str, outcomes: Vec<TestOutcome>) -> CaseResult {
         CaseResult {
+            index: 0,
             sampler: sampler.into(),
             target: "lambert".into(),
             theta_o: Some(0.0),
@@ -700,12 +813,14 @@ mod tests {
         TestOutcome::deterministic(name, 0.0, ok, String::new())
     }
 
-    fn assembled(
-        cases: Vec<CaseResult>,
-        mutants: Vec<(CaseResult, CaseResult)>,
-    ) -> ValidationReport {
+    fn assembled(cases: Vec<CaseResult>, pairs: Vec<(CaseResult, CaseResult)>) -> ValidationReport {
         let config = ValidateConfig::quick();
-        assemble(&config, &Plan::new(Tier::Quick, 1000), cases, mutants)
+        let pairs = pairs
+            .into_iter()
+            .zip(mutants())
+            .map(|((mc, cc), m)| (m, mc, cc))
+            .collect();
+        assemble(&config, &Plan::new(Tier::Quick, 1000), cases, pairs, None)
     }
 
     #[test]

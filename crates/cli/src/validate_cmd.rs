@@ -1,9 +1,10 @@
-//! `brdf-lab validate`: the statistical validation suite over samplers, BRDFs and angles.
+//! `brdf-lab validate`: the statistical validation suite over samplers, BRDFs and angles;
+//! `--shard K/N` runs a part of it and `brdf-lab validate merge` recombines the parts.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use clap::Args;
-use validation::{ProgressEvent, ValidateConfig};
+use clap::{Args, Subcommand};
+use validation::{ProgressEvent, Shard, ValidateConfig, ValidationReport};
 
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
@@ -12,7 +13,10 @@ use crate::values::{self, End, count, counted};
 
 /// Arguments of `brdf-lab validate`.
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub(crate) struct ValidateArgs {
+    #[command(subcommand)]
+    merge: Option<ValidateSub>,
     /// BRDF spec to test (repeatable); default: the tier's list.
     #[arg(long = "brdf")]
     brdfs: Vec<String>,
@@ -47,11 +51,46 @@ pub(crate) struct ValidateArgs {
     /// at the run's angles; without --sampler, only the sets are validated.
     #[arg(long = "set", value_name = "FILE")]
     sets: Vec<PathBuf>,
+    /// Run only the cases i (in the plan's fixed order) with i mod N = K − 1 (K/N, 1 ≤ K ≤ N);
+    /// needs --json; `validate merge` judges the parts together (docs/validation.md).
+    #[arg(long, value_name = "K/N", requires = "json")]
+    shard: Option<String>,
+}
+
+/// `brdf-lab validate merge`.
+#[derive(Debug, Subcommand)]
+enum ValidateSub {
+    /// Combine the JSON reports of the shards (`validate --shard K/N --json PART`) into the
+    /// single run's report and verdict (exit 1 if a test failed, 3 if no test ran).
+    Merge(MergeArgs),
+}
+
+/// Arguments of `brdf-lab validate merge`.
+#[derive(Debug, Args)]
+struct MergeArgs {
+    /// The shards' JSON reports, one per shard K = 1..N, in any order.
+    #[arg(required = true, value_name = "PART.json")]
+    parts: Vec<PathBuf>,
+    /// Write the merged report as JSON (the schema of a single run).
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the merged readable markdown report.
+    #[arg(long)]
+    report: Option<PathBuf>,
 }
 
 /// Runs `brdf-lab validate`: exit 0 when everything passed, 1 when a test failed (or a mutant
 /// escaped), 2 on bad input, 3 when no test ran (every case skipped: no sampler applied).
 pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
+    if let Some(ValidateSub::Merge(m)) = &args.merge {
+        return merge(m);
+    }
+    let shard = args
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()
+        .map_err(CliError::input)?;
     crate::output::check_all([
         ("--json", args.json.as_deref()),
         ("--report", args.report.as_deref()),
@@ -97,18 +136,72 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
         ProgressEvent::Started { total } => pb.set_length(total as u64),
         ProgressEvent::Finished { done, .. } => pb.set_position(done as u64),
     };
-    let report = validation::run(&config, &on_progress).map_err(CliError::input);
+    let report = validation::run_shard(&config, shard, &on_progress).map_err(CliError::input);
     pb.finish_and_clear();
     let report = report?;
+    write_outputs(&report, args.json.as_deref(), args.report.as_deref())?;
+    if let Some(info) = &report.shard {
+        // A shard's verdict is the merge's: its tests are judged with the others'.
+        println!(
+            "shard      {}/{}: {} of the plan's {}, {}; judge them with `brdf-lab validate merge`",
+            info.index,
+            info.count,
+            count(info.cases, "case", "cases"),
+            info.total_cases,
+            counted(report.tests.len(), "record")
+        );
+        return Ok(());
+    }
+    verdict(&report)
+}
 
-    if let Some(path) = &args.json {
+/// Writes the JSON and markdown reports asked for (each atomically).
+fn write_outputs(
+    report: &ValidationReport,
+    json: Option<&Path>,
+    md: Option<&Path>,
+) -> CliResult<()> {
+    if let Some(path) = json {
         let json = report.to_json();
         write_atomically(path, |w| w.write_all(json.as_bytes()))?;
     }
-    if let Some(path) = &args.report {
+    if let Some(path) = md {
         let md = report.to_markdown();
         write_atomically(path, |w| w.write_all(md.as_bytes()))?;
     }
+    Ok(())
+}
+
+/// `brdf-lab validate merge`: reads the parts, merges them (refusing missing, duplicate or
+/// mismatched shards), writes the outputs and exits as the single run would.
+fn merge(args: &MergeArgs) -> CliResult<()> {
+    crate::output::check_all([
+        ("--json", args.json.as_deref()),
+        ("--report", args.report.as_deref()),
+    ])?;
+    let parts = args
+        .parts
+        .iter()
+        .map(|path| {
+            let name = crate::values::display_path(path);
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::input(format!("cannot read {name}: {e}")))?;
+            let report: ValidationReport = serde_json::from_str(&text).map_err(|e| {
+                CliError::input(format!("{name} is not a validate JSON report: {e}"))
+            })?;
+            Ok((name, report))
+        })
+        .collect::<CliResult<Vec<_>>>()?;
+    let n = parts.len();
+    let report = validation::merge(parts).map_err(CliError::input)?;
+    write_outputs(&report, args.json.as_deref(), args.report.as_deref())?;
+    println!("merged     {}", count(n, "shard", "shards"));
+    verdict(&report)
+}
+
+/// Prints the summary of a whole (or merged) run and returns its exit status: 0 passed,
+/// 1 a test failed (or a mutant escaped), 3 no test ran.
+fn verdict(report: &ValidationReport) -> CliResult<()> {
     let failed: Vec<_> = report.tests.iter().filter(|t| !t.passed).collect();
     let skipped: Vec<_> = report.skipped().collect();
     let run = report.tests_run();
