@@ -10,14 +10,15 @@
 //! Wall time is measured `--repeat` times per sampler, interleaved across samplers (so a change
 //! of machine load spreads over all of them), and the median is reported with the spread.
 //! BRDF evaluations per sample (including the estimator's one) are counted in a separate,
-//! untimed pass through a counting wrapper; they do not depend on the load.
+//! untimed pass through the study's counting wrapper (`study::CountingBrdf`, which keeps the
+//! model's prepared fast path); they do not depend on the load. The timed runs go through the
+//! same wrapper (one thread-local increment per evaluation, a few ns at most).
 
-use std::cell::Cell;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use brdf::{Brdf, Outgoing, Vec3};
+use brdf::{Brdf, Vec3};
 use brdf_sampling::DirectionSampler;
 use clap::{Args, ValueEnum};
 use partition_sampler::chunk_seed;
@@ -25,6 +26,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
+use study::{CountingBrdf, thread_evaluations};
 
 use crate::brdf_args::{self, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
@@ -118,63 +120,6 @@ struct BenchRecord {
     mean_weight: f64,
 }
 
-thread_local! {
-    static EVALS: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Forwards everything to the wrapped BRDF (its `prepare` too, so the sampler keeps its fast
-/// path) and counts `eval`, `eval_rgb` and `eval_prepared` calls on the calling thread.
-struct Counted(Arc<dyn Brdf>);
-
-fn count() {
-    EVALS.with(|c| c.set(c.get() + 1));
-}
-
-impl Brdf for Counted {
-    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        count();
-        self.0.eval(wo, wi)
-    }
-    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
-        count();
-        self.0.eval_rgb(wo, wi)
-    }
-    fn prepare(&self, wo: &Vec3) -> Outgoing {
-        self.0.prepare(wo)
-    }
-    fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
-        count();
-        self.0.eval_prepared(q, wi)
-    }
-    fn is_isotropic(&self) -> bool {
-        self.0.is_isotropic()
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        self.0.is_mirror_symmetric()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        self.0.is_half_turn_symmetric()
-    }
-    fn is_reciprocal(&self) -> bool {
-        self.0.is_reciprocal()
-    }
-    fn conserves_energy(&self) -> bool {
-        self.0.conserves_energy()
-    }
-    fn bounded_at_horizon(&self) -> bool {
-        self.0.bounded_at_horizon()
-    }
-    fn analytic_lobes(&self) -> Option<brdf::AnalyticLobes> {
-        self.0.analytic_lobes()
-    }
-    fn name(&self) -> &str {
-        self.0.name()
-    }
-    fn as_any(&self) -> Option<&dyn std::any::Any> {
-        self.0.as_any()
-    }
-}
-
 /// The outgoing direction of query `i` of a chunk.
 fn query(queries: Queries, fixed: &Vec3, rng: &mut Xoshiro256PlusPlus) -> Vec3 {
     match queries {
@@ -206,7 +151,7 @@ fn run_samples(
         .map(|c| {
             let len = CHUNK.min(n - c * CHUNK);
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
-            let before = EVALS.with(Cell::get);
+            let before = thread_evaluations();
             let mut sum = 0.0;
             for _ in 0..len {
                 let wo = query(queries, fixed, &mut rng);
@@ -215,7 +160,7 @@ fn run_samples(
                     sum += brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf;
                 }
             }
-            (sum, EVALS.with(Cell::get) - before)
+            (sum, thread_evaluations() - before)
         })
         .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
@@ -268,18 +213,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
             return checks.into_iter().next().unwrap_or(Ok(()));
         }
     }
-    if !(args.theta_o >= 0.0 && args.theta_o < 90.0) {
-        return Err(CliError::input(format!(
-            "--theta-o must be in [0, 90) degrees, got {}",
-            args.theta_o
-        )));
-    }
-    if !args.phi_o.is_finite() {
-        return Err(CliError::input(format!(
-            "--phi-o must be finite, got {}",
-            args.phi_o
-        )));
-    }
+    // θo and φo are range-checked by their parsers (`values::theta_o`, `values::azimuth`).
     let n = usize::try_from(args.n).map_err(CliError::input)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.map_or(0, |t| t as usize))
@@ -288,7 +222,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
     let threads = pool.current_num_threads();
     let fixed = brdf::direction_from_angles(args.theta_o, args.phi_o);
     let plain = brdf_args::parse_brdf(&args.spec)?;
-    let counted: Arc<dyn Brdf> = Arc::new(Counted(plain.clone()));
+    let counted: Arc<dyn Brdf> = Arc::new(CountingBrdf(plain.clone()));
 
     // Built over the counting wrapper: one build serves both passes (a build can take seconds).
     let mut subjects = Vec::with_capacity(args.samplers.len());
@@ -436,23 +370,10 @@ mod tests {
     }
 
     #[test]
-    fn counting_wrapper_counts_every_evaluation_route() {
-        let inner: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("phong:n=20").unwrap());
-        let c = Counted(inner.clone());
-        let wo = brdf::direction_from_angles(20.0, 0.0);
-        let wi = brdf::direction_from_angles(25.0, 180.0);
-        let before = EVALS.with(Cell::get);
-        let q = c.prepare(&wo);
-        assert_eq!(c.eval_prepared(&q, &wi), inner.eval(&wo, &wi));
-        assert_eq!(c.eval(&wo, &wi), inner.eval(&wo, &wi));
-        let _ = c.eval_rgb(&wo, &wi);
-        assert_eq!(EVALS.with(Cell::get) - before, 3);
-    }
-
-    #[test]
     fn samples_and_counts_do_not_depend_on_the_thread_count() {
-        let brdf: Arc<dyn Brdf> =
-            Arc::new(Counted(Arc::from(brdf::parse_spec("phong:n=20").unwrap())));
+        let brdf: Arc<dyn Brdf> = Arc::new(CountingBrdf(Arc::from(
+            brdf::parse_spec("phong:n=20").unwrap(),
+        )));
         let sampler = baselines::CosineHemisphere;
         let wo = brdf::direction_from_angles(30.0, 0.0);
         let on = |t: usize| {

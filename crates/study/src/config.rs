@@ -148,7 +148,10 @@ impl StudyConfig {
         let mut brdfs: Vec<String> = QUICK_BRDFS.iter().map(|s| s.to_string()).collect();
         let measured = root.and_then(|root| {
             MEASURED_CANDIDATES.iter().find_map(|(reader, path)| {
-                let spec = format!("{reader}:{}", root.join("..").join(path).display());
+                // Canonical, so reports and plot titles name `/…/shared/…`, not `…/repo/../shared/…`.
+                let path = root.join("..").join(path);
+                let path = std::fs::canonicalize(&path).unwrap_or(path);
+                let spec = format!("{reader}:{}", path.display());
                 brdf::parse_spec(&spec).is_ok().then_some(spec)
             })
         });
@@ -240,6 +243,7 @@ fn find_candidate(root: Option<&std::path::Path>, candidates: &[&str]) -> Option
         .iter()
         .map(|c| parent.join(c))
         .find(|p| std::fs::File::open(p).is_ok())
+        .map(|p| std::fs::canonicalize(&p).unwrap_or(p))
 }
 
 /// One part of a study run on its own: cells `i` with `i % count == index - 1`.

@@ -14,7 +14,8 @@ pub fn thread_evaluations() -> u64 {
     EVALUATIONS.with(Cell::get)
 }
 
-/// Forwards everything to the wrapped BRDF and counts each `eval` / `eval_rgb` call in a
+/// Forwards everything to the wrapped BRDF (its `prepare` too) and counts each `eval` /
+/// `eval_rgb` / `eval_prepared` call in a
 /// thread-local counter ([`thread_evaluations`]). Samplers are built on it, so the study
 /// counts the BRDF evaluations a sampler makes per sample whatever the sampler is.
 pub struct CountingBrdf(pub Arc<dyn Brdf>);
@@ -29,6 +30,17 @@ impl Brdf for CountingBrdf {
     fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
         EVALUATIONS.with(|c| c.set(c.get() + 1));
         self.0.eval_rgb(wo, wi)
+    }
+    /// Forwarded, so a sampler keeps the wrapped model's prepared fast path (not counted: it
+    /// is no evaluation).
+    #[inline]
+    fn prepare(&self, wo: &Vec3) -> brdf::Outgoing {
+        self.0.prepare(wo)
+    }
+    #[inline]
+    fn eval_prepared(&self, q: &brdf::Outgoing, wi: &Vec3) -> f64 {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval_prepared(q, wi)
     }
     fn is_isotropic(&self) -> bool {
         self.0.is_isotropic()
@@ -86,6 +98,14 @@ mod tests {
         let _ = b.eval(&wo, &wo);
         let _ = b.eval_rgb(&wo, &wo);
         assert_eq!(thread_evaluations() - before, 2);
+        // The prepared route is counted once and gives the wrapped model's value.
+        let phong = brdf::parse_spec("phong:n=20").unwrap();
+        let counted = CountingBrdf(Arc::from(brdf::parse_spec("phong:n=20").unwrap()));
+        let wi = brdf::direction_from_angles(25.0, 180.0);
+        let before = thread_evaluations();
+        let q = counted.prepare(&wo);
+        assert_eq!(counted.eval_prepared(&q, &wi), phong.eval(&wo, &wi));
+        assert_eq!(thread_evaluations() - before, 1);
         let other = std::thread::spawn(thread_evaluations).join().unwrap();
         assert_eq!(other, 0);
     }

@@ -58,6 +58,31 @@ pub(crate) struct StudyBrdf {
 /// A built sampler and its build time (s), or why it could not be built.
 pub(crate) type BuildOutcome = Result<(samplers::BuiltDirection, f64), String>;
 
+/// The warnings of the built samplers, one note each: the `warning: …` lines of their
+/// `build_report` (e.g. `srbf` fits that stopped at the L-BFGS iteration cap), so the report
+/// says when a sampler's fit is not converged.
+fn build_warnings<'a>(
+    built: &[((usize, usize), BuildOutcome)],
+    sampler_name: impl Fn(usize) -> &'a str,
+    brdf_spec: impl Fn(usize) -> &'a str,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for ((s, b), outcome) in built {
+        let Ok((d, _)) = outcome else { continue };
+        let Some(report) = d.sampler.build_report() else {
+            continue;
+        };
+        for w in report.lines().filter_map(|l| l.strip_prefix("warning: ")) {
+            notes.push(format!(
+                "sampler {} on {}: {w}",
+                sampler_name(*s),
+                brdf_spec(*b)
+            ));
+        }
+    }
+    notes
+}
+
 /// A cell with its indices into the plan.
 #[derive(Debug, Clone)]
 struct PlanCell {
@@ -328,12 +353,20 @@ impl StudyPlan {
             r.timing = Some(t.finish(mse));
         }
         progress(cells.len() as u64);
+        let mut warnings = build_warnings(
+            &built,
+            |s| self.entries[s].name,
+            |b| self.brdfs[b].spec.as_str(),
+        );
+        warnings.sort();
+        warnings.dedup();
         let mut out = StudyResults {
             schema: SCHEMA.to_string(),
             config: self.config.clone(),
             shard,
             total_cells: self.cells.len(),
             notes: self.notes.clone(),
+            build_warnings: warnings,
             lights: self
                 .config
                 .lights
@@ -796,5 +829,51 @@ mod tests {
         let (m, v) = mean_var(&[1.0, 2.0, 3.0, 4.0]);
         assert_eq!(m, 2.5);
         assert!((v - 5.0 / 3.0).abs() < 1e-15);
+    }
+}
+
+#[cfg(test)]
+mod build_warning_tests {
+    use super::*;
+    use brdf::Vec3;
+    use brdf_sampling::{DirSample, DirectionSampler};
+    use partition_sampler::UniformSource;
+
+    /// A sampler whose report carries one warning line among others.
+    struct Warns;
+
+    impl DirectionSampler for Warns {
+        fn sample(&self, _wo: &Vec3, _u: &mut dyn UniformSource) -> DirSample {
+            DirSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 1.0,
+            }
+        }
+        fn pdf(&self, _wo: &Vec3, _wi: &Vec3) -> f64 {
+            1.0
+        }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+        fn build_report(&self) -> Option<String> {
+            Some("fit  ok\nwarning: 2 of 2 fits hit the L-BFGS cap\nmemory 0".into())
+        }
+    }
+
+    #[test]
+    fn build_warnings_become_one_line_per_sampler_and_brdf() {
+        let ok: BuildOutcome = Ok((
+            samplers::BuiltDirection::plain(std::sync::Arc::new(Warns)),
+            0.1,
+        ));
+        let failed: BuildOutcome = Err("cannot build".into());
+        let built = vec![((0, 1), ok), ((1, 0), failed)];
+        let names = ["srbf", "cosine"];
+        let specs = ["lambert", "phong"];
+        let w = build_warnings(&built, |s| names[s], |b| specs[b]);
+        assert_eq!(
+            w,
+            vec!["sampler srbf on phong: 2 of 2 fits hit the L-BFGS cap".to_string()]
+        );
     }
 }

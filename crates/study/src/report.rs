@@ -59,6 +59,9 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     for n in &results.notes {
         let _ = writeln!(s, "> **Note:** {n}\n");
     }
+    for w in &results.build_warnings {
+        let _ = writeln!(s, "> **Warning:** {w}\n");
+    }
     s.push_str("## Lights\n\n");
     for l in &results.lights {
         let _ = writeln!(s, "* `{}`: {}", short_light(&l.spec), l.description);

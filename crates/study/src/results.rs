@@ -241,6 +241,10 @@ pub struct StudyResults {
     pub total_cells: usize,
     /// Notes for the report (e.g. a missing map file and what replaced it).
     pub notes: Vec<String>,
+    /// Warnings of the samplers' builds (e.g. `srbf` fits stopped at the L-BFGS iteration cap),
+    /// one per sampler and BRDF; a merge keeps the union of its shards', sorted.
+    #[serde(default)]
+    pub build_warnings: Vec<String>,
     /// The lights.
     pub lights: Vec<LightInfo>,
     /// The cells run, by index.
@@ -404,6 +408,15 @@ impl StudyResults {
             shard: None,
             total_cells: first.total_cells,
             notes: first.notes.clone(),
+            build_warnings: {
+                let mut w: Vec<String> = parts
+                    .iter()
+                    .flat_map(|p| p.build_warnings.iter().cloned())
+                    .collect();
+                w.sort();
+                w.dedup();
+                w
+            },
             lights: first.lights.clone(),
             cells,
             runs: parts.iter().flat_map(|p| p.runs.iter().cloned()).collect(),
