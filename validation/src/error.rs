@@ -40,9 +40,6 @@ pub enum ValidationError {
     /// The significance level is not in `(0, 1)`.
     #[error("significance level must lie in (0, 1), got {0}")]
     BadAlpha(f64),
-    /// `--shard K/N` with `K` not in `1..=N`, or not of that form.
-    #[error("--shard {0}: expected K/N with 1 <= K <= N")]
-    BadShard(String),
     /// The selection contains nothing to test.
     #[error("nothing to validate: {0}")]
     Empty(String),

@@ -6,7 +6,6 @@ use serde::{Deserialize, Serialize};
 use stats::QuadratureOptions;
 
 use crate::domain::Resolution;
-use crate::error::ValidationError;
 
 /// Suite tier.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -162,35 +161,7 @@ impl ValidateConfig {
 /// (in its fixed order, mutants last) with `i mod N = K − 1`. Every case is seeded from the
 /// master seed and its own label, so its tests give the same statistics and p-values in any
 /// shard as in a single run; [`crate::merge`] recombines the parts and judges them together.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// `K` of `K/N`, from 1.
-    pub index: usize,
-    /// `N` of `K/N`.
-    pub count: usize,
-}
-
-impl Shard {
-    /// Parses `K/N` with `1 <= K <= N`.
-    ///
-    /// # Errors
-    /// [`ValidationError::BadShard`] for anything else.
-    pub fn parse(s: &str) -> Result<Self, ValidationError> {
-        let bad = || ValidationError::BadShard(s.to_string());
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let index: usize = k.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if !(1..=count).contains(&index) {
-            return Err(bad());
-        }
-        Ok(Self { index, count })
-    }
-
-    /// Whether case `i` of the full plan belongs to this shard.
-    pub fn contains(&self, i: usize) -> bool {
-        i % self.count == self.index - 1
-    }
-}
+pub use partition_sampler::Shard;
 
 /// Sample counts, binning and tolerances of a run (resolved from the tier and the config).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -273,7 +244,7 @@ mod tests {
         assert_eq!(Shard::parse("2/3").unwrap(), Shard { index: 2, count: 3 });
         for bad in ["0/3", "4/3", "1", "a/2", "1/0", "-1/2"] {
             assert!(
-                matches!(Shard::parse(bad), Err(ValidationError::BadShard(_))),
+                matches!(Shard::parse(bad), Err(partition_sampler::ShardError(_))),
                 "{bad}"
             );
         }

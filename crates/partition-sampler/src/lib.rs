@@ -81,7 +81,7 @@ pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
 };
 pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
-pub use parallel::{PAR_CHUNK, chunk_rng, chunk_seed, sample_par};
+pub use parallel::{PAR_CHUNK, Shard, ShardError, chunk_rng, chunk_seed, sample_par};
 pub use persist::FORMAT_VERSION;
 pub use piecewise_constant::{
     PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1, fill_cdf,

@@ -54,3 +54,42 @@ pub fn sample_par<S: Sampler2D + ?Sized>(sampler: &S, n: usize, seed: u64) -> Ve
         .for_each(|(chunk, slot)| sampler.sample_into(&mut chunk_rng(seed, chunk as u64), slot));
     out
 }
+
+/// One part `K/N` of a run split over independent processes (`--shard K/N` of `brdf-lab study`
+/// and `brdf-lab validate`): the items `i` of the full run (cells, cases; in its fixed order)
+/// with `i mod N = K − 1`. Each item is seeded on its own (as [`chunk_seed`] seeds chunks), so a
+/// shard gives the same results for its items as the whole run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// `K` of `K/N`, from 1.
+    pub index: usize,
+    /// `N` of `K/N`.
+    pub count: usize,
+}
+
+/// `--shard` text that is not `K/N` with `1 ≤ K ≤ N`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("--shard {0}: expected K/N with 1 <= K <= N")]
+pub struct ShardError(pub String);
+
+impl Shard {
+    /// Parses `K/N` with `1 <= K <= N`.
+    ///
+    /// # Errors
+    /// [`ShardError`] for anything else.
+    pub fn parse(s: &str) -> Result<Self, ShardError> {
+        let bad = || ShardError(s.to_string());
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let index: usize = k.trim().parse().map_err(|_| bad())?;
+        let count: usize = n.trim().parse().map_err(|_| bad())?;
+        if !(1..=count).contains(&index) {
+            return Err(bad());
+        }
+        Ok(Self { index, count })
+    }
+
+    /// Whether item `i` of the full run belongs to this shard.
+    pub fn contains(&self, i: usize) -> bool {
+        i % self.count == self.index - 1
+    }
+}

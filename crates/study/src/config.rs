@@ -247,32 +247,7 @@ fn find_candidate(root: Option<&std::path::Path>, candidates: &[&str]) -> Option
 }
 
 /// One part of a study run on its own: cells `i` with `i % count == index - 1`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// `K` of `K/N`, from 1.
-    pub index: usize,
-    /// `N` of `K/N`.
-    pub count: usize,
-}
-
-impl Shard {
-    /// Parses `K/N` with `1 <= K <= N`.
-    pub fn parse(s: &str) -> Result<Self, StudyError> {
-        let bad = || StudyError::BadShard(s.to_string());
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let index: usize = k.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if !(1..=count).contains(&index) {
-            return Err(bad());
-        }
-        Ok(Self { index, count })
-    }
-
-    /// Whether cell `i` belongs to this shard.
-    pub fn contains(&self, i: usize) -> bool {
-        i % self.count == self.index - 1
-    }
-}
+pub use partition_sampler::Shard;
 
 /// One cell of the grid.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -41,9 +41,6 @@ pub enum StudyError {
     /// A study with no sampler, BRDF, angle or light.
     #[error("the study has no {0}")]
     EmptyGrid(&'static str),
-    /// `--shard K/N` with `K` not in `1..=N` or a malformed value.
-    #[error("--shard {0}: expected K/N with 1 <= K <= N")]
-    BadShard(String),
     /// Shards given to `merge` that do not form one study.
     #[error("cannot merge: {0}")]
     Merge(String),
