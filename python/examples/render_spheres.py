@@ -23,9 +23,9 @@ Modes:
 
 * ``compare``: K independent renders (distinct seeds) of each configuration; per-block means
   (``--block`` × ``--block`` pixels inside the sphere) of every render; Welch's t per block and
-  channel between the native render and each plugin render, plus one Welch t of the frame mean
-  (a uniform scale); family-wise α (``--alpha``) with Šidák's correction over all the tests of a
-  comparison. ``--scale S`` multiplies the plugin's BRDF by S (a deliberately wrong material:
+  channel between the native render and each plugin render, plus one Welch t of the mean over
+  the sphere (a uniform scale); family-wise α (``--alpha``): α/2 for the mean, α/2 shared by the
+  blocks × channels with Šidák's correction. ``--scale S`` multiplies the plugin's BRDF by S (a deliberately wrong material:
   the test must then reject).
 * ``timing``: a high-spp native reference, then for each configuration R renders at each spp of
   ``--spp-list``: wall time (median, after a warm-up render) and RMSE over the sphere's pixels
@@ -250,27 +250,24 @@ def compare_replicates(native: np.ndarray, plugin: np.ndarray, mask: np.ndarray,
     fp = np.array([im[mask].mean() for im in plugin])
     tf, dff = welch(fn[:, None], fp[:, None])
     pf = float(2 * stats.t.sf(abs(tf[0]), dff[0]))
-    n_tests = pb.size + 1
-    level = 1 - (1 - alpha) ** (1 / n_tests)
-    p_min = float(min(pb.min(), pf))
+    # α/2 for the frame mean (a uniform scale: the most likely error, tested with all pixels),
+    # α/2 shared by the blocks × channels with Šidák's correction (local differences)
+    level_blocks = 1 - (1 - alpha / 2) ** (1 / pb.size)
     ratio = float(fp.mean() / fn.mean())
     ratio_se = float(ratio * math.sqrt(fp.var(ddof=1) / len(fp) / fp.mean() ** 2
                                        + fn.var(ddof=1) / len(fn) / fn.mean() ** 2))
     return {
-        "blocks": int(bn.shape[1]), "tests": n_tests, "alpha": alpha, "per_test_level": level,
+        "blocks": int(bn.shape[1]), "block_tests": int(pb.size), "alpha": alpha,
+        "level_frame": alpha / 2, "level_block": level_blocks,
         "p_min_block": float(pb.min()), "p_frame": pf, "max_abs_t_block": float(np.abs(tb).max()),
         "mean_ratio_plugin_over_native": ratio, "mean_ratio_se": ratio_se,
-        "passed": bool(p_min > level),
+        "passed": bool(pf > alpha / 2 and pb.min() > level_blocks),
     }
 
 
-def tonemap_png(img: np.ndarray, path: Path, exposure: float = 1.0) -> None:
-    """A small 8-bit sRGB PNG of a linear image (Reinhard x/(1+x), then the sRGB curve), written
-    with the standard library only (zlib)."""
-    x = np.clip(img * exposure, 0.0, None)
-    x = x / (1 + x)
-    x = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-    u8 = (np.clip(x, 0, 1) * 255 + 0.5).astype(np.uint8)
+def write_png(disp: np.ndarray, path: Path) -> None:
+    """An 8-bit RGB PNG of display values in [0, 1], written with the standard library (zlib)."""
+    u8 = (np.clip(disp, 0, 1) * 255 + 0.5).astype(np.uint8)
     h, w = u8.shape[:2]
     raw = b"".join(b"\x00" + u8[i].tobytes() for i in range(h))
 
@@ -281,20 +278,43 @@ def tonemap_png(img: np.ndarray, path: Path, exposure: float = 1.0) -> None:
                      + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
-def configurations(materials: List[Material], scale: float):
-    """(material, name, native bsdf, plugin bsdf) for every plugin sampler of every material."""
-    for m in materials:
-        for s in m.samplers:
-            yield m, s, plugin_bsdf(m, s, scale)
+def tonemap(img: np.ndarray) -> np.ndarray:
+    """Linear RGB → display values in [0, 1] (Reinhard x/(1+x), then the sRGB curve)."""
+    x = np.clip(img, 0.0, None)
+    x = x / (1 + x)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def t_map(native: np.ndarray, plugin: np.ndarray, mask: np.ndarray, cap: float = 4.0) -> np.ndarray:
+    """Per-pixel Welch t of the luminance (plugin − native) as colours: red > 0, blue < 0, full
+    at |t| = ``cap``; black outside the sphere."""
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    t, _ = welch(plugin @ lum, native @ lum)
+    a = np.clip(np.nan_to_num(t) / cap, -1, 1)
+    rgb = np.stack([np.clip(a, 0, 1), np.zeros_like(a), np.clip(-a, 0, 1)], axis=-1)
+    return np.where(mask[..., None], rgb, 0.0)
+
+
+def write_montage(rows: List[List[np.ndarray]], path: Path, pad: int = 2) -> None:
+    """Display-ready tiles (values in [0, 1]) in rows, padded with white, as one PNG."""
+    h, w = rows[0][0].shape[:2]
+    ncol = max(len(r) for r in rows)
+    out = np.ones((len(rows) * (h + pad) - pad, ncol * (w + pad) - pad, 3))
+    for i, r in enumerate(rows):
+        for j, tile in enumerate(r):
+            out[i * (h + pad):i * (h + pad) + h, j * (w + pad):j * (w + pad) + w] = tile
+    write_png(out, path)
 
 
 def run_compare(args, mi, dr, materials: List[Material]) -> dict:
     mask = sphere_mask(args.res)
     out: Dict[str, dict] = {}
+    rows: List[List[np.ndarray]] = []
     for ci, m in enumerate(materials):
         scene_n = mi.load_dict(scene_dict(mi, m.native, args.map, args.res, args.spp, args.strategy))
         native = np.array([render_passes(mi, dr, scene_n, args.spp, args.seed + 1000 * ci + k, args.pass_spp)
                            for k in range(args.repeats)])
+        row = [tonemap(native.mean(axis=0))]
         for si, s in enumerate(m.samplers):
             bsdf = plugin_bsdf(m, s, args.scale)
             scene_p = mi.load_dict(scene_dict(mi, bsdf, args.map, args.res, args.spp, args.strategy))
@@ -306,30 +326,32 @@ def run_compare(args, mi, dr, materials: List[Material]) -> dict:
             out[key] = r
             print(f"{key:40s} {'PASS' if r['passed'] else 'FAIL'}  plugin/native mean "
                   f"{r['mean_ratio_plugin_over_native']:.4f} ± {r['mean_ratio_se']:.4f}  "
-                  f"min p {min(r['p_min_block'], r['p_frame']):.3g} (level {r['per_test_level']:.3g}, "
-                  f"{r['tests']} tests)", flush=True)
-            if args.png:
-                tonemap_png(plugin.mean(axis=0), args.out / f"{m.label}-{s}.png")
-        if args.png:
-            tonemap_png(native.mean(axis=0), args.out / f"{m.label}-native.png")
+                  f"p frame {r['p_frame']:.3g} (level {r['level_frame']:.3g}), min p of "
+                  f"{r['block_tests']} blocks×channels {r['p_min_block']:.3g} (level {r['level_block']:.3g})",
+                  flush=True)
+            row += [tonemap(plugin.mean(axis=0)), t_map(native, plugin, mask)]
+        rows.append(row)
+    if args.png:
+        # per material: native, then per plugin sampler its image and the per-pixel t map
+        write_montage(rows, args.out / "compare.png")
     return out
 
 
 def run_timing(args, mi, dr, materials: List[Material]) -> dict:
     mask = sphere_mask(args.res)
     out: Dict[str, dict] = {}
+    rows: List[List[np.ndarray]] = []
     for ci, m in enumerate(materials):
         scene_ref = mi.load_dict(scene_dict(mi, m.native, args.map, args.res, args.ref_spp, args.strategy))
         t0 = time.perf_counter()
         ref = render_passes(mi, dr, scene_ref, args.ref_spp, 10_000 + ci, args.pass_spp)
         print(f"{m.label}: reference {args.ref_spp} spp (native) in {time.perf_counter() - t0:.1f} s", flush=True)
-        if args.png:
-            tonemap_png(ref, args.out / f"{m.label}-reference.png")
+        row = [tonemap(ref)]
         confs = [("native", m.native)] + [(f"brdf_lab/{s}", plugin_bsdf(m, s)) for s in m.samplers]
         for name, bsdf in confs:
             scene = mi.load_dict(scene_dict(mi, bsdf, args.map, args.res, 1, args.strategy))
-            render_once(mi, scene, 1, 999)  # warm-up: kernel compilation, sampler build
             for spp in args.spp_list:
+                render_once(mi, scene, spp, 999)  # warm-up: kernels for this spp, sampler build
                 times, errs = [], []
                 for r in range(args.repeats):
                     t0 = time.perf_counter()
@@ -337,6 +359,8 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
                     times.append(time.perf_counter() - t0)
                     errs.append(float(np.sqrt(np.mean((img[mask] - ref[mask]) ** 2))))
                 t, e = float(np.median(times)), float(np.median(errs))
+                if spp == args.spp_list[0]:
+                    row.append(tonemap(img))
                 out[f"{m.label}/{name}/{spp}"] = {"spp": spp, "seconds_median": t, "rmse_median": e,
                                                   "seconds": times, "rmse": errs}
                 print(f"{m.label:24s} {name:26s} {spp:5d} spp  {t:8.3f} s  RMSE {e:.5g}", flush=True)
@@ -346,6 +370,10 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
             for name, _ in confs:
                 c = out[f"{m.label}/{name}/{spp}"]
                 c["rmse_at_native_time"] = c["rmse_median"] * math.sqrt(c["seconds_median"] / tn)
+        rows.append(row)
+    if args.png:
+        # per material: the reference, then each configuration at the first spp of --spp-list
+        write_montage(rows, args.out / "timing.png")
     return out
 
 
