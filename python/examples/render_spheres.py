@@ -359,7 +359,7 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
                     times.append(time.perf_counter() - t0)
                     errs.append(float(np.sqrt(np.mean((img[mask] - ref[mask]) ** 2))))
                 t, e = float(np.median(times)), float(np.median(errs))
-                if spp == args.spp_list[0]:
+                if spp == args.spp_list[-1]:
                     row.append(tonemap(img))
                 out[f"{m.label}/{name}/{spp}"] = {"spp": spp, "seconds_median": t, "rmse_median": e,
                                                   "seconds": times, "rmse": errs}
@@ -372,7 +372,7 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
                 c["rmse_at_native_time"] = c["rmse_median"] * math.sqrt(c["seconds_median"] / tn)
         rows.append(row)
     if args.png:
-        # per material: the reference, then each configuration at the first spp of --spp-list
+        # per material: the reference, then each configuration at the last spp of --spp-list
         write_montage(rows, args.out / "timing.png")
     return out
 

@@ -1,7 +1,8 @@
 """A small version of python/examples/render_spheres.py's agreement test: a sphere under an
 environment map rendered through the brdf_lab plugin and through Mitsuba's native plugin for the
-same material agrees within noise (Welch's t per block and channel and of the frame mean, Šidák
-at α = 0.01), and the same comparison rejects the plugin's BRDF scaled by 0.97."""
+same material agrees within noise (Welch's t of the mean over the sphere at α/2 and per block
+and channel with Šidák at α/2, α = 0.01), and the same comparison rejects the plugin's BRDF
+scaled by 0.97. A synthetic map and the repository's RGL file: no data outside the repository."""
 
 import sys
 from pathlib import Path
@@ -13,7 +14,7 @@ mi = pytest.importorskip("mitsuba", reason="Mitsuba 3 is not installed (pip inst
 dr = pytest.importorskip("drjit")
 pytest.importorskip("scipy")
 
-from conftest import REPO, shared_file  # noqa: E402
+from conftest import REPO  # noqa: E402
 
 sys.path.insert(0, str(REPO / "python" / "examples"))
 import render_spheres as rs  # noqa: E402
@@ -74,7 +75,7 @@ def test_scaled_brdf_is_rejected(env):
 
 
 def test_rgl_plugin_matches_measured(env):
-    f = shared_file("data/measured/rgl/paper_white_rgb.bsdf")
+    f = REPO / "data" / "measured" / "rgl" / "paper_white_rgb.bsdf"  # in the repository
     r = compare(env, rs.parse_material(f"rgl:{f}", 0.2), "adaptive-exact")
     assert r["passed"], r
 
