@@ -25,8 +25,8 @@ Modes:
   (``--block`` × ``--block`` pixels inside the sphere) of every render; Welch's t per block and
   channel between the native render and each plugin render, plus one Welch t of the mean over
   the sphere (a uniform scale); family-wise α (``--alpha``): α/2 for the mean, α/2 shared by the
-  blocks × channels with Šidák's correction. ``--scale S`` multiplies the plugin's BRDF by S (a deliberately wrong material:
-  the test must then reject).
+  blocks × channels with Šidák's correction. ``--scale S`` multiplies the plugin's BRDF by S
+  (a deliberately wrong material: the test must then reject).
 * ``timing``: a high-spp native reference, then for each configuration R renders at each spp of
   ``--spp-list``: wall time (median, after a warm-up render) and RMSE over the sphere's pixels
   against the reference; the equal-time RMSE follows from RMSE² ∝ 1/time.
@@ -175,7 +175,8 @@ def scene_dict(mi, bsdf: dict, map_path: Path, res: int, spp: int, strategy: str
         "integrator": integ,
         "sensor": {
             "type": "perspective", "fov": FOV, "fov_axis": "x",
-            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0, DISTANCE], target=[0, 0, 0], up=[0, 1, 0]),
+            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0, DISTANCE], target=[0, 0, 0],
+                                                       up=[0, 1, 0]),
             "film": {"type": "hdrfilm", "width": res, "height": res, "rfilter": {"type": "box"},
                      "pixel_format": "rgb"},
             "sampler": {"type": "independent", "sample_count": spp},
@@ -262,6 +263,7 @@ def compare_replicates(native: np.ndarray, plugin: np.ndarray, mask: np.ndarray,
         "p_min_block": float(pb.min()), "p_frame": pf, "max_abs_t_block": float(np.abs(tb).max()),
         "mean_ratio_plugin_over_native": ratio, "mean_ratio_se": ratio_se,
         "passed": bool(pf > alpha / 2 and pb.min() > level_blocks),
+        "worst_block": _worst_block(bn, bp, tb, pb, mask, block),
     }
 
 
@@ -276,6 +278,17 @@ def write_png(disp: np.ndarray, path: Path) -> None:
 
     path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
                      + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def _worst_block(bn, bp, tb, pb, mask: np.ndarray, block: int) -> dict:
+    """Where the smallest block p-value is: block origin (row, column), channel, t, both means."""
+    b, c = np.unravel_index(int(np.argmin(pb)), pb.shape)
+    h, w = mask.shape
+    origins = [(i, j) for i in range(0, h - block + 1, block) for j in range(0, w - block + 1, block)
+               if mask[i:i + block, j:j + block].all()]
+    return {"row": origins[b][0], "col": origins[b][1], "channel": "RGB"[c],
+            "t_native_minus_plugin": float(tb[b, c]), "p": float(pb[b, c]),
+            "native": float(bn[:, b, c].mean()), "plugin": float(bp[:, b, c].mean())}
 
 
 def tonemap(img: np.ndarray) -> np.ndarray:
@@ -327,7 +340,8 @@ def run_compare(args, mi, dr, materials: List[Material]) -> dict:
             print(f"{key:40s} {'PASS' if r['passed'] else 'FAIL'}  plugin/native mean "
                   f"{r['mean_ratio_plugin_over_native']:.4f} ± {r['mean_ratio_se']:.4f}  "
                   f"p frame {r['p_frame']:.3g} (level {r['level_frame']:.3g}), min p of "
-                  f"{r['block_tests']} blocks×channels {r['p_min_block']:.3g} (level {r['level_block']:.3g})",
+                  f"{r['block_tests']} blocks×channels {r['p_min_block']:.3g} "
+                  f"(level {r['level_block']:.3g})",
                   flush=True)
             row += [tonemap(plugin.mean(axis=0)), t_map(native, plugin, mask)]
         rows.append(row)
@@ -345,7 +359,8 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
         scene_ref = mi.load_dict(scene_dict(mi, m.native, args.map, args.res, args.ref_spp, args.strategy))
         t0 = time.perf_counter()
         ref = render_passes(mi, dr, scene_ref, args.ref_spp, 10_000 + ci, args.pass_spp)
-        print(f"{m.label}: reference {args.ref_spp} spp (native) in {time.perf_counter() - t0:.1f} s", flush=True)
+        print(f"{m.label}: reference {args.ref_spp} spp (native) in {time.perf_counter() - t0:.1f} s",
+              flush=True)
         row = [tonemap(ref)]
         confs = [("native", m.native)] + [(f"brdf_lab/{s}", plugin_bsdf(m, s)) for s in m.samplers]
         for name, bsdf in confs:
@@ -415,7 +430,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         args.map = args.map.resolve()
         args.out.mkdir(parents=True, exist_ok=True)
         mi, dr = setup_mitsuba(args.variant)
-        res = run_compare(args, mi, dr, materials) if args.mode == "compare" else run_timing(args, mi, dr, materials)
+        run = run_compare if args.mode == "compare" else run_timing
+        res = run(args, mi, dr, materials)
     except RenderError as e:
         print(f"render_spheres: {e}", file=sys.stderr)
         return 2
