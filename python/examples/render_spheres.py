@@ -126,23 +126,30 @@ def setup_mitsuba(variant: str):
 
 
 def _register_scaled(mi) -> None:
-    """A test-only BSDF ``scaled_bsdf``: a nested BSDF times a constant (eval and sample weight;
-    the pdf is unchanged). Used to show that the comparison rejects a wrong material."""
+    """A diagnostic BSDF ``scaled_bsdf``: a nested BSDF times a constant (eval and sample weight;
+    the pdf is unchanged), optionally with negative values clamped to 0 (``clamp``). Used to
+    show that the comparison rejects a wrong material, and to apply brdf-lab's clamping of
+    negative RGL entries to Mitsuba's ``measured`` (``--clamp-native``)."""
+    import drjit as dr
 
     class ScaledBSDF(mi.BSDF):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
             self.nested = props["nested"]
             self.scale = float(props["scale"])
+            self.clamp = bool(props["clamp"]) if "clamp" in props else False
             self.m_components = [self.nested.flags()]
             self.m_flags = self.nested.flags()
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             bs, w = self.nested.sample(ctx, si, sample1, sample2, active)
-            return bs, w * self.scale
+            return bs, self._out(w)
 
         def eval(self, ctx, si, wo, active=True):
-            return self.nested.eval(ctx, si, wo, active) * self.scale
+            return self._out(self.nested.eval(ctx, si, wo, active))
+
+        def _out(self, v):
+            return (dr.maximum(v, 0.0) if self.clamp else v) * self.scale
 
         def pdf(self, ctx, si, wo, active=True):
             return self.nested.pdf(ctx, si, wo, active)
@@ -260,7 +267,8 @@ def compare_replicates(native: np.ndarray, plugin: np.ndarray, mask: np.ndarray,
     return {
         "blocks": int(bn.shape[1]), "block_tests": int(pb.size), "alpha": alpha,
         "level_frame": alpha / 2, "level_block": level_blocks,
-        "p_min_block": float(pb.min()), "p_frame": pf, "max_abs_t_block": float(np.abs(tb).max()),
+        "p_min_block": float(pb.min()), "p_min_block_rgb": [float(x) for x in pb.min(axis=0)],
+        "p_frame": pf, "max_abs_t_block": float(np.abs(tb).max()),
         "mean_ratio_plugin_over_native": ratio, "mean_ratio_se": ratio_se,
         "passed": bool(pf > alpha / 2 and pb.min() > level_blocks),
         "worst_block": _worst_block(bn, bp, tb, pb, mask, block),
@@ -324,7 +332,10 @@ def run_compare(args, mi, dr, materials: List[Material]) -> dict:
     out: Dict[str, dict] = {}
     rows: List[List[np.ndarray]] = []
     for ci, m in enumerate(materials):
-        scene_n = mi.load_dict(scene_dict(mi, m.native, args.map, args.res, args.spp, args.strategy))
+        nat = m.native
+        if args.clamp_native:
+            nat = {"type": "scaled_bsdf", "scale": 1.0, "clamp": True, "nested": nat}
+        scene_n = mi.load_dict(scene_dict(mi, nat, args.map, args.res, args.spp, args.strategy))
         native = np.array([render_passes(mi, dr, scene_n, args.spp, args.seed + 1000 * ci + k, args.pass_spp)
                            for k in range(args.repeats)])
         row = [tonemap(native.mean(axis=0))]
@@ -407,6 +418,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--block", type=int, default=8, help="compare: block size (pixels)")
     ap.add_argument("--alpha", type=float, default=0.01, help="compare: family-wise significance level")
     ap.add_argument("--scale", type=float, default=1.0, help="compare: multiply the plugin's BRDF (a mutant)")
+    ap.add_argument("--clamp-native", action="store_true",
+                    help="compare: clamp the native BSDF's negative values to 0 (as brdf-lab's RGL reader)")
     ap.add_argument("--spp-list", type=int, nargs="+", default=[4, 16, 64], help="timing: spp values")
     ap.add_argument("--ref-spp", type=int, default=4096, help="timing: the native reference's spp")
     ap.add_argument("--pass-spp", type=int, default=256, help="at most this many spp per mi.render call")
