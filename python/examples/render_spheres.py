@@ -26,7 +26,9 @@ Modes:
   channel between the native render and each plugin render, plus one Welch t of the mean over
   the sphere (a uniform scale); family-wise α (``--alpha``): α/2 for the mean, α/2 shared by the
   blocks × channels with Šidák's correction. ``--scale S`` multiplies the plugin's BRDF by S
-  (a deliberately wrong material: the test must then reject).
+  (a deliberately wrong material: the test must then reject). ``--clamp-native`` clamps the
+  native BSDF's values at 0, as brdf-lab's RGL reader does with the files' negative entries
+  (Mitsuba's ``measured`` keeps them).
 * ``timing``: a high-spp native reference, then for each configuration R renders at each spp of
   ``--spp-list``: wall time (median, after a warm-up render) and RMSE over the sphere's pixels
   against the reference; the equal-time RMSE follows from RMSE² ∝ 1/time.
