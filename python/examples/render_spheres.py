@@ -118,9 +118,12 @@ def setup_mitsuba(variant: str):
             dr.eval(mi.Float([1.0, 2.0]))
     except Exception as e:  # noqa: BLE001 - Dr.Jit raises various errors without LLVM
         raise RenderError(f"cannot use {variant} ({e}); for llvm_* install libllvm19") from e
-    import brdf_lab.mitsuba as plugin
+    try:
+        import brdf_lab.mitsuba as plugin  # registers "brdf_lab" for the variant on import
 
-    plugin.register()
+        plugin.register()
+    except RuntimeError as e:
+        raise RenderError(str(e)) from e
     if not variant.startswith("scalar"):
         plugin.evaluated_mode()
     _register_scaled(mi)
@@ -193,6 +196,16 @@ def scene_dict(mi, bsdf: dict, map_path: Path, res: int, spp: int, strategy: str
         "emitter": {"type": "envmap", "filename": str(map_path)},
         "ball": {"type": "sphere", "radius": RADIUS, "bsdf": bsdf},
     }
+
+
+def load_scene(mi, scene: dict):
+    """``mi.load_dict`` with Mitsuba's errors (unreadable map or RGL file, a plugin the variant
+    lacks) as a one-line :class:`RenderError`."""
+    try:
+        return mi.load_dict(scene)
+    except Exception as e:  # noqa: BLE001 - Mitsuba raises RuntimeError and others
+        lines = [ln for ln in str(e).splitlines() if ln.strip()]
+        raise RenderError(f"Mitsuba cannot load the scene: {lines[-1] if lines else type(e).__name__}") from e
 
 
 def sphere_mask(res: int) -> np.ndarray:
@@ -337,13 +350,13 @@ def run_compare(args, mi, dr, materials: List[Material]) -> dict:
         nat = m.native
         if args.clamp_native:
             nat = {"type": "scaled_bsdf", "scale": 1.0, "clamp": True, "nested": nat}
-        scene_n = mi.load_dict(scene_dict(mi, nat, args.map, args.res, args.spp, args.strategy))
+        scene_n = load_scene(mi, scene_dict(mi, nat, args.map, args.res, args.spp, args.strategy))
         native = np.array([render_passes(mi, dr, scene_n, args.spp, args.seed + 1000 * ci + k, args.pass_spp)
                            for k in range(args.repeats)])
         row = [tonemap(native.mean(axis=0))]
         for si, s in enumerate(m.samplers):
             bsdf = plugin_bsdf(m, s, args.scale)
-            scene_p = mi.load_dict(scene_dict(mi, bsdf, args.map, args.res, args.spp, args.strategy))
+            scene_p = load_scene(mi, scene_dict(mi, bsdf, args.map, args.res, args.spp, args.strategy))
             base = args.seed + 1000 * ci + 100 * (si + 1)
             plugin = np.array([render_passes(mi, dr, scene_p, args.spp, base + k, args.pass_spp)
                                for k in range(args.repeats)])
@@ -369,7 +382,7 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
     out: Dict[str, dict] = {}
     rows: List[List[np.ndarray]] = []
     for ci, m in enumerate(materials):
-        scene_ref = mi.load_dict(scene_dict(mi, m.native, args.map, args.res, args.ref_spp, args.strategy))
+        scene_ref = load_scene(mi, scene_dict(mi, m.native, args.map, args.res, args.ref_spp, args.strategy))
         t0 = time.perf_counter()
         ref = render_passes(mi, dr, scene_ref, args.ref_spp, 10_000 + ci, args.pass_spp)
         print(f"{m.label}: reference {args.ref_spp} spp (native) in {time.perf_counter() - t0:.1f} s",
@@ -377,7 +390,7 @@ def run_timing(args, mi, dr, materials: List[Material]) -> dict:
         row = [tonemap(ref)]
         confs = [("native", m.native)] + [(f"brdf_lab/{s}", plugin_bsdf(m, s)) for s in m.samplers]
         for name, bsdf in confs:
-            scene = mi.load_dict(scene_dict(mi, bsdf, args.map, args.res, 1, args.strategy))
+            scene = load_scene(mi, scene_dict(mi, bsdf, args.map, args.res, 1, args.strategy))
             for spp in args.spp_list:
                 render_once(mi, scene, spp, 999)  # warm-up: kernels for this spp, sampler build
                 times, errs = [], []

@@ -91,3 +91,11 @@ def test_sphere_mask_is_inside_the_sphere():
 def test_cli_errors(tmp_path, capsys):
     assert rs.main(["compare", "--map", str(tmp_path / "none.hdr")]) == 2
     assert "not found" in capsys.readouterr().err
+    junk = tmp_path / "junk.hdr"
+    junk.write_text("not an image")
+    args = ["--res", "8", "--spp", "1", "--block", "2", "--out", str(tmp_path / "out")]
+    assert rs.main(["compare", "--map", str(junk), *args]) == 2
+    err = capsys.readouterr().err
+    assert "cannot load the scene" in err and len(err.strip().splitlines()) == 1, err
+    assert rs.main(["compare", "--map", str(junk), "--materials", "phong", *args]) == 2
+    assert "unknown material" in capsys.readouterr().err
