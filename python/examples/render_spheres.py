@@ -33,8 +33,11 @@ Modes:
   ``--spp-list``: wall time (median, after a warm-up render) and RMSE over the sphere's pixels
   against the reference; the equal-time RMSE follows from RMSE² ∝ 1/time.
 
-Writes ``results.json`` (and, with ``--png``, small tonemapped PNGs) to ``--out``. Needs
-``pip install "./python[mitsuba]"``; ``llvm_*`` variants need libllvm19.
+Writes ``results.json`` (and, with ``--png``, a small tonemapped montage) to ``--out``. Needs
+``pip install "./python[mitsuba]"``; ``llvm_*`` variants need libllvm19. Variants: ``llvm_ad_rgb``
+(default) or ``scalar_rgb`` (correct but slow: Mitsuba then calls the Python plugin once per
+lane); ``measured`` refuses the RGL ``*_rgb`` files in mono and spectral variants, and the
+plugin has no spectral variant.
 
 Example::
 
