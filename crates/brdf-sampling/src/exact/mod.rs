@@ -64,6 +64,7 @@
 
 mod chebyshev;
 mod density;
+mod tabulated;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -1436,6 +1437,7 @@ fn build_interval(
     // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
     // split, and the other nodes' quadratures are not needed.
     let nt = theta_nodes.len();
+    let merl_nodes = isotropic && tabulated::table_normaliser_exists(brdf.as_ref());
     let mut normalisers: Vec<(NormaliserKey, Normaliser)> = Vec::new();
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
@@ -1471,6 +1473,14 @@ fn build_interval(
             );
             let r = match known(&normalisers, i, d) {
                 Some(r) => r,
+                None if merl_nodes => {
+                    // The MERL layout: integrated over its own bins (`tabulated.rs`).
+                    let (total, rel_err) =
+                        tabulated::table_normaliser(brdf.as_ref(), t).unwrap_or((f64::NAN, 0.0));
+                    let r = Normaliser { total, rel_err };
+                    normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
+                    r
+                }
                 None => {
                     let q = QueryDensity::new(
                         brdf.as_ref(),
