@@ -845,6 +845,10 @@ impl ExactSet {
             Vec::new()
         };
         let var = table_var(isotropic, !kinks.is_empty());
+        // `follow_kinks: false` also keeps the leaf quadrature for the MERL layout (before
+        // issue 27).
+        let table_nodes =
+            follow_kinks && isotropic && tabulated::table_normaliser_exists(brdf.as_ref());
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
         let layout = layout_for(
             brdf.as_ref(),
@@ -910,6 +914,7 @@ impl ExactSet {
                         var,
                         cache,
                         min_width,
+                        table_nodes,
                     };
                     build_interval(&brdf, options, job, &ctx).map(|b| (job.clone(), b))
                 })
@@ -1257,6 +1262,9 @@ struct IntervalContext {
     cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     min_width: f64,
+    /// Integrate the normaliser nodes in the BRDF's own table cells (the MERL layout,
+    /// `tabulated.rs`) instead of on the tree's leaves.
+    table_nodes: bool,
 }
 
 /// One interval's build: the interval (`None`: to be split) and what its children can reuse.
@@ -1431,13 +1439,20 @@ fn build_interval(
     // double (Lobatto-nested) while their tail exceeds the tolerance.
     let var = ctx.var;
     let (va, vb) = (var.of(ta), var.of(tb));
-    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), options.normaliser_nodes);
+    // Nodes integrated in the table's cells are exact to ~1e-6 but cost ~10⁵ lookups each;
+    // `A(θo)` of the MERL layout interpolates to < 1e-5 on 5 of them (`tabulated.rs`).
+    let n_theta = if ctx.table_nodes {
+        options.normaliser_nodes.min(tabulated::TABLE_NODES)
+    } else {
+        options.normaliser_nodes
+    };
+    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), n_theta);
     let before = crate::disc::thread_evaluations();
     let volume = tree.volume();
     // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
     // split, and the other nodes' quadratures are not needed.
     let nt = theta_nodes.len();
-    let merl_nodes = isotropic && tabulated::table_normaliser_exists(brdf.as_ref());
+    let merl_nodes = ctx.table_nodes;
     let mut normalisers: Vec<(NormaliserKey, Normaliser)> = Vec::new();
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
