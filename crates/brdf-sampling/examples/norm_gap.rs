@@ -147,7 +147,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(list) = arg::<String>(&args, "--at") {
         angles = list.split(',').filter_map(|v| v.parse().ok()).collect();
     }
-    println!("| θo ° | A (fine) | Â | A/Â − 1 | declared | ref. quad. A/Â − 1 |");
+    let merl = brdf.as_any().and_then(|a| a.downcast_ref::<MerlBrdf>());
+    println!("| θo ° | A (fine) | Â | A/Â − 1 | declared | ref. quad. A/Â − 1 | in bins A/Â − 1 |");
     println!("|---|---|---|---|---|---|");
     let (mut worst, mut worst_at, mut worst_check, mut under) = (0.0f64, 0.0, 0.0f64, 0usize);
     let mut worst_adaptive = 0.0f64;
@@ -184,7 +185,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             f64::NAN
         };
-        println!("| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {r:+.2e} |");
+        // MERL layout: also the table integrated over its own bins to 1e-6 (a second
+        // reference, `MerlBrdf::albedo_in_bins`; the set's nodes use it at 1e-5).
+        let bins = merl.map_or(String::new(), |m| {
+            let b = m.albedo_in_bins(t.to_radians(), 1e-6, 5_000_000);
+            format!(
+                " {:+.2e} (±{:.0e}) |",
+                b.value / a_hat - 1.0,
+                b.abs_err / b.value
+            )
+        });
+        println!("| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {r:+.2e} |{bins}");
     }
     println!(
         "{spec}: max |A/Â − 1| = {worst:.2e} at θo = {worst_at:.3}° over {} angles; declared error below the gap at {under} of them; fine rule n = {n} vs {check_n}: max rel. difference {worst_check:.1e}",

@@ -466,4 +466,8 @@ impl Brdf for MerlBrdf {
     fn name(&self) -> &str {
         "merl"
     }
+    /// For [`MerlBrdf::albedo_in_bins`] (the exact sampler's normaliser, issue 27).
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }

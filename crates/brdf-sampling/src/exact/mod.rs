@@ -27,7 +27,8 @@
 //! **pdf** (w.r.t. solid angle): `p(ωi | ωo) = f_r(ωo, ωi) cos θi / A(θo, δ)`, with
 //! `A = ∫_Ω f_r(ωo, ·) cos θi dσ` (the disc integral of `g`), tabulated per interval at
 //! Chebyshev–Lobatto nodes ([`ExactOptions::normaliser_nodes`] × [`ExactOptions::phi_normaliser_nodes`]),
-//! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`);
+//! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`;
+//! a MERL table over its own bins instead, 5 nodes per interval, `tabulated.rs`, issue 27);
 //! the δ nodes are doubled (Lobatto-nested, up to 17) while the δ tail exceeds the same floor;
 //! `A · cos θo` is interpolated ([`chebyshev`]): it stays smooth up to grazing angles for models
 //! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The
@@ -64,6 +65,7 @@
 
 mod chebyshev;
 mod density;
+mod tabulated;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -844,6 +846,10 @@ impl ExactSet {
             Vec::new()
         };
         let var = table_var(isotropic, !kinks.is_empty());
+        // `follow_kinks: false` also keeps the leaf quadrature for the MERL layout (before
+        // issue 27).
+        let table_nodes =
+            follow_kinks && isotropic && tabulated::table_normaliser_exists(brdf.as_ref());
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
         let layout = layout_for(
             brdf.as_ref(),
@@ -909,6 +915,7 @@ impl ExactSet {
                         var,
                         cache,
                         min_width,
+                        table_nodes,
                     };
                     build_interval(&brdf, options, job, &ctx).map(|b| (job.clone(), b))
                 })
@@ -1256,6 +1263,9 @@ struct IntervalContext {
     cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     min_width: f64,
+    /// Integrate the normaliser nodes in the BRDF's own table cells (the MERL layout,
+    /// `tabulated.rs`) instead of on the tree's leaves.
+    table_nodes: bool,
 }
 
 /// One interval's build: the interval (`None`: to be split) and what its children can reuse.
@@ -1430,12 +1440,20 @@ fn build_interval(
     // double (Lobatto-nested) while their tail exceeds the tolerance.
     let var = ctx.var;
     let (va, vb) = (var.of(ta), var.of(tb));
-    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), options.normaliser_nodes);
+    // Nodes integrated in the table's cells are exact to ~1e-6 but cost ~10⁵ lookups each;
+    // `A(θo)` of the MERL layout interpolates to < 1e-5 on 5 of them (`tabulated.rs`).
+    let n_theta = if ctx.table_nodes {
+        options.normaliser_nodes.min(tabulated::TABLE_NODES)
+    } else {
+        options.normaliser_nodes
+    };
+    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), n_theta);
     let before = crate::disc::thread_evaluations();
     let volume = tree.volume();
     // The ends and the middle first: a node whose mean trials `ΣV/A` exceed the cap decides a
     // split, and the other nodes' quadratures are not needed.
     let nt = theta_nodes.len();
+    let merl_nodes = ctx.table_nodes;
     let mut normalisers: Vec<(NormaliserKey, Normaliser)> = Vec::new();
     let mut nd = options.phi_normaliser_nodes;
     let (table, quad_err) = loop {
@@ -1471,6 +1489,14 @@ fn build_interval(
             );
             let r = match known(&normalisers, i, d) {
                 Some(r) => r,
+                None if merl_nodes => {
+                    // The MERL layout: integrated over its own bins (`tabulated.rs`).
+                    let (total, rel_err) =
+                        tabulated::table_normaliser(brdf.as_ref(), t).unwrap_or((f64::NAN, 0.0));
+                    let r = Normaliser { total, rel_err };
+                    normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
+                    r
+                }
                 None => {
                     let q = QueryDensity::new(
                         brdf.as_ref(),

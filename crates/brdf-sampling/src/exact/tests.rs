@@ -410,3 +410,56 @@ fn intervals_cut_at_the_rgl_slices_normalise_to_1e4() {
         "uniform intervals: max |A/Â − 1| = {worst_old:e}"
     );
 }
+
+/// Issue 27: a MERL-layout table (nearest-bin lookup, piecewise constant) whose value jumps by
+/// half at every bin edge (a checkerboard over `(θh_i, θd_i, φd_i)` of `0.2 · (1, 1.5)`):
+/// the normaliser integrated over the table's own bins (`tabulated.rs`) meets
+/// `|A/Â − 1| ≤ 1e-4` at angles between its nodes, within the declared error; the leaf
+/// quadrature of before (`follow_kinks: false`) misses it (measured 3.1–8.5e-4 at these
+/// angles, against 1–2e-7 now: the test fails with the old normaliser). References: the same
+/// table integrated over its bins to 1e-5 (rings of constant θh, `MerlBrdf::albedo_in_bins`),
+/// and, independently, the equal-area midpoint rule on 1024² cells at two of the angles
+/// (measured 1.9e-6 from it; asserted within 2e-5).
+#[test]
+fn merl_layout_normaliser_in_the_table_cells_is_within_1e4() {
+    let table = brdf::MerlBrdf::from_fn(|th, td, pd| {
+        let bin = brdf::merl::index_from_angles(th, td, pd);
+        let odd = (bin.theta_h + bin.theta_d + bin.phi_d) % 2 == 1;
+        [if odd { 0.3 } else { 0.2 }; 3]
+    });
+    let brdf: Arc<dyn Brdf> = Arc::new(table.clone());
+    let opts = ExactOptions::default();
+    let new = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+    let old = ExactSet::build_with(Arc::clone(&brdf), &opts, None, None, false).unwrap();
+    let (mut worst_new, mut worst_old) = (0.0f64, 0.0f64);
+    for t in [13.7f64, 41.3, 66.2, 83.9] {
+        let wo = brdf::direction_from_angles(t, 0.0);
+        let reference = table.albedo_in_bins(t.to_radians(), 1e-5, 5_000_000);
+        assert!(reference.abs_err <= 1e-5 * reference.value, "{reference:?}");
+        let a = reference.value;
+        if t == 13.7 || t == 66.2 {
+            let mid = midpoint_albedo(brdf.as_ref(), &wo, 512);
+            assert!(
+                (mid / a - 1.0).abs() < 2e-5,
+                "θo {t}: midpoint {mid} vs {a}"
+            );
+        }
+        let gap = |s: &ExactSet| (a / s.normaliser(&wo).unwrap() - 1.0).abs();
+        let g = gap(&new);
+        let declared = new.normaliser_rel_err(&wo).unwrap();
+        assert!(
+            g <= declared,
+            "θo {t}: gap {g:e} above the declared {declared:e}"
+        );
+        worst_new = worst_new.max(g);
+        worst_old = worst_old.max(gap(&old));
+    }
+    assert!(
+        worst_new <= 1e-4,
+        "table cells: max |A/Â − 1| = {worst_new:e}"
+    );
+    assert!(
+        worst_old > 1e-4,
+        "leaf quadrature: max |A/Â − 1| = {worst_old:e}"
+    );
+}
