@@ -17,17 +17,19 @@ use crate::values::{self, counted, display_path};
 pub(crate) struct StudyArgs {
     #[command(subcommand)]
     merge: Option<StudySub>,
-    /// BRDF spec (repeatable); default: the quick study's BRDFs.
+    /// BRDF spec (repeatable); default: every analytic model, every shared measured file and
+    /// four MERL-100 fits (the quick study's with --quick).
     #[arg(long = "brdf")]
     brdfs: Vec<String>,
     /// Registered direction sampler (repeatable); default: every registered sampler of the
     /// preferred list (uniform, cosine, the lobe/CDF/factored baselines, the adaptive ones).
     #[arg(long = "sampler")]
     samplers: Vec<String>,
-    /// Outgoing polar angle θo in degrees, in [0, 90) (repeatable); default 30 and 60.
+    /// Outgoing polar angle θo in degrees, in [0, 90) (repeatable); default 0, 30, 60, 80, 88
+    /// (30 and 60 with --quick).
     #[arg(long = "theta-o", allow_hyphen_values = true)]
     theta_o: Vec<f64>,
-    /// Light (repeatable): `sky` (default, built in), `envmap:PATH`,
+    /// Light (repeatable): `sky` (built in; the default when no map is found), `envmap:PATH`,
     /// `area[:theta=DEG,phi=DEG,radius=DEG,radiance=L]`, `constant[:radiance=L]`.
     #[arg(long = "light")]
     lights: Vec<String>,
@@ -38,6 +40,10 @@ pub(crate) struct StudyArgs {
     /// The papers' study (reduced size, stated in the report): sphere scene lights and BRDFs.
     #[arg(long)]
     paper: bool,
+    /// Without a preset: study every MERL-100 fit (SGD and ABC, 200 BRDFs) instead of the four
+    /// default ones (long: shard it).
+    #[arg(long, conflicts_with_all = ["quick", "paper"])]
+    all_merl_fits: bool,
     /// Sample counts N of the error curves, comma-separated, strictly increasing
     /// (default 1,25,100,225,400,900,1600,2500).
     #[arg(long, value_delimiter = ',', value_parser = values::at_least(1usize), allow_hyphen_values = true)]
@@ -103,10 +109,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
             "--paper runs the sphere-scene estimator study at reduced size (2 BRDFs, 3 angles, the area light and the sky); the paper tables that need the factored baseline or MERL data are produced only for the samplers and data present".to_string(),
         ])
     } else {
-        let (q, _) = StudyConfig::quick(None);
-        let mut c = StudyConfig::new(q.samplers, q.brdfs, q.theta_o_deg, vec!["sky".into()]);
-        c.preset = "custom".into();
-        (c, Vec::new())
+        StudyConfig::full(shared_root().as_deref(), args.all_merl_fits)
     };
     if !args.brdfs.is_empty() {
         config.brdfs.clone_from(&args.brdfs);

@@ -55,8 +55,9 @@ mod report;
 mod results;
 
 pub use config::{
-    BATCH_REPETITIONS, CellSpec, MAP_CANDIDATES, MEASURED_CANDIDATES, Mode, PAPER_N_GRID,
-    PREFERRED_SAMPLERS, QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
+    BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, FULL_THETA_O_DEG, MAP_CANDIDATES,
+    MEASURED_CANDIDATES, MEASURED_DIRS, Mode, PAPER_N_GRID, PREFERRED_SAMPLERS, QUICK_BRDFS, Shard,
+    StudyConfig, all_merl_fits, analytic_models, registered_preferred, shared_measured,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
