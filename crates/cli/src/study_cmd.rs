@@ -323,7 +323,11 @@ fn write_outputs(
         let png = format!("plots/{}.png", p.stem);
         write_atomically(&dir.join(&png), |w| w.write_all(&p.png))?;
         write_text(&dir.join(format!("plots/{}.svg", p.stem)), &p.svg)?;
-        assets.plots.push((p.slug, p.caption, png));
+        if p.slug.is_empty() {
+            assets.summary_plots.push((p.caption, png));
+        } else {
+            assets.plots.push((p.slug, p.caption, png));
+        }
     }
     write_text(&dir.join("results.json"), &results.to_json())?;
     write_text(&dir.join("results.csv"), &results.to_csv())?;

@@ -20,11 +20,11 @@ pub struct Group<'a> {
 }
 
 impl Group<'_> {
-    /// `BRDF at θo = …° under LIGHT`.
+    /// `BRDF at θo = …° under LIGHT` (short names: no paths).
     pub fn title(&self) -> String {
         format!(
             "{} at θo = {}° under {}",
-            self.brdf,
+            short_brdf(self.brdf),
             self.theta_o_deg,
             short_light(self.light)
         )
@@ -54,6 +54,80 @@ pub fn short_light(spec: &str) -> String {
                 .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned())
         ),
         _ => spec.to_string(),
+    }
+}
+
+/// A BRDF spec without a long path or key: `rgl:/…/paper_white_rgb.bsdf` →
+/// `rgl:paper_white_rgb`, `sgd:material=red-fabric` → `sgd:red-fabric`; analytic specs as
+/// they are.
+pub fn short_brdf(spec: &str) -> String {
+    match spec.split_once(':') {
+        Some((reader @ ("rgl" | "cornell" | "merl"), path)) => format!(
+            "{reader}:{}",
+            std::path::Path::new(path)
+                .file_stem()
+                .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned())
+        ),
+        Some((fit @ ("sgd" | "abc"), rest)) => {
+            format!("{fit}:{}", rest.strip_prefix("material=").unwrap_or(rest))
+        }
+        _ => spec.to_string(),
+    }
+}
+
+/// A material family, for the report's answers in words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Family {
+    /// Analytic models without a glossy lobe (Lambert, Oren–Nayar, Minnaert, Schlick's diffuse).
+    DiffuseAnalytic,
+    /// Isotropic analytic models with a glossy lobe.
+    GlossyAnalytic,
+    /// Anisotropic analytic models (at their parameters).
+    AnisotropicAnalytic,
+    /// Published fits of MERL-100 materials (`sgd:`, `abc:`).
+    MerlFit,
+    /// Measured files: RGL, Cornell, MERL.
+    Measured,
+}
+
+/// Analytic models with no glossy lobe.
+const DIFFUSE_MODELS: [&str; 4] = ["lambert", "oren-nayar", "minnaert", "schlick-diffuse"];
+
+impl Family {
+    /// Every family, in report order.
+    pub const ALL: [Family; 5] = [
+        Family::DiffuseAnalytic,
+        Family::GlossyAnalytic,
+        Family::AnisotropicAnalytic,
+        Family::MerlFit,
+        Family::Measured,
+    ];
+
+    /// The family of a BRDF spec; anisotropy is read from the built model
+    /// (`Brdf::is_isotropic`), so `ward:alpha_x=0.1,alpha_y=0.3` is anisotropic and the
+    /// default `ward` is not.
+    pub fn of(spec: &str) -> Family {
+        let name = spec.split(':').next().unwrap_or(spec).trim();
+        match name {
+            "rgl" | "cornell" | "merl" => Family::Measured,
+            "sgd" | "abc" => Family::MerlFit,
+            _ if DIFFUSE_MODELS.contains(&name) => Family::DiffuseAnalytic,
+            _ => match brdf::parse_spec(spec) {
+                Ok(b) if !b.is_isotropic() => Family::AnisotropicAnalytic,
+                _ => Family::GlossyAnalytic,
+            },
+        }
+    }
+
+    /// The family in words (plural).
+    pub fn describe(self) -> &'static str {
+        match self {
+            Family::DiffuseAnalytic => "diffuse analytic models",
+            Family::GlossyAnalytic => "glossy isotropic analytic models",
+            Family::AnisotropicAnalytic => "anisotropic analytic models",
+            Family::MerlFit => "MERL-100 fits (SGD, ABC)",
+            Family::Measured => "measured files (RGL, Cornell, MERL)",
+        }
     }
 }
 

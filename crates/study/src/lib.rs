@@ -38,6 +38,7 @@
 // Validation is written `if !(x > 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod answers;
 mod config;
 mod counting;
 pub mod dispersion;
@@ -62,7 +63,7 @@ pub use config::{
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
 pub use error::StudyError;
-pub use groups::{Group, groups, is_adaptive, short_light};
+pub use groups::{Family, Group, groups, is_adaptive, short_brdf, short_light};
 pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use machine::{COMMIT, RunInfo};
@@ -70,7 +71,10 @@ pub use paper::{
     MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
     paper_tables,
 };
-pub use plot::{Figure, PLOT_SIZE, PlotFile, Series, group_figures, study_plots};
+pub use plot::{
+    Figure, Marker, PLOT_SIZE, PlotFile, SamplerStyle, Series, group_figures, sampler_style,
+    study_plots, summary_figures,
+};
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
