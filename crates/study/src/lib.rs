@@ -68,8 +68,8 @@ pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use machine::{COMMIT, RunInfo};
 pub use paper::{
-    MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
-    paper_tables,
+    Claim, ClaimVerdict, MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS,
+    TIME_MARGIN, paper_markdown, paper_tables,
 };
 pub use plot::{
     Figure, Marker, PLOT_SIZE, PlotFile, SamplerStyle, Series, group_figures, sampler_style,
