@@ -20,6 +20,9 @@ use crate::CellResult;
 use crate::groups::{Family, short_brdf, short_light};
 use crate::ranking::{ESTIMATOR_BRDF, Ranking, Verdict};
 
+/// Samplers named in a sentence's "tied" list (the rest are counted).
+const TIED_SHOWN: usize = 5;
+
 /// How one sampler fares over a set of comparisons.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Tally {
@@ -143,12 +146,22 @@ pub(crate) fn sentence(
     let t = tallies(rankings);
     let y = t.first()?;
     let n = rankings.len();
-    let tied: Vec<String> = t
+    let all_tied: Vec<String> = t
         .iter()
         .skip(1)
         .filter(|x| x.top == y.top)
-        .map(|x| format!("{} ({}/{}, best in {})", x.label, x.top, x.ranked, x.best))
+        .map(|x| {
+            if x.best > 0 {
+                format!("{} (best in {})", x.label, x.best)
+            } else {
+                x.label.clone()
+            }
+        })
         .collect();
+    let mut tied: Vec<String> = all_tied.iter().take(TIED_SHOWN).cloned().collect();
+    if all_tied.len() > TIED_SHOWN {
+        tied.push(format!("and {} more", all_tied.len() - TIED_SHOWN));
+    }
     let mut s = format!(
         "For **{what}** use **{}**: best or tied with the best in {} of {} comparisons (best in {}, significantly worse in {}; geometric mean of best / {} = {:.2})",
         y.label,
@@ -161,8 +174,15 @@ pub(crate) fn sentence(
     );
     if tied.is_empty() {
         s.push_str("; no other sampler is as often best or tied");
+    } else if all_tied.len() + 1 == t.len() {
+        let _ = write!(
+            s,
+            "; **no sampler stands out**: all {} are as often best or tied (the intervals are too wide to separate them; tied: {})",
+            t.len(),
+            tied.join(", ")
+        );
     } else {
-        let _ = write!(s, "; tied: {}", tied.join(", "));
+        let _ = write!(s, "; tied (as often best or tied): {}", tied.join(", "));
     }
     // Its worst comparison.
     let worst = rankings
@@ -209,19 +229,30 @@ pub(crate) fn sentence(
             cells,
         );
         if let (Some(m), Some(ti)) = (mse, time) {
-            let why = if m.0 < 1.0 && ti.0 <= 1.0 {
-                "fewer errors per sample and faster samples"
-            } else if m.0 < 1.0 {
-                "fewer errors per sample, which outweigh its slower samples"
-            } else if ti.0 < 1.0 {
-                "faster samples, which outweigh its larger errors per sample"
-            } else {
-                "it is more often inside the intervals of the best"
+            let word = |x: (f64, f64, f64, usize), less: &'static str, more: &'static str| {
+                if x.2 < 1.0 {
+                    less
+                } else if x.1 > 1.0 {
+                    more
+                } else {
+                    "not significantly different"
+                }
             };
             let _ = write!(
                 s,
-                ", because of {why}: against the runner-up {} ({}/{}) over {} shared comparisons its MSE per sample is {:.2}× [{:.2}, {:.2}] and its time per sample {:.2}× [{:.2}, {:.2}] † the runner-up's (geometric means, 95 %)",
-                r.label, r.top, r.ranked, m.3, m.0, m.1, m.2, ti.0, ti.1, ti.2
+                ", because against the runner-up {} ({}/{}), over {} shared comparisons, its MSE per sample is {:.2}× [{:.2}, {:.2}] the runner-up's ({}) and its time per sample {:.2}× [{:.2}, {:.2}] † ({}) (geometric means, 95 %)",
+                r.label,
+                r.top,
+                r.ranked,
+                m.3,
+                m.0,
+                m.1,
+                m.2,
+                word(m, "smaller", "larger"),
+                ti.0,
+                ti.1,
+                ti.2,
+                word(ti, "faster", "slower"),
             );
         }
     }
@@ -282,21 +313,16 @@ pub(crate) fn family_answers(rankings: &[Ranking], cells: &[CellResult]) -> Stri
                         rs.iter().copied().filter(|r| r.theta_o == *th).collect();
                     let t = tallies(&sub);
                     let y = t.first()?;
-                    let tied: Vec<&str> = t
-                        .iter()
-                        .skip(1)
-                        .filter(|x| x.top == y.top)
-                        .map(|x| x.label.as_str())
-                        .collect();
+                    let tied = t.iter().skip(1).filter(|x| x.top == y.top).count();
                     Some(format!(
                         "{th}°: {} ({}/{}{})",
                         y.label,
                         y.top,
                         sub.len(),
-                        if tied.is_empty() {
+                        if tied == 0 {
                             String::new()
                         } else {
-                            format!("; tied: {}", tied.join(", "))
+                            format!(", {tied} more as often best or tied")
                         }
                     ))
                 })
@@ -323,7 +349,7 @@ mod tests {
 
     /// Three glossy comparisons: `analytic` is best in two and tied in the third (where
     /// `cosine` leads by a hair); `cosine` is tied once and worse twice; `uniform` is always
-    /// worse. The recommendation is analytic (3/3), because of fewer errors per sample (its
+    /// worse. The recommendation is analytic (3/3), because its errors per sample are smaller (its
     /// MSE is a third of cosine's at the same time), and the sentence names its rows.
     #[test]
     fn the_family_answer_recommends_the_most_often_best_or_tied() {
@@ -355,7 +381,8 @@ mod tests {
             "{line}"
         );
         assert!(
-            line.contains("because of fewer errors per sample"),
+            line.contains("its MSE per sample is 0.47× [")
+                && line.contains("the runner-up's (smaller)"),
             "{line}"
         );
         assert!(line.contains("runner-up cosine (1/3)"), "{line}");

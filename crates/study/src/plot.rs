@@ -327,7 +327,14 @@ impl Figure {
                 draw_legend(
                     &legend,
                     series.iter().map(|s| (s.label.as_str(), s.dashed)),
-                    series.iter().any(|s| !s.intervals.is_empty()),
+                    series
+                        .iter()
+                        .any(|s| !s.intervals.is_empty())
+                        .then_some(if *x_linear {
+                            "whiskers: the ranking's intervals"
+                        } else {
+                            "bands: 95 % intervals"
+                        }),
                 )
                 .map_err(|x| e(&x))?;
             }
@@ -474,7 +481,7 @@ where
 fn draw_legend<'a, DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: impl Iterator<Item = (&'a str, bool)>,
-    bands: bool,
+    note: Option<&str>,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let (x0, y0) = area.get_base_pixel();
     let text = ("sans-serif", 14).into_font().color(&BLACK);
@@ -505,9 +512,9 @@ fn draw_legend<'a, DB: DrawingBackend>(
         ))?;
         y += 22;
     }
-    if bands {
+    if let Some(note) = note {
         area.draw(&Text::new(
-            "bands: 95 % intervals".to_string(),
+            note.to_string(),
             (4, y - y0 + 4),
             ("sans-serif", 13).into_font().color(&RGBColor(90, 90, 90)),
         ))?;
