@@ -154,10 +154,9 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
                 seed: args.seed,
                 ..study::RenderConfig::default()
             };
-            plan.render(&cfg, &|n| bar.inc(n))
+            render_sheet(&plan, &cfg, &|n| bar.inc(n))
         })
-        .transpose()
-        .map_err(CliError::input)?;
+        .transpose()?;
     let tables = if args.paper && shard.is_none() {
         Some(study::paper_tables(&|n| bar.inc(n)).map_err(CliError::input)?)
     } else {
@@ -197,9 +196,7 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
             ..study::RenderConfig::default()
         };
         let bar = progress::bar(1 + 2 * plan.config().samplers.len() as u64, "images");
-        let r = plan
-            .render(&cfg, &|n| bar.inc(n))
-            .map_err(CliError::input)?;
+        let r = render_sheet(&plan, &cfg, &|n| bar.inc(n))?;
         bar.finish_and_clear();
         Some(r)
     };
@@ -207,6 +204,41 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
     staging.commit()?;
     summary(&args.out, &merged);
     Ok(())
+}
+
+/// The sphere images of `plan`: of every BRDF when there are at most
+/// [`study::SHEET_MAX_BRDFS`], else of [`study::sheet_brdfs`] (one per material family first),
+/// said in the returned render's notes. Returns the render and the sentence to print above it.
+fn render_sheet(
+    plan: &StudyPlan,
+    cfg: &study::RenderConfig,
+    progress: study::ProgressFn<'_>,
+) -> CliResult<(study::Render, Option<String>)> {
+    let all = &plan.config().brdfs;
+    let chosen = study::sheet_brdfs(all, study::SHEET_MAX_BRDFS);
+    if chosen.len() == all.len() {
+        return Ok((plan.render(cfg, progress).map_err(CliError::input)?, None));
+    }
+    let sub = StudyPlan::new(
+        StudyConfig {
+            brdfs: chosen.clone(),
+            ..plan.config().clone()
+        },
+        Vec::new(),
+    )
+    .map_err(CliError::input)?;
+    let r = sub.render(cfg, progress).map_err(CliError::input)?;
+    let note = format!(
+        "The sphere images show {} of the study's {} materials (the first of each material family, then in order; `study::SHEET_MAX_BRDFS`), left to right: {}.\n\n",
+        chosen.len(),
+        all.len(),
+        chosen
+            .iter()
+            .map(|b| format!("`{}`", study::short_brdf(b)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok((r, Some(note)))
 }
 
 /// The directory holding `../shared` for the quick study's data: the current directory when
@@ -309,12 +341,20 @@ impl Staging {
 fn write_outputs(
     dir: &Path,
     results: &StudyResults,
-    render: Option<&study::Render>,
+    render: Option<&(study::Render, Option<String>)>,
     tables: Option<&[study::PaperTable]>,
 ) -> CliResult<()> {
     let mut assets = study::ReportAssets::default();
-    if let Some(r) = render {
-        assets.sections.push(write_images(dir, r)?);
+    if let Some((r, note)) = render {
+        let section = write_images(dir, r)?;
+        assets.sections.push(match note {
+            // After the section's heading line.
+            Some(n) => match section.split_once('\n') {
+                Some((head, rest)) => format!("{head}\n\n{n}{rest}"),
+                None => format!("{n}{section}"),
+            },
+            None => section,
+        });
     }
     if let Some(t) = tables {
         assets.sections.push(study::paper_markdown(t));

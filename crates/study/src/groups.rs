@@ -131,6 +131,38 @@ impl Family {
     }
 }
 
+/// Most materials in one sphere sheet: a study with more renders a subset
+/// ([`sheet_brdfs`]), so that the default study's images stay cheap.
+pub const SHEET_MAX_BRDFS: usize = 6;
+
+/// The BRDFs of the sphere sheet, at most `max`: the first of each [`Family`] in config order,
+/// then the next ones in config order; all of them when there are at most `max`. Config order
+/// is kept.
+pub fn sheet_brdfs(brdfs: &[String], max: usize) -> Vec<String> {
+    if brdfs.len() <= max {
+        return brdfs.to_vec();
+    }
+    let mut chosen: Vec<usize> = Vec::new();
+    let mut seen = Vec::new();
+    for (i, b) in brdfs.iter().enumerate() {
+        let f = Family::of(b);
+        if !seen.contains(&f) && chosen.len() < max {
+            seen.push(f);
+            chosen.push(i);
+        }
+    }
+    for i in 0..brdfs.len() {
+        if chosen.len() >= max {
+            break;
+        }
+        if !chosen.contains(&i) {
+            chosen.push(i);
+        }
+    }
+    chosen.sort_unstable();
+    chosen.into_iter().map(|i| brdfs[i].clone()).collect()
+}
+
 /// The groups of `results`, in config order (light, BRDF, θo).
 pub fn groups(results: &StudyResults) -> Vec<Group<'_>> {
     let cfg = &results.config;
@@ -162,4 +194,55 @@ pub fn groups(results: &StudyResults) -> Vec<Group<'_>> {
 /// Whether a sampler is one of the adaptive family.
 pub fn is_adaptive(sampler: &str) -> bool {
     sampler.starts_with("adaptive")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn families_short_names_and_the_sheet_subset() {
+        assert_eq!(Family::of("lambert"), Family::DiffuseAnalytic);
+        assert_eq!(Family::of("ggx"), Family::GlossyAnalytic);
+        assert_eq!(
+            Family::of("ward:alpha_x=0.1,alpha_y=0.3"),
+            Family::AnisotropicAnalytic
+        );
+        assert_eq!(Family::of("sgd:material=red-fabric"), Family::MerlFit);
+        assert_eq!(Family::of("rgl:/x/paper_white_rgb.bsdf"), Family::Measured);
+        assert_eq!(
+            short_brdf("rgl:/a/b/paper_white_rgb.bsdf"),
+            "rgl:paper_white_rgb"
+        );
+        assert_eq!(short_brdf("abc:material=red-fabric"), "abc:red-fabric");
+        assert_eq!(short_brdf("phong:n=50"), "phong:n=50");
+        let brdfs: Vec<String> = [
+            "lambert",
+            "phong",
+            "ggx",
+            "oren-nayar",
+            "cook-torrance",
+            "rgl:/x/a.bsdf",
+            "cornell:/x/b.brdf",
+            "sgd:material=red-fabric",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let sheet = sheet_brdfs(&brdfs, 4);
+        // One per family first, in config order.
+        assert_eq!(
+            sheet,
+            [
+                "lambert",
+                "phong",
+                "rgl:/x/a.bsdf",
+                "sgd:material=red-fabric"
+            ]
+            .map(String::from)
+        );
+        // Then the next ones in config order.
+        assert_eq!(sheet_brdfs(&brdfs, 5)[2], "ggx");
+        assert_eq!(sheet_brdfs(&brdfs[..3], 4), brdfs[..3].to_vec());
+    }
 }

@@ -63,7 +63,9 @@ pub use config::{
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
 pub use error::StudyError;
-pub use groups::{Family, Group, groups, is_adaptive, short_brdf, short_light};
+pub use groups::{
+    Family, Group, SHEET_MAX_BRDFS, groups, is_adaptive, sheet_brdfs, short_brdf, short_light,
+};
 pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use machine::{COMMIT, RunInfo};
