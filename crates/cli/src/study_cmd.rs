@@ -217,7 +217,9 @@ fn render_sheet(
     let all = &plan.config().brdfs;
     let chosen = study::sheet_brdfs(all, study::SHEET_MAX_BRDFS);
     if chosen.len() == all.len() {
-        return Ok((plan.render(cfg, progress).map_err(CliError::input)?, None));
+        let r = plan.render(cfg, progress).map_err(CliError::input)?;
+        let note = missing_samplers(plan, &r);
+        return Ok((r, note));
     }
     let sub = StudyPlan::new(
         StudyConfig {
@@ -238,7 +240,27 @@ fn render_sheet(
             .collect::<Vec<_>>()
             .join(", ")
     );
+    let note = note + &missing_samplers(plan, &r).unwrap_or_default();
     Ok((r, Some(note)))
+}
+
+/// The study's samplers that have no sphere image, and why: one sphere row holds several
+/// materials, and a sampler is drawn only when it can be built for every one of them
+/// (`analytic` applies to analytic models only, `rgl-native` to RGL files only).
+fn missing_samplers(plan: &StudyPlan, r: &study::Render) -> Option<String> {
+    let missing: Vec<String> = plan
+        .config()
+        .samplers
+        .iter()
+        .filter(|s| !r.images.iter().any(|i| &i.sampler == *s))
+        .map(|s| format!("`{s}`"))
+        .collect();
+    (!missing.is_empty()).then(|| {
+        format!(
+            "Not in the sphere images: {} — a sampler is drawn only when it can be built for every material of the row (`analytic` applies to analytic models only, `rgl-native` to RGL files only); their numbers are in the tables above.\n\n",
+            missing.join(", ")
+        )
+    })
 }
 
 /// The directory holding `../shared` for the quick study's data: the current directory when
@@ -400,10 +422,18 @@ fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
     }
     let mut sheets = Vec::new();
     for kind in ["equal samples", "equal time"] {
-        let rows: Vec<image::RgbImage> = std::iter::once(&r.reference)
+        let rows: Vec<(String, image::RgbImage)> = std::iter::once(&r.reference)
             .chain(r.images.iter().filter(|i| i.kind == kind))
-            .map(|i| i.to_rgb8(exposure))
+            .map(|i| {
+                let label = if i.kind == "reference" {
+                    format!("reference ({} spp)", i.spp)
+                } else {
+                    format!("{} ({} spp)", i.sampler, i.spp)
+                };
+                (label, i.to_rgb8(exposure))
+            })
             .collect();
+        let columns: Vec<String> = r.brdfs.iter().map(|b| study::short_brdf(b)).collect();
         let order: Vec<String> = r
             .images
             .iter()
@@ -411,7 +441,8 @@ fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
             .map(|i| format!("{} ({} spp)", i.sampler, i.spp))
             .collect();
         let file = format!("images/spheres-{}.png", kind.replace(' ', "-"));
-        let bytes = study::encode_png(&study::stack(&rows), &file).map_err(CliError::input)?;
+        let sheet = study::labelled_sheet(&rows, &columns).map_err(CliError::input)?;
+        let bytes = study::encode_png(&sheet, &file).map_err(CliError::input)?;
         write_atomically(&dir.join(&file), |w| w.write_all(&bytes))?;
         sheets.push((
             format!("{kind}, top to bottom: reference, {}", order.join(", ")),

@@ -54,6 +54,7 @@ mod reference;
 mod render;
 mod report;
 mod results;
+mod sheet;
 
 pub use config::{
     BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, FULL_THETA_O_DEG, MAP_CANDIDATES,
@@ -74,7 +75,7 @@ pub use paper::{
     TIME_MARGIN, paper_markdown, paper_tables,
 };
 pub use plot::{
-    Figure, Marker, PLOT_SIZE, PlotFile, SamplerStyle, Series, group_figures, sampler_style,
+    Bar, Figure, Marker, PLOT_SIZE, PlotFile, SamplerStyle, Series, group_figures, sampler_style,
     study_plots, summary_figures,
 };
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
@@ -82,3 +83,4 @@ pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
 pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+pub use sheet::labelled_sheet;

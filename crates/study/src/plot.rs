@@ -20,7 +20,8 @@ const LEGEND_WIDTH: u32 = 270;
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
-fn register_font() {
+/// Registers the compiled-in font once (plots and sheets).
+pub(crate) fn register_font() {
     REGISTER.call_once(|| {
         // The font is compiled in and valid; failing here would only lose text.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
@@ -167,6 +168,9 @@ pub struct Series {
     pub dashed: bool,
 }
 
+/// One bar: `(label shown, sampler label for the style, value > 0, 95 % interval)`.
+pub type Bar = (String, String, f64, Option<(f64, f64)>);
+
 /// What a figure shows.
 #[derive(Debug, Clone)]
 pub enum Figure {
@@ -190,8 +194,8 @@ pub enum Figure {
         title: String,
         /// x-axis label.
         y_label: String,
-        /// `(label shown, sampler label for the style, value > 0, 95 % interval)`.
-        bars: Vec<(String, String, f64, Option<(f64, f64)>)>,
+        /// The bars, top to bottom.
+        bars: Vec<Bar>,
     },
 }
 
@@ -595,7 +599,7 @@ pub fn group_figures(g: &Group<'_>, ranking: Option<&Ranking>) -> Vec<(String, S
             })
         })
         .collect();
-    let mut bars: Vec<(String, String, f64, Option<(f64, f64)>)> = ok
+    let mut bars: Vec<Bar> = ok
         .iter()
         .filter_map(|c| {
             let eff = c.timing?.efficiency?;
