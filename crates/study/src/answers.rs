@@ -162,6 +162,18 @@ pub(crate) fn sentence(
     if all_tied.len() > TIED_SHOWN {
         tied.push(format!("and {} more", all_tied.len() - TIED_SHOWN));
     }
+    if !all_tied.is_empty() && all_tied.len() + 1 == t.len() {
+        return Some(format!(
+            "For **{what}** **no sampler stands out**: all {} samplers are best or tied with the best in {} of {} comparisons (the intervals are too wide to separate them); the tie-break (geometric mean of best / this) prefers {} ({:.2}, best in {}) (rows {}).",
+            t.len(),
+            y.top,
+            n,
+            y.label,
+            y.geo_ratio,
+            y.best,
+            rows_text(&y.rows)
+        ));
+    }
     let mut s = format!(
         "For **{what}** use **{}**: best or tied with the best in {} of {} comparisons (best in {}, significantly worse in {}; geometric mean of best / {} = {:.2})",
         y.label,
@@ -174,13 +186,6 @@ pub(crate) fn sentence(
     );
     if tied.is_empty() {
         s.push_str("; no other sampler is as often best or tied");
-    } else if all_tied.len() + 1 == t.len() {
-        let _ = write!(
-            s,
-            "; **no sampler stands out**: all {} are as often best or tied (the intervals are too wide to separate them; tied: {})",
-            t.len(),
-            tied.join(", ")
-        );
     } else {
         let _ = write!(s, "; tied (as often best or tied): {}", tied.join(", "));
     }
@@ -388,6 +393,22 @@ mod tests {
         assert!(line.contains("runner-up cosine (1/3)"), "{line}");
         assert!(line.contains("(rows 0, 3, 6; runner-up 1, 4, 7)"), "{line}");
         assert!(line.contains("Materials: phong, ggx, blinn."), "{line}");
+        // A comparison in which everything is tied: no sampler stands out.
+        let tied_cells = [
+            cell(20, "analytic", "ggx", 1.0, 0.5, 100.0, 0.02),
+            cell(21, "cosine", "ggx", 1.05, 0.5, 100.0, 0.02),
+        ];
+        let refs: Vec<&CellResult> = tied_cells.iter().collect();
+        let tied_only = [rank_cells(&refs, ESTIMATOR_BRDF, ALPHA, true).unwrap()];
+        assert!(tied_only[0].worse.is_empty());
+        let s = family_answers(&tied_only, &tied_cells);
+        assert!(
+            s.contains(
+                "For **glossy isotropic analytic models** **no sampler stands out**: all 2 samplers"
+            ),
+            "{s}"
+        );
+        assert!(!s.contains(" use **"), "{s}");
         let t = tallies(&rankings.iter().collect::<Vec<_>>());
         assert_eq!(t[0].label, "analytic");
         assert_eq!(t.last().unwrap().label, "uniform");
