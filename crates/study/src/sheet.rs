@@ -35,8 +35,8 @@ pub fn labelled_sheet(
         let n = columns.len().max(1) as u32;
         let col_w = img_w / n;
         for (k, c) in columns.iter().enumerate() {
-            // Clip long names to the column's width (about 8 px per character at 15 px).
-            let max_chars = (col_w / 8).max(4) as usize;
+            // Clip long names to the column's width (up to about 9 px per character at 15 px).
+            let max_chars = (col_w / 9).max(4) as usize;
             let text: String = if c.chars().count() > max_chars {
                 c.chars().take(max_chars - 1).chain(['…']).collect()
             } else {
