@@ -17,17 +17,19 @@ use crate::values::{self, counted, display_path};
 pub(crate) struct StudyArgs {
     #[command(subcommand)]
     merge: Option<StudySub>,
-    /// BRDF spec (repeatable); default: the quick study's BRDFs.
+    /// BRDF spec (repeatable); default: every analytic model, every shared measured file and
+    /// four MERL-100 fits (the quick study's with --quick).
     #[arg(long = "brdf")]
     brdfs: Vec<String>,
     /// Registered direction sampler (repeatable); default: every registered sampler of the
     /// preferred list (uniform, cosine, the lobe/CDF/factored baselines, the adaptive ones).
     #[arg(long = "sampler")]
     samplers: Vec<String>,
-    /// Outgoing polar angle θo in degrees, in [0, 90) (repeatable); default 30 and 60.
+    /// Outgoing polar angle θo in degrees, in [0, 90) (repeatable); default 0, 30, 60, 80, 88
+    /// (30 and 60 with --quick).
     #[arg(long = "theta-o", allow_hyphen_values = true)]
     theta_o: Vec<f64>,
-    /// Light (repeatable): `sky` (default, built in), `envmap:PATH`,
+    /// Light (repeatable): `sky` (built in; the default when no map is found), `envmap:PATH`,
     /// `area[:theta=DEG,phi=DEG,radius=DEG,radiance=L]`, `constant[:radiance=L]`.
     #[arg(long = "light")]
     lights: Vec<String>,
@@ -38,6 +40,10 @@ pub(crate) struct StudyArgs {
     /// The papers' study (reduced size, stated in the report): sphere scene lights and BRDFs.
     #[arg(long)]
     paper: bool,
+    /// Without a preset: study every MERL-100 fit (SGD and ABC, 200 BRDFs) instead of the four
+    /// default ones (long: shard it).
+    #[arg(long, conflicts_with_all = ["quick", "paper"])]
+    all_merl_fits: bool,
     /// Sample counts N of the error curves, comma-separated, strictly increasing
     /// (default 1,25,100,225,400,900,1600,2500).
     #[arg(long, value_delimiter = ',', value_parser = values::at_least(1usize), allow_hyphen_values = true)]
@@ -103,10 +109,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
             "--paper runs the sphere-scene estimator study at reduced size (2 BRDFs, 3 angles, the area light and the sky); the paper tables that need the factored baseline or MERL data are produced only for the samplers and data present".to_string(),
         ])
     } else {
-        let (q, _) = StudyConfig::quick(None);
-        let mut c = StudyConfig::new(q.samplers, q.brdfs, q.theta_o_deg, vec!["sky".into()]);
-        c.preset = "custom".into();
-        (c, Vec::new())
+        StudyConfig::full(shared_root().as_deref(), args.all_merl_fits)
     };
     if !args.brdfs.is_empty() {
         config.brdfs.clone_from(&args.brdfs);
@@ -151,10 +154,9 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
                 seed: args.seed,
                 ..study::RenderConfig::default()
             };
-            plan.render(&cfg, &|n| bar.inc(n))
+            render_sheet(&plan, &cfg, &|n| bar.inc(n))
         })
-        .transpose()
-        .map_err(CliError::input)?;
+        .transpose()?;
     let tables = if args.paper && shard.is_none() {
         Some(study::paper_tables(&|n| bar.inc(n)).map_err(CliError::input)?)
     } else {
@@ -194,9 +196,7 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
             ..study::RenderConfig::default()
         };
         let bar = progress::bar(1 + 2 * plan.config().samplers.len() as u64, "images");
-        let r = plan
-            .render(&cfg, &|n| bar.inc(n))
-            .map_err(CliError::input)?;
+        let r = render_sheet(&plan, &cfg, &|n| bar.inc(n))?;
         bar.finish_and_clear();
         Some(r)
     };
@@ -204,6 +204,63 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
     staging.commit()?;
     summary(&args.out, &merged);
     Ok(())
+}
+
+/// The sphere images of `plan`: of every BRDF when there are at most
+/// [`study::SHEET_MAX_BRDFS`], else of [`study::sheet_brdfs`] (one per material family first),
+/// said in the returned render's notes. Returns the render and the sentence to print above it.
+fn render_sheet(
+    plan: &StudyPlan,
+    cfg: &study::RenderConfig,
+    progress: study::ProgressFn<'_>,
+) -> CliResult<(study::Render, Option<String>)> {
+    let all = &plan.config().brdfs;
+    let chosen = study::sheet_brdfs(all, study::SHEET_MAX_BRDFS);
+    if chosen.len() == all.len() {
+        let r = plan.render(cfg, progress).map_err(CliError::input)?;
+        let note = missing_samplers(plan, &r);
+        return Ok((r, note));
+    }
+    let sub = StudyPlan::new(
+        StudyConfig {
+            brdfs: chosen.clone(),
+            ..plan.config().clone()
+        },
+        Vec::new(),
+    )
+    .map_err(CliError::input)?;
+    let r = sub.render(cfg, progress).map_err(CliError::input)?;
+    let note = format!(
+        "The sphere images show {} of the study's {} materials (the first of each material family, then in order; `study::SHEET_MAX_BRDFS`), left to right: {}.\n\n",
+        chosen.len(),
+        all.len(),
+        chosen
+            .iter()
+            .map(|b| format!("`{}`", study::short_brdf(b)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let note = note + &missing_samplers(plan, &r).unwrap_or_default();
+    Ok((r, Some(note)))
+}
+
+/// The study's samplers that have no sphere image, and why: one sphere row holds several
+/// materials, and a sampler is drawn only when it can be built for every one of them
+/// (`analytic` applies to analytic models only, `rgl-native` to RGL files only).
+fn missing_samplers(plan: &StudyPlan, r: &study::Render) -> Option<String> {
+    let missing: Vec<String> = plan
+        .config()
+        .samplers
+        .iter()
+        .filter(|s| !r.images.iter().any(|i| &i.sampler == *s))
+        .map(|s| format!("`{s}`"))
+        .collect();
+    (!missing.is_empty()).then(|| {
+        format!(
+            "Not in the sphere images: {} — a sampler is drawn only when it can be built for every material of the row (`analytic` applies to analytic models only, `rgl-native` to RGL files only); their numbers are in the tables above.\n\n",
+            missing.join(", ")
+        )
+    })
 }
 
 /// The directory holding `../shared` for the quick study's data: the current directory when
@@ -306,12 +363,20 @@ impl Staging {
 fn write_outputs(
     dir: &Path,
     results: &StudyResults,
-    render: Option<&study::Render>,
+    render: Option<&(study::Render, Option<String>)>,
     tables: Option<&[study::PaperTable]>,
 ) -> CliResult<()> {
     let mut assets = study::ReportAssets::default();
-    if let Some(r) = render {
-        assets.sections.push(write_images(dir, r)?);
+    if let Some((r, note)) = render {
+        let section = write_images(dir, r)?;
+        assets.sections.push(match note {
+            // After the section's heading line.
+            Some(n) => match section.split_once('\n') {
+                Some((head, rest)) => format!("{head}\n\n{n}{rest}"),
+                None => format!("{n}{section}"),
+            },
+            None => section,
+        });
     }
     if let Some(t) = tables {
         assets.sections.push(study::paper_markdown(t));
@@ -320,7 +385,11 @@ fn write_outputs(
         let png = format!("plots/{}.png", p.stem);
         write_atomically(&dir.join(&png), |w| w.write_all(&p.png))?;
         write_text(&dir.join(format!("plots/{}.svg", p.stem)), &p.svg)?;
-        assets.plots.push((p.slug, p.caption, png));
+        if p.slug.is_empty() {
+            assets.summary_plots.push((p.caption, png));
+        } else {
+            assets.plots.push((p.slug, p.caption, png));
+        }
     }
     write_text(&dir.join("results.json"), &results.to_json())?;
     write_text(&dir.join("results.csv"), &results.to_csv())?;
@@ -353,10 +422,18 @@ fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
     }
     let mut sheets = Vec::new();
     for kind in ["equal samples", "equal time"] {
-        let rows: Vec<image::RgbImage> = std::iter::once(&r.reference)
+        let rows: Vec<(String, image::RgbImage)> = std::iter::once(&r.reference)
             .chain(r.images.iter().filter(|i| i.kind == kind))
-            .map(|i| i.to_rgb8(exposure))
+            .map(|i| {
+                let label = if i.kind == "reference" {
+                    format!("reference ({} spp)", i.spp)
+                } else {
+                    format!("{} ({} spp)", i.sampler, i.spp)
+                };
+                (label, i.to_rgb8(exposure))
+            })
             .collect();
+        let columns: Vec<String> = r.brdfs.iter().map(|b| study::short_brdf(b)).collect();
         let order: Vec<String> = r
             .images
             .iter()
@@ -364,7 +441,8 @@ fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
             .map(|i| format!("{} ({} spp)", i.sampler, i.spp))
             .collect();
         let file = format!("images/spheres-{}.png", kind.replace(' ', "-"));
-        let bytes = study::encode_png(&study::stack(&rows), &file).map_err(CliError::input)?;
+        let sheet = study::labelled_sheet(&rows, &columns).map_err(CliError::input)?;
+        let bytes = study::encode_png(&sheet, &file).map_err(CliError::input)?;
         write_atomically(&dir.join(&file), |w| w.write_all(&bytes))?;
         sheets.push((
             format!("{kind}, top to bottom: reference, {}", order.join(", ")),

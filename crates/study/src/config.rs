@@ -53,6 +53,87 @@ pub const MAP_CANDIDATES: [&str; 2] = [
     "shared/data/envmaps/railway_bridge_02_1k.hdr",
 ];
 
+/// Outgoing polar angles of the default study: normal, moderate and grazing incidence.
+pub const FULL_THETA_O_DEG: [f64; 5] = [0.0, 30.0, 60.0, 80.0, 88.0];
+
+/// Directories of shared measured BRDFs (relative to the repository root's parent) with their
+/// reader and file extension: the default study takes **every** file found in them.
+pub const MEASURED_DIRS: [(&str, &str, &str); 3] = [
+    ("rgl", "shared/data/measured/rgl", "bsdf"),
+    ("cornell", "shared/data/measured/cornell", "brdf"),
+    ("merl", "shared/data/merl", "binary"),
+];
+
+/// The MERL-100 fits of the default study (compiled in, no file needed): the two published
+/// fits (SGD, Bagher et al. 2012; ABC, Low et al. 2012) of a glossy metallic paint and of a
+/// near-diffuse fabric. `--all-merl-fits` takes every material of both fits instead
+/// ([`all_merl_fits`]).
+pub const DEFAULT_MERL_FITS: [&str; 4] = [
+    "sgd:material=gold-metallic-paint",
+    "abc:material=gold-metallic-paint",
+    "sgd:material=red-fabric",
+    "abc:material=red-fabric",
+];
+
+/// Every analytic model of the `brdf` registry (models built from numeric parameters, not
+/// from a file or a fitted preset), by name with its default parameters, in registry order.
+pub fn analytic_models() -> Vec<String> {
+    brdf::models()
+        .iter()
+        .filter(|m| !m.needs_argument())
+        .map(|m| m.name.to_string())
+        .collect()
+}
+
+/// Every MERL-100 fit of the registry: `sgd:material=NAME` and `abc:material=NAME` for each
+/// published material (200 specs), SGD first.
+pub fn all_merl_fits() -> Vec<String> {
+    ["sgd", "abc"]
+        .iter()
+        .flat_map(|model| {
+            brdf::preset_names(model)
+                .unwrap_or_default()
+                .into_iter()
+                .map(move |name| format!("{model}:material={name}"))
+        })
+        .collect()
+}
+
+/// Every readable measured file of [`MEASURED_DIRS`] under `root/..` whose spec parses, as
+/// `reader:CANONICAL_PATH`, sorted by reader then file name; notes say which directories are
+/// missing and which files could not be read.
+pub fn shared_measured(root: Option<&std::path::Path>) -> (Vec<String>, Vec<String>) {
+    let mut specs = Vec::new();
+    let mut notes = Vec::new();
+    let Some(root) = root else {
+        notes.push("no shared data directory found: the study has no measured BRDF files".into());
+        return (specs, notes);
+    };
+    for (reader, dir, ext) in MEASURED_DIRS {
+        let path = root.join("..").join(dir);
+        let Ok(entries) = std::fs::read_dir(&path) else {
+            notes.push(format!(
+                "no {reader} directory ({dir}): none of its files is studied"
+            ));
+            continue;
+        };
+        let mut files: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == ext))
+            .map(|p| std::fs::canonicalize(&p).unwrap_or(p))
+            .collect();
+        files.sort();
+        for f in files {
+            let spec = format!("{reader}:{}", f.display());
+            match brdf::parse_spec(&spec) {
+                Ok(_) => specs.push(spec),
+                Err(e) => notes.push(format!("{spec} is not studied: {e}")),
+            }
+        }
+    }
+    (specs, notes)
+}
+
 /// Default repetitions of a batch-mode cell at every N: with `R` near-normal estimates the
 /// MSE's 95 % interval is about `±1.96 √(2/R)`, ±17 % at 256 (±49 % at the 32 of the
 /// one-sample mode's error curves).
@@ -189,6 +270,41 @@ impl StudyConfig {
         c
     }
 
+    /// The default study (no preset flag): every analytic model ([`analytic_models`]), every
+    /// shared measured file ([`shared_measured`]), the [`DEFAULT_MERL_FITS`] (every MERL-100
+    /// fit with `all_merl_fits`), θo ∈ [`FULL_THETA_O_DEG`], under the first real map found
+    /// (the procedural sky when none is, said in the notes); the [`PREFERRED_SAMPLERS`] that
+    /// are registered; the papers' N grid with 32 repetitions (256 in batch mode). Returns the
+    /// config and notes for the report.
+    pub fn full(root: Option<&std::path::Path>, all_merl_fits: bool) -> (Self, Vec<String>) {
+        let mut brdfs = analytic_models();
+        let (measured, mut notes) = shared_measured(root);
+        brdfs.extend(measured);
+        if all_merl_fits {
+            brdfs.extend(self::all_merl_fits());
+        } else {
+            brdfs.extend(DEFAULT_MERL_FITS.iter().map(|s| s.to_string()));
+        }
+        let light = match find_candidate(root, &MAP_CANDIDATES) {
+            Some(p) => format!("envmap:{}", p.display()),
+            None => {
+                notes.push(format!(
+                    "no environment map file found (looked for ../{}); the study uses the built-in procedural sky instead",
+                    MAP_CANDIDATES[0]
+                ));
+                "sky".into()
+            }
+        };
+        let mut c = Self::new(
+            registered_preferred(),
+            brdfs,
+            FULL_THETA_O_DEG.to_vec(),
+            vec![light],
+        );
+        c.preset = "default".into();
+        (c, notes)
+    }
+
     /// Checks the numeric settings (not the names: [`crate::StudyPlan::new`] resolves those).
     pub fn check(&self) -> Result<(), StudyError> {
         if self.n_grid.is_empty()
@@ -317,6 +433,57 @@ mod tests {
             ..ok
         };
         assert!(c.check().is_err());
+    }
+
+    #[test]
+    fn the_default_study_covers_every_material_and_grazing_angles() {
+        let (c, notes) = StudyConfig::full(None, false);
+        assert_eq!(c.preset, "default");
+        assert!(c.check().is_ok());
+        // Every analytic model of the registry, by name.
+        for m in brdf::models().iter().filter(|m| !m.needs_argument()) {
+            assert!(c.brdfs.iter().any(|b| b == m.name), "{} missing", m.name);
+        }
+        assert!(c.brdfs.iter().any(|b| b == "lambert") && c.brdfs.iter().any(|b| b == "ggx"));
+        for f in DEFAULT_MERL_FITS {
+            assert!(c.brdfs.iter().any(|b| b == f), "{f}");
+            assert!(brdf::parse_spec(f).is_ok(), "{f}");
+        }
+        assert_eq!(c.theta_o_deg, [0.0, 30.0, 60.0, 80.0, 88.0]);
+        // Without a data directory: the sky, and notes saying what is missing.
+        assert_eq!(c.lights, ["sky"]);
+        assert!(notes.iter().any(|n| n.contains("measured")), "{notes:?}");
+        let (all, _) = StudyConfig::full(None, true);
+        let fits = all_merl_fits();
+        assert_eq!(fits.len(), 200);
+        assert!(fits.iter().all(|f| all.brdfs.contains(f)));
+        assert!(brdf::parse_spec(&fits[0]).is_ok() && brdf::parse_spec(&fits[199]).is_ok());
+    }
+
+    #[test]
+    fn the_default_study_takes_every_shared_measured_file() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let data = root.join("../shared/data/measured");
+        if !data.is_dir() {
+            eprintln!("skipped: no shared data at {}", data.display());
+            return;
+        }
+        let (specs, _) = shared_measured(Some(&root));
+        for (reader, dir, ext) in MEASURED_DIRS {
+            let Ok(entries) = std::fs::read_dir(root.join("..").join(dir)) else {
+                continue;
+            };
+            let n = entries
+                .filter_map(|e| e.ok())
+                .filter(|e| e.path().extension().is_some_and(|x| x == ext))
+                .count();
+            let got = specs
+                .iter()
+                .filter(|s| s.starts_with(&format!("{reader}:")))
+                .count();
+            assert_eq!(got, n, "{reader}: {specs:?}");
+        }
+        assert!(specs.iter().all(|s| !s.contains("..")), "{specs:?}");
     }
 
     #[test]

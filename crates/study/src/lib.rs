@@ -38,6 +38,7 @@
 // Validation is written `if !(x > 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod answers;
 mod config;
 mod counting;
 pub mod dispersion;
@@ -53,25 +54,33 @@ mod reference;
 mod render;
 mod report;
 mod results;
+mod sheet;
 
 pub use config::{
-    BATCH_REPETITIONS, CellSpec, MAP_CANDIDATES, MEASURED_CANDIDATES, Mode, PAPER_N_GRID,
-    PREFERRED_SAMPLERS, QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
+    BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, FULL_THETA_O_DEG, MAP_CANDIDATES,
+    MEASURED_CANDIDATES, MEASURED_DIRS, Mode, PAPER_N_GRID, PREFERRED_SAMPLERS, QUICK_BRDFS, Shard,
+    StudyConfig, all_merl_fits, analytic_models, registered_preferred, shared_measured,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
 pub use error::StudyError;
-pub use groups::{Group, groups, is_adaptive, short_light};
+pub use groups::{
+    Family, Group, SHEET_MAX_BRDFS, groups, is_adaptive, sheet_brdfs, short_brdf, short_light,
+};
 pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
 pub use machine::{COMMIT, RunInfo};
 pub use paper::{
-    MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS, paper_markdown,
-    paper_tables,
+    Claim, ClaimVerdict, MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS,
+    TIME_MARGIN, paper_markdown, paper_tables,
 };
-pub use plot::{Figure, PLOT_SIZE, PlotFile, Series, group_figures, study_plots};
+pub use plot::{
+    Bar, Figure, Marker, PLOT_SIZE, PlotFile, SamplerStyle, Series, group_figures, sampler_style,
+    study_plots, summary_figures,
+};
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
 pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
+pub use sheet::labelled_sheet;

@@ -204,6 +204,10 @@ fn outcome(s: &mut String, results: &StudyResults) {
             crate::ranking::ALPHA,
         );
         verdicts(s, &results.rankings);
+        s.push_str(&crate::answers::family_answers(
+            &results.rankings,
+            &results.cells,
+        ));
     }
     let flagged: Vec<&CellResult> = results
         .cells
