@@ -165,11 +165,55 @@ mod tests {
             merge(vec![p1.clone(), other]),
             Err(MergeError::ConfigMismatch { .. })
         ));
-        let mut whole = p2;
+        let mut whole = p2.clone();
         whole.1.shard = None;
         assert!(matches!(
             merge(vec![p1, whole]),
             Err(MergeError::NotAShard(_))
         ));
+    }
+
+    #[test]
+    fn a_nan_p_value_gives_the_single_runs_verdict_after_json() {
+        // A NaN p-value is written as `null` in a shard's JSON; the merge must count the same
+        // family (m) and reach the same verdict as the single run over the same records.
+        let (nan, low) = (record(0, f64::NAN), record(2, 0.0023));
+        let others = [record(1, 0.5), record(1, 0.6), record(1, 0.7)];
+        let single = ValidationReport {
+            tests: vec![
+                nan.clone(),
+                others[0].clone(),
+                others[1].clone(),
+                others[2].clone(),
+                low.clone(),
+            ],
+            shard: None,
+            ..part(1, Vec::new()).1
+        }
+        .judged();
+        let through_json = |(name, r): (String, ValidationReport)| {
+            let back: ValidationReport = serde_json::from_str(&r.to_json()).unwrap();
+            (name, back)
+        };
+        let merged = merge(vec![
+            through_json(part(1, vec![nan, low])),
+            through_json(part(2, others.to_vec())),
+        ])
+        .unwrap();
+        assert_eq!(merged.m, single.m);
+        assert_eq!(merged.per_test_level, single.per_test_level);
+        assert_eq!(merged.passed, single.passed);
+        let verdicts = |r: &ValidationReport| {
+            r.tests
+                .iter()
+                .map(|t| (t.case, t.passed))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(verdicts(&merged), verdicts(&single));
+        // The NaN test failed in both, and p = 0.0023 fails at the level of m = 4 (≈ 0.00251)
+        // but would pass at that of m = 5 (≈ 0.00201): the family sizes matter.
+        assert_eq!(single.m, 4);
+        assert!(!single.passed && !single.tests[0].passed);
+        assert!(!single.tests.iter().find(|t| t.case == 2).unwrap().passed);
     }
 }

@@ -62,6 +62,15 @@ impl TestRecord {
         }
     }
 
+    /// A NaN p-value becomes no p-value, the test failed (see [`ValidationReport::judged`]).
+    fn drop_nan_p_value(&mut self) {
+        if self.p_value.is_some_and(f64::is_nan) {
+            self.p_value = None;
+            self.passed = false;
+            self.detail.push_str(" (p-value NaN: the test failed)");
+        }
+    }
+
     /// Re-judges a p-valued record at `level` (deterministic ones keep their verdict).
     pub(crate) fn judge(&mut self, level: f64) {
         if let Some(p) = self.p_value {
@@ -203,7 +212,20 @@ impl ValidationReport {
     /// mutants' controls, every p-value at the Šidák level `1 − (1 − α)^{1/m}`, the mutants'
     /// verdicts, and `passed` (every test passed, every mutant caught with its control
     /// passing, and at least one test ran). A single run and [`crate::merge`] both end here.
+    ///
+    /// A statistical test whose p-value is not finite (NaN) has no p-value: it becomes a failed
+    /// test outside the family (`p_value` `None`, which is also what its JSON `null` reads back
+    /// as), so a merge of the shards' JSON counts the same `m` and gives the same verdict as
+    /// the single run.
     pub(crate) fn judged(mut self) -> Self {
+        self.tests
+            .iter_mut()
+            .chain(
+                self.mutants
+                    .iter_mut()
+                    .flat_map(|m| m.tests.iter_mut().chain(m.control_tests.iter_mut())),
+            )
+            .for_each(TestRecord::drop_nan_p_value);
         self.m = self
             .tests
             .iter()

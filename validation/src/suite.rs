@@ -889,4 +889,30 @@ mod tests {
         );
         assert!(!assembled(Vec::new(), Vec::new()).passed());
     }
+
+    #[test]
+    fn uniform_on_lambert_at_the_minimum_count_gets_a_chi_square() {
+        // `validate --sampler uniform --brdf lambert --samples 2000` (the full tier): the
+        // 24 × 48 bins expected 1.7 samples each, all pooled into one cell — no statistic.
+        let config = ValidateConfig {
+            samplers: vec!["uniform".into()],
+            brdfs: vec!["lambert".into()],
+            theta_o: vec![30.0],
+            samples: Some(crate::MIN_SAMPLES),
+            ..ValidateConfig::full()
+        };
+        let report = run(&config, &|_| {}).expect("valid config");
+        let chi: Vec<_> = report
+            .tests
+            .iter()
+            .filter(|t| t.test == names::CHI_SQUARE)
+            .collect();
+        assert_eq!(chi.len(), 1);
+        assert!(
+            chi[0].statistic.is_finite() && chi[0].p_value.is_some_and(|p| p > 0.0),
+            "{:?}",
+            chi[0]
+        );
+        assert!(report.passed(), "{}", report.to_markdown());
+    }
 }
