@@ -107,6 +107,16 @@ pub struct MutantRecord {
     pub control_tests: Vec<TestRecord>,
 }
 
+/// A warning of a sampler's build (its `build_report`'s `warning: …` lines, e.g. `srbf`
+/// slice fits stopped at the iteration cap unconverged).
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct BuildWarning {
+    /// The first case (in the plan's order) of the build.
+    pub case: usize,
+    /// `sampler NAME on SPEC: …`.
+    pub message: String,
+}
+
 /// What a shard's report (`validate --shard K/N --json`) says about the run it is part of.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ShardInfo {
@@ -147,6 +157,9 @@ pub struct ValidationReport {
     pub m: usize,
     /// Šidák per-test level `1 − (1 − α)^{1/m}`.
     pub per_test_level: f64,
+    /// Warnings of the samplers' builds, in case order (absent from the JSON when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<BuildWarning>,
     /// Set in a shard's report only (absent from a whole run's and a merged report's JSON).
     /// A shard's `passed`, `m` and `per_test_level` cover its own tests only: the run's
     /// verdict is the merge's ([`crate::merge`]).
@@ -218,6 +231,9 @@ impl ValidationReport {
     /// as), so a merge of the shards' JSON counts the same `m` and gives the same verdict as
     /// the single run.
     pub(crate) fn judged(mut self) -> Self {
+        // Several shards may build the same sampler: one warning per build.
+        self.warnings.sort();
+        self.warnings.dedup();
         self.tests
             .iter_mut()
             .chain(
@@ -317,6 +333,13 @@ impl ValidationReport {
             self.batches[0],
             self.batches[1]
         );
+        if !self.warnings.is_empty() {
+            let _ = writeln!(s, "## Build warnings\n");
+            for w in &self.warnings {
+                let _ = writeln!(s, "- {}", w.message);
+            }
+            let _ = writeln!(s);
+        }
         let _ = writeln!(s, "## Tests\n");
         table(&mut s, &self.tests);
         if !self.mutants.is_empty() {
