@@ -57,6 +57,34 @@ pub struct Resolution {
 }
 
 impl Resolution {
+    /// This resolution coarsened for `samples` draws: each domain's bin counts are halved
+    /// (both axes, rounding up, at least 1) until its cells (the sphere's, for the direction bins) number at most
+    /// `samples / DEFAULT_MIN_EXPECTED`, so a density spread evenly over the domain expects at
+    /// least [`stats::DEFAULT_MIN_EXPECTED`] samples per cell. Without it a small `--samples`
+    /// on the full tier's 24 × 48 hemisphere bins left every cell of a uniform sampler below
+    /// the χ² pooling threshold: one pooled cell, no statistic. The tiers' own sample counts
+    /// keep their resolutions.
+    pub fn for_samples(self, samples: usize) -> Self {
+        let max_cells = ((samples as f64 / stats::DEFAULT_MIN_EXPECTED) as usize).max(1);
+        let halve = |n: usize| n.div_ceil(2).max(1);
+        // `cells(d)`: the domain's cell count for bins `d` (the sphere doubles the cos θ bins).
+        let fit2 = |mut d: [usize; 2], cells: fn([usize; 2]) -> usize| {
+            while cells(d) > max_cells && (d[0] > 1 || d[1] > 1) {
+                d = [halve(d[0]), halve(d[1])];
+            }
+            d
+        };
+        let mut disc = self.disc;
+        while disc * disc > max_cells && disc > 1 {
+            disc = halve(disc);
+        }
+        Self {
+            directions: fit2(self.directions, |d| 2 * d[0] * d[1]),
+            disc,
+            square: fit2(self.square, |d| d[0] * d[1]),
+        }
+    }
+
     /// The direction binning of `domain` (`None` for planar domains).
     ///
     /// # Errors

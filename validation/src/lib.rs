@@ -72,7 +72,7 @@ pub use plan::{
     MIN_SAMPLES, PRESET_THETA_O, Plan, QUICK_BRDFS, QUICK_CORNELL, QUICK_RGL, QUICK_SAMPLES,
     QUICK_THETA_O, Shard, Tier, ValidateConfig,
 };
-pub use report::{MutantRecord, ShardInfo, TestRecord, ValidationReport};
+pub use report::{BuildWarning, MutantRecord, ShardInfo, TestRecord, ValidationReport};
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };

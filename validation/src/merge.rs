@@ -66,9 +66,11 @@ pub fn merge(parts: Vec<(String, ValidationReport)>) -> Result<ValidationReport,
     let mut header = parts[0].1.clone();
     let mut tests = Vec::new();
     let mut mutants = Vec::new();
+    let mut warnings = Vec::new();
     for (_, p) in parts {
         tests.extend(p.tests);
         mutants.extend(p.mutants);
+        warnings.extend(p.warnings);
     }
     // Each case lies in one shard: a stable sort by case restores the single run's order.
     tests.sort_by_key(|t| t.case);
@@ -86,6 +88,7 @@ pub fn merge(parts: Vec<(String, ValidationReport)>) -> Result<ValidationReport,
     }
     header.tests = tests;
     header.mutants = mutants;
+    header.warnings = warnings;
     header.shard = None;
     Ok(header.judged())
 }
@@ -117,6 +120,7 @@ mod tests {
             batches: [50, 256],
             m: 0,
             per_test_level: 0.0,
+            warnings: Vec::new(),
             shard: Some(ShardInfo {
                 index,
                 count: 2,
@@ -165,11 +169,73 @@ mod tests {
             merge(vec![p1.clone(), other]),
             Err(MergeError::ConfigMismatch { .. })
         ));
-        let mut whole = p2;
+        let mut whole = p2.clone();
         whole.1.shard = None;
         assert!(matches!(
             merge(vec![p1, whole]),
             Err(MergeError::NotAShard(_))
         ));
+    }
+
+    #[test]
+    fn a_nan_p_value_gives_the_single_runs_verdict_after_json() {
+        // A NaN p-value is written as `null` in a shard's JSON; the merge must count the same
+        // family (m) and reach the same verdict as the single run over the same records.
+        let (nan, low) = (record(0, f64::NAN), record(2, 0.0023));
+        let others = [record(1, 0.5), record(1, 0.6), record(1, 0.7)];
+        let single = ValidationReport {
+            tests: vec![
+                nan.clone(),
+                others[0].clone(),
+                others[1].clone(),
+                others[2].clone(),
+                low.clone(),
+            ],
+            shard: None,
+            ..part(1, Vec::new()).1
+        }
+        .judged();
+        let through_json = |(name, r): (String, ValidationReport)| {
+            let back: ValidationReport = serde_json::from_str(&r.to_json()).unwrap();
+            (name, back)
+        };
+        let warn = |case| crate::report::BuildWarning {
+            case,
+            message: "sampler srbf on phong: 1 of 2 BRDF slice fits hit the iteration cap".into(),
+        };
+        let with_warnings = |(name, mut r): (String, ValidationReport), w: Vec<_>| {
+            r.warnings = w;
+            (name, r)
+        };
+        let single = ValidationReport {
+            warnings: vec![warn(0), warn(1)],
+            ..single
+        }
+        .judged();
+        // Both shards built the sampler of case 1's job: the merge keeps one warning.
+        let merged = merge(vec![
+            through_json(with_warnings(
+                part(1, vec![nan, low]),
+                vec![warn(1), warn(0)],
+            )),
+            through_json(with_warnings(part(2, others.to_vec()), vec![warn(1)])),
+        ])
+        .unwrap();
+        assert_eq!(merged.m, single.m);
+        assert_eq!(merged.warnings, single.warnings);
+        assert_eq!(merged.per_test_level, single.per_test_level);
+        assert_eq!(merged.passed, single.passed);
+        let verdicts = |r: &ValidationReport| {
+            r.tests
+                .iter()
+                .map(|t| (t.case, t.passed))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(verdicts(&merged), verdicts(&single));
+        // The NaN test failed in both, and p = 0.0023 fails at the level of m = 4 (≈ 0.00251)
+        // but would pass at that of m = 5 (≈ 0.00201): the family sizes matter.
+        assert_eq!(single.m, 4);
+        assert!(!single.passed && !single.tests[0].passed);
+        assert!(!single.tests.iter().find(|t| t.case == 2).unwrap().passed);
     }
 }

@@ -217,7 +217,7 @@ impl Plan {
             samples,
             batch_size,
             batches: (samples / (2 * batch_size)).max(50),
-            resolution,
+            resolution: resolution.for_samples(samples),
             quadrature: QuadratureOptions::default(),
             normalisation_tolerance,
             pdf_rel_tol: 1e-6,
@@ -252,5 +252,29 @@ mod tests {
         for i in 0..20 {
             assert_eq!(shards.iter().filter(|s| s.contains(i)).count(), 1);
         }
+    }
+
+    #[test]
+    fn small_sample_counts_get_coarser_bins() {
+        // The tiers' own counts keep their resolutions.
+        for tier in [Tier::Quick, Tier::Full] {
+            let p = Plan::new(tier, Plan::default_samples(tier));
+            let base = match tier {
+                Tier::Quick => [16, 32],
+                Tier::Full => [24, 48],
+            };
+            assert_eq!(p.resolution.directions, base);
+        }
+        // MIN_SAMPLES on the full tier: the sphere's cells expect ≥ 5 samples of an even
+        // density (24 × 48 hemisphere bins would expect 1.7 each: one pooled χ² cell).
+        let p = Plan::new(Tier::Full, MIN_SAMPLES);
+        let [nc, np] = p.resolution.directions;
+        assert!(
+            2 * nc * np <= MIN_SAMPLES / 5 && nc * np >= 16,
+            "{:?}",
+            p.resolution
+        );
+        assert!(p.resolution.disc.pow(2) <= MIN_SAMPLES / 5);
+        assert!(p.resolution.square[0] * p.resolution.square[1] <= MIN_SAMPLES / 5);
     }
 }

@@ -62,6 +62,15 @@ impl TestRecord {
         }
     }
 
+    /// A NaN p-value becomes no p-value, the test failed (see [`ValidationReport::judged`]).
+    fn drop_nan_p_value(&mut self) {
+        if self.p_value.is_some_and(f64::is_nan) {
+            self.p_value = None;
+            self.passed = false;
+            self.detail.push_str(" (p-value NaN: the test failed)");
+        }
+    }
+
     /// Re-judges a p-valued record at `level` (deterministic ones keep their verdict).
     pub(crate) fn judge(&mut self, level: f64) {
         if let Some(p) = self.p_value {
@@ -96,6 +105,16 @@ pub struct MutantRecord {
     pub tests: Vec<TestRecord>,
     /// The control's tests.
     pub control_tests: Vec<TestRecord>,
+}
+
+/// A warning of a sampler's build (its `build_report`'s `warning: …` lines, e.g. `srbf`
+/// slice fits stopped at the iteration cap unconverged).
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct BuildWarning {
+    /// The first case (in the plan's order) of the build.
+    pub case: usize,
+    /// `sampler NAME on SPEC: …`.
+    pub message: String,
 }
 
 /// What a shard's report (`validate --shard K/N --json`) says about the run it is part of.
@@ -138,6 +157,9 @@ pub struct ValidationReport {
     pub m: usize,
     /// Šidák per-test level `1 − (1 − α)^{1/m}`.
     pub per_test_level: f64,
+    /// Warnings of the samplers' builds, in case order (absent from the JSON when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<BuildWarning>,
     /// Set in a shard's report only (absent from a whole run's and a merged report's JSON).
     /// A shard's `passed`, `m` and `per_test_level` cover its own tests only: the run's
     /// verdict is the merge's ([`crate::merge`]).
@@ -203,7 +225,23 @@ impl ValidationReport {
     /// mutants' controls, every p-value at the Šidák level `1 − (1 − α)^{1/m}`, the mutants'
     /// verdicts, and `passed` (every test passed, every mutant caught with its control
     /// passing, and at least one test ran). A single run and [`crate::merge`] both end here.
+    ///
+    /// A statistical test whose p-value is not finite (NaN) has no p-value: it becomes a failed
+    /// test outside the family (`p_value` `None`, which is also what its JSON `null` reads back
+    /// as), so a merge of the shards' JSON counts the same `m` and gives the same verdict as
+    /// the single run.
     pub(crate) fn judged(mut self) -> Self {
+        // Several shards may build the same sampler: one warning per build.
+        self.warnings.sort();
+        self.warnings.dedup();
+        self.tests
+            .iter_mut()
+            .chain(
+                self.mutants
+                    .iter_mut()
+                    .flat_map(|m| m.tests.iter_mut().chain(m.control_tests.iter_mut())),
+            )
+            .for_each(TestRecord::drop_nan_p_value);
         self.m = self
             .tests
             .iter()
@@ -295,6 +333,13 @@ impl ValidationReport {
             self.batches[0],
             self.batches[1]
         );
+        if !self.warnings.is_empty() {
+            let _ = writeln!(s, "## Build warnings\n");
+            for w in &self.warnings {
+                let _ = writeln!(s, "- {}", w.message);
+            }
+            let _ = writeln!(s);
+        }
         let _ = writeln!(s, "## Tests\n");
         table(&mut s, &self.tests);
         if !self.mutants.is_empty() {

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use brdf::{Brdf, Vec3, direction_from_angles};
@@ -25,7 +26,7 @@ use crate::plan::{
     QUICK_BRDFS, QUICK_THETA_O, Shard, Tier, ValidateConfig,
 };
 use crate::references::{albedo_reference, lit_reference};
-use crate::report::{MutantRecord, ShardInfo, TestRecord, ValidationReport};
+use crate::report::{BuildWarning, MutantRecord, ShardInfo, TestRecord, ValidationReport};
 use crate::seeding::{case_seed, label_hash};
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
@@ -257,6 +258,7 @@ fn run_brdf_job(
     seed: u64,
     cases: Cases<'_>,
     on_done: &(dyn Fn(&CaseResult) + Sync),
+    warnings: &Mutex<Vec<BuildWarning>>,
 ) -> Vec<CaseResult> {
     let (spec, brdf) = &r.brdfs[bi];
     // Nothing of this job in the shard: not built.
@@ -274,6 +276,16 @@ fn run_brdf_job(
             .map(|s| (s, domain))
             .map_err(|e| e.to_string())
     });
+    if let Some(Ok((sampler, _))) = &built
+        && let Ok(mut all) = warnings.lock()
+    {
+        all.extend(build_warnings(
+            entry.name,
+            spec,
+            cases.base,
+            sampler.build_report(),
+        ));
+    }
     let subject_at = |wo: Vec3, refs: &BrdfReferences| match &built {
         Some(b) => {
             let (sampler, domain) = b.as_ref().map_err(Clone::clone)?;
@@ -287,6 +299,25 @@ fn run_brdf_job(
         ))),
     };
     run_angles(entry.name, spec, r, refs, seed, cases, on_done, &subject_at)
+}
+
+/// The `warning: …` lines of a build report, as the report's build warnings of the job whose
+/// first case is `case`.
+fn build_warnings(
+    sampler: &str,
+    spec: &str,
+    case: usize,
+    report: Option<String>,
+) -> Vec<BuildWarning> {
+    report
+        .iter()
+        .flat_map(|r| r.lines())
+        .filter_map(|l| l.strip_prefix("warning: "))
+        .map(|w| BuildWarning {
+            case,
+            message: format!("sampler {sampler} on {spec}: {w}"),
+        })
+        .collect()
 }
 
 /// The first case index of a job and the shard's selection of case indices.
@@ -604,15 +635,23 @@ pub fn run_shard(
             outcomes: vec![error_outcome(names::BUILD, e)],
         })
         .collect();
+    let warnings: Mutex<Vec<BuildWarning>> = Mutex::new(Vec::new());
     let results: Vec<Vec<CaseResult>> = jobs
         .par_iter()
         .zip(&bases)
         .map(|(job, &base)| {
             let cases = Cases { base, keep: &keep };
             match job {
-                Job::Brdf { entry, brdf } => {
-                    run_brdf_job(entry, &r, *brdf, &refs[*brdf], seed, cases, &on_done)
-                }
+                Job::Brdf { entry, brdf } => run_brdf_job(
+                    entry,
+                    &r,
+                    *brdf,
+                    &refs[*brdf],
+                    seed,
+                    cases,
+                    &on_done,
+                    &warnings,
+                ),
                 Job::Standalone { .. } if !keep(base) => Vec::new(),
                 Job::Standalone { entry, case } => {
                     let c = CaseResult {
@@ -723,6 +762,7 @@ pub fn run_shard(
             .chain(results.into_iter().flatten())
             .collect(),
         mutant_results,
+        warnings.into_inner().unwrap_or_default(),
         shard_info,
     ))
 }
@@ -755,6 +795,7 @@ fn assemble(
     plan: &Plan,
     cases: Vec<CaseResult>,
     mutant_results: Vec<MutantCase>,
+    warnings: Vec<BuildWarning>,
     shard: Option<ShardInfo>,
 ) -> ValidationReport {
     let mutants: Vec<MutantRecord> = mutant_results
@@ -785,6 +826,7 @@ fn assemble(
         batches: [plan.batches, plan.batch_size],
         m: 0,
         per_test_level: 0.0,
+        warnings,
         shard,
     }
     .judged()
@@ -820,7 +862,14 @@ mod tests {
             .zip(mutants())
             .map(|((mc, cc), m)| (m, mc, cc))
             .collect();
-        assemble(&config, &Plan::new(Tier::Quick, 1000), cases, pairs, None)
+        assemble(
+            &config,
+            &Plan::new(Tier::Quick, 1000),
+            cases,
+            pairs,
+            Vec::new(),
+            None,
+        )
     }
 
     #[test]
@@ -888,5 +937,66 @@ mod tests {
             r.to_markdown()
         );
         assert!(!assembled(Vec::new(), Vec::new()).passed());
+    }
+
+    #[test]
+    fn uniform_on_lambert_at_the_minimum_count_gets_a_chi_square() {
+        // `validate --sampler uniform --brdf lambert --samples 2000` (the full tier): the
+        // 24 × 48 bins expected 1.7 samples each, all pooled into one cell — no statistic.
+        let config = ValidateConfig {
+            samplers: vec!["uniform".into()],
+            brdfs: vec!["lambert".into()],
+            theta_o: vec![30.0],
+            samples: Some(crate::MIN_SAMPLES),
+            ..ValidateConfig::full()
+        };
+        let report = run(&config, &|_| {}).expect("valid config");
+        let chi: Vec<_> = report
+            .tests
+            .iter()
+            .filter(|t| t.test == names::CHI_SQUARE)
+            .collect();
+        assert_eq!(chi.len(), 1);
+        assert!(
+            chi[0].statistic.is_finite() && chi[0].p_value.is_some_and(|p| p > 0.0),
+            "{:?}",
+            chi[0]
+        );
+        assert!(report.passed(), "{}", report.to_markdown());
+    }
+
+    #[test]
+    fn build_warnings_reach_the_report_and_its_markdown() {
+        let report = Some(
+            "srbf       2 slices\nwarning: 2 of 2 BRDF slice fits hit the iteration cap\nmore"
+                .into(),
+        );
+        let w = build_warnings("srbf", "phong", 3, report);
+        assert_eq!(
+            w,
+            [BuildWarning {
+                case: 3,
+                message: "sampler srbf on phong: 2 of 2 BRDF slice fits hit the iteration cap"
+                    .into()
+            }]
+        );
+        assert!(build_warnings("srbf", "phong", 3, None).is_empty());
+        let config = ValidateConfig::quick();
+        let r = assemble(
+            &config,
+            &Plan::new(Tier::Quick, 1000),
+            vec![case("a", vec![p("x", 0.5)])],
+            Vec::new(),
+            [w.clone(), w.clone()].concat(),
+            None,
+        );
+        // One warning per build, in the markdown and the JSON.
+        assert_eq!(r.warnings, w);
+        assert!(
+            r.to_markdown()
+                .contains("## Build warnings\n\n- sampler srbf on phong: 2 of 2")
+        );
+        let back: ValidationReport = serde_json::from_str(&r.to_json()).unwrap();
+        assert_eq!(back.warnings, w);
     }
 }

@@ -102,6 +102,19 @@ fn check(
                 );
                 continue;
             }
+            // A single-technique estimate flagged heavy-tailed (one sample holds most of the
+            // variance estimate: a rare sun hit) has no usable standard error either. Measured
+            // 2026-11-26: brdf:srbf on the phong scene at normal +z, twelve seeds of 20 000
+            // samples, 0.38–1.08 against 0.758, every run but one flagged (the unflagged one
+            // hit the sun not at all, ±0.001).
+            if single && e.heavy_tailed {
+                eprintln!(
+                    "{} normal {normal:?}: {} z = {zz:.2} (heavy-tailed: not tested)",
+                    brdf.name(),
+                    e.estimator
+                );
+                continue;
+            }
             if zz.is_nan() || zz.abs() >= 4.0 {
                 failures.push(format!(
                     "{} normal {normal:?}: {} = {:.6e} ± {:.2e} vs reference {:.6e} ± {:.2e} (z = {zz:.2})",

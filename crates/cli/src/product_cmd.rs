@@ -226,15 +226,12 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
     let brdf_fit = SrbfSampler::build(brdf.as_ref(), &srbf_options).map_err(CliError::input)?;
     let map_fit = fit_envmap(&map, &srbf_options).map_err(CliError::input)?;
     let br = brdf_fit.report();
-    if br.not_converged > 0 {
-        eprintln!(
-            "brdf-lab: warning: {} of {} BRDF slice fits hit the L-BFGS cap (--srbf-max-iter); largest residual (rel. L2) {:.3e}",
-            br.not_converged, br.slices, br.max_rel_l2
-        );
+    if let Some(w) = br.lbfgs_cap_warning() {
+        eprintln!("brdf-lab: warning: {w}");
     }
     if !map_fit.report.converged {
         eprintln!(
-            "brdf-lab: warning: the map fit hit the L-BFGS cap; residual (rel. L2) {:.3e}",
+            "brdf-lab: warning: the map fit hit the L-BFGS cap (--srbf-max-iter); residual (rel. L2) {:.3e}",
             map_fit.report.rel_l2
         );
     }

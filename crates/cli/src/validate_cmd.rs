@@ -142,6 +142,9 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
     write_outputs(&report, args.json.as_deref(), args.report.as_deref())?;
     if let Some(info) = &report.shard {
         // A shard's verdict is the merge's: its tests are judged with the others'.
+        for w in &report.warnings {
+            eprintln!("brdf-lab: warning: {}", w.message);
+        }
         println!(
             "shard      {}/{}: {} of the plan's {}, {}; judge them with `brdf-lab validate merge`",
             info.index,
@@ -202,6 +205,9 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
 /// Prints the summary of a whole (or merged) run and returns its exit status: 0 passed,
 /// 1 a test failed (or a mutant escaped), 3 no test ran.
 fn verdict(report: &ValidationReport) -> CliResult<()> {
+    for w in &report.warnings {
+        eprintln!("brdf-lab: warning: {}", w.message);
+    }
     let failed: Vec<_> = report.tests.iter().filter(|t| !t.passed).collect();
     let skipped: Vec<_> = report.skipped().collect();
     let run = report.tests_run();

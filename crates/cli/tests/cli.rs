@@ -1221,7 +1221,7 @@ fn srbf_fits_at_the_iteration_cap_are_warned_about_everywhere() {
         "--srbf-max-iter",
         "1",
     ];
-    let warning = "brdf-lab: warning: --sampler srbf: 2 of 2 BRDF slice fits hit the L-BFGS cap";
+    let warning = "brdf-lab: warning: --sampler srbf: 2 of 2 BRDF slice fits hit the iteration cap";
     let runs: [Vec<&str>; 3] = [
         vec!["build", "--brdf", "phong:n=200"],
         vec![

@@ -27,7 +27,9 @@ pub struct SrbfOptions {
     pub map_lambda: (f64, f64),
     /// Width of the box-filtered copy of the map that is fitted (height = width / 2).
     pub map_fit_width: usize,
-    /// L-BFGS iteration cap per fit.
+    /// Iteration cap per fit: Levenberg–Marquardt trial steps of each BRDF slice, L-BFGS
+    /// iterations of the map. A safety net: the fits stop at their convergence tests (the 32
+    /// slices of `phong:n=50` need 38–1337 steps; docs/benchmarks.md).
     pub max_iter: usize,
     /// Product lobes kept (largest masses) by the product estimator.
     pub product_lobes: usize,
@@ -50,7 +52,7 @@ impl Default for SrbfOptions {
             map_lobes: 64,
             map_lambda: (0.5, 5e3),
             map_fit_width: 128,
-            max_iter: 150,
+            max_iter: 2000,
             product_lobes: 32,
             defensive: 0.2,
         }

@@ -12,7 +12,7 @@ use envmap::EnvMap;
 use envmap::latlong::{sin_integral, uv_to_direction};
 
 use super::SrbfError;
-use super::fit::{FitReport, FitTarget, fit};
+use super::fit::{FitReport, FitTarget, fit_lbfgs};
 use super::vmf::SgLobe;
 use crate::SrbfOptions;
 
@@ -64,11 +64,12 @@ pub fn envmap_target(map: &EnvMap, fit_width: usize) -> Result<FitTarget, SrbfEr
     Ok(FitTarget::new(dirs, area, values)?.with_spacing(std::f64::consts::PI / ch as f64))
 }
 
-/// Fits `options.map_lobes` SRBFs to `map`'s luminance (options checked first).
+/// Fits `options.map_lobes` SRBFs to `map`'s luminance (options checked first; L-BFGS
+/// refinement, [`super::fit::fit_lbfgs`]).
 pub fn fit_envmap(map: &EnvMap, options: &SrbfOptions) -> Result<EnvSrbf, SrbfError> {
     options.validate()?;
     let target = envmap_target(map, options.map_fit_width)?;
-    let f = fit(&target, &options.map_settings())?;
+    let f = fit_lbfgs(&target, &options.map_settings())?;
     Ok(EnvSrbf {
         lobes: f.lobes,
         report: f.report,

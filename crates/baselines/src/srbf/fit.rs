@@ -9,10 +9,15 @@
 //!    concentration), then greedily a lobe at the residual's peak, `λ = ln 2 / (1 − cos α½)` from the
 //!    nearest sample below half the peak, `c` by 1D non-negative least squares, subtract, repeat;
 //!    then all `c_k` jointly by NNLS (projected coordinate descent on the normal equations).
-//! 2. Joint refinement with L-BFGS ([`super::lbfgs`]) in bound-free parameters: `c = e^a`,
-//!    `λ = λ_min + (λ_max − λ_min)·σ(b)`, `ξ = v/‖v‖` (`v ∈ ℝ³`), on `E / Σ A_i f_i²`. The analytic
-//!    gradient (§C.2) is chained through the reparametrisation; a test checks it against finite
-//!    differences.
+//! 2. Joint refinement of every parameter: [`fit`] (BRDF slices) by bound-constrained
+//!    Levenberg–Marquardt on the weighted residuals ([`super::lm`]), stopped by a scale-free
+//!    test; [`fit_lbfgs`] (the map) by L-BFGS ([`super::lbfgs`]) in bound-free parameters:
+//!    `c = e^a`, `λ = λ_min + (λ_max − λ_min)·σ(b)`, `ξ = v/‖v‖` (`v ∈ ℝ³`), on
+//!    `E / Σ A_i f_i²`, the analytic gradient (§C.2) chained through the reparametrisation (a
+//!    test checks it against finite differences). L-BFGS crawled on the slices: near-duplicate
+//!    lobes make the problem ill-conditioned, and the README's `phong:n=50` slices were still
+//!    improving after 3000 iterations; Levenberg–Marquardt reaches a lower error than that
+//!    within 50 (docs/benchmarks.md).
 
 use std::time::Instant;
 
@@ -86,6 +91,21 @@ impl FitTarget {
         self.spacing.map(|d| 4.0 / (d * d))
     }
 
+    /// The sample directions.
+    pub(crate) fn directions(&self) -> &[Vec3] {
+        &self.directions
+    }
+
+    /// The solid-angle weights `A_i`.
+    pub(crate) fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// The values `f_i`.
+    pub(crate) fn values(&self) -> &[f64] {
+        &self.values
+    }
+
     /// Number of sample directions.
     pub fn len(&self) -> usize {
         self.values.len()
@@ -129,7 +149,7 @@ pub struct FitSettings {
     pub lambda_min: f64,
     /// Upper bandwidth bound `λ_max > λ_min`.
     pub lambda_max: f64,
-    /// L-BFGS iteration cap.
+    /// Iteration cap of the refinement (Levenberg–Marquardt trial steps, or L-BFGS iterations).
     pub max_iter: usize,
 }
 
@@ -162,12 +182,12 @@ pub struct FitReport {
     pub rel_l2: f64,
     /// Relative L1 error `Σ A |r| / Σ A f`.
     pub rel_l1: f64,
-    /// Relative L2 error of the greedy initial guess (before L-BFGS).
+    /// Relative L2 error of the greedy initial guess (before the refinement).
     pub initial_rel_l2: f64,
-    /// L-BFGS iterations.
+    /// Refinement iterations.
     pub iterations: usize,
-    /// Whether L-BFGS met a stopping test before its iteration cap; if not, `rel_l2` is the
-    /// residual it reached.
+    /// Whether the refinement met its stopping test before the iteration cap; if not,
+    /// `rel_l2` is the residual it reached.
     pub converged: bool,
     /// Wall time of the fit in seconds.
     pub seconds: f64,
@@ -182,8 +202,31 @@ pub struct SrbfFit {
     pub report: FitReport,
 }
 
-/// Fits `settings.lobes` non-negative Gaussian SRBFs to `target` (greedy guess, NNLS, L-BFGS).
+/// Fits `settings.lobes` non-negative Gaussian SRBFs to `target`: greedy guess, NNLS, then
+/// the joint bound-constrained Levenberg–Marquardt refinement of [`super::lm`] (scale-free
+/// convergence test; what the BRDF slices use).
 pub fn fit(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfError> {
+    fit_with(target, settings, Refiner::LevenbergMarquardt)
+}
+
+/// [`fit`] with the bound-free L-BFGS refinement instead (the environment map's fit: its 64
+/// lobes make the Levenberg–Marquardt normal equations 256 × 256, measured 30× slower there
+/// for no better product sampling; docs/benchmarks.md).
+pub fn fit_lbfgs(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfError> {
+    fit_with(target, settings, Refiner::Lbfgs)
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Refiner {
+    LevenbergMarquardt,
+    Lbfgs,
+}
+
+fn fit_with(
+    target: &FitTarget,
+    settings: &FitSettings,
+    refiner: Refiner,
+) -> Result<SrbfFit, SrbfError> {
     settings.validate("fit")?;
     let mut settings = *settings;
     if let Some(cap) = target.lambda_cap() {
@@ -195,26 +238,40 @@ pub fn fit(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfEr
     nnls_amplitudes(target, &mut lobes);
     lobes.retain(|l| l.amplitude > 0.0);
     let initial_rel_l2 = target.errors(&lobes).0;
-    let problem = Problem {
-        target,
-        lambda_min: settings.lambda_min,
-        lambda_max: settings.lambda_max,
-    };
-    let x0 = problem.encode(&lobes);
     let (mut iterations, mut converged) = (0, true);
     if !lobes.is_empty() && settings.max_iter > 0 {
-        let min = minimise(
-            |x, g| problem.objective(x, Some(g)),
-            x0,
-            Stop {
-                max_iter: settings.max_iter,
-                grad_tol: 1e-9,
-                rel_tol: 1e-9,
-            },
-        );
-        iterations = min.iterations;
-        converged = min.converged;
-        let refined = problem.decode(&min.x);
+        let (refined, its, conv) = match refiner {
+            Refiner::LevenbergMarquardt => {
+                let r = super::lm::refine(
+                    target,
+                    &lobes,
+                    settings.lambda_min,
+                    settings.lambda_max,
+                    settings.max_iter,
+                    super::lm::GN_TOL,
+                );
+                (r.lobes, r.iterations, r.converged)
+            }
+            Refiner::Lbfgs => {
+                let problem = Problem {
+                    target,
+                    lambda_min: settings.lambda_min,
+                    lambda_max: settings.lambda_max,
+                };
+                let min = minimise(
+                    |x, g| problem.objective(x, Some(g)),
+                    problem.encode(&lobes),
+                    Stop {
+                        max_iter: settings.max_iter,
+                        grad_tol: 1e-9,
+                        rel_tol: 1e-9,
+                    },
+                );
+                (problem.decode(&min.x), min.iterations, min.converged)
+            }
+        };
+        iterations = its;
+        converged = conv;
         if target.errors(&refined).0 <= initial_rel_l2 {
             lobes = refined;
         }

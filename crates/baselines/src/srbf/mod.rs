@@ -3,7 +3,8 @@
 //! sampling (baselines.md §C, §D).
 //!
 //! * [`vmf`] — the closed forms (SG integral and product) and the stable vMF sampler.
-//! * [`fit`] — non-negative SRBF fitting: greedy guess, NNLS, bound-free L-BFGS.
+//! * [`fit`] — non-negative SRBF fitting: greedy guess, NNLS, then Levenberg–Marquardt (BRDF
+//!   slices) or bound-free L-BFGS (the map).
 //! * [`sampler`] — [`SrbfSampler`], the BRDF-only mixture sampler (pdf w.r.t. solid angle on
 //!   the whole sphere).
 //! * [`envfit`] — the fit of an environment map's luminance.
@@ -42,13 +43,14 @@ pub mod envfit;
 mod error;
 pub mod fit;
 mod lbfgs;
+mod lm;
 pub mod product;
 pub mod sampler;
 pub mod vmf;
 
 pub use envfit::{EnvSrbf, fit_envmap};
 pub use error::SrbfError;
-pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit};
+pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit, fit_lbfgs};
 pub use product::{
     Estimate, LocalFrame, MisHeuristic, ProductScene, ProductSettings, ProductStats, estimate_brdf,
     estimate_light, estimate_mis, estimate_srbf_product, quadrature_reference,

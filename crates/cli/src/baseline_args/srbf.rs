@@ -31,7 +31,7 @@ pub(crate) struct SrbfArgs {
     /// (0 = the SRBF mixture alone).
     #[arg(long = "srbf-brdf-defensive", default_value_t = SrbfOptions::default().brdf_defensive, allow_hyphen_values = true)]
     pub(crate) srbf_brdf_defensive: f64,
-    /// srbf: L-BFGS iteration cap per fit (a fit that reaches it is warned about).
+    /// srbf: iteration cap per fit (Levenberg–Marquardt steps per BRDF slice, L-BFGS iterations of the map; a fit that reaches it unconverged is warned about).
     #[arg(long = "srbf-max-iter", default_value_t = SrbfOptions::default().max_iter, allow_negative_numbers = true)]
     pub(crate) srbf_max_iter: usize,
 }
@@ -100,7 +100,7 @@ impl SrbfArgs {
     pub(crate) fn options(&self, product: Option<&SrbfProductArgs>) -> CliResult<SrbfOptions> {
         if self.srbf_max_iter == 0 {
             return Err(CliError::input(
-                "--srbf-max-iter 0: the L-BFGS iteration cap must be at least 1",
+                "--srbf-max-iter 0: the fit iteration cap must be at least 1",
             ));
         }
         let defaults = SrbfProductArgs::default();
