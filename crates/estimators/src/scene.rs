@@ -42,6 +42,15 @@ impl LocalFrame {
         })
     }
 
+    /// The world frame itself (`t = x`, `b = y`, `n = z`): local and world directions agree.
+    pub fn identity() -> Self {
+        Self {
+            t: Vec3::new(1.0, 0.0, 0.0),
+            b: Vec3::new(0.0, 1.0, 0.0),
+            n: Vec3::new(0.0, 0.0, 1.0),
+        }
+    }
+
     /// A world direction in local coordinates (`z` along the normal).
     pub fn to_local(&self, w: &Vec3) -> Vec3 {
         Vec3::new(w.dot(&self.t), w.dot(&self.b), w.dot(&self.n))

@@ -55,8 +55,9 @@ mod report;
 mod results;
 
 pub use config::{
-    BATCH_REPETITIONS, CellSpec, MAP_CANDIDATES, MEASURED_CANDIDATES, Mode, PAPER_N_GRID,
-    PREFERRED_SAMPLERS, QUICK_BRDFS, Shard, StudyConfig, registered_preferred,
+    BATCH_REPETITIONS, CellSpec, EXTRA_ESTIMATORS, LIGHT_SAMPLERS, MAP_CANDIDATES,
+    MEASURED_CANDIDATES, Mode, PAPER_N_GRID, PREFERRED_SAMPLERS, QUICK_BRDFS, QUICK_MIS_SAMPLERS,
+    Shard, StudyConfig, registered_preferred,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;
