@@ -217,6 +217,8 @@ impl StudyConfig {
             vec!["area".into(), "sky".into()],
         );
         c.preset = "paper".into();
+        // The papers' tables rank BRDF sampling alone; no light or MIS cells.
+        c.estimators.clear();
         c
     }
 
