@@ -199,6 +199,9 @@ impl StudyConfig {
         };
         let mut c = Self::new(registered_preferred(), brdfs, vec![30.0, 60.0], vec![light]);
         c.preset = "quick".into();
+        // A small slice: the map samplers alone and the balance heuristic (the default study
+        // runs the power heuristic too).
+        c.estimators = vec!["light".into(), "mis-balance".into()];
         c.mis_samplers = QUICK_MIS_SAMPLERS
             .iter()
             .filter(|n| c.samplers.iter().any(|s| s == *n))

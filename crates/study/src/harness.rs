@@ -1056,12 +1056,19 @@ mod tests {
         let light = Light::parse("area:theta=20,phi=180,radius=15").unwrap();
         let wo = brdf::direction_from_angles(20.0, 0.0);
         let reference = crate::reference(brdf.as_ref(), &wo, &light).value;
-        z_of(&brdf, &light, Technique::Brdf(sampler), reference, 0.0, n)
+        z_of(
+            brdf.as_ref(),
+            &light,
+            Technique::Brdf(sampler),
+            reference,
+            0.0,
+            n,
+        )
     }
 
     /// z-score of a technique's mean over `n` values against `reference`.
     fn z_of(
-        brdf: &Box<dyn Brdf>,
+        brdf: &dyn Brdf,
         light: &Light,
         technique: Technique<'_>,
         reference: f64,
@@ -1069,7 +1076,7 @@ mod tests {
         n: usize,
     ) -> f64 {
         let est = Estimator {
-            brdf: brdf.as_ref(),
+            brdf,
             light,
             technique,
             mode: Mode::OneSample,
@@ -1113,7 +1120,7 @@ mod tests {
         let cosine = baselines_cosine();
         let n = 100_000;
         let z = z_of(
-            &brdf,
+            brdf.as_ref(),
             &light,
             Technique::Light(&cdf),
             reference.value,
@@ -1131,7 +1138,7 @@ mod tests {
                 })
             };
             let z = z_of(
-                &brdf,
+                brdf.as_ref(),
                 &light,
                 pair(cosine.as_ref()),
                 reference.value,
@@ -1140,7 +1147,7 @@ mod tests {
             );
             assert!(z.abs() < 4.0, "{heuristic:?}: z = {z}");
             let z = z_of(
-                &brdf,
+                brdf.as_ref(),
                 &light,
                 pair(&BrokenCosine),
                 reference.value,
