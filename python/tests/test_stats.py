@@ -68,6 +68,9 @@ def test_study_returns_cells_and_writes_the_cli_files(tmp_path):
         ["cosine", "analytic"], ["phong:n=20"], theta_o=[30.0], lights=["sky"],
         preset="custom", n_grid=[16, 64], repetitions=4, out=tmp_path,
     )
-    assert r.cells and {c["sampler"] for c in r.cells} == {"cosine", "analytic"}
+    brdf_only = [c for c in r.cells if c["estimator"] == "brdf"]
+    assert brdf_only and {c["sampler"] for c in brdf_only} == {"cosine", "analytic"}
+    # Under a map the study also runs light sampling and MIS (each sampler with each map sampler).
+    assert {c["estimator"] for c in r.cells} == {"brdf", "light", "mis-balance", "mis-power"}
     for f in ["results.json", "results.csv", "report.md"]:
         assert (tmp_path / f).stat().st_size > 0

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice};
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, EnvSample, LeafChoice};
 use partition_sampler::{PAR_CHUNK, Sample2, Sampler2D, TreeParams, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -13,9 +13,6 @@ use crate::error::{CliError, CliResult};
 use crate::output::{num, write_atomically};
 use crate::progress;
 use crate::values::{self, counted, display_path};
-
-/// Width and height of the built-in procedural sky.
-const SKY_SIZE: (usize, usize) = (1024, 512);
 /// Samples generated per block (each block seeded from (seed, block index): thread-independent).
 const BLOCK: usize = 1 << 20;
 
@@ -100,7 +97,7 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
             (map, display_path(path))
         }
         None => {
-            let map = envmap::procedural_sky(SKY_SIZE.0, SKY_SIZE.1).map_err(CliError::input)?;
+            let (map, _) = estimators::load_map(None).map_err(CliError::input)?;
             (map, "built-in procedural sky with a sun".to_string())
         }
     };
@@ -125,10 +122,9 @@ pub(crate) fn run(args: &EnvmapArgs) -> CliResult<()> {
     for (b, start) in (0..n).step_by(BLOCK).enumerate() {
         let len = BLOCK.min(n - start);
         let block = sampler.sample_uv_par(len, chunk_seed(args.seed, b as u64));
-        for s in &block {
-            let pdf_sa = envmap::latlong::pdf_uv_to_solid_angle(s.pdf, s.point[1]);
-            let y = envmap::luminance(map.radiance_uv(s.point[0], s.point[1]));
-            estimate.add(if pdf_sa > 0.0 { y / pdf_sa } else { 0.0 });
+        for s in block.iter().map(|s| EnvSample::from_uv(*s)) {
+            let y = envmap::luminance(map.radiance_uv(s.u, s.v));
+            estimate.add(if s.pdf_sa > 0.0 { y / s.pdf_sa } else { 0.0 });
         }
         if args.out.is_some() {
             blocks.push(block);
@@ -239,10 +235,15 @@ fn write_samples(path: &std::path::Path, blocks: &[Vec<Sample2>]) -> CliResult<(
     let result = write_atomically(path, |w| {
         writeln!(w, "u,v,pdf_uv,pdf_sa")?;
         for block in blocks {
-            for s in block {
-                let [u, v] = s.point;
-                let pdf_sa = envmap::latlong::pdf_uv_to_solid_angle(s.pdf, v);
-                writeln!(w, "{},{},{},{}", num(u), num(v), num(s.pdf), num(pdf_sa))?;
+            for s in block.iter().map(|s| EnvSample::from_uv(*s)) {
+                writeln!(
+                    w,
+                    "{},{},{},{}",
+                    num(s.u),
+                    num(s.v),
+                    num(s.pdf_uv),
+                    num(s.pdf_sa)
+                )?;
             }
             pb.inc(block.len() as u64);
         }

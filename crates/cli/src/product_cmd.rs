@@ -6,25 +6,15 @@
 //! about it; `--theta-o/--phi-o` are in that local frame. Samplers come from the registry.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
-use baselines::srbf::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
-    estimate_srbf_product, fit_envmap,
-};
-use baselines::{SrbfOptions, SrbfSampler};
-use brdf_sampling::DirectionSampler;
 use clap::Args;
-use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use estimators::{LocalFrame, ProductExperiment, load_map};
 use serde::Serialize;
 
 use crate::brdf_args::{SetArgs, parse_brdf};
 use crate::error::{CliError, CliResult};
 use crate::output::{check_all, num, write_atomically};
 use crate::values;
-
-/// Width and height of the built-in procedural sky.
-const SKY_SIZE: (usize, usize) = (1024, 512);
 
 /// Arguments of `brdf-lab product`.
 #[derive(Debug, Args)]
@@ -159,25 +149,6 @@ struct Estimate2 {
     warning: Option<String>,
 }
 
-fn load_map(path: Option<&PathBuf>) -> CliResult<(EnvMap, String)> {
-    match path {
-        Some(path) => {
-            let map = EnvMap::load(path)
-                .map_err(|e| CliError::input(format!("--map {}: {e}", path.display())))?;
-            Ok((map, path.display().to_string()))
-        }
-        None => Ok((
-            envmap::procedural_sky(SKY_SIZE.0, SKY_SIZE.1).map_err(CliError::input)?,
-            "procedural-sky".to_string(),
-        )),
-    }
-}
-
-/// Distinct seeds per estimator.
-fn stream(seed: u64, k: u64) -> u64 {
-    partition_sampler::chunk_seed(seed, k)
-}
-
 /// Runs `brdf-lab product`.
 pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
     check_all([
@@ -196,36 +167,32 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
     let frame = LocalFrame::new(args.normal, args.rotation.to_radians())
         .map_err(|e| CliError::input(format!("--normal: {e}")))?;
     let baselines = args.set.baselines.options()?;
-    let srbf_options: SrbfOptions = baselines.srbf.clone();
     let brdf = parse_brdf(&args.spec)?;
-    let (map, map_name) = load_map(args.map.as_ref())?;
-    let n = args.n as usize;
-    let wo = brdf::direction_from_angles(args.theta_o, args.phi_o);
-    let scene = ProductScene::new(brdf.as_ref(), &map, frame, wo).map_err(CliError::input)?;
-
-    // Samplers from the registry (built once; their build time is not in the estimators').
-    let options = args.set.options();
-    let mut brdf_samplers: Vec<(String, Arc<dyn DirectionSampler>)> = Vec::new();
-    for name in &args.brdf_samplers {
-        let request = samplers::DirectionRequest::new(Arc::clone(&brdf), &options)
-            .with_baselines(baselines.clone())
-            .with_spec(&args.spec);
-        let built = samplers::build_direction(name, &request).map_err(CliError::input)?;
-        brdf_samplers.push((name.clone(), built.sampler));
+    let (map, map_name) =
+        load_map(args.map.as_deref()).map_err(|e| CliError::input(format!("--map {e}")))?;
+    let outcome = ProductExperiment {
+        brdf,
+        spec: &args.spec,
+        map: &map,
+        frame,
+        wo: brdf::direction_from_angles(args.theta_o, args.phi_o),
+        n: args.n as usize,
+        reference_samples: args.reference_samples as usize,
+        seed: args.seed,
+        brdf_samplers: &args.brdf_samplers,
+        light_samplers: &args.light_samplers,
+        set_options: args.set.options(),
+        baselines,
     }
-    let mut light_samplers: Vec<(String, EnvMapSampler)> = Vec::new();
-    for name in &args.light_samplers {
-        let entry = samplers::find(name).map_err(CliError::input)?;
-        let sampler = entry
-            .build_envmap(&map, &AdaptiveOptions::default())
-            .map_err(CliError::input)?;
-        light_samplers.push((name.clone(), sampler));
-    }
-
-    // SRBF fits (preprocessing, timed separately).
-    let brdf_fit = SrbfSampler::build(brdf.as_ref(), &srbf_options).map_err(CliError::input)?;
-    let map_fit = fit_envmap(&map, &srbf_options).map_err(CliError::input)?;
-    let br = brdf_fit.report();
+    .run()
+    .map_err(CliError::input)?;
+    let (reference, estimates, br, map_fit, stats) = (
+        &outcome.reference,
+        &outcome.estimates,
+        &outcome.brdf_fit,
+        &outcome.map_fit,
+        &outcome.stats,
+    );
     if let Some(w) = br.lbfgs_cap_warning() {
         eprintln!("brdf-lab: warning: {w}");
     }
@@ -234,77 +201,6 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
             "brdf-lab: warning: the map fit hit the L-BFGS cap (--srbf-max-iter); residual (rel. L2) {:.3e}",
             map_fit.report.rel_l2
         );
-    }
-
-    // The reference.
-    let reference = estimate_mis(
-        &scene,
-        brdf_samplers[0].1.as_ref(),
-        &light_samplers[0].1,
-        MisHeuristic::Balance,
-        &format!(
-            "reference mis-balance:{}+{}",
-            brdf_samplers[0].0, light_samplers[0].0
-        ),
-        args.reference_samples as usize,
-        stream(args.seed, 0),
-    )
-    .map_err(CliError::input)?;
-
-    let mut estimates: Vec<Estimate> = Vec::new();
-    let (product, stats) = estimate_srbf_product(
-        &scene,
-        &brdf_fit,
-        &map_fit,
-        &light_samplers[0].1,
-        &srbf_options.product_settings(),
-        n,
-        stream(args.seed, 1),
-    )
-    .map_err(CliError::input)?;
-    estimates.push(product);
-    let mut k = 2;
-    for (name, s) in &brdf_samplers {
-        estimates.push(
-            estimate_brdf(
-                &scene,
-                s.as_ref(),
-                &format!("brdf:{name}"),
-                n,
-                stream(args.seed, k),
-            )
-            .map_err(CliError::input)?,
-        );
-        k += 1;
-    }
-    for (name, s) in &light_samplers {
-        estimates.push(
-            estimate_light(&scene, s, &format!("light:{name}"), n, stream(args.seed, k))
-                .map_err(CliError::input)?,
-        );
-        k += 1;
-    }
-    for (bname, b) in &brdf_samplers {
-        for (lname, l) in &light_samplers {
-            for (h, hname) in [
-                (MisHeuristic::Balance, "balance"),
-                (MisHeuristic::Power, "power"),
-            ] {
-                estimates.push(
-                    estimate_mis(
-                        &scene,
-                        b.as_ref(),
-                        l,
-                        h,
-                        &format!("mis-{hname}:{bname}+{lname}"),
-                        n,
-                        stream(args.seed, k),
-                    )
-                    .map_err(CliError::input)?,
-                );
-                k += 1;
-            }
-        }
     }
 
     let rows: Vec<Row> = estimates

@@ -191,7 +191,30 @@ pub struct StudyConfig {
     pub slices: usize,
     /// Master seed; cell `i` uses `partition_sampler::chunk_seed(seed, i)`.
     pub seed: u64,
+    /// Estimators besides BRDF sampling alone, run under the map lights (the sky and map
+    /// files) only: `light` (each of [`Self::light_samplers`] alone), `mis-balance`,
+    /// `mis-power` (each BRDF sampler of [`Self::mis_samplers`] with each map sampler, one
+    /// draw of each per sample). Their cells follow every BRDF-only cell, so adding them
+    /// changes no BRDF-only cell's seed.
+    #[serde(default)]
+    pub estimators: Vec<String>,
+    /// Map samplers (registry names) of the `light` and MIS estimators.
+    #[serde(default)]
+    pub light_samplers: Vec<String>,
+    /// BRDF samplers inside MIS (each must be in [`Self::samplers`]); empty: all of them.
+    #[serde(default)]
+    pub mis_samplers: Vec<String>,
 }
+
+/// The estimators of a study besides BRDF sampling alone.
+pub const EXTRA_ESTIMATORS: [&str; 3] = ["light", "mis-balance", "mis-power"];
+
+/// Map samplers of the light and MIS estimators in the default and quick studies.
+pub const LIGHT_SAMPLERS: [&str; 2] = ["envmap-adaptive", "envmap-cdf"];
+
+/// BRDF samplers inside MIS in the quick study (those registered and in the study): a
+/// baseline without fit, the models' own lobes, a fitted mixture and the adaptive set.
+pub const QUICK_MIS_SAMPLERS: [&str; 4] = ["cosine", "analytic", "srbf", "adaptive"];
 
 impl StudyConfig {
     /// A custom study of the given grid with the default counts (the papers' N grid, 32
@@ -216,6 +239,9 @@ impl StudyConfig {
             timing_repeats: 9,
             slices: brdf_sampling::SetOptions::default().slices,
             seed: 1,
+            estimators: EXTRA_ESTIMATORS.iter().map(|s| s.to_string()).collect(),
+            light_samplers: LIGHT_SAMPLERS.iter().map(|s| s.to_string()).collect(),
+            mis_samplers: Vec::new(),
         }
     }
 
@@ -254,6 +280,14 @@ impl StudyConfig {
         };
         let mut c = Self::new(registered_preferred(), brdfs, vec![30.0, 60.0], vec![light]);
         c.preset = "quick".into();
+        // A small slice: the map samplers alone and the balance heuristic (the default study
+        // runs the power heuristic too).
+        c.estimators = vec!["light".into(), "mis-balance".into()];
+        c.mis_samplers = QUICK_MIS_SAMPLERS
+            .iter()
+            .filter(|n| c.samplers.iter().any(|s| s == *n))
+            .map(|n| n.to_string())
+            .collect();
         (c, notes)
     }
 
@@ -267,6 +301,8 @@ impl StudyConfig {
             vec!["area".into(), "sky".into()],
         );
         c.preset = "paper".into();
+        // The papers' tables rank BRDF sampling alone; no light or MIS cells.
+        c.estimators.clear();
         c
     }
 
@@ -329,6 +365,22 @@ impl StudyConfig {
                 return Err(StudyError::TooFew { what, min, got });
             }
         }
+        if let Some(bad) = self
+            .estimators
+            .iter()
+            .find(|e| !EXTRA_ESTIMATORS.contains(&e.as_str()))
+        {
+            return Err(StudyError::UnknownEstimator(bad.clone()));
+        }
+        if let Some(bad) = self
+            .mis_samplers
+            .iter()
+            .find(|m| !self.samplers.contains(m))
+        {
+            return Err(StudyError::UnknownEstimator(format!(
+                "MIS sampler `{bad}` is not among the study's samplers"
+            )));
+        }
         for (what, empty) in [
             ("sampler", self.samplers.is_empty()),
             ("BRDF", self.brdfs.is_empty()),
@@ -380,6 +432,10 @@ pub struct CellSpec {
     pub theta_o_deg: f64,
     /// Light spec.
     pub light: String,
+    /// `brdf`, `light`, `mis-balance` or `mis-power`.
+    pub estimator: String,
+    /// The map sampler of a `light` or MIS cell.
+    pub light_sampler: Option<String>,
 }
 
 #[cfg(test)]

@@ -41,6 +41,9 @@ pub enum StudyError {
     /// A study with no sampler, BRDF, angle or light.
     #[error("the study has no {0}")]
     EmptyGrid(&'static str),
+    /// An estimator the study does not know, or a MIS sampler outside the study's samplers.
+    #[error("unknown estimator setting: {0} (estimators: light, mis-balance, mis-power)")]
+    UnknownEstimator(String),
     /// Shards given to `merge` that do not form one study.
     #[error("cannot merge: {0}")]
     Merge(String),

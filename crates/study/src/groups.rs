@@ -163,7 +163,8 @@ pub fn sheet_brdfs(brdfs: &[String], max: usize) -> Vec<String> {
     chosen.into_iter().map(|i| brdfs[i].clone()).collect()
 }
 
-/// The groups of `results`, in config order (light, BRDF, θo).
+/// The groups of `results`, in config order (light, BRDF, θo): the cells of the BRDF-only
+/// estimator (the light and MIS cells are ranked apart, module `ranking`).
 pub fn groups(results: &StudyResults) -> Vec<Group<'_>> {
     let cfg = &results.config;
     let mut out = Vec::new();
@@ -174,6 +175,7 @@ pub fn groups(results: &StudyResults) -> Vec<Group<'_>> {
                     .cells
                     .iter()
                     .filter(|c| &c.light == light && &c.brdf == brdf && c.theta_o_deg == theta)
+                    .filter(|c| c.estimator == crate::ranking::ESTIMATOR_BRDF)
                     .collect();
                 if cells.is_empty() {
                     continue;

@@ -57,9 +57,10 @@ mod results;
 mod sheet;
 
 pub use config::{
-    BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, FULL_THETA_O_DEG, MAP_CANDIDATES,
-    MEASURED_CANDIDATES, MEASURED_DIRS, Mode, PAPER_N_GRID, PREFERRED_SAMPLERS, QUICK_BRDFS, Shard,
-    StudyConfig, all_merl_fits, analytic_models, registered_preferred, shared_measured,
+    BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, EXTRA_ESTIMATORS, FULL_THETA_O_DEG,
+    LIGHT_SAMPLERS, MAP_CANDIDATES, MEASURED_CANDIDATES, MEASURED_DIRS, Mode, PAPER_N_GRID,
+    PREFERRED_SAMPLERS, QUICK_BRDFS, QUICK_MIS_SAMPLERS, Shard, StudyConfig, all_merl_fits,
+    analytic_models, registered_preferred, shared_measured,
 };
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use dispersion::BudgetMse;

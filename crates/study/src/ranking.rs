@@ -47,8 +47,11 @@ pub const ALPHA: f64 = 0.05;
 /// Name of the multiple-comparison rule.
 pub const RULE: &str = "sidak";
 
-/// The estimator every cell of this study uses: BRDF sampling alone.
+/// The estimator of the study's main cells: BRDF sampling alone.
 pub const ESTIMATOR_BRDF: &str = "brdf";
+
+/// Light sampling alone (its comparisons rank the map samplers).
+pub const ESTIMATOR_LIGHT: &str = "light";
 
 /// `best`, `tied` or `worse`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -127,6 +130,9 @@ pub struct Ranking {
     pub light: String,
     /// Estimator ([`ESTIMATOR_BRDF`]).
     pub estimator: String,
+    /// The map sampler every ranked BRDF sampler is paired with (MIS comparisons only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_sampler: Option<String>,
     /// The most efficient sampler (point estimate).
     pub best: String,
     /// The samplers statistically tied with it.
@@ -325,6 +331,7 @@ pub fn rank_cells(
         theta_o: first.theta_o_deg,
         light: first.light.clone(),
         estimator: estimator.to_string(),
+        light_sampler: None,
         best: entries[0].sampler.clone(),
         tied: of(Verdict::Tied),
         worse: of(Verdict::Worse),
@@ -337,13 +344,51 @@ pub fn rank_cells(
     })
 }
 
-/// The rankings of every comparison of `results` (one per light, BRDF, θo; estimator
-/// `brdf`), at [`ALPHA`] with the Šidák rule.
+/// The rankings of every comparison of `results`, at [`ALPHA`] with the Šidák rule: first
+/// one per (light, BRDF, θo) of the BRDF samplers alone (estimator `brdf`), then, in config
+/// order, one per (light, BRDF, θo) of the map samplers alone (`light`) and one per (light,
+/// BRDF, θo, estimator `mis-balance` / `mis-power`, map sampler) of the BRDF samplers inside
+/// MIS with that map sampler. The significance rules are the same for all.
 pub fn rankings(results: &StudyResults) -> Vec<Ranking> {
-    groups(results)
+    let mut out: Vec<Ranking> = groups(results)
         .iter()
         .filter_map(|g| rank_cells(&g.cells, ESTIMATOR_BRDF, ALPHA, true))
-        .collect()
+        .collect();
+    let cfg = &results.config;
+    for light in &cfg.lights {
+        for brdf in &cfg.brdfs {
+            for &theta in &cfg.theta_o_deg {
+                for estimator in &cfg.estimators {
+                    let light_samplers: Vec<Option<&str>> = if estimator == ESTIMATOR_LIGHT {
+                        vec![None]
+                    } else {
+                        cfg.light_samplers
+                            .iter()
+                            .map(|l| Some(l.as_str()))
+                            .collect()
+                    };
+                    for ls in light_samplers {
+                        let cells: Vec<&CellResult> = results
+                            .cells
+                            .iter()
+                            .filter(|c| {
+                                &c.light == light
+                                    && &c.brdf == brdf
+                                    && c.theta_o_deg == theta
+                                    && &c.estimator == estimator
+                                    && c.light_sampler.as_deref() == ls
+                            })
+                            .collect();
+                        if let Some(mut r) = rank_cells(&cells, estimator, ALPHA, true) {
+                            r.light_sampler = ls.map(str::to_string);
+                            out.push(r);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
 }
 
 /// A significant order `better ≻ worse` of one comparison that another run reverses.
@@ -384,6 +429,7 @@ pub fn compare_rankings(a: &[Ranking], b: &[Ranking]) -> RankingComparison {
             r.theta_o.to_bits(),
             r.light.clone(),
             r.estimator.clone(),
+            r.light_sampler.clone(),
         )
     };
     let pairs = |r: &Ranking| -> Vec<(String, String)> {
@@ -439,6 +485,7 @@ pub fn compare_rankings(a: &[Ranking], b: &[Ranking]) -> RankingComparison {
 #[cfg(test)]
 pub(crate) mod synthetic {
     use crate::dispersion::BudgetMse;
+    use crate::ranking::ESTIMATOR_BRDF;
     use crate::{CellResult, Mode, Reference, Timing, WithCi};
 
     /// A cell of `sampler` with per-sample MSE `mse ± mse_ci95`, estimator time `ns` per
@@ -459,6 +506,8 @@ pub(crate) mod synthetic {
             brdf: brdf.to_string(),
             theta_o_deg: 30.0,
             light: "sky".into(),
+            estimator: ESTIMATOR_BRDF.into(),
+            light_sampler: None,
             status: None,
             reference: Reference {
                 value: 1.0,

@@ -95,10 +95,12 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     }
     s.push_str("## Results\n\n");
     for g in groups(results) {
-        let ranking = results
-            .rankings
-            .iter()
-            .find(|r| r.brdf == g.brdf && r.theta_o == g.theta_o_deg && r.light == g.light);
+        let ranking = results.rankings.iter().find(|r| {
+            r.brdf == g.brdf
+                && r.theta_o == g.theta_o_deg
+                && r.light == g.light
+                && r.estimator == crate::ranking::ESTIMATOR_BRDF
+        });
         group_table(&mut s, &g, cfg.n_grid.last().copied().unwrap_or(0), ranking);
         for (slug, caption, path) in &assets.plots {
             if *slug == g.slug {
@@ -203,11 +205,15 @@ fn outcome(s: &mut String, results: &StudyResults) {
             results.config.timing_repeats,
             crate::ranking::ALPHA,
         );
-        verdicts(s, &results.rankings);
-        s.push_str(&crate::answers::family_answers(
-            &results.rankings,
-            &results.cells,
-        ));
+        let brdf_only: Vec<Ranking> = results
+            .rankings
+            .iter()
+            .filter(|r| r.estimator == crate::ranking::ESTIMATOR_BRDF)
+            .cloned()
+            .collect();
+        verdicts(s, &brdf_only);
+        s.push_str(&crate::answers::family_answers(&brdf_only, &results.cells));
+        mis_outcome(s, results);
     }
     let flagged: Vec<&CellResult> = results
         .cells
@@ -495,6 +501,91 @@ pub(crate) fn bytes(b: usize) -> String {
     } else {
         format!("{:.2} MiB", b / 1024.0 / 1024.0)
     }
+}
+
+/// The light and MIS estimators in words (one sentence per material, map and map sampler):
+/// "inside MIS (balance) under MAP, the best BRDF sampler for BRDF is X …", per θo, with the
+/// results.csv rows (`index`) each ranking rests on; then the light-only comparisons. Nothing
+/// when the study ran no such estimator.
+pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
+    let others: Vec<&Ranking> = results
+        .rankings
+        .iter()
+        .filter(|r| r.estimator != crate::ranking::ESTIMATOR_BRDF)
+        .collect();
+    if others.is_empty() {
+        return;
+    }
+    s.push_str("\n### Inside MIS and light sampling\n\n");
+    s.push_str("Estimators as renderers use them, under the maps: each BRDF sampler inside multiple importance sampling with a map sampler (one draw of each per sample; balance or power heuristic), and each map sampler alone; same efficiency, intervals and Šidák rule as above, comparisons per (BRDF, θo, map, estimator, map sampler).\n\n");
+    let list = |v: &[String]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    let cfg = &results.config;
+    for estimator in ["mis-balance", "mis-power"] {
+        for light in &cfg.lights {
+            for brdf in &cfg.brdfs {
+                for ls in &cfg.light_samplers {
+                    let parts: Vec<String> = others
+                        .iter()
+                        .filter(|r| {
+                            r.estimator == estimator
+                                && &r.light == light
+                                && &r.brdf == brdf
+                                && r.light_sampler.as_deref() == Some(ls.as_str())
+                        })
+                        .map(|r| {
+                            format!(
+                                "at θo = {}° **{}** (tied: {}; rows {})",
+                                r.theta_o,
+                                r.best,
+                                list(&r.tied),
+                                r.rows()
+                                    .iter()
+                                    .map(usize::to_string)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            )
+                        })
+                        .collect();
+                    if parts.is_empty() {
+                        continue;
+                    }
+                    let _ = writeln!(
+                        s,
+                        "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{brdf}` is {}.",
+                        estimator.trim_start_matches("mis-"),
+                        crate::short_light(light),
+                        parts.join("; ")
+                    );
+                }
+            }
+        }
+    }
+    for r in others
+        .iter()
+        .filter(|r| r.estimator == crate::ranking::ESTIMATOR_LIGHT)
+    {
+        let _ = writeln!(
+            s,
+            "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** (tied: {}; rows {}).",
+            crate::short_light(&r.light),
+            r.brdf,
+            r.theta_o,
+            r.best,
+            list(&r.tied),
+            r.rows()
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    s.push('\n');
 }
 
 #[cfg(test)]

@@ -14,6 +14,8 @@
 //!   "lights": [ { "spec", "description" } ],
 //!   "cells": [ {
 //!       "index", "sampler", "mode" ("one-sample" | "batch"), "brdf", "theta_o_deg", "light",
+//!       "estimator" ("brdf" | "light" | "mis-balance" | "mis-power"),
+//!       "light_sampler": null | map sampler of a MIS cell (a light cell's is its `sampler`),
 //!       "status": null | "why the cell could not run",
 //!       "reference": { "value", "abs_err", "method" },   // L_r(ωo), luminance
 //!       "bytes": memory of the sampler's structures,
@@ -32,7 +34,8 @@
 //!   "runs": [ { "commit", "cpu_model", "logical_cpus", "threads", "load_start": [1, 5, 15 min],
 //!               "load_end", "wall_seconds", "cpu_seconds" } ],        // one per run / shard
 //!   "rankings": [ {                                   // empty for a shard; module `ranking`
-//!       "brdf", "theta_o", "light", "estimator" ("brdf"),
+//!       "brdf", "theta_o", "light", "estimator" ("brdf", "light", "mis-balance", "mis-power"),
+//!       "light_sampler" (MIS only: the map sampler every ranked BRDF sampler is paired with),
 //!       "best": label, "tied": [label], "worse": [label],   // label: `sampler` or `sampler (batch)`
 //!       "alpha", "rule" ("sidak"), "comparisons" (m), "level" (of each interval),
 //!       "entries": [ { "sampler", "cell" (the cell's index), "verdict", "efficiency",
@@ -162,6 +165,14 @@ pub struct CellResult {
     pub theta_o_deg: f64,
     /// Light spec.
     pub light: String,
+    /// The estimator: `brdf` (the sampler alone), `light` (the map sampler alone; `sampler`
+    /// names it), `mis-balance` or `mis-power` (the BRDF sampler `sampler` with the map
+    /// sampler `light_sampler`, one draw of each per sample).
+    #[serde(default = "brdf_estimator")]
+    pub estimator: String,
+    /// The map sampler of a MIS cell.
+    #[serde(default)]
+    pub light_sampler: Option<String>,
     /// Why the cell could not run (e.g. the sampler does not apply to this BRDF).
     pub status: Option<String>,
     /// The reference `L_r(ωo)`.
@@ -202,7 +213,7 @@ impl CellResult {
         self.errors.last()
     }
 
-    /// `sampler` or `sampler (batch)`.
+    /// `sampler` or `sampler (batch)` (the ranked name inside a comparison).
     pub fn label(&self) -> String {
         match self.mode {
             Mode::OneSample => self.sampler.clone(),
@@ -217,6 +228,10 @@ impl CellResult {
             ..self.clone()
         }
     }
+}
+
+fn brdf_estimator() -> String {
+    crate::ranking::ESTIMATOR_BRDF.to_string()
 }
 
 /// A light of the study and its description.
@@ -293,7 +308,7 @@ impl StudyResults {
     /// header. Fields are quoted where needed (BRDF specs contain commas).
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
-            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],estimator_wall_ns[timing],efficiency[timing]\n",
+            "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],estimator_wall_ns[timing],efficiency[timing],estimator,light_sampler\n",
         );
         for c in &self.cells {
             let t = c.timing;
@@ -345,6 +360,10 @@ impl StudyResults {
                     out.push(',');
                     out.push_str(t);
                 }
+                out.push(',');
+                out.push_str(&quote(&c.estimator));
+                out.push(',');
+                out.push_str(&quote(c.light_sampler.as_deref().unwrap_or("")));
                 out.push('\n');
             }
         }

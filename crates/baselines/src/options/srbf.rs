@@ -36,7 +36,7 @@ pub struct SrbfOptions {
     /// Share of the product estimator's samples given to the BRDF slice's lobes
     /// (defensive components, `[0, 1 − γ − β)` with `γ`, `β` = `ProductSettings::DEFAULT_COSINE`,
     /// `DEFAULT_LIGHT` the cosine and light components' shares; see
-    /// `srbf::estimate_srbf_product`).
+    /// `estimators::estimate_srbf_product`).
     pub defensive: f64,
 }
 

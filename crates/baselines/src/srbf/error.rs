@@ -54,32 +54,6 @@ pub enum SrbfError {
     /// The target is zero everywhere (e.g. an all-black map): nothing to fit.
     #[error("the fit target is zero everywhere (e.g. an all-black map)")]
     BlackTarget,
-    /// A surface normal of zero length or with a non-finite component.
-    #[error("the normal ({x}, {y}, {z}) must be finite with non-zero length")]
-    BadNormal {
-        /// x component.
-        x: f64,
-        /// y component.
-        y: f64,
-        /// z component.
-        z: f64,
-    },
-    /// An outgoing direction below or on the horizon of the local frame.
-    #[error("the outgoing direction must be above the horizon (cos θo = {cos_theta})")]
-    BelowHorizon {
-        /// Its cosine with the normal.
-        cos_theta: f64,
-    },
-    /// A sample count too small for the estimator.
-    #[error("{estimator} needs at least {min} samples (got {got})")]
-    TooFewSamples {
-        /// The estimator.
-        estimator: &'static str,
-        /// The minimum.
-        min: usize,
-        /// The count given.
-        got: usize,
-    },
     /// A defensive sample share outside `[0, 1)`.
     #[error("the defensive share must be in [0, 1) (got {value})")]
     BadDefensive {

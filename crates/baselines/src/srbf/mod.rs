@@ -8,11 +8,10 @@
 //! * [`sampler`] — [`SrbfSampler`], the BRDF-only mixture sampler (pdf w.r.t. solid angle on
 //!   the whole sphere).
 //! * [`envfit`] — the fit of an environment map's luminance.
-//! * [`product`] — estimators of reflected radiance under an environment map: SRBF product
-//!   sampling, BRDF sampling, light sampling and MIS.
+//! * [`product`] — the settings of the SRBF product estimator (the estimator itself, with the
+//!   BRDF, light and MIS estimators, is in the `estimators` crate).
 //!
 //! ```
-//! use baselines::srbf::{LocalFrame, ProductScene, estimate_srbf_product, fit_envmap};
 //! use baselines::{SrbfOptions, SrbfSampler};
 //! use brdf_sampling::DirectionSampler;
 //! use rand::SeedableRng;
@@ -24,15 +23,6 @@
 //! let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(1);
 //! let s = sampler.sample(&wo, &mut rng); // pdf w.r.t. solid angle, on the whole sphere
 //! assert!((sampler.pdf(&wo, &s.wi) - s.pdf).abs() <= 1e-9 * s.pdf);
-//!
-//! // Reflected radiance under the procedural sky, by SRBF product sampling.
-//! let sky = envmap::procedural_sky(64, 32)?;
-//! let map_fit = fit_envmap(&sky, &options)?;
-//! let light = envmap::EnvMapSampler::piecewise_constant(&sky)?;
-//! let frame = LocalFrame::new([0.0, 0.3, 1.0], 0.0)?;
-//! let scene = ProductScene::new(brdf.as_ref(), &sky, frame, wo)?;
-//! let (estimate, stats) = estimate_srbf_product(&scene, &sampler, &map_fit, &light, &options.product_settings(), 10_000, 7)?;
-//! assert!(estimate.estimate > 0.0 && estimate.std_err > 0.0 && stats.kept >= 1);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -51,9 +41,6 @@ pub mod vmf;
 pub use envfit::{EnvSrbf, fit_envmap};
 pub use error::SrbfError;
 pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit, fit_lbfgs};
-pub use product::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, ProductSettings, ProductStats, estimate_brdf,
-    estimate_light, estimate_mis, estimate_srbf_product, quadrature_reference,
-};
+pub use product::ProductSettings;
 pub use sampler::{SrbfReport, SrbfSampler};
 pub use vmf::SgLobe;

@@ -24,17 +24,18 @@
 //! `issue_27_bias_is_gone_and_its_mutant_is_detected` runs the pre-fix mixture in CI.
 //!
 //! The 10⁶-sample check of the issue's own 256 × 128 cases is `full_adversarial_cases`
-//! (ignored; `cargo test -p baselines --release --test product_adversarial -- --ignored`).
+//! (ignored; `cargo test -p estimators --release --test product_adversarial -- --ignored`).
 
-use baselines::srbf::{
-    EnvSrbf, Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light,
-    estimate_mis, estimate_srbf_product, fit_envmap, quadrature_reference,
-};
+use baselines::srbf::{EnvSrbf, fit_envmap};
 use baselines::{CosineHemisphere, SrbfOptions, SrbfSampler};
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirSample, DirectionSampler};
 use envmap::latlong::uv_to_direction;
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use estimators::{
+    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    estimate_srbf_product, quadrature_reference,
+};
 use partition_sampler::UniformSource;
 
 /// Dim deterministic noise in `[0.05, 0.25)` (a hash of the pixel index).

@@ -4,14 +4,15 @@
 //! (for `brdf-lab product --map`). Figures: docs/validation.md, "Product estimators:
 //! unbiasedness under adversarial maps".
 //!
-//! `cargo run --release -p baselines --example product_bias -- [U [N [OUT.pfm]]]`
+//! `cargo run --release -p estimators --example product_bias -- [U [N [OUT.pfm]]]`
 
-use baselines::srbf::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
-    estimate_srbf_product, fit_envmap, quadrature_reference,
-};
+use baselines::srbf::fit_envmap;
 use baselines::{SrbfOptions, SrbfSampler};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use estimators::{
+    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    estimate_srbf_product, quadrature_reference,
+};
 
 /// Dim deterministic noise in `[0.05, 0.25)` (a hash of the pixel index).
 fn noise(i: usize) -> f32 {

@@ -2,19 +2,20 @@
 //! agrees with an independent converged reference within 4 standard errors.
 //!
 //! `reduced_*` runs in CI (small maps and fits, every estimator tested); `full_tier_*` (ignored; run with
-//! `cargo test -p baselines --release --test srbf_product -- --ignored`) covers the three maps of
+//! `cargo test -p estimators --release --test srbf_product -- --ignored`) covers the three maps of
 //! `../shared/data/envmaps`, the procedural sky, four BRDFs (diffuse, glossy, sharp,
 //! MERL-layout) and three normals each; there the single-technique estimators are reported, not
 //! tested
 //! (see [`check`]).
 
-use baselines::srbf::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
-    estimate_srbf_product, fit_envmap,
-};
+use baselines::srbf::fit_envmap;
 use baselines::{CosineHemisphere, SrbfOptions, SrbfSampler};
 use brdf::Brdf;
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use estimators::{
+    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    estimate_srbf_product,
+};
 
 /// `(a − b) / √(σa² + σb²)`.
 fn z(a: &Estimate, b: &Estimate) -> f64 {
