@@ -275,7 +275,7 @@ macro_rules! model_common {
         $crate::params::model_common!(@impl $Model($Params));
         impl Default for $Model {
             fn default() -> Self {
-                $crate::models::expect_default(Self::new($Params::default()))
+                $crate::params::expect_default(Self::new($Params::default()))
             }
         }
     };
@@ -283,7 +283,7 @@ macro_rules! model_common {
         $crate::params::model_common!(@impl $Model($Params, $arg: $Arg));
         impl Default for $Model {
             fn default() -> Self {
-                $crate::models::expect_default(Self::new($Params::default(), $arg_default))
+                $crate::params::expect_default(Self::new($Params::default(), $arg_default))
             }
         }
     };
@@ -308,6 +308,15 @@ macro_rules! model_common {
     };
 }
 pub(crate) use model_common;
+
+/// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
+/// unit tests, so an error here is a bug in this crate, never a consequence of user input.
+pub(crate) fn expect_default<T>(r: Result<T, ParamError>) -> T {
+    match r {
+        Ok(v) => v,
+        Err(e) => panic!("built-in default parameters are invalid: {e}"),
+    }
+}
 
 /// Copy the first `N` values (missing ones become NaN, which validation rejects).
 pub(crate) fn take<const N: usize>(v: &[f64]) -> [f64; N] {

@@ -3,5 +3,6 @@
 
 pub mod cornell;
 pub mod rgl;
+mod rgl_error;
 pub mod tensor;
 pub mod warp;

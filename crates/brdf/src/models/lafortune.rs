@@ -174,7 +174,7 @@ impl Lafortune {
 
 impl Default for Lafortune {
     fn default() -> Self {
-        super::expect_default(Self::new(LafortuneParams::default()))
+        crate::params::expect_default(Self::new(LafortuneParams::default()))
     }
 }
 

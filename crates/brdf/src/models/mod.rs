@@ -47,12 +47,3 @@ pub use ward::{Ward, WardNormalisation, WardParams};
 pub(crate) use crate::params::{model_common, model_params};
 pub use properties::Properties;
 pub(crate) use properties::brdf_properties;
-
-/// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
-/// unit tests, so an error here is a bug in this crate, never a consequence of user input.
-pub(crate) fn expect_default<T>(r: Result<T, crate::params::ParamError>) -> T {
-    match r {
-        Ok(v) => v,
-        Err(e) => panic!("built-in default parameters are invalid: {e}"),
-    }
-}

@@ -163,7 +163,7 @@ impl Schlick {
 
 impl Default for Schlick {
     fn default() -> Self {
-        super::expect_default(Self::new(SchlickParams::specular()))
+        crate::params::expect_default(Self::new(SchlickParams::specular()))
     }
 }
 
