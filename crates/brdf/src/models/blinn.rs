@@ -8,11 +8,9 @@
 //! The albedo is largest at normal incidence (checked numerically in the tests), so the model
 //! conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
-use super::half_vector_lobe::HalfVectorLobe;
-use super::{Properties, brdf_properties, model_common, model_params};
-use crate::brdf::Brdf;
-use crate::geometry::Vec3;
-use crate::params::{ParamError, Range};
+use super::half_vector_lobe::half_vector_model;
+use super::model_params;
+use crate::params::Range;
 use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "blinn";
@@ -29,57 +27,14 @@ model_params! {
     }
 }
 
-/// Blinn–Phong BRDF (normalised half-vector cosine lobe).
-#[derive(Debug, Clone)]
-pub struct Blinn {
-    params: BlinnParams,
-    lobe: HalfVectorLobe,
-}
-
 /// Default parameters of [`Blinn`]: n = 100, ks = 0.6, kd = 0.4 (as [`BlinnParams::default`]).
 pub fn blinn_defaults() -> BlinnParams {
     BlinnParams::default()
 }
 
-impl Blinn {
-    /// Validate the parameters and build the model.
-    pub fn new(params: BlinnParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        let n = params.n;
-        let norm = (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()));
-        Ok(Self {
-            params,
-            lobe: HalfVectorLobe::new(n, params.ks, params.kd, norm),
-        })
-    }
-
-    /// Symmetries and energy: `n·h` only (isotropic, even under `y ↦ −y`), reciprocal;
-    /// conserves energy iff `kd + ks ≤ 1`.
-    pub fn properties(&self) -> Properties {
-        Properties::ISOTROPIC_SYMMETRIC
-            | Properties::RECIPROCAL
-            | Properties::CONSERVES_ENERGY.when(self.lobe.conserves_energy())
-    }
-}
-
-model_common!(Blinn(BlinnParams));
-
-impl Brdf for Blinn {
-    #[inline]
-    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        self.lobe.eval(wo, wi)
-    }
-    brdf_properties!();
-    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
-        Some(crate::AnalyticLobes {
-            diffuse: self.params.kd,
-            specular: self.params.ks,
-            lobe: Some(crate::SpecularLobe::HalfVector {
-                exponent: self.params.n,
-            }),
-        })
-    }
-    fn name(&self) -> &str {
-        NAME
-    }
-}
+half_vector_model!(
+    /// Blinn–Phong BRDF (normalised half-vector cosine lobe).
+    Blinn(BlinnParams),
+    NAME,
+    norm = |n| (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()))
+);

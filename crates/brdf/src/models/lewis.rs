@@ -10,21 +10,12 @@
 //! normalisation of the mirror-direction lobe, `(n+2)/(2π)`, is the [`Phong`](super::Phong)
 //! model of this crate.)
 
-use super::half_vector_lobe::HalfVectorLobe;
-use super::{Properties, brdf_properties, model_common, model_params};
-use crate::brdf::Brdf;
-use crate::geometry::Vec3;
-use crate::params::{ParamError, Range};
+use super::half_vector_lobe::half_vector_model;
+use super::model_params;
+use crate::params::Range;
 use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "lewis";
-
-/// Lewis-normalised Blinn–Phong BRDF.
-#[derive(Debug, Clone)]
-pub struct Lewis {
-    params: LewisParams,
-    lobe: HalfVectorLobe,
-}
 
 model_params! {
     /// Parameters of [`Lewis`] (SPEC keys `n`, `ks`, `kd`).
@@ -43,45 +34,9 @@ pub fn lewis_defaults() -> LewisParams {
     LewisParams::default()
 }
 
-impl Lewis {
-    /// Validate the parameters and build the model.
-    pub fn new(params: LewisParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        let n = params.n;
-        let norm = (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()));
-        Ok(Self {
-            params,
-            lobe: HalfVectorLobe::new(n, params.ks, params.kd, norm),
-        })
-    }
-
-    /// Symmetries and energy: `n·h` only (isotropic, even under `y ↦ −y`), reciprocal;
-    /// conserves energy iff `kd + ks ≤ 1`.
-    pub fn properties(&self) -> Properties {
-        Properties::ISOTROPIC_SYMMETRIC
-            | Properties::RECIPROCAL
-            | Properties::CONSERVES_ENERGY.when(self.lobe.conserves_energy())
-    }
-}
-
-model_common!(Lewis(LewisParams));
-
-impl Brdf for Lewis {
-    #[inline]
-    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        self.lobe.eval(wo, wi)
-    }
-    brdf_properties!();
-    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
-        Some(crate::AnalyticLobes {
-            diffuse: self.params.kd,
-            specular: self.params.ks,
-            lobe: Some(crate::SpecularLobe::HalfVector {
-                exponent: self.params.n,
-            }),
-        })
-    }
-    fn name(&self) -> &str {
-        NAME
-    }
-}
+half_vector_model!(
+    /// Lewis-normalised Blinn–Phong BRDF.
+    Lewis(LewisParams),
+    NAME,
+    norm = |n| (n + 2.0) / (4.0 * PI * (2.0 - (-0.5 * n).exp2()))
+);
