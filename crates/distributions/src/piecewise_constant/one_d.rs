@@ -20,7 +20,7 @@ pub struct Sample1 {
 /// `n` equal cells: `p(x) = f_i / ∫f` with respect to length, sampled by inverting its CDF.
 ///
 /// ```
-/// use partition_sampler::PiecewiseConstant1D;
+/// use distributions::PiecewiseConstant1D;
 /// let d = PiecewiseConstant1D::new(vec![1.0, 3.0], 0.0, 2.0).unwrap();
 /// let s = d.sample(0.5); // the CDF reaches 0.25 at x = 1
 /// assert_eq!(s.index, 1);
