@@ -4,12 +4,13 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use stats::{
-    Axis, Binning, DEFAULT_MIN_EXPECTED, TestOutcome, chi_square_gof, expected_masses_with,
-    histogram, ks_projection_test_with_singularities, normalisation, pdf_consistency,
-    support_coverage,
+    Axis, Binning, TestOutcome, expected_masses_with, ks_projection_test_with_singularities,
+    normalisation, pdf_consistency, support_coverage,
 };
 
 use crate::cells::{CellModel, ExactTests};
+pub use crate::outcomes::names;
+pub(crate) use crate::outcomes::{chi_square, error_outcome, skipped_outcome};
 use crate::plan::Plan;
 use crate::seeding::{chunk_seed, stream_seed};
 use crate::subject::{AnySubject, Reference, SamplerUnderTest, Subject};
@@ -21,43 +22,6 @@ pub const DRAW_CHUNK: usize = 4096;
 /// declared normaliser error ([`SamplerUnderTest::normaliser_rel_err`], e.g. a Richardson
 /// estimate, which is an estimate, not a bound).
 pub const DECLARED_ERROR_FACTOR: f64 = 3.0;
-
-/// Test names, in report order.
-pub mod names {
-    /// Pearson chi-square of the one-sample draws against the reported pdf.
-    pub const CHI_SQUARE: &str = "chi-square";
-    /// Chi-square of the pooled batch draws.
-    pub const BATCH_CHI_SQUARE: &str = "batch-chi-square";
-    /// pdf returned with samples equals `pdf(x)` and is positive.
-    pub const PDF_CONSISTENCY: &str = "pdf-consistency";
-    /// `∫ pdf = 1` within the plan's tolerance.
-    pub const NORMALISATION: &str = "normalisation";
-    /// No region where the target is positive and the pdf is not.
-    pub const SUPPORT: &str = "support-coverage";
-    /// One-sample estimator z-test against the reference.
-    pub const UNBIASEDNESS: &str = "unbiasedness";
-    /// Every batch returned the number of samples asked for.
-    pub const BATCH_SIZE: &str = "batch-size";
-    /// z-test of the per-batch estimates against the reference.
-    pub const BATCH_UNBIASEDNESS: &str = "batch-unbiasedness";
-    /// Zero bound violations during the run.
-    pub const BOUND_AUDIT: &str = "bound-audit";
-    /// The sampler could be built.
-    pub const BUILD: &str = "build";
-    /// The sampler does not apply to this target (e.g. `analytic` for a model without an
-    /// analytic sampler): reported, not failed.
-    pub const SKIPPED: &str = "skipped";
-}
-
-/// A passed deterministic outcome recording that the case was skipped, and why.
-pub(crate) fn skipped_outcome(reason: impl std::fmt::Display) -> TestOutcome {
-    TestOutcome::deterministic(names::SKIPPED, f64::NAN, true, format!("skipped: {reason}"))
-}
-
-/// A failed deterministic outcome describing an error that prevented a test.
-pub(crate) fn error_outcome(name: &str, error: impl std::fmt::Display) -> TestOutcome {
-    TestOutcome::deterministic(name, f64::NAN, false, format!("error: {error}"))
-}
 
 fn renamed(mut o: TestOutcome, name: &str) -> TestOutcome {
     o.name = name.to_owned();
@@ -190,28 +154,6 @@ pub fn z_test(
         values.len()
     );
     TestOutcome::with_p_value(name, z, p, alpha, detail)
-}
-
-pub(crate) fn chi_square<P: Copy + Send + Sync>(
-    name: &str,
-    binning: &dyn Binning<Point = P>,
-    masses: &[f64],
-    points: &[P],
-    alpha: f64,
-) -> TestOutcome {
-    if points.is_empty() {
-        return error_outcome(name, "no samples");
-    }
-    let hist = histogram(binning, points);
-    let n = points.len() as f64;
-    let mut observed = hist.counts;
-    let mut expected: Vec<f64> = masses.iter().map(|m| m * n).collect();
-    observed.push(hist.outside);
-    expected.push(0.0);
-    match chi_square_gof(&observed, &expected, DEFAULT_MIN_EXPECTED) {
-        Ok(r) => r.outcome(name, alpha),
-        Err(e) => error_outcome(name, e),
-    }
 }
 
 /// Parameter coordinates of the declared singular points inside the domain, each with copies

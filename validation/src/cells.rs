@@ -24,8 +24,8 @@ use stats::{
     expected_masses_with, integrate, ks_onesample, project, projection_cdf,
 };
 
-use crate::case::{chi_square, error_outcome, names};
 use crate::domain::Domain;
+use crate::outcomes::{chi_square, error_outcome, names};
 use crate::plan::Plan;
 use crate::subject::{Dir3, SamplerUnderTest};
 

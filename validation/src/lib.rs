@@ -50,6 +50,7 @@ mod domain;
 mod error;
 mod merge;
 pub mod mutants;
+mod outcomes;
 mod plan;
 pub mod references;
 mod report;

@@ -197,6 +197,136 @@ pub(crate) const fn param(
     }
 }
 
+/// Declare a model's parameters once: the spec table (`$TABLE`, in canonical order), the
+/// parameter struct (one `f64` field a key), its `Default` (the table's defaults), and the
+/// conversions the constructors and the registry use (`values`, `from_values`, `validate`).
+///
+/// A field reads `name [as "key"] = [default] in range, "doc";` where `default` is a number or
+/// `same_as other_key`; the spec key is the field name unless `as "key"` gives another.
+macro_rules! model_params {
+    (
+        $(#[$meta:meta])*
+        pub struct $Params:ident in $TABLE:ident {
+            $(
+                $(#[$fmeta:meta])*
+                $field:ident $(as $key:literal)? = [$($def:tt)+] in $range:expr, $doc:literal;
+            )+
+        }
+    ) => {
+        pub(crate) const $TABLE: &[$crate::params::ParamInfo] = &[
+            $(
+                $crate::params::ParamInfo {
+                    key: $crate::params::model_params!(@key $field $($key)?),
+                    default: $crate::params::model_params!(@default $($def)+),
+                    range: $range,
+                    doc: $doc,
+                },
+            )+
+        ];
+
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct $Params {
+            $( $(#[$fmeta])* pub $field: f64, )+
+        }
+
+        impl Default for $Params {
+            fn default() -> Self {
+                let [$($field),+] = $crate::params::defaults($TABLE);
+                Self { $($field),+ }
+            }
+        }
+
+        #[allow(dead_code)]
+        impl $Params {
+            /// The values in table order.
+            pub(crate) fn values(&self) -> [f64; $TABLE.len()] {
+                [$(self.$field),+]
+            }
+
+            /// From values in table order; missing ones become NaN, which validation rejects.
+            pub(crate) fn from_values(v: &[f64]) -> Self {
+                let [$($field),+] = $crate::params::take(v);
+                Self { $($field),+ }
+            }
+
+            /// Check every value against the table's range, reporting errors as `model`.
+            pub(crate) fn validate(&self, model: &'static str) -> Result<(), $crate::params::ParamError> {
+                $crate::params::validate(model, $TABLE, &self.values())
+            }
+        }
+    };
+    (@key $field:ident) => { stringify!($field) };
+    (@key $field:ident $key:literal) => { $key };
+    (@default same_as $other:ident) => {
+        $crate::params::ParamDefault::SameAs(stringify!($other))
+    };
+    (@default $v:expr) => { $crate::params::ParamDefault::Value($v) };
+}
+pub(crate) use model_params;
+
+/// The scaffolding every parametric model shares, from its parameter struct: `params()`,
+/// `from_values` (the registry's builder) and `Default` (built from the default parameters).
+/// Models with a variant argument (`Ward`'s normalisation, `Microfacet`'s distribution) name
+/// it, with its default when the model has a `Default`:
+/// `model_common!(Ward(WardParams, norm: WardNormalisation = …))`.
+macro_rules! model_common {
+    ($Model:ident($Params:ident)) => {
+        $crate::params::model_common!(@impl $Model($Params));
+        impl Default for $Model {
+            fn default() -> Self {
+                $crate::params::expect_default(Self::new($Params::default()))
+            }
+        }
+    };
+    ($Model:ident($Params:ident, $arg:ident : $Arg:ty = $arg_default:expr)) => {
+        $crate::params::model_common!(@impl $Model($Params, $arg: $Arg));
+        impl Default for $Model {
+            fn default() -> Self {
+                $crate::params::expect_default(Self::new($Params::default(), $arg_default))
+            }
+        }
+    };
+    ($Model:ident($Params:ident, $arg:ident : $Arg:ty)) => {
+        $crate::params::model_common!(@impl $Model($Params, $arg: $Arg));
+    };
+    (@impl $Model:ident($Params:ident $(, $arg:ident : $Arg:ty)?)) => {
+        impl $Model {
+            /// The parameters this model was built with.
+            pub fn params(&self) -> &$Params {
+                &self.params
+            }
+
+            #[allow(dead_code)]
+            pub(crate) fn from_values(
+                v: &[f64]
+                $(, $arg: $Arg)?
+            ) -> Result<Self, $crate::params::ParamError> {
+                Self::new($Params::from_values(v) $(, $arg)?)
+            }
+        }
+    };
+}
+pub(crate) use model_common;
+
+/// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
+/// unit tests, so an error here is a bug in this crate, never a consequence of user input.
+pub(crate) fn expect_default<T>(r: Result<T, ParamError>) -> T {
+    match r {
+        Ok(v) => v,
+        Err(e) => panic!("built-in default parameters are invalid: {e}"),
+    }
+}
+
+/// Copy the first `N` values (missing ones become NaN, which validation rejects).
+pub(crate) fn take<const N: usize>(v: &[f64]) -> [f64; N] {
+    let mut out = [f64::NAN; N];
+    for (o, x) in out.iter_mut().zip(v) {
+        *o = *x;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -87,6 +87,13 @@ impl ModelInfo {
             }
             given[i] = Some(value);
         }
+        let resolved = self.resolve(&given);
+        (self.build)(&resolved).map_err(SpecError::Invalid)
+    }
+
+    /// The values in table order: `given[i]` where set, else the key's default (a `SameAs`
+    /// default follows the other key's given value or its default).
+    fn resolve(&self, given: &[Option<f64>]) -> Vec<f64> {
         let mut resolved = vec![f64::NAN; self.params.len()];
         for (i, p) in self.params.iter().enumerate() {
             resolved[i] = match (given[i], p.default) {
@@ -101,7 +108,7 @@ impl ModelInfo {
                 }
             };
         }
-        (self.build)(&resolved).map_err(SpecError::Invalid)
+        resolved
     }
 
     /// Whether the model is built from a spec argument (a file path such as `merl:PATH` or a
@@ -655,6 +662,108 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::Properties;
+
+    /// Values just inside a range (closed ends, the midpoint) and just outside it (an open end
+    /// itself, or one unit beyond a closed end).
+    fn probes(r: Range) -> (Vec<f64>, Vec<f64>) {
+        let (lo, hi) = (r.min.max(-1e3), r.max.min(1e3));
+        let mut inside = vec![0.5 * (lo + hi)];
+        let mut outside = Vec::new();
+        if r.min_open {
+            outside.push(r.min);
+        } else {
+            inside.push(r.min);
+            outside.push(r.min - 1.0);
+        }
+        if r.max_open {
+            outside.push(r.max);
+        } else {
+            inside.push(r.max);
+            outside.push(r.max + 1.0);
+        }
+        (
+            inside,
+            outside.into_iter().filter(|x| x.is_finite()).collect(),
+        )
+    }
+
+    /// Every parametric model's declared table (keys, ranges) is the one its constructor checks,
+    /// and its declared flags agree with the registry's isotropy and with each other, at the
+    /// defaults and with each parameter moved to the ends of its range.
+    #[test]
+    fn declared_ranges_and_flags_round_trip_through_the_registry() {
+        for m in models().iter().filter(|m| !m.needs_argument()) {
+            let defaults = m.resolve(&vec![None; m.params.len()]);
+            let mut anisotropic_seen = false;
+            let mut built = 0;
+            for (i, p) in m.params.iter().enumerate() {
+                let (inside, outside) = probes(p.range);
+                for v in outside {
+                    let mut values = defaults.clone();
+                    values[i] = v;
+                    match (m.build)(&values) {
+                        Err(ParamError::OutOfRange {
+                            model,
+                            key,
+                            value,
+                            range,
+                        }) => {
+                            assert_eq!((model, key, range), (m.name, p.key, p.range));
+                            assert_eq!(value.to_bits(), v.to_bits());
+                        }
+                        other => panic!(
+                            "{} {}={v}: expected OutOfRange, got {:?}",
+                            m.name,
+                            p.key,
+                            other.map(|b| b.name().to_string())
+                        ),
+                    }
+                    let spec = format!("{}:{}={v:?}", m.name, p.key);
+                    assert!(
+                        matches!(parse_spec(&spec), Err(SpecError::OutOfRange { .. })),
+                        "{spec}"
+                    );
+                }
+                for v in inside {
+                    let mut values = defaults.clone();
+                    values[i] = v;
+                    let b = match (m.build)(&values) {
+                        Ok(b) => b,
+                        // A cross-parameter constraint (e.g. Beard–Maxwell's R(0) > 0).
+                        Err(ParamError::Constraint { .. }) => continue,
+                        Err(e) => panic!("{} {}={v}: {e}", m.name, p.key),
+                    };
+                    built += 1;
+                    assert_eq!(b.name(), m.name);
+                    let f = Properties::of(&*b);
+                    if f.contains(Properties::ISOTROPIC) {
+                        assert!(f.contains(Properties::HALF_TURN_SYMMETRIC), "{}", m.name);
+                    }
+                    if f.contains(Properties::MIRROR_SYMMETRIC) {
+                        assert!(f.contains(Properties::ISOTROPIC), "{}", m.name);
+                    }
+                    let iso = f.contains(Properties::ISOTROPIC);
+                    anisotropic_seen |= !iso;
+                    match m.isotropic {
+                        Isotropy::Always => assert!(iso, "{} {}={v}", m.name, p.key),
+                        Isotropy::Never => assert!(!iso, "{} {}={v}", m.name, p.key),
+                        Isotropy::WhenParamsEqual => {}
+                    }
+                }
+            }
+            assert!(built > 0, "{}", m.name);
+            let b = (m.build)(&defaults).unwrap_or_else(|e| panic!("{}: {e}", m.name));
+            let at_defaults = Properties::of(&*b).contains(Properties::ISOTROPIC);
+            match m.isotropic {
+                Isotropy::WhenParamsEqual => {
+                    assert!(at_defaults && anisotropic_seen, "{}", m.name)
+                }
+                Isotropy::Always => assert!(at_defaults && !anisotropic_seen, "{}", m.name),
+                Isotropy::Never => assert!(!at_defaults, "{}", m.name),
+            }
+        }
+    }
 
     #[test]
     fn every_model_builds_from_defaults() {

@@ -16,10 +16,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use distributions::{Sample2, Sampler2D};
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
-use partition_sampler::{Sample2, Sampler2D};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 

@@ -8,10 +8,10 @@
 
 use std::time::Instant;
 
+use distributions::{Sample2, Sampler2D};
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
-use partition_sampler::{Sample2, Sampler2D};
 
 /// CPU seconds (user + system) of the calling thread, from `/proc/thread-self/stat` (clock
 /// ticks of 1/100 s); `None` where that file does not exist.

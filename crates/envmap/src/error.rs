@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use thiserror::Error;
 
-use crate::MapFormat;
+use crate::format::MapFormat;
 
 /// Why a map could not be loaded or validated, or a sampler not built.
 #[derive(Debug, Error)]
@@ -132,5 +132,5 @@ pub enum EnvMapError {
     Build(#[from] partition_sampler::BuildError),
     /// The piecewise-constant sampler rejected the luminance table.
     #[error("cannot build the piecewise-constant sampler: {0}")]
-    PiecewiseConstant(#[from] partition_sampler::PiecewiseConstantError),
+    PiecewiseConstant(#[from] distributions::PiecewiseConstantError),
 }

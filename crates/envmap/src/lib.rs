@@ -16,7 +16,7 @@
 //! carries `pdf_uv` (w.r.t. area on `[0,1]²`) and `pdf_sa = pdf_uv / (2π² sin(πv))` (w.r.t.
 //! solid angle). [`EnvMapSampler`] offers the adaptive-partition sampler of
 //! `partition_sampler` (exact target; envelope or paper scheme; alias or descent leaf choice)
-//! and the classic piecewise-constant CDF `partition_sampler::PiecewiseConstant2D` (midpoint
+//! and the classic piecewise-constant CDF `distributions::PiecewiseConstant2D` (midpoint
 //! approximation of the sine).
 //!
 //! ```
@@ -48,6 +48,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod error;
+mod format;
 pub mod latlong;
 mod load;
 mod map;
@@ -55,7 +56,7 @@ mod sampler;
 mod sky;
 
 pub use error::EnvMapError;
-pub use load::MapFormat;
+pub use format::MapFormat;
 pub use map::{EnvMap, MAX_PIXELS, luminance};
 pub use partition_sampler::{LeafChoice, Scheme, TreeParams};
 pub use sampler::{AdaptiveOptions, EnvMapSampler, EnvSample, SamplerKind};

@@ -2,10 +2,10 @@
 
 use std::time::{Duration, Instant};
 
+use distributions::{PiecewiseConstant2D, Point2, Rect, Sample2, Sampler2D, UniformSource};
 use partition_sampler::{
-    LeafChoice, MemoryReport, PiecewiseConstant2D, Point2, QuadTreeBuilder, QuadTreeSampler, Rect,
-    Sample2, Sampler2D, SamplerStats, Scheme, SinPiRows, TabulatedDensity, TreeParams,
-    UniformSource,
+    LeafChoice, MemoryReport, QuadTreeBuilder, QuadTreeSampler, SamplerStats, Scheme, SinPiRows,
+    TabulatedDensity, TreeParams,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -250,11 +250,11 @@ impl EnvMapSampler {
         EnvSample::from_uv(self.sample_uv(u))
     }
 
-    /// `n` planar samples drawn in parallel by [`partition_sampler::sample_par`] (fixed chunks of
-    /// `partition_sampler::PAR_CHUNK`, one generator per chunk seeded from `(seed, chunk)`): the
+    /// `n` planar samples drawn in parallel by [`distributions::sample_par`] (fixed chunks of
+    /// `distributions::PAR_CHUNK`, one generator per chunk seeded from `(seed, chunk)`): the
     /// result depends only on `(n, seed)`, never on the thread count.
     pub fn sample_uv_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
-        partition_sampler::sample_par(self, n, seed)
+        distributions::sample_par(self, n, seed)
     }
 
     /// `n` directions drawn in parallel: [`EnvMapSampler::sample_uv_par`] completed (also in

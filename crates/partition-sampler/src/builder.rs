@@ -10,10 +10,7 @@ use crate::tree::{
     EMPTY, LEAF, LeafChoice, Node, QuadTree, Scheme, TreeCounts, TreeParams, cell_rect,
 };
 
-/// Largest accepted `max_depth` (cells of `2^-24` of the domain). Leaves store their
-/// rectangles as `f32` (root-normalised, or domain coordinates for dyadic roots), in which
-/// every cell edge down to this depth is exact; a deeper limit would need another encoding.
-pub const MAX_DEPTH_LIMIT: u32 = 24;
+pub use crate::limits::MAX_DEPTH_LIMIT;
 
 /// Builds a [`QuadTreeSampler`] from a [`RegionStats`] provider.
 ///

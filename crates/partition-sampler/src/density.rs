@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::contract::Point2;
 use crate::error::DensityError;
 use crate::rect::{Domain, Rect};
+pub use crate::shape::{DensityShape, ProviderKind};
 
 /// A non-negative function `f` on the plane, evaluated pointwise.
 ///
@@ -71,34 +72,6 @@ pub enum IntegralSource {
     GridEstimate,
     /// Per-cell quadrature at a caller-given resolution.
     Quadrature,
-}
-
-/// Which provider built a tree: used to check that a stored tree is re-attached to a
-/// compatible density.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ProviderKind {
-    /// [`crate::TabulatedDensity`].
-    Tabulated,
-    /// [`crate::SampledGridDensity`].
-    SampledGrid,
-    /// [`crate::UserBoundDensity`].
-    UserBound,
-    /// Any other implementation of [`RegionStats`].
-    Custom,
-}
-
-/// Identity of a density as far as a stored tree is concerned.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct DensityShape {
-    /// The provider type.
-    pub kind: ProviderKind,
-    /// The domain.
-    pub domain: Domain,
-    /// Grid dimensions (width, height), or quadrature resolution, or `[0, 0]`.
-    pub dims: [u64; 2],
-    /// A provider-defined fingerprint of the data (e.g. the bits of the total integral);
-    /// 0 when the provider has none.
-    pub fingerprint: u64,
 }
 
 /// A density that can also bound and integrate itself over rectangles: what the quadtree

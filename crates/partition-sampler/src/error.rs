@@ -107,7 +107,7 @@ pub enum BuildError {
     #[error("n_max = {0} must be finite and ≥ 1")]
     InvalidNMax(f64),
     /// `max_depth` exceeds the supported limit.
-    #[error("max_depth = {0} exceeds the limit {max}", max = crate::builder::MAX_DEPTH_LIMIT)]
+    #[error("max_depth = {0} exceeds the limit {max}", max = crate::limits::MAX_DEPTH_LIMIT)]
     MaxDepthTooLarge(u32),
     /// `min_leaf_size` must be finite and ≥ 0.
     #[error("min_leaf_size = {0} must be finite and ≥ 0")]
@@ -191,9 +191,9 @@ pub enum AttachError {
     #[error("density shape {found:?} differs from the tree's {expected:?}")]
     ShapeMismatch {
         /// The tree's shape.
-        expected: Box<crate::density::DensityShape>,
+        expected: Box<crate::shape::DensityShape>,
         /// The density's shape.
-        found: Box<crate::density::DensityShape>,
+        found: Box<crate::shape::DensityShape>,
     },
     /// The tree violates a structural invariant.
     #[error("corrupt tree: {0}")]

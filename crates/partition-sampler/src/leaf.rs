@@ -21,7 +21,7 @@ use crate::rect::Rect;
 pub(crate) const MAX_F32_EXACT_DEPTH: u32 = 24;
 
 // Every cell edge must be exact in f32: the builder cannot go deeper than 24 levels.
-const _: () = assert!(crate::builder::MAX_DEPTH_LIMIT <= MAX_F32_EXACT_DEPTH);
+const _: () = assert!(crate::limits::MAX_DEPTH_LIMIT <= MAX_F32_EXACT_DEPTH);
 
 /// The affine map `x = origin + u · extent` (per axis, in `f64`) from stored leaf
 /// coordinates to the domain; a function of the root rectangle only.

@@ -49,24 +49,25 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod alias;
 pub mod allocate;
 mod audit;
+// The general planar machinery lives in the `distributions` crate: the sampler contract,
+// alias tables, index helpers, rectangles and domains, parallel sampling and the
+// piecewise-constant tables. Re-exported here so that `partition_sampler::X` keeps working.
+pub use distributions::contract;
+use distributions::{alias, index, rect};
 mod builder;
-pub mod contract;
 mod density;
 mod error;
-mod index;
 #[cfg(test)]
 mod layout_tests;
 mod leaf;
-mod parallel;
+mod limits;
 mod persist;
-mod piecewise_constant;
 mod pyramid;
 mod quadtree_sampler;
-mod rect;
 mod sampled;
+mod shape;
 mod tabulated;
 mod tree;
 mod user_bound;
@@ -80,17 +81,19 @@ pub use contract::{
 pub use density::{
     Density, DensityShape, IntegralSource, ProviderKind, RegionEstimate, RegionStats, SharedDensity,
 };
-pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
-pub use parallel::{PAR_CHUNK, Shard, ShardError, chunk_rng, chunk_seed, sample_par};
-pub use persist::FORMAT_VERSION;
-pub use piecewise_constant::{
+pub use distributions::parallel::{
+    PAR_CHUNK, Shard, ShardError, chunk_rng, chunk_seed, sample_par,
+};
+pub use distributions::piecewise_constant::{
     PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1, fill_cdf,
     fill_guide, find_cell, find_cell_guided,
 };
+pub use distributions::rect::{Domain, Rect};
+pub use error::{AllocationError, AttachError, BuildError, DensityError, PersistError};
+pub use persist::FORMAT_VERSION;
 pub use quadtree_sampler::{
     Batch, MAX_TRIALS_PER_SAMPLE, MemoryReport, QuadTreeSampler, SamplerStats,
 };
-pub use rect::{Domain, Rect};
 pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,

@@ -79,7 +79,7 @@ impl TreeParams {
         if !(self.n_max.is_finite() && self.n_max >= 1.0) {
             return Err(BuildError::InvalidNMax(self.n_max));
         }
-        if self.max_depth > crate::MAX_DEPTH_LIMIT {
+        if self.max_depth > crate::limits::MAX_DEPTH_LIMIT {
             return Err(BuildError::MaxDepthTooLarge(self.max_depth));
         }
         if !(self.min_leaf_size.is_finite() && self.min_leaf_size >= 0.0) {
@@ -407,7 +407,7 @@ impl QuadTree {
     /// Structural checks (so decoded bytes can never make sampling index out of range or loop).
     pub(crate) fn validate(&self) -> Result<(), &'static str> {
         let p = &self.params;
-        if !(p.n_max.is_finite() && p.n_max >= 1.0) || p.max_depth > crate::builder::MAX_DEPTH_LIMIT
+        if !(p.n_max.is_finite() && p.n_max >= 1.0) || p.max_depth > crate::limits::MAX_DEPTH_LIMIT
         {
             return Err("invalid parameters");
         }

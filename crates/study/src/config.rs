@@ -189,7 +189,7 @@ pub struct StudyConfig {
     pub timing_repeats: usize,
     /// Outgoing slices of the adaptive sets.
     pub slices: usize,
-    /// Master seed; cell `i` uses `partition_sampler::chunk_seed(seed, i)`.
+    /// Master seed; cell `i` uses `distributions::chunk_seed(seed, i)`.
     pub seed: u64,
     /// Estimators besides BRDF sampling alone, run under the map lights (the sky and map
     /// files) only: `light` (each of [`Self::light_samplers`] alone), `mis-balance`,
@@ -415,7 +415,7 @@ fn find_candidate(root: Option<&std::path::Path>, candidates: &[&str]) -> Option
 }
 
 /// One part of a study run on its own: cells `i` with `i % count == index - 1`.
-pub use partition_sampler::Shard;
+pub use distributions::Shard;
 
 /// One cell of the grid.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

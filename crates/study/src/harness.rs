@@ -20,7 +20,7 @@
 //!   has one (and the wall clock beside); the median and the spread are kept.
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
-//! `partition_sampler::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
+//! `distributions::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it.
 
 use std::sync::{Arc, Mutex};
@@ -581,7 +581,7 @@ impl StudyPlan {
             mode: c.spec.mode,
             wo,
         };
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(distributions::chunk_seed(
             cfg.seed,
             c.spec.index as u64,
         ));
@@ -716,7 +716,7 @@ impl StudyPlan {
                 mode: c.spec.mode,
                 wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
             },
-            rng: Xoshiro256PlusPlus::seed_from_u64(partition_sampler::chunk_seed(
+            rng: Xoshiro256PlusPlus::seed_from_u64(distributions::chunk_seed(
                 cfg.seed ^ 0x7469_6d65,
                 c.spec.index as u64,
             )),
@@ -1023,7 +1023,7 @@ mod tests {
     struct BrokenCosine;
 
     impl DirectionSampler for BrokenCosine {
-        fn sample(&self, wo: &Vec3, u: &mut dyn partition_sampler::UniformSource) -> DirSample {
+        fn sample(&self, wo: &Vec3, u: &mut dyn distributions::UniformSource) -> DirSample {
             let s = baselines_cosine().sample(wo, u);
             DirSample {
                 pdf: 1.25 * s.pdf,
@@ -1181,7 +1181,7 @@ mod build_warning_tests {
     use super::*;
     use brdf::Vec3;
     use brdf_sampling::{DirSample, DirectionSampler};
-    use partition_sampler::UniformSource;
+    use distributions::UniformSource;
 
     /// A sampler whose report carries one warning line among others.
     struct Warns;

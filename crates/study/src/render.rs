@@ -31,8 +31,8 @@ use std::time::Instant;
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::DirectionSampler;
+use distributions::{UniformSource, chunk_seed};
 use envmap::{AdaptiveOptions, EnvMapSampler};
-use partition_sampler::{UniformSource, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;

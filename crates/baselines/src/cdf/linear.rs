@@ -6,26 +6,15 @@
 //! between. Its density (w.r.t. the grid coordinate) is the slope of the segment,
 //! `(C_{m+1} − C_m) / (x_{m+1} − x_m)`. The uncompressed CDF has `x_m = m` (every cell edge).
 
-/// The largest `f64` below 1.
-pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
-
-/// Maps any number to `[0, 1)`: NaN and negatives to 0, values ≥ 1 to [`ONE_MINUS_EPSILON`].
-#[inline]
-pub(crate) fn clamp_unit(u: f64) -> f64 {
-    if u >= 0.0 {
-        u.min(ONE_MINUS_EPSILON)
-    } else {
-        0.0
-    }
-}
+use distributions::clamp_unit;
 
 /// The normalised running sum of cell masses (a zero-mass row gets the uniform CDF,
 /// baselines.md §B.5): the planar CDFs' own routine.
-pub(crate) use partition_sampler::fill_cdf;
+pub(crate) use distributions::fill_cdf;
 
 /// The segment `m` with `C_m ≤ u < C_{m+1}` for `u ∈ [0, 1)` and the position `du ∈ [0, 1)` of
 /// `u` inside it (the planar CDFs' cell search; the segment found always has positive mass).
-pub(crate) use partition_sampler::find_cell as find_segment;
+pub(crate) use distributions::find_cell as find_segment;
 
 /// The segment `m` with `x_m ≤ t < x_{m+1}` (clamped to the first and last segment).
 #[inline]
@@ -65,11 +54,11 @@ pub(crate) fn draw(xs: &[u32], cs: &[f64], u: f64) -> Draw {
 }
 
 /// [`draw`] on the uncompressed axis `x_m = m` (every cell edge kept, `xs` implicit); the
-/// segment is found from `guide` ([`partition_sampler::fill_guide`] of `cs`), which gives the
+/// segment is found from `guide` ([`distributions::fill_guide`] of `cs`), which gives the
 /// binary search's segment exactly.
 #[inline]
 pub(crate) fn draw_uniform(cs: &[f64], guide: &[u32], u: f64) -> Draw {
-    let (m, du) = partition_sampler::find_cell_guided(cs, guide, clamp_unit(u));
+    let (m, du) = distributions::find_cell_guided(cs, guide, clamp_unit(u));
     let x0 = m as f64;
     let mut t = x0 + du;
     if !(t > 0.0 && t >= x0 && t < x0 + 1.0) {

@@ -10,7 +10,7 @@ use brdf_sampling::{
     CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SliceLayout,
     SliceLocator,
 };
-use partition_sampler::UniformSource;
+use distributions::UniformSource;
 use rayon::prelude::*;
 
 use super::grid::{GridShape, slice_values};

@@ -14,7 +14,7 @@ use crate::CdfOptions;
 /// piecewise constant, `p(z, φ) = (M_a / Σ M) / Δz · (g_ab / M_a) / Δφ = g_ab / (Σ g Δz Δφ)`,
 /// which is a solid-angle density since `dz dφ = dω`.
 ///
-/// Sampling starts each CDF search from a guide table ([`partition_sampler::fill_guide`], one
+/// Sampling starts each CDF search from a guide table ([`distributions::fill_guide`], one
 /// `u32` per `GUIDE_CELLS` = 8 cells, +6 % of the table's memory) instead of a binary search
 /// over the row: the same cell for every `u`, one or two cache lines read instead of ~9
 /// dependent probes of a 4 KiB row.
@@ -48,14 +48,14 @@ impl TabulatedSlice {
         let mut marginal = vec![0.0; shape.n_z + 1];
         fill_cdf(&row_sums, &mut marginal);
         let mut marginal_guide = vec![0; guide_len(shape.n_z)];
-        partition_sampler::fill_guide(&marginal, &mut marginal_guide);
+        distributions::fill_guide(&marginal, &mut marginal_guide);
         let g = guide_len(n_phi);
         let mut conditional_guide = vec![0; shape.n_z * g];
         for (cdf, guide) in conditional
             .chunks_exact(n_phi + 1)
             .zip(conditional_guide.chunks_exact_mut(g))
         {
-            partition_sampler::fill_guide(cdf, guide);
+            distributions::fill_guide(cdf, guide);
         }
         Self {
             marginal,

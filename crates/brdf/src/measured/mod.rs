@@ -5,5 +5,6 @@
 pub mod cornell;
 pub mod merl_albedo;
 pub mod rgl;
+mod rgl_error;
 pub mod tensor;
 pub mod warp;

@@ -7,7 +7,7 @@
 //! 10 = `f32` (Mitsuba's `Struct::Type` numbering: 0 invalid, 1 u8, 2 i8, 3 u16, 4 i16, 5 u32,
 //! 6 i32, 7 u64, 8 i64, 9 f16, 10 f32, 11 f64).
 
-use super::rgl::RglError;
+use super::rgl_error::RglError;
 
 /// The magic bytes at the start of a tensor file.
 pub const MAGIC: &[u8; 12] = b"tensor_file\0";

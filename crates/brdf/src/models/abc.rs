@@ -15,6 +15,7 @@
 //! reciprocal; bounded at the horizon (`G ≤ 2 cos θh cos θi/(ωi·h)` cancels `1/cos θi`); not
 //! energy-conserving by construction.
 
+use super::{Properties, brdf_properties};
 use crate::brdf::{Brdf, luminance};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
@@ -93,6 +94,11 @@ impl Abc {
     pub fn params(&self) -> &AbcParams {
         &self.params
     }
+
+    /// Symmetries: isotropic, even under `y ↦ −y`, reciprocal; energy not guaranteed.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL
+    }
 }
 
 impl Brdf for Abc {
@@ -119,18 +125,7 @@ impl Brdf for Abc {
         out
     }
 
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

@@ -12,52 +12,25 @@
 //! only approximately); the tests confirm albedo ≤ 1 for `rs, rd ≤ 1` at the angles checked, and
 //! `conserves_energy()` reports true.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamDefault, ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "ashikhmin-shirley";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "nu",
-        100.0,
-        Range::closed(0.0, 1e5),
-        "Phong exponent along the tangent x",
-    ),
-    ParamInfo {
-        key: "nv",
-        default: ParamDefault::SameAs("nu"),
-        range: Range::closed(0.0, 1e5),
-        doc: "Phong exponent along the bitangent y",
-    },
-    param(
-        "rs",
-        0.3,
-        Range::closed(0.0, 1.0),
-        "specular reflectance at normal incidence",
-    ),
-    param("rd", 0.6, Range::closed(0.0, 1.0), "diffuse reflectance"),
-];
-
-/// Parameters of [`AshikhminShirley`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AshikhminShirleyParams {
-    /// Exponent along x.
-    pub nu: f64,
-    /// Exponent along y.
-    pub nv: f64,
-    /// Specular reflectance.
-    pub rs: f64,
-    /// Diffuse reflectance.
-    pub rd: f64,
-}
-
-impl Default for AshikhminShirleyParams {
-    fn default() -> Self {
-        let [nu, nv, rs, rd] = defaults(PARAMS);
-        Self { nu, nv, rs, rd }
+model_params! {
+    /// Parameters of [`AshikhminShirley`].
+    pub struct AshikhminShirleyParams in PARAMS {
+        /// Exponent along x.
+        nu = [100.0] in Range::closed(0.0, 1e5), "Phong exponent along the tangent x";
+        /// Exponent along y.
+        nv = [same_as nu] in Range::closed(0.0, 1e5), "Phong exponent along the bitangent y";
+        /// Specular reflectance.
+        rs = [0.3] in Range::closed(0.0, 1.0), "specular reflectance at normal incidence";
+        /// Diffuse reflectance.
+        rd = [0.6] in Range::closed(0.0, 1.0), "diffuse reflectance";
     }
 }
 
@@ -72,7 +45,7 @@ pub struct AshikhminShirley {
 impl AshikhminShirley {
     /// Validate the parameters and build the model.
     pub fn new(params: AshikhminShirleyParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.nu, params.nv, params.rs, params.rd])?;
+        params.validate(NAME)?;
         Ok(Self {
             params,
             spec_scale: ((params.nu + 1.0) * (params.nv + 1.0)).sqrt() / (8.0 * PI),
@@ -80,22 +53,18 @@ impl AshikhminShirley {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &AshikhminShirleyParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [nu, nv, rs, rd] = super::take(v);
-        Self::new(AshikhminShirleyParams { nu, nv, rs, rd })
-    }
-}
-
-impl Default for AshikhminShirley {
-    fn default() -> Self {
-        super::expect_default(Self::new(AshikhminShirleyParams::default()))
+    /// Symmetries and energy: half-turn symmetric for all `nu, nv` (terms in `h_x²`, `h_y²`),
+    /// isotropic and mirror-symmetric iff `nu = nv`; reciprocal; conserves energy.
+    pub fn properties(&self) -> Properties {
+        Properties::HALF_TURN_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY
+            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
+                .when(self.params.nu == self.params.nv)
     }
 }
+
+model_common!(AshikhminShirley(AshikhminShirleyParams));
 
 #[inline]
 fn pow5(x: f64) -> f64 {
@@ -124,23 +93,7 @@ impl Brdf for AshikhminShirley {
         let diff = self.diff_scale * (1.0 - pow5(1.0 - 0.5 * ci)) * (1.0 - pow5(1.0 - 0.5 * co));
         spec + diff
     }
-    fn is_isotropic(&self) -> bool {
-        self.params.nu == self.params.nv
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): h_x², h_y², ωi·h and cosines only.
-        self.is_isotropic()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Even under (x, y) ↦ (−x, −y) for all nu, nv: h_x², h_y², ωi·h and cosines only.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

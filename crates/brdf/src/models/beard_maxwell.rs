@@ -20,99 +20,34 @@
 //! `ior ∈ (0, 100]` (default 0.2), `kappa ∈ [0, 100]` (default 3). Reciprocal and isotropic;
 //! not energy-conserving in general.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, PI};
 
 pub(crate) const NAME: &str = "beard-maxwell";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "rs",
-        0.7,
-        Range::closed(0.0, 1.0),
-        "first-surface (specular) reflectance",
-    ),
-    param(
-        "rd",
-        0.5,
-        Range::closed(0.0, 1.0),
-        "volumetric Lambertian reflectance",
-    ),
-    param(
-        "rv",
-        0.2,
-        Range::closed(0.0, 1.0),
-        "volumetric directional reflectance",
-    ),
-    param(
-        "sigma",
-        0.15,
-        Range::closed(0.005, 1.0),
-        "facet tilt spread σ (radians)",
-    ),
-    param(
-        "omega",
-        1.0,
-        Range::left_open(0.0, 90.0),
-        "obscuration constant Ω (degrees)",
-    ),
-    param(
-        "tau",
-        0.0,
-        Range::closed(0.0, 90.0),
-        "shadowing decay τ (degrees; 0 = no shadowing recovery)",
-    ),
-    param(
-        "ior",
-        0.2,
-        Range::left_open(0.0, 100.0),
-        "refractive index, real part",
-    ),
-    param(
-        "kappa",
-        3.0,
-        Range::closed(0.0, 100.0),
-        "refractive index, imaginary part",
-    ),
-];
-
-/// Parameters of [`BeardMaxwell`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BeardMaxwellParams {
-    /// First-surface reflectance.
-    pub rs: f64,
-    /// Volumetric Lambertian reflectance.
-    pub rd: f64,
-    /// Volumetric directional reflectance.
-    pub rv: f64,
-    /// Facet tilt spread (radians).
-    pub sigma: f64,
-    /// Obscuration constant Ω (degrees).
-    pub omega: f64,
-    /// Shadowing decay τ (degrees).
-    pub tau: f64,
-    /// Refractive index (real).
-    pub ior: f64,
-    /// Extinction coefficient.
-    pub kappa: f64,
-}
-
-impl Default for BeardMaxwellParams {
-    fn default() -> Self {
-        let [rs, rd, rv, sigma, omega, tau, ior, kappa] = defaults(PARAMS);
-        Self {
-            rs,
-            rd,
-            rv,
-            sigma,
-            omega,
-            tau,
-            ior,
-            kappa,
-        }
+model_params! {
+    /// Parameters of [`BeardMaxwell`].
+    pub struct BeardMaxwellParams in PARAMS {
+        /// First-surface reflectance.
+        rs = [0.7] in Range::closed(0.0, 1.0), "first-surface (specular) reflectance";
+        /// Volumetric Lambertian reflectance.
+        rd = [0.5] in Range::closed(0.0, 1.0), "volumetric Lambertian reflectance";
+        /// Volumetric directional reflectance.
+        rv = [0.2] in Range::closed(0.0, 1.0), "volumetric directional reflectance";
+        /// Facet tilt spread (radians).
+        sigma = [0.15] in Range::closed(0.005, 1.0), "facet tilt spread σ (radians)";
+        /// Obscuration constant Ω (degrees).
+        omega = [1.0] in Range::left_open(0.0, 90.0), "obscuration constant Ω (degrees)";
+        /// Shadowing decay τ (degrees).
+        tau = [0.0] in Range::closed(0.0, 90.0), "shadowing decay τ (degrees; 0 = no shadowing recovery)";
+        /// Refractive index (real).
+        ior = [0.2] in Range::left_open(0.0, 100.0), "refractive index, real part";
+        /// Extinction coefficient.
+        kappa = [3.0] in Range::closed(0.0, 100.0), "refractive index, imaginary part";
     }
 }
 
@@ -129,11 +64,7 @@ impl BeardMaxwell {
     /// Validate the parameters and build the model.
     pub fn new(params: BeardMaxwellParams) -> Result<Self, ParamError> {
         let p = params;
-        validate(
-            NAME,
-            PARAMS,
-            &[p.rs, p.rd, p.rv, p.sigma, p.omega, p.tau, p.ior, p.kappa],
-        )?;
+        p.validate(NAME)?;
         let r0 = fresnel_conductor(1.0, p.ior, p.kappa);
         if !(r0 > 0.0) {
             return Err(ParamError::Constraint {
@@ -151,31 +82,14 @@ impl BeardMaxwell {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &BeardMaxwellParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [rs, rd, rv, sigma, omega, tau, ior, kappa] = super::take(v);
-        Self::new(BeardMaxwellParams {
-            rs,
-            rd,
-            rv,
-            sigma,
-            omega,
-            tau,
-            ior,
-            kappa,
-        })
+    /// Symmetries: isotropic, even under `y ↦ −y`, reciprocal; the shadowing term leaves `f_r`
+    /// unbounded at the horizon; energy conservation is not guaranteed.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL | Properties::UNBOUNDED_AT_HORIZON
     }
 }
 
-impl Default for BeardMaxwell {
-    fn default() -> Self {
-        super::expect_default(Self::new(BeardMaxwellParams::default()))
-    }
-}
+model_common!(BeardMaxwell(BeardMaxwellParams));
 
 impl Brdf for BeardMaxwell {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
@@ -201,24 +115,7 @@ impl Brdf for BeardMaxwell {
         let vol = p.rd * FRAC_1_PI + 2.0 * p.rv * FRAC_1_PI / (ci + co);
         first + vol
     }
-    fn bounded_at_horizon(&self) -> bool {
-        // The first-surface term carries 1/(cosθi cosθo).
-        false
-    }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): n·h, ωi·h and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

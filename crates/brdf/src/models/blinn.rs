@@ -8,48 +8,22 @@
 //! The albedo is largest at normal incidence (checked numerically in the tests), so the model
 //! conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
-use super::half_vector_lobe::HalfVectorLobe;
-use crate::brdf::Brdf;
-use crate::geometry::Vec3;
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use super::half_vector_lobe::half_vector_model;
+use super::model_params;
+use crate::params::Range;
 use std::f64::consts::PI;
 
 pub(crate) const NAME: &str = "blinn";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("n", 100.0, Range::closed(0.0, 1e5), "half-vector exponent"),
-    param(
-        "ks",
-        0.6,
-        Range::closed(0.0, 1.0),
-        "specular albedo at normal incidence",
-    ),
-    param("kd", 0.4, Range::closed(0.0, 1.0), "diffuse albedo"),
-];
-
-/// Blinn–Phong BRDF (normalised half-vector cosine lobe).
-#[derive(Debug, Clone)]
-pub struct Blinn {
-    params: BlinnParams,
-    lobe: HalfVectorLobe,
-}
-
-/// Parameters of [`Blinn`] (SPEC keys `n`, `ks`, `kd`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BlinnParams {
-    /// Half-vector exponent `n ∈ [0, 10⁵]`.
-    pub n: f64,
-    /// Specular albedo at normal incidence, in `[0, 1]`.
-    pub ks: f64,
-    /// Diffuse albedo, in `[0, 1]`.
-    pub kd: f64,
-}
-
-impl Default for BlinnParams {
-    /// n = 100, ks = 0.6, kd = 0.4.
-    fn default() -> Self {
-        let [n, ks, kd] = defaults(PARAMS);
-        Self { n, ks, kd }
+model_params! {
+    /// Parameters of [`Blinn`] (SPEC keys `n`, `ks`, `kd`).
+    pub struct BlinnParams in PARAMS {
+        /// Half-vector exponent `n ∈ [0, 10⁵]`.
+        n = [100.0] in Range::closed(0.0, 1e5), "half-vector exponent";
+        /// Specular albedo at normal incidence, in `[0, 1]`.
+        ks = [0.6] in Range::closed(0.0, 1.0), "specular albedo at normal incidence";
+        /// Diffuse albedo, in `[0, 1]`.
+        kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
 }
 
@@ -58,67 +32,9 @@ pub fn blinn_defaults() -> BlinnParams {
     BlinnParams::default()
 }
 
-impl Blinn {
-    /// Validate the parameters and build the model.
-    pub fn new(params: BlinnParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
-        let n = params.n;
-        let norm = (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()));
-        Ok(Self {
-            params,
-            lobe: HalfVectorLobe::new(n, params.ks, params.kd, norm),
-        })
-    }
-
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &BlinnParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [n, ks, kd] = super::take(v);
-        Self::new(BlinnParams { n, ks, kd })
-    }
-}
-
-impl Default for Blinn {
-    fn default() -> Self {
-        super::expect_default(Self::new(blinn_defaults()))
-    }
-}
-
-impl Brdf for Blinn {
-    #[inline]
-    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        self.lobe.eval(wo, wi)
-    }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): n·h only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.lobe.conserves_energy()
-    }
-    fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
-        Some(crate::AnalyticLobes {
-            diffuse: self.params.kd,
-            specular: self.params.ks,
-            lobe: Some(crate::SpecularLobe::HalfVector {
-                exponent: self.params.n,
-            }),
-        })
-    }
-    fn name(&self) -> &str {
-        NAME
-    }
-}
+half_vector_model!(
+    /// Blinn–Phong BRDF (normalised half-vector cosine lobe).
+    Blinn(BlinnParams),
+    NAME,
+    norm = |n| (n + 2.0) * (n + 4.0) / (8.0 * PI * (n + (-0.5 * n).exp2()))
+);

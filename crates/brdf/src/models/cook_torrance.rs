@@ -13,48 +13,26 @@
 //! `kd + ks ≤ 1`. Keys: `m ∈ [0.001, 2]` (RMS slope, default 0.2), `ior ∈ (1, 100]`
 //! (default 1.5), `ks ∈ [0, 1]` (default 0.8), `kd ∈ [0, 1]` (default 0.2). Reciprocal, isotropic.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, PI};
 
 pub(crate) const NAME: &str = "cook-torrance";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "m",
-        0.2,
-        Range::closed(0.001, 2.0),
-        "RMS microfacet slope (Beckmann)",
-    ),
-    param(
-        "ior",
-        1.5,
-        Range::left_open(1.0, 100.0),
-        "relative index of refraction (Fresnel)",
-    ),
-    param("ks", 0.8, Range::closed(0.0, 1.0), "specular weight"),
-    param("kd", 0.2, Range::closed(0.0, 1.0), "diffuse albedo"),
-];
-
-/// Parameters of [`CookTorrance`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CookTorranceParams {
-    /// RMS slope `m`.
-    pub m: f64,
-    /// Index of refraction.
-    pub ior: f64,
-    /// Specular weight.
-    pub ks: f64,
-    /// Diffuse albedo.
-    pub kd: f64,
-}
-
-impl Default for CookTorranceParams {
-    fn default() -> Self {
-        let [m, ior, ks, kd] = defaults(PARAMS);
-        Self { m, ior, ks, kd }
+model_params! {
+    /// Parameters of [`CookTorrance`].
+    pub struct CookTorranceParams in PARAMS {
+        /// RMS slope `m`.
+        m = [0.2] in Range::closed(0.001, 2.0), "RMS microfacet slope (Beckmann)";
+        /// Index of refraction.
+        ior = [1.5] in Range::left_open(1.0, 100.0), "relative index of refraction (Fresnel)";
+        /// Specular weight.
+        ks = [0.8] in Range::closed(0.0, 1.0), "specular weight";
+        /// Diffuse albedo.
+        kd = [0.2] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
 }
 
@@ -70,7 +48,7 @@ pub struct CookTorrance {
 impl CookTorrance {
     /// Validate the parameters and build the model.
     pub fn new(params: CookTorranceParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.m, params.ior, params.ks, params.kd])?;
+        params.validate(NAME)?;
         let m2 = params.m * params.m;
         Ok(Self {
             params,
@@ -80,22 +58,16 @@ impl CookTorrance {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &CookTorranceParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [m, ior, ks, kd] = super::take(v);
-        Self::new(CookTorranceParams { m, ior, ks, kd })
+    /// Symmetries and energy: `n·h`, `ωo·h` and cosines only (isotropic, even under `y ↦ −y`),
+    /// reciprocal; conserves energy iff `kd + ks ≤ 1`.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
 
-impl Default for CookTorrance {
-    fn default() -> Self {
-        super::expect_default(Self::new(CookTorranceParams::default()))
-    }
-}
+model_common!(CookTorrance(CookTorranceParams));
 
 impl Brdf for CookTorrance {
     #[inline]
@@ -114,23 +86,7 @@ impl Brdf for CookTorrance {
         let f = fresnel_dielectric(vh, self.params.ior);
         self.diffuse + self.params.ks * f * d * g / (4.0 * ci * co)
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): n·h, ωo·h and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
-    }
+    brdf_properties!();
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.kd,

@@ -17,30 +17,15 @@
 //! false. Keys: `m ∈ [0.01, 1]` (default 0.2), `f0 ∈ [0, 1]` (default 0.1), `kd ∈ [0, 1]`
 //! (default 0.8). Isotropic.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_schlick;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 
 pub(crate) const NAME: &str = "coupled";
-
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "m",
-        0.2,
-        Range::closed(0.01, 1.0),
-        "RMS microfacet slope (Beckmann)",
-    ),
-    param(
-        "f0",
-        0.1,
-        Range::closed(0.0, 1.0),
-        "Fresnel reflectance at normal incidence",
-    ),
-    param("kd", 0.8, Range::closed(0.0, 1.0), "matte albedo"),
-];
 
 /// Number of intervals of the albedo table.
 const TABLE_INTERVALS: usize = 256;
@@ -52,21 +37,15 @@ fn node(i: usize) -> f64 {
     x * x
 }
 
-/// Parameters of [`Coupled`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CoupledParams {
-    /// Beckmann RMS slope.
-    pub m: f64,
-    /// Schlick `f0`.
-    pub f0: f64,
-    /// Matte albedo.
-    pub kd: f64,
-}
-
-impl Default for CoupledParams {
-    fn default() -> Self {
-        let [m, f0, kd] = defaults(PARAMS);
-        Self { m, f0, kd }
+model_params! {
+    /// Parameters of [`Coupled`].
+    pub struct CoupledParams in PARAMS {
+        /// Beckmann RMS slope.
+        m = [0.2] in Range::closed(0.01, 1.0), "RMS microfacet slope (Beckmann)";
+        /// Schlick `f0`.
+        f0 = [0.1] in Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence";
+        /// Matte albedo.
+        kd = [0.8] in Range::closed(0.0, 1.0), "matte albedo";
     }
 }
 
@@ -87,7 +66,7 @@ pub struct Coupled {
 impl Coupled {
     /// Validate the parameters, tabulate the specular albedo and build the model.
     pub fn new(params: CoupledParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.m, params.f0, params.kd])?;
+        params.validate(NAME)?;
         let m2 = params.m * params.m;
         let mut model = Self {
             params,
@@ -129,11 +108,6 @@ impl Coupled {
         Ok(model)
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &CoupledParams {
-        &self.params
-    }
-
     /// Tabulated specular albedo `a(ω)` for `cosθ = mu` (linear interpolation, clamped to [0, 1]).
     pub fn specular_albedo_at(&self, mu: f64) -> f64 {
         let mu = mu.clamp(0.0, 1.0);
@@ -144,11 +118,6 @@ impl Coupled {
             (Some(a0), Some(a1)) => a0 + t * (a1 - a0),
             _ => 0.0,
         }
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [m, f0, kd] = super::take(v);
-        Self::new(CoupledParams { m, f0, kd })
     }
 
     #[inline]
@@ -214,13 +183,17 @@ impl Coupled {
         }
         total
     }
-}
 
-impl Default for Coupled {
-    fn default() -> Self {
-        super::expect_default(Self::new(CoupledParams::default()))
+    /// Symmetries and energy: isotropic, even under `y ↦ −y`, reciprocal; conserves energy when
+    /// the tabulated albedo stays at most 1.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY.when(self.max_raw_albedo <= 1.0 + 1e-9)
     }
 }
+
+model_common!(Coupled(CoupledParams));
 
 impl Brdf for Coupled {
     #[inline]
@@ -233,23 +206,7 @@ impl Brdf for Coupled {
             * (1.0 - self.specular_albedo_at(wi.z));
         self.specular(wo, wi) + matte
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): n·h, ωi·h and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.max_raw_albedo <= 1.0 + 1e-9
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

@@ -44,3 +44,67 @@ impl HalfVectorLobe {
         self.albedo_bound <= 1.0
     }
 }
+
+/// A half-vector lobe model from its parameter type (fields `n`, `ks`, `kd`), its registry
+/// name and its normalisation `norm(n)`: the model struct, `new` (validation, then the lobe),
+/// `properties`, the common scaffolding and the `Brdf` impl. Blinn and Lewis differ only in
+/// these.
+macro_rules! half_vector_model {
+    ($(#[$meta:meta])* $Model:ident($Params:ident), $name:expr, norm = $norm:expr) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone)]
+        pub struct $Model {
+            params: $Params,
+            lobe: $crate::models::half_vector_lobe::HalfVectorLobe,
+        }
+
+        impl $Model {
+            /// Validate the parameters and build the model.
+            pub fn new(params: $Params) -> Result<Self, $crate::params::ParamError> {
+                params.validate($name)?;
+                let norm: fn(f64) -> f64 = $norm;
+                Ok(Self {
+                    params,
+                    lobe: $crate::models::half_vector_lobe::HalfVectorLobe::new(
+                        params.n,
+                        params.ks,
+                        params.kd,
+                        norm(params.n),
+                    ),
+                })
+            }
+
+            /// Symmetries and energy: `n·h` only (isotropic, even under `y ↦ −y`), reciprocal;
+            /// conserves energy iff `kd + ks ≤ 1`.
+            pub fn properties(&self) -> $crate::models::Properties {
+                use $crate::models::Properties;
+                Properties::ISOTROPIC_SYMMETRIC
+                    | Properties::RECIPROCAL
+                    | Properties::CONSERVES_ENERGY.when(self.lobe.conserves_energy())
+            }
+        }
+
+        $crate::models::model_common!($Model($Params));
+
+        impl $crate::brdf::Brdf for $Model {
+            #[inline]
+            fn eval(&self, wo: &$crate::geometry::Vec3, wi: &$crate::geometry::Vec3) -> f64 {
+                self.lobe.eval(wo, wi)
+            }
+            $crate::models::brdf_properties!();
+            fn analytic_lobes(&self) -> Option<$crate::AnalyticLobes> {
+                Some($crate::AnalyticLobes {
+                    diffuse: self.params.kd,
+                    specular: self.params.ks,
+                    lobe: Some($crate::SpecularLobe::HalfVector {
+                        exponent: self.params.n,
+                    }),
+                })
+            }
+            fn name(&self) -> &str {
+                $name
+            }
+        }
+    };
+}
+pub(crate) use half_vector_model;

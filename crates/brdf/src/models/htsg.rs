@@ -51,49 +51,16 @@
 //! `kd ∈ [0, 1]` (uniform diffuse albedo, default 0). Reciprocal and isotropic; energy
 //! conservation is not claimed (Kirchhoff approximation).
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use crate::special::{beckmann_lambda_with_erfc, erfc};
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::LazyLock;
 
 pub(crate) const NAME: &str = "htsg";
-
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "sigma",
-        0.5,
-        Range::left_open(0.0, 10.0),
-        "RMS surface height σ0 (µm)",
-    ),
-    param(
-        "tau",
-        3.0,
-        Range::left_open(0.0, 100.0),
-        "autocorrelation length τ (µm)",
-    ),
-    param(
-        "lambda",
-        800.0,
-        Range::closed(100.0, 10_000.0),
-        "wavelength λ (nm)",
-    ),
-    param(
-        "ior",
-        1.5,
-        Range::left_open(0.0, 100.0),
-        "refractive index, real part",
-    ),
-    param(
-        "kappa",
-        0.0,
-        Range::closed(0.0, 100.0),
-        "refractive index, imaginary part (extinction)",
-    ),
-    param("kd", 0.0, Range::closed(0.0, 1.0), "uniform-diffuse albedo"),
-];
 
 /// Below this `g` the Poisson series alone is used.
 const G_SERIES_ONLY: f64 = 150.0;
@@ -240,34 +207,21 @@ fn lambert_w0(z: f64) -> f64 {
     w
 }
 
-/// Parameters of [`Htsg`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HtsgParams {
-    /// RMS roughness σ0 in µm.
-    pub sigma: f64,
-    /// Autocorrelation length τ in µm.
-    pub tau: f64,
-    /// Wavelength in nm.
-    pub lambda: f64,
-    /// Real part of the refractive index.
-    pub ior: f64,
-    /// Extinction coefficient.
-    pub kappa: f64,
-    /// Uniform diffuse albedo.
-    pub kd: f64,
-}
-
-impl Default for HtsgParams {
-    fn default() -> Self {
-        let [sigma, tau, lambda, ior, kappa, kd] = defaults(PARAMS);
-        Self {
-            sigma,
-            tau,
-            lambda,
-            ior,
-            kappa,
-            kd,
-        }
+model_params! {
+    /// Parameters of [`Htsg`].
+    pub struct HtsgParams in PARAMS {
+        /// RMS roughness σ0 in µm.
+        sigma = [0.5] in Range::left_open(0.0, 10.0), "RMS surface height σ0 (µm)";
+        /// Autocorrelation length τ in µm.
+        tau = [3.0] in Range::left_open(0.0, 100.0), "autocorrelation length τ (µm)";
+        /// Wavelength in nm.
+        lambda = [800.0] in Range::closed(100.0, 10_000.0), "wavelength λ (nm)";
+        /// Real part of the refractive index.
+        ior = [1.5] in Range::left_open(0.0, 100.0), "refractive index, real part";
+        /// Extinction coefficient.
+        kappa = [0.0] in Range::closed(0.0, 100.0), "refractive index, imaginary part (extinction)";
+        /// Uniform diffuse albedo.
+        kd = [0.0] in Range::closed(0.0, 1.0), "uniform-diffuse albedo";
     }
 }
 
@@ -289,14 +243,9 @@ impl Htsg {
     /// Validate the parameters and build the model.
     pub fn new(params: HtsgParams) -> Result<Self, ParamError> {
         let HtsgParams {
-            sigma,
-            tau,
-            lambda,
-            ior,
-            kappa,
-            kd,
+            sigma, tau, lambda, ..
         } = params;
-        validate(NAME, PARAMS, &[sigma, tau, lambda, ior, kappa, kd])?;
+        params.validate(NAME)?;
         let lambda_um = lambda * 1e-3;
         let k = 2.0 * PI / lambda_um;
         Ok(Self {
@@ -305,23 +254,6 @@ impl Htsg {
             d_prefactor: PI * PI * tau * tau / (4.0 * lambda_um * lambda_um),
             tau_over_2sigma: tau / (2.0 * sigma),
             a_scale: k * k * tau * tau / 4.0,
-        })
-    }
-
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &HtsgParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [sigma, tau, lambda, ior, kappa, kd] = super::take(v);
-        Self::new(HtsgParams {
-            sigma,
-            tau,
-            lambda,
-            ior,
-            kappa,
-            kd,
         })
     }
 
@@ -485,13 +417,14 @@ impl Htsg {
         };
         self.d_prefactor * s
     }
-}
 
-impl Default for Htsg {
-    fn default() -> Self {
-        super::expect_default(Self::new(HtsgParams::default()))
+    /// Symmetries: isotropic, even under `y ↦ −y`, reciprocal; energy not guaranteed.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL
     }
 }
+
+model_common!(Htsg(HtsgParams));
 
 impl Brdf for Htsg {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
@@ -514,20 +447,7 @@ impl Brdf for Htsg {
         let d = self.distribution(g, a);
         fres * geo * shadow * d / (PI * ci * co) + self.params.kd * FRAC_1_PI
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): s_x² + s_y², s_z, |s| and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

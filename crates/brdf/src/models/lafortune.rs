@@ -16,6 +16,7 @@
 //! Phong lobe of the same `n`, so the model conserves energy when additionally
 //! `kd + Σ ks ≤ 1`.
 
+use super::{Properties, brdf_properties};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate, validate_key};
@@ -146,17 +147,34 @@ impl Lafortune {
     }
 
     pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [kd, ks, cx, cy, cz, n] = super::take(v);
+        let [kd, ks, cx, cy, cz, n] = crate::params::take(v);
         Self::new(LafortuneParams {
             kd,
             lobes: vec![LafortuneLobe { ks, cx, cy, cz, n }],
         })
     }
+
+    /// Symmetries and energy: products `x x'`, `y y'`, `z z'` only (half-turn symmetric; isotropic and
+    /// mirror-symmetric iff `Cx = Cy` for every lobe), reciprocal; conserves energy when
+    /// `kd + Σ ks ≤ 1` and every `|C| ≤ 1`.
+    pub fn properties(&self) -> Properties {
+        let ks: f64 = self.params.lobes.iter().map(|l| l.ks).sum();
+        let bounded_lobes = self
+            .params
+            .lobes
+            .iter()
+            .all(|l| l.cx.abs() <= 1.0 && l.cy.abs() <= 1.0 && l.cz.abs() <= 1.0);
+        Properties::HALF_TURN_SYMMETRIC
+            | Properties::RECIPROCAL
+            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
+                .when(self.params.lobes.iter().all(|l| l.cx == l.cy))
+            | Properties::CONSERVES_ENERGY.when(self.params.kd + ks <= 1.0 && bounded_lobes)
+    }
 }
 
 impl Default for Lafortune {
     fn default() -> Self {
-        super::expect_default(Self::new(LafortuneParams::default()))
+        crate::params::expect_default(Self::new(LafortuneParams::default()))
     }
 }
 
@@ -176,29 +194,7 @@ impl Brdf for Lafortune {
         }
         f
     }
-    fn is_isotropic(&self) -> bool {
-        self.params.lobes.iter().all(|l| l.cx == l.cy)
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): the products ωo.x ωi.x, ωo.y ωi.y, ωo.z ωi.z.
-        self.is_isotropic()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Even under (x, y) ↦ (−x, −y) for all Cx, Cy: the products ωo.x ωi.x, ωo.y ωi.y, ωo.z ωi.z.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        let ks: f64 = self.params.lobes.iter().map(|l| l.ks).sum();
-        self.params.kd + ks <= 1.0
-            && self
-                .params
-                .lobes
-                .iter()
-                .all(|l| l.cx.abs() <= 1.0 && l.cy.abs() <= 1.0 && l.cz.abs() <= 1.0)
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

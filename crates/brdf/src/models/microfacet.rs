@@ -16,36 +16,16 @@
 //! projected-area constraint, so the albedo is at most `max F ≤ 1`: energy-conserving, reciprocal,
 //! isotropic iff `alpha = alpha_y`.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_schlick;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamDefault, ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use crate::special::beckmann_lambda;
 use std::f64::consts::PI;
 
 pub(crate) const NAME_BECKMANN: &str = "beckmann";
 pub(crate) const NAME_GGX: &str = "ggx";
-
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "alpha",
-        0.2,
-        Range::closed(0.001, 2.0),
-        "roughness α along the tangent x",
-    ),
-    ParamInfo {
-        key: "alpha_y",
-        default: ParamDefault::SameAs("alpha"),
-        range: Range::closed(0.001, 2.0),
-        doc: "roughness α along the bitangent y",
-    },
-    param(
-        "f0",
-        1.0,
-        Range::closed(0.0, 1.0),
-        "Fresnel reflectance at normal incidence (Schlick)",
-    ),
-];
 
 /// Microfacet normal distribution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,25 +36,15 @@ pub enum NormalDistribution {
     Ggx,
 }
 
-/// Parameters of [`Microfacet`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MicrofacetParams {
-    /// Roughness along x.
-    pub alpha_x: f64,
-    /// Roughness along y.
-    pub alpha_y: f64,
-    /// Schlick `f0`.
-    pub f0: f64,
-}
-
-impl Default for MicrofacetParams {
-    fn default() -> Self {
-        let [alpha_x, alpha_y, f0] = defaults(PARAMS);
-        Self {
-            alpha_x,
-            alpha_y,
-            f0,
-        }
+model_params! {
+    /// Parameters of [`Microfacet`].
+    pub struct MicrofacetParams in PARAMS {
+        /// Roughness along x.
+        alpha_x as "alpha" = [0.2] in Range::closed(0.001, 2.0), "roughness α along the tangent x";
+        /// Roughness along y.
+        alpha_y = [same_as alpha] in Range::closed(0.001, 2.0), "roughness α along the bitangent y";
+        /// Schlick `f0`.
+        f0 = [1.0] in Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence (Schlick)";
     }
 }
 
@@ -97,7 +67,7 @@ impl Microfacet {
             NormalDistribution::Beckmann => NAME_BECKMANN,
             NormalDistribution::Ggx => NAME_GGX,
         };
-        validate(name, PARAMS, &[params.alpha_x, params.alpha_y, params.f0])?;
+        params.validate(name)?;
         let (ax, ay) = (params.alpha_x, params.alpha_y);
         Ok(Self {
             params,
@@ -118,11 +88,6 @@ impl Microfacet {
     /// GGX model with the given parameters.
     pub fn ggx(params: MicrofacetParams) -> Result<Self, ParamError> {
         Self::new(params, NormalDistribution::Ggx)
-    }
-
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &MicrofacetParams {
-        &self.params
     }
 
     /// The normal distribution in use.
@@ -164,18 +129,18 @@ impl Microfacet {
         }
     }
 
-    pub(crate) fn from_values(v: &[f64], dist: NormalDistribution) -> Result<Self, ParamError> {
-        let [alpha_x, alpha_y, f0] = super::take(v);
-        Self::new(
-            MicrofacetParams {
-                alpha_x,
-                alpha_y,
-                f0,
-            },
-            dist,
-        )
+    /// Symmetries and energy: half-turn symmetric for all `αx, αy`, isotropic and mirror-symmetric
+    /// iff `αx = αy`; reciprocal; conserves energy (single scattering loses energy, never gains).
+    pub fn properties(&self) -> Properties {
+        Properties::HALF_TURN_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY
+            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
+                .when(self.params.alpha_x == self.params.alpha_y)
     }
 }
+
+model_common!(Microfacet(MicrofacetParams, dist: NormalDistribution));
 
 impl Brdf for Microfacet {
     #[inline]
@@ -189,23 +154,7 @@ impl Brdf for Microfacet {
         let f = fresnel_schlick(self.params.f0, wi.dot(&h));
         f * d * g / (4.0 * wi.z * wo.z)
     }
-    fn is_isotropic(&self) -> bool {
-        self.params.alpha_x == self.params.alpha_y
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): squared x/y components, ωi·h, cosines.
-        self.is_isotropic()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Even under (x, y) ↦ (−x, −y) for all αx, αy: D and Λ use squared x/y components only.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: 0.0,

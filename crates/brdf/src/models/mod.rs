@@ -18,6 +18,7 @@ pub mod minnaert;
 pub mod oren_nayar;
 pub mod phong;
 pub mod poulin_fournier;
+mod properties;
 pub mod schlick;
 pub mod sgd;
 pub mod strauss;
@@ -43,20 +44,6 @@ pub use sgd::{Sgd, SgdChannel};
 pub use strauss::{Strauss, StraussParams};
 pub use ward::{Ward, WardNormalisation, WardParams};
 
-/// Copy the first `N` values (missing ones become NaN, which validation rejects).
-pub(crate) fn take<const N: usize>(v: &[f64]) -> [f64; N] {
-    let mut out = [f64::NAN; N];
-    for (o, x) in out.iter_mut().zip(v) {
-        *o = *x;
-    }
-    out
-}
-
-/// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
-/// unit tests, so an error here is a bug in this crate, never a consequence of user input.
-pub(crate) fn expect_default<T>(r: Result<T, crate::params::ParamError>) -> T {
-    match r {
-        Ok(v) => v,
-        Err(e) => panic!("built-in default parameters are invalid: {e}"),
-    }
-}
+pub(crate) use crate::params::{model_common, model_params};
+pub use properties::Properties;
+pub(crate) use properties::brdf_properties;

@@ -11,36 +11,21 @@
 //! small σ its albedo slightly exceeds ρ at grazing view (≈ 1.008 ρ for σ = 0.1 at θo = 89.9°),
 //! so `conserves_energy()` is true only for σ = 0.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
 
 pub(crate) const NAME: &str = "oren-nayar";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("rho", 0.8, Range::closed(0.0, 1.0), "albedo ρ"),
-    param(
-        "sigma",
-        0.5,
-        Range::closed(0.0, FRAC_PI_2),
-        "facet slope deviation σ (radians)",
-    ),
-];
-
-/// Parameters of [`OrenNayar`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OrenNayarParams {
-    /// Albedo.
-    pub rho: f64,
-    /// Roughness σ in radians.
-    pub sigma: f64,
-}
-
-impl Default for OrenNayarParams {
-    fn default() -> Self {
-        let [rho, sigma] = defaults(PARAMS);
-        Self { rho, sigma }
+model_params! {
+    /// Parameters of [`OrenNayar`].
+    pub struct OrenNayarParams in PARAMS {
+        /// Albedo.
+        rho = [0.8] in Range::closed(0.0, 1.0), "albedo ρ";
+        /// Roughness σ in radians.
+        sigma = [0.5] in Range::closed(0.0, FRAC_PI_2), "facet slope deviation σ (radians)";
     }
 }
 
@@ -55,7 +40,7 @@ pub struct OrenNayar {
 impl OrenNayar {
     /// Validate the parameters and build the model.
     pub fn new(params: OrenNayarParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.rho, params.sigma])?;
+        params.validate(NAME)?;
         let s2 = params.sigma * params.sigma;
         let k = params.rho * FRAC_1_PI;
         Ok(Self {
@@ -65,22 +50,16 @@ impl OrenNayar {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &OrenNayarParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [rho, sigma] = super::take(v);
-        Self::new(OrenNayarParams { rho, sigma })
+    /// Symmetries and energy: `cos(φi − φo)` and angles only (isotropic, even under `y ↦ −y`),
+    /// reciprocal; conserves energy only in the Lambertian limit `sigma = 0`.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY.when(self.params.sigma == 0.0)
     }
 }
 
-impl Default for OrenNayar {
-    fn default() -> Self {
-        super::expect_default(Self::new(OrenNayarParams::default()))
-    }
-}
+model_common!(OrenNayar(OrenNayarParams));
 
 impl Brdf for OrenNayar {
     #[inline]
@@ -95,23 +74,7 @@ impl Brdf for OrenNayar {
             self.a
         }
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): ωi.x ωo.x + ωi.y ωo.y and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.params.sigma == 0.0
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

@@ -8,39 +8,23 @@
 //! The `(n+2)/(2π)` factor makes the specular lobe's albedo exactly `ks` at normal incidence and
 //! smaller elsewhere, so the model conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, PI};
 
 pub(crate) const NAME: &str = "phong";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("n", 50.0, Range::closed(0.0, 1e5), "specular exponent"),
-    param(
-        "ks",
-        0.7,
-        Range::closed(0.0, 1.0),
-        "specular albedo at normal incidence",
-    ),
-    param("kd", 0.3, Range::closed(0.0, 1.0), "diffuse albedo"),
-];
-
-/// Parameters of [`Phong`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PhongParams {
-    /// Cosine-lobe exponent `n ≥ 0`.
-    pub n: f64,
-    /// Specular coefficient.
-    pub ks: f64,
-    /// Diffuse coefficient.
-    pub kd: f64,
-}
-
-impl Default for PhongParams {
-    fn default() -> Self {
-        let [n, ks, kd] = defaults(PARAMS);
-        Self { n, ks, kd }
+model_params! {
+    /// Parameters of [`Phong`].
+    pub struct PhongParams in PARAMS {
+        /// Cosine-lobe exponent `n ≥ 0`.
+        n = [50.0] in Range::closed(0.0, 1e5), "specular exponent";
+        /// Specular coefficient.
+        ks = [0.7] in Range::closed(0.0, 1.0), "specular albedo at normal incidence";
+        /// Diffuse coefficient.
+        kd = [0.3] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
 }
 
@@ -55,7 +39,7 @@ pub struct Phong {
 impl Phong {
     /// Validate the parameters and build the model.
     pub fn new(params: PhongParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.n, params.ks, params.kd])?;
+        params.validate(NAME)?;
         Ok(Self {
             params,
             diffuse: params.kd * FRAC_1_PI,
@@ -63,22 +47,16 @@ impl Phong {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &PhongParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [n, ks, kd] = super::take(v);
-        Self::new(PhongParams { n, ks, kd })
+    /// Symmetries and energy: `ω_r·ωi` and cosines only (isotropic, even under `y ↦ −y`),
+    /// reciprocal; conserves energy iff `kd + ks ≤ 1`.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
 
-impl Default for Phong {
-    fn default() -> Self {
-        super::expect_default(Self::new(PhongParams::default()))
-    }
-}
+model_common!(Phong(PhongParams));
 
 impl Brdf for Phong {
     #[inline]
@@ -94,23 +72,7 @@ impl Brdf for Phong {
         };
         self.diffuse + spec
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): ω_r·ωi and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
-    }
+    brdf_properties!();
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.kd,

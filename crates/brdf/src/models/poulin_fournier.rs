@@ -52,9 +52,10 @@
 //! anisotropic. Visible cylinder area projects exactly onto `d cosθ` per period, and masking
 //! only removes light, so the model conserves energy when `kd + ks ≤ 1`.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
 use crate::special::ln_gamma_diff;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -62,33 +63,6 @@ use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 use std::sync::LazyLock;
 
 pub(crate) const NAME: &str = "poulin-fournier";
-
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param(
-        "d",
-        2.0,
-        Range::closed(2.0, 100.0),
-        "cylinder spacing in radii (2 = touching)",
-    ),
-    param(
-        "n",
-        20.0,
-        Range::closed(0.0, 1e4),
-        "Phong exponent of the cylinder surface",
-    ),
-    param(
-        "ks",
-        0.6,
-        Range::closed(0.0, 1.0),
-        "specular albedo of the cylinder surface",
-    ),
-    param(
-        "kd",
-        0.4,
-        Range::closed(0.0, 1.0),
-        "diffuse albedo of the cylinder surface",
-    ),
-];
 
 /// Gauss–Legendre nodes/weights on [−1, 1] (12 points) for the specular panels (`n_exp < 10`).
 const GL_POINTS: usize = 12;
@@ -186,23 +160,17 @@ struct Lobe {
     u_whole: f64,
 }
 
-/// Parameters of [`PoulinFournier`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PoulinFournierParams {
-    /// Centre spacing in cylinder radii.
-    pub d: f64,
-    /// Local Phong exponent.
-    pub n: f64,
-    /// Local specular albedo.
-    pub ks: f64,
-    /// Local diffuse albedo.
-    pub kd: f64,
-}
-
-impl Default for PoulinFournierParams {
-    fn default() -> Self {
-        let [d, n, ks, kd] = defaults(PARAMS);
-        Self { d, n, ks, kd }
+model_params! {
+    /// Parameters of [`PoulinFournier`].
+    pub struct PoulinFournierParams in PARAMS {
+        /// Centre spacing in cylinder radii.
+        d = [2.0] in Range::closed(2.0, 100.0), "cylinder spacing in radii (2 = touching)";
+        /// Local Phong exponent.
+        n = [20.0] in Range::closed(0.0, 1e4), "Phong exponent of the cylinder surface";
+        /// Local specular albedo.
+        ks = [0.6] in Range::closed(0.0, 1.0), "specular albedo of the cylinder surface";
+        /// Local diffuse albedo.
+        kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo of the cylinder surface";
     }
 }
 
@@ -224,7 +192,7 @@ pub struct PoulinFournier {
 impl PoulinFournier {
     /// Validate the parameters and build the model.
     pub fn new(params: PoulinFournierParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.d, params.n, params.ks, params.kd])?;
+        params.validate(NAME)?;
         let gl = GaussLegendre::new(GL_POINTS);
         let mut nodes = [0.0; GL_POINTS];
         let mut weights = [0.0; GL_POINTS];
@@ -250,16 +218,6 @@ impl PoulinFournier {
             lobe_rule,
             tail_factor: (-TAIL_LN / n).exp(),
         })
-    }
-
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &PoulinFournierParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [d, n, ks, kd] = super::take(v);
-        Self::new(PoulinFournierParams { d, n, ks, kd })
     }
 
     /// Range of cylinder angles γ visible from direction `w` (upper hemisphere), given
@@ -450,13 +408,17 @@ impl PoulinFournier {
             }
         }
     }
-}
 
-impl Default for PoulinFournier {
-    fn default() -> Self {
-        super::expect_default(Self::new(PoulinFournierParams::default()))
+    /// Symmetries and energy: anisotropic (cylinders along x) but half-turn symmetric,
+    /// reciprocal; conserves energy iff `kd + ks ≤ 1`.
+    pub fn properties(&self) -> Properties {
+        Properties::HALF_TURN_SYMMETRIC
+            | Properties::RECIPROCAL
+            | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
+
+model_common!(PoulinFournier(PoulinFournierParams));
 
 impl Brdf for PoulinFournier {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
@@ -492,22 +454,7 @@ impl Brdf for PoulinFournier {
         }
         ((diffuse + spec) / (self.params.d * wi.z * wo.z)).max(0.0)
     }
-    fn is_isotropic(&self) -> bool {
-        false
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // (x, y) ↦ (−x, −y) keeps A, B = −ωo,x ωi,x and cosΔ, and flips ψ ↦ −ψ: the visible and
-        // lit ranges (which use |ω_y| only) become [−γ1, −γ0], so [δa, δb] becomes [−δb, −δa],
-        // and both the diffuse term and the lobe F(δ) (even in δ) integrate to the same value.
-        // (The cylinder surface, translation-invariant in x and even in y, is half-turn symmetric.)
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn conserves_energy(&self) -> bool {
-        self.params.kd + self.params.ks <= 1.0
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

@@ -23,6 +23,7 @@
 //! exact Smith masking at grazing angles, so the albedo passes 1 near the horizon (≈ 0.97 at
 //! θo = 0 but ≈ 2.4 at θo = 89° for `c = 1, r = 0.05`; measured in the tests).
 
+use super::{Properties, brdf_properties};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
@@ -131,12 +132,12 @@ impl Schlick {
     }
 
     pub(crate) fn specular_from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [c, r, p] = super::take(v);
+        let [c, r, p] = crate::params::take(v);
         Self::new(SchlickParams { c, r, p, d: None })
     }
 
     pub(crate) fn diffuse_from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [c, r, p, d] = super::take(v);
+        let [c, r, p, d] = crate::params::take(v);
         Self::new(SchlickParams {
             c,
             r,
@@ -150,11 +151,19 @@ impl Schlick {
         let r = self.params.r;
         v / (r - r * v + v)
     }
+
+    /// Symmetries: `A(w)` is even in `cos φh`, so half-turn symmetric; isotropic and mirror-symmetric
+    /// iff `p = 1`; reciprocal; not energy-conserving (see the module docs).
+    pub fn properties(&self) -> Properties {
+        Properties::HALF_TURN_SYMMETRIC
+            | Properties::RECIPROCAL
+            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC).when(self.params.p == 1.0)
+    }
 }
 
 impl Default for Schlick {
     fn default() -> Self {
-        super::expect_default(Self::new(SchlickParams::specular()))
+        crate::params::expect_default(Self::new(SchlickParams::specular()))
     }
 }
 
@@ -192,20 +201,7 @@ impl Brdf for Schlick {
             Some(d) => s * glossy + (1.0 - s) * d * FRAC_1_PI,
         }
     }
-    fn is_isotropic(&self) -> bool {
-        self.params.p == 1.0
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): n·h, ωi·h, h_x²/(h_x² + h_y²) and cosines only.
-        self.is_isotropic()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Even under (x, y) ↦ (−x, −y) for all p: A(w) uses h_x²/(h_x² + h_y²) only.
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         if self.params.d.is_some() {
             NAME_DIFFUSE

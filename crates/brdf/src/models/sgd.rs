@@ -16,6 +16,7 @@
 //! construction. Declared unbounded at the horizon (the safe answer): `f` carries `1/cos θi`,
 //! cancelled only where a fit's shadowing term reaches 0 before the horizon.
 
+use super::{Properties, brdf_properties};
 use crate::brdf::{Brdf, luminance};
 use crate::geometry::{Vec3, both_above};
 use crate::models::merl_fits::{self, FitRow};
@@ -121,6 +122,12 @@ impl Sgd {
     pub fn channels(&self) -> &[SgdChannel; 3] {
         &self.channels
     }
+
+    /// Symmetries: isotropic, even under `y ↦ −y`, reciprocal; the fitted shadowing term leaves
+    /// `f_r` unbounded at the horizon; energy not guaranteed.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL | Properties::UNBOUNDED_AT_HORIZON
+    }
 }
 
 fn g1(cos_theta: f64, p: &SgdChannel) -> f64 {
@@ -160,21 +167,7 @@ impl Brdf for Sgd {
         })
     }
 
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        true
-    }
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
-    fn bounded_at_horizon(&self) -> bool {
-        false
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

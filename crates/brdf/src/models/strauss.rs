@@ -17,45 +17,28 @@
 //! `t ∈ [0, 1]` (default 0), `c ∈ [0, 1]` (default 0.8). Isotropic; not reciprocal (`F` and
 //! the `1/cosθi` use the incidence angle only); not energy-conserving.
 
+use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
 
 pub(crate) const NAME: &str = "strauss";
 
-pub(crate) const PARAMS: &[ParamInfo] = &[
-    param("s", 0.8, Range::closed(0.0, 0.99), "smoothness"),
-    param("m", 0.0, Range::closed(0.0, 1.0), "metalness"),
-    param("t", 0.0, Range::closed(0.0, 1.0), "transparency"),
-    param(
-        "c",
-        0.8,
-        Range::closed(0.0, 1.0),
-        "surface colour (grey level)",
-    ),
-];
-
 const KF: f64 = 1.12;
 const KG: f64 = 1.01;
 
-/// Parameters of [`Strauss`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StraussParams {
-    /// Smoothness.
-    pub s: f64,
-    /// Metalness.
-    pub m: f64,
-    /// Transparency.
-    pub t: f64,
-    /// Colour.
-    pub c: f64,
-}
-
-impl Default for StraussParams {
-    fn default() -> Self {
-        let [s, m, t, c] = defaults(PARAMS);
-        Self { s, m, t, c }
+model_params! {
+    /// Parameters of [`Strauss`].
+    pub struct StraussParams in PARAMS {
+        /// Smoothness.
+        s = [0.8] in Range::closed(0.0, 0.99), "smoothness";
+        /// Metalness.
+        m = [0.0] in Range::closed(0.0, 1.0), "metalness";
+        /// Transparency.
+        t = [0.0] in Range::closed(0.0, 1.0), "transparency";
+        /// Colour.
+        c = [0.8] in Range::closed(0.0, 1.0), "surface colour (grey level)";
     }
 }
 
@@ -85,7 +68,7 @@ fn strauss_g(x: f64) -> f64 {
 impl Strauss {
     /// Validate the parameters and build the model.
     pub fn new(params: StraussParams) -> Result<Self, ParamError> {
-        validate(NAME, PARAMS, &[params.s, params.m, params.t, params.c])?;
+        params.validate(NAME)?;
         let StraussParams { s, m, t, c } = params;
         let rd = (1.0 - s * s * s) * (1.0 - t);
         let d = 1.0 - m * s;
@@ -97,22 +80,14 @@ impl Strauss {
         })
     }
 
-    /// The parameters this model was built with.
-    pub fn params(&self) -> &StraussParams {
-        &self.params
-    }
-
-    pub(crate) fn from_values(v: &[f64]) -> Result<Self, ParamError> {
-        let [s, m, t, c] = super::take(v);
-        Self::new(StraussParams { s, m, t, c })
+    /// Symmetries: isotropic, even under `y ↦ −y`; not reciprocal, energy not guaranteed,
+    /// unbounded at the horizon.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC_SYMMETRIC | Properties::UNBOUNDED_AT_HORIZON
     }
 }
 
-impl Default for Strauss {
-    fn default() -> Self {
-        super::expect_default(Self::new(StraussParams::default()))
-    }
-}
+model_common!(Strauss(StraussParams));
 
 impl Brdf for Strauss {
     #[inline]
@@ -133,21 +108,7 @@ impl Brdf for Strauss {
         let spec = rj * cs * c.powf(self.exponent) * FRAC_1_PI / wi.z.max(1e-12);
         self.diffuse + spec.max(0.0)
     }
-    fn bounded_at_horizon(&self) -> bool {
-        // The specular term is divided by cosθi.
-        false
-    }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        // Even under (x, y, z) ↦ (x, −y, z): mirror dot product and cosines only.
-        true
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        // Isotropic, and R_π is a rotation about the normal.
-        true
-    }
+    brdf_properties!();
     fn name(&self) -> &str {
         NAME
     }

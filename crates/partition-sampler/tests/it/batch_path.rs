@@ -7,44 +7,11 @@ use crate::common;
 
 use common::*;
 use partition_sampler::{
-    Audit, Density, DensityShape, Domain, IntegralSource, LeafChoice, Point2, QuadTreeBuilder,
-    QuadTreeSampler, Rect, RegionEstimate, RegionStats, Sample2, SampledGridDensity, Sampler2D,
-    Scheme, SinPiRows, TabulatedDensity,
+    Audit, Domain, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, Sample2,
+    SampledGridDensity, Sampler2D, Scheme, SinPiRows, TabulatedDensity,
 };
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
-
-/// Bounds scaled by `scale` (< 1: violations; huge: every sample hits the trial cap).
-struct ScaledBounds<D> {
-    inner: D,
-    scale: f64,
-}
-
-impl<D: RegionStats> Density for ScaledBounds<D> {
-    fn eval(&self, p: Point2) -> f64 {
-        self.inner.eval(p)
-    }
-}
-
-impl<D: RegionStats> RegionStats for ScaledBounds<D> {
-    fn domain(&self) -> Domain {
-        self.inner.domain()
-    }
-    fn region(&self, cell: &Rect) -> RegionEstimate {
-        let mut e = self.inner.region(cell);
-        e.max_bound *= self.scale;
-        e
-    }
-    fn integral_source(&self) -> IntegralSource {
-        self.inner.integral_source()
-    }
-    fn shape(&self) -> DensityShape {
-        self.inner.shape()
-    }
-    fn bytes_used(&self) -> usize {
-        self.inner.bytes_used()
-    }
-}
 
 fn density(rect: Rect) -> TabulatedDensity<SinPiRows> {
     let (w, h) = (64, 32);
@@ -111,9 +78,10 @@ fn block_path_equals_one_sample_path_on_mapped_frame() {
 
 #[test]
 fn block_path_counts_the_same_violations() {
-    let broken = ScaledBounds {
+    let broken = Broken {
         inner: density(Rect::UNIT),
-        scale: 0.5,
+        bound_scale: 0.5,
+        left_integral_scale: 1.0,
     };
     let s = QuadTreeBuilder::new().max_depth(3).build(broken).unwrap();
     let a = check_same(&s, 5000, 7);
@@ -123,9 +91,10 @@ fn block_path_counts_the_same_violations() {
 #[test]
 fn block_path_abandons_samples_at_the_trial_cap_like_the_one_sample_path() {
     // Bounds 1e30 too high: acceptance probability ~1e-30, every sample hits the cap.
-    let hopeless = ScaledBounds {
+    let hopeless = Broken {
         inner: density(Rect::UNIT),
-        scale: 1e30,
+        bound_scale: 1e30,
+        left_integral_scale: 1.0,
     };
     let s = QuadTreeBuilder::new().max_depth(2).build(hopeless).unwrap();
     let a = check_same(&s, 2, 9);

@@ -6,49 +6,11 @@ use crate::common;
 
 use common::*;
 use partition_sampler::{
-    Density, DensityShape, Domain, IntegralSource, LeafChoice, Point2, QuadTreeBuilder,
-    QuadTreeSampler, Rect, RegionEstimate, RegionStats, Sampler2D, Scheme, SinPiRows,
+    LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, Sampler2D, Scheme, SinPiRows,
     TabulatedDensity,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-
-/// A provider that lies: bounds scaled by `bound_scale`, integrals of cells left of x = 0.5
-/// scaled by `left_integral_scale`.
-struct Broken<D> {
-    inner: D,
-    bound_scale: f64,
-    left_integral_scale: f64,
-}
-
-impl<D: RegionStats> Density for Broken<D> {
-    fn eval(&self, p: Point2) -> f64 {
-        self.inner.eval(p)
-    }
-}
-
-impl<D: RegionStats> RegionStats for Broken<D> {
-    fn domain(&self) -> Domain {
-        self.inner.domain()
-    }
-    fn region(&self, cell: &Rect) -> RegionEstimate {
-        let mut e = self.inner.region(cell);
-        e.max_bound *= self.bound_scale;
-        if cell.x1 <= 0.5 {
-            e.integral *= self.left_integral_scale;
-        }
-        e
-    }
-    fn integral_source(&self) -> IntegralSource {
-        self.inner.integral_source()
-    }
-    fn shape(&self) -> DensityShape {
-        self.inner.shape()
-    }
-    fn bytes_used(&self) -> usize {
-        self.inner.bytes_used()
-    }
-}
 
 fn map() -> (Vec<f64>, usize, usize) {
     (sun_map(32, 16, 1.0), 32, 16)

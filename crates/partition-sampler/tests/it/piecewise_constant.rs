@@ -299,10 +299,7 @@ fn construction_errors_are_typed() {
     ));
     assert_eq!(
         PiecewiseConstant1D::new(vec![], 0.0, 1.0).unwrap_err(),
-        PiecewiseConstantError::Empty {
-            width: 0,
-            height: 1
-        }
+        PiecewiseConstantError::EmptyInterval
     );
     assert_eq!(
         PiecewiseConstant1D::new(vec![0.0, 0.0], 0.0, 1.0).unwrap_err(),
@@ -310,12 +307,22 @@ fn construction_errors_are_typed() {
     );
     assert!(matches!(
         PiecewiseConstant1D::new(vec![1.0, -1.0], 0.0, 1.0),
-        Err(PiecewiseConstantError::Negative { column: 1, .. })
+        Err(PiecewiseConstantError::NegativeValue { index: 1, .. })
     ));
     assert!(matches!(
-        PiecewiseConstant1D::new(vec![1.0], 2.0, 1.0),
-        Err(PiecewiseConstantError::InvalidDomain { .. })
+        PiecewiseConstant1D::new(vec![1.0, f64::NAN], 0.0, 1.0),
+        Err(PiecewiseConstantError::NonFiniteValue { index: 1, .. })
     ));
+    assert_eq!(
+        PiecewiseConstant1D::new(vec![1.0], 2.0, 1.0).unwrap_err(),
+        PiecewiseConstantError::InvalidInterval { min: 2.0, max: 1.0 }
+    );
+    assert_eq!(
+        PiecewiseConstant1D::new(vec![1.0], 2.0, 1.0)
+            .unwrap_err()
+            .to_string(),
+        "invalid interval [2, 1]: need finite min < max"
+    );
 }
 
 #[test]

@@ -2,7 +2,9 @@
 //! and a small chi-square goodness-of-fit test.
 #![allow(dead_code, unreachable_pub)]
 
-use partition_sampler::{Point2, Rect};
+use partition_sampler::{
+    Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats,
+};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// Significance level of every statistical test.
@@ -167,4 +169,41 @@ pub fn sun_map_masses(vals: &[f64], w: usize, h: usize, bins: &Bins) -> Vec<f64>
     }
     let t: f64 = m.iter().sum();
     m.iter().map(|v| v / t).collect()
+}
+
+/// A provider that lies (shared by the negative and the batch-path tests): bounds scaled by `bound_scale`, integrals of cells left of x = 0.5
+/// scaled by `left_integral_scale`.
+pub struct Broken<D> {
+    pub inner: D,
+    pub bound_scale: f64,
+    pub left_integral_scale: f64,
+}
+
+impl<D: RegionStats> Density for Broken<D> {
+    fn eval(&self, p: Point2) -> f64 {
+        self.inner.eval(p)
+    }
+}
+
+impl<D: RegionStats> RegionStats for Broken<D> {
+    fn domain(&self) -> Domain {
+        self.inner.domain()
+    }
+    fn region(&self, cell: &Rect) -> RegionEstimate {
+        let mut e = self.inner.region(cell);
+        e.max_bound *= self.bound_scale;
+        if cell.x1 <= 0.5 {
+            e.integral *= self.left_integral_scale;
+        }
+        e
+    }
+    fn integral_source(&self) -> IntegralSource {
+        self.inner.integral_source()
+    }
+    fn shape(&self) -> DensityShape {
+        self.inner.shape()
+    }
+    fn bytes_used(&self) -> usize {
+        self.inner.bytes_used()
+    }
 }

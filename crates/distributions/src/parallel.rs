@@ -36,7 +36,7 @@ pub fn chunk_rng(seed: u64, chunk: u64) -> Xoshiro256PlusPlus {
 /// PAR_CHUNK)`, so the output depends only on `(n, seed)`, never on the number of threads.
 ///
 /// ```
-/// use partition_sampler::{PiecewiseConstant2D, Rect, sample_par};
+/// use distributions::{PiecewiseConstant2D, Rect, sample_par};
 /// let table = PiecewiseConstant2D::new(2, 1, vec![1.0, 3.0], Rect::UNIT).unwrap();
 /// let batch = sample_par(&table, 10_000, 42);
 /// assert_eq!(batch, sample_par(&table, 10_000, 42));

@@ -9,7 +9,7 @@
 /// above `last` give `last`), through a 32-bit conversion when `last` fits in `u32` (the
 /// other branch is never taken by a table that fits in memory, and is predicted).
 #[inline(always)]
-pub(crate) fn floor_index(x: f64, last: usize) -> usize {
+pub fn floor_index(x: f64, last: usize) -> usize {
     match u32::try_from(last) {
         Ok(last) => (x as u32).min(last) as usize,
         Err(_) => (x as usize).min(last),
@@ -18,7 +18,7 @@ pub(crate) fn floor_index(x: f64, last: usize) -> usize {
 
 /// `i as f64` for an index `i` (of a slice, so `i ≤ isize::MAX`): one signed conversion.
 #[inline(always)]
-pub(crate) fn index_to_f64(i: usize) -> f64 {
+pub fn index_to_f64(i: usize) -> f64 {
     i as i64 as f64
 }
 

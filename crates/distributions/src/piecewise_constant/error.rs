@@ -63,6 +63,33 @@ pub enum PiecewiseConstantError {
         /// Upper y bound.
         y1: f64,
     },
+    /// A 1D table was given no value.
+    #[error("empty 1D table: no cell")]
+    EmptyInterval,
+    /// A 1D table's interval is degenerate or not finite (`!(min < max)`).
+    #[error("invalid interval [{min}, {max}]: need finite min < max")]
+    InvalidInterval {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// A value of a 1D table is NaN or ±∞.
+    #[error("value {value} of cell {index} is not finite")]
+    NonFiniteValue {
+        /// Index of the cell (0 = first, at `min`).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A value of a 1D table is negative.
+    #[error("value {value} of cell {index} is negative")]
+    NegativeValue {
+        /// Index of the cell.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
     /// A serialised table carries an unknown format version.
     #[error("unsupported format version {found} (this build reads version {expected})")]
     FormatVersion {

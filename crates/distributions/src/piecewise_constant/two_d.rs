@@ -21,7 +21,7 @@ use super::cdf::{
 /// `invert ∘ sample_square` is the identity on `[0,1)²` (up to rounding).
 ///
 /// ```
-/// use partition_sampler::{InvertibleSampler2D, PiecewiseConstant2D, Rect, Sampler2D};
+/// use distributions::{InvertibleSampler2D, PiecewiseConstant2D, Rect, Sampler2D};
 /// let unit = Rect { x0: 0.0, y0: 0.0, x1: 1.0, y1: 1.0 };
 /// let t = PiecewiseConstant2D::new(2, 1, vec![1.0, 3.0], unit).unwrap();
 /// let s = t.sample_square([0.5, 0.5]);

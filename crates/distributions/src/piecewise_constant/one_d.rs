@@ -20,7 +20,7 @@ pub struct Sample1 {
 /// `n` equal cells: `p(x) = f_i / ∫f` with respect to length, sampled by inverting its CDF.
 ///
 /// ```
-/// use partition_sampler::PiecewiseConstant1D;
+/// use distributions::PiecewiseConstant1D;
 /// let d = PiecewiseConstant1D::new(vec![1.0, 3.0], 0.0, 2.0).unwrap();
 /// let s = d.sample(0.5); // the CDF reaches 0.25 at x = 1
 /// assert_eq!(s.index, 1);
@@ -42,24 +42,35 @@ pub struct PiecewiseConstant1D {
 impl PiecewiseConstant1D {
     /// Builds the sampler of the density ∝ `values` on `[min, max]`.
     ///
-    /// Errors: empty `values`, a NaN/negative/infinite value (named by its index, reported as
-    /// column), all values zero, an overflowing sum, or a degenerate interval.
+    /// Errors, in 1D terms: no value ([`EmptyInterval`](PiecewiseConstantError::EmptyInterval)),
+    /// a degenerate interval ([`InvalidInterval`](PiecewiseConstantError::InvalidInterval)), a
+    /// NaN/infinite or negative value named by its cell index
+    /// ([`NonFiniteValue`](PiecewiseConstantError::NonFiniteValue),
+    /// [`NegativeValue`](PiecewiseConstantError::NegativeValue)), all values zero, or an
+    /// overflowing sum.
     pub fn new(values: Vec<f64>, min: f64, max: f64) -> Result<Self, PiecewiseConstantError> {
         if values.is_empty() {
-            return Err(PiecewiseConstantError::Empty {
-                width: 0,
-                height: 1,
-            });
+            return Err(PiecewiseConstantError::EmptyInterval);
         }
         if !(min.is_finite() && max.is_finite() && min < max) {
-            return Err(PiecewiseConstantError::InvalidDomain {
-                x0: min,
-                y0: 0.0,
-                x1: max,
-                y1: 1.0,
-            });
+            return Err(PiecewiseConstantError::InvalidInterval { min, max });
         }
-        validate_values(&values, values.len())?;
+        // One row: the 2D kernel's (column, 0) is the cell index.
+        validate_values(&values, values.len()).map_err(|e| match e {
+            PiecewiseConstantError::NonFinite { column, value, .. } => {
+                PiecewiseConstantError::NonFiniteValue {
+                    index: column,
+                    value,
+                }
+            }
+            PiecewiseConstantError::Negative { column, value, .. } => {
+                PiecewiseConstantError::NegativeValue {
+                    index: column,
+                    value,
+                }
+            }
+            other => other,
+        })?;
         let mut cdf = vec![0.0; values.len() + 1];
         let sum = fill_cdf(&values, &mut cdf);
         if !sum.is_finite() {

@@ -5,7 +5,7 @@
 ///
 /// A draw takes `s = u · n`, `i = ⌊s⌋`, and returns `i` when `s − i < threshold[i]`, else
 /// `alias[i]`. Deterministic for given weights.
-pub(crate) fn build_alias(w: &[f64]) -> Vec<(f64, u32)> {
+pub fn build_alias(w: &[f64]) -> Vec<(f64, u32)> {
     let n = w.len();
     let total: f64 = w.iter().sum();
     let mut out = vec![(1.0f64, 0u32); n];

@@ -154,7 +154,7 @@ impl Domain {
 
 /// Distance from 0 to the nearest point of `[a, b]`.
 #[inline]
-pub(crate) fn interval_min_abs(a: f64, b: f64) -> f64 {
+pub fn interval_min_abs(a: f64, b: f64) -> f64 {
     if a <= 0.0 && b >= 0.0 {
         0.0
     } else {

@@ -4,11 +4,11 @@ use super::PiecewiseConstantError;
 use crate::index::{floor_index, index_to_f64};
 
 /// The largest `f64` below 1.
-pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
+pub const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
 
 /// Maps any number to `[0, 1)`: NaN and negatives to 0, values ≥ 1 to [`ONE_MINUS_EPSILON`].
 #[inline]
-pub(crate) fn clamp_unit(u: f64) -> f64 {
+pub fn clamp_unit(u: f64) -> f64 {
     if u >= 0.0 {
         u.min(ONE_MINUS_EPSILON)
     } else {
