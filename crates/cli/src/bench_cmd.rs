@@ -2,7 +2,9 @@
 //! one BRDF in one run — "which sampler is fastest for my material".
 //!
 //! One sample is `sample(ωo, u) -> (ωi, pdf)` **plus the one evaluation `f_r(ωo, ωi)`** the
-//! estimator `f cos / pdf` needs. Queries are either one fixed `ωo` (`--theta-o/--phi-o`) or a
+//! estimator `f cos / pdf` needs, drawn together through the fused
+//! [`DirectionSampler::sample_eval`] (a rejection sampler returns the `f` of its accepted
+//! trial; the others evaluate once). Queries are either one fixed `ωo` (`--theta-o/--phi-o`) or a
 //! fresh `ωo` per query (`--queries random`: uniform in solid angle over θo ∈ [0°, 89°], as
 //! when ωo changes from pixel to pixel). Samples are split into fixed chunks, each with its own
 //! generator seeded from `(seed, chunk)`, so the samples do not depend on the thread count.
@@ -155,10 +157,7 @@ fn run_samples(
             let mut sum = 0.0;
             for _ in 0..len {
                 let wo = query(queries, fixed, &mut rng);
-                let s = sampler.sample(&wo, &mut rng);
-                if s.pdf > 0.0 && s.wi.z > 0.0 {
-                    sum += brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf;
-                }
+                sum += sampler.sample_eval(brdf, &wo, &mut rng).weight();
             }
             (sum, thread_evaluations() - before)
         })
@@ -314,7 +313,7 @@ fn print_table(args: &BenchArgs, records: &[BenchRecord], threads: usize) {
     println!("queries    {queries}");
     println!(
         "timing     {} samples per run, median of {} interleaved run{}, {threads} thread{}; \
-         a sample = sample(ωo, u) + the estimator's f(ωo, ωi)",
+         a sample = sample_eval(ωo, u) -> (ωi, pdf, f(ωo, ωi)), the estimator's f included",
         args.n,
         args.repeat,
         if args.repeat == 1 { "" } else { "s" },

@@ -64,6 +64,7 @@
 
 mod chebyshev;
 mod density;
+mod fused;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -75,7 +76,7 @@ use partition_sampler::{
 };
 use rayon::prelude::*;
 
-use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
@@ -1139,6 +1140,19 @@ impl ExactSet {
     /// One direction; `audit` receives the trials.
     #[inline]
     fn draw(&self, wo: &Vec3, u: &mut dyn UniformSource, audit: &mut Audit) -> Option<DirSample> {
+        self.draw_with_f(wo, u, audit).map(|(s, _)| s)
+    }
+
+    /// [`ExactSet::draw`] and the `f_r` of the accepted trial, evaluated in the interval's
+    /// frame at the served `ωo` (`None` when no trial was accepted or the query was served
+    /// at another `ωo`, above [`THETA_TOP_DEG`]).
+    #[inline]
+    fn draw_with_f(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> Option<(DirSample, Option<f64>)> {
         let q = self.locate(wo)?;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
@@ -1147,15 +1161,26 @@ impl ExactSet {
             Some((x, gx)) => {
                 let a = iv.normaliser(self.var, &q);
                 let v = iv.map.to_direction(x);
-                DirSample {
+                let s = DirSample {
                     wi: q.turn.apply(&v),
                     pdf: iv.map.area_to_solid_angle(gx / a, &v),
-                }
+                };
+                // `g` is `f` (projected map) or `2 f cos θi` (equal-area map, `v.z > 0` where
+                // a trial is accepted: `g > 0`).
+                let f = match iv.map {
+                    DiscMap::Projected => gx,
+                    DiscMap::EqualArea => gx / (2.0 * v.z),
+                };
+                let served = q.wo == *wo;
+                (s, (served && f.is_finite()).then_some(f))
             }
-            None => DirSample {
-                wi: Vec3::new(0.0, 0.0, 1.0),
-                pdf: 0.0,
-            },
+            None => (
+                DirSample {
+                    wi: Vec3::new(0.0, 0.0, 1.0),
+                    pdf: 0.0,
+                },
+                None,
+            ),
         };
         Some(s)
     }
@@ -1636,6 +1661,33 @@ impl DirectionSampler for ExactSet {
                 wi: Vec3::new(0.0, 0.0, 1.0),
                 pdf: 0.0,
             },
+        }
+    }
+
+    /// The accepted trial's `f` when `brdf` is the set's own BRDF object and the query was
+    /// served at its own `ωo` (θo ≤ [`THETA_TOP_DEG`]); otherwise one evaluation of `brdf`.
+    fn sample_eval(&self, brdf: &dyn Brdf, wo: &Vec3, u: &mut dyn UniformSource) -> EvalSample {
+        let mut a = Audit::default();
+        let Some((s, f)) = self.draw_with_f(wo, u, &mut a) else {
+            return EvalSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 0.0,
+                f: 0.0,
+            };
+        };
+        self.counters.record(&a);
+        let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
+            0.0
+        } else {
+            match f {
+                Some(f) if fused::same_brdf(brdf, self.brdf.as_ref()) => f,
+                _ => brdf.eval(wo, &s.wi),
+            }
+        };
+        EvalSample {
+            wi: s.wi,
+            pdf: s.pdf,
+            f,
         }
     }
 
