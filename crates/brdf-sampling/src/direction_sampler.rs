@@ -29,6 +29,14 @@ pub struct EvalSample {
 }
 
 impl EvalSample {
+    /// The sample that contributes nothing (no direction for this `ωo`): `ωi` = the normal,
+    /// pdf 0, f 0.
+    pub const NONE: Self = Self {
+        wi: Vec3::new(0.0, 0.0, 1.0),
+        pdf: 0.0,
+        f: 0.0,
+    };
+
     /// The estimator's weight `f cos θi / pdf` (0 for a sample that contributes nothing).
     #[inline]
     pub fn weight(&self) -> f64 {
@@ -78,6 +86,24 @@ pub trait DirectionSampler: Send + Sync {
             pdf: s.pdf,
             f,
         }
+    }
+
+    /// A batch of queries: `out` is cleared and receives one [`EvalSample`] per `wos[k]`, in
+    /// the caller's order, each distributed as [`sample_eval`](DirectionSampler::sample_eval)
+    /// at `wos[k]` (same law, same `f` contract). The results are a function of the queries and
+    /// of the uniforms `u` delivers — hence of the seed only — but a sampler may consume the
+    /// uniforms in its own order (queries grouped by its structure, so each group is served
+    /// while its tables are in cache), so they need not equal `wos.len()` consecutive
+    /// `sample_eval` calls. The default is that loop, in order.
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut Vec<EvalSample>,
+    ) {
+        out.clear();
+        out.extend(wos.iter().map(|wo| self.sample_eval(brdf, wo, u)));
     }
 
     /// Draws `n` directions for one `wo` as a batch. The default draws `n` independent samples;

@@ -4,7 +4,38 @@
 //!
 //! [`DirectionSampler::sample_eval`]: crate::DirectionSampler::sample_eval
 
-use brdf::Brdf;
+use brdf::{Brdf, Vec3};
+
+use super::ExactSet;
+use crate::{DirSample, EvalSample};
+
+impl ExactSet {
+    /// The [`EvalSample`] of a drawn sample `s` at `wo`, with `f` the accepted trial's value
+    /// from [`ExactSet::draw_with_f`]: that value when `brdf` is the set's own BRDF object,
+    /// otherwise one evaluation of `brdf`; 0 for a sample that contributes nothing.
+    #[inline]
+    pub(super) fn finish(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        s: DirSample,
+        f: Option<f64>,
+    ) -> EvalSample {
+        let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
+            0.0
+        } else {
+            match f {
+                Some(f) if same_brdf(brdf, self.brdf.as_ref()) => f,
+                _ => brdf.eval(wo, &s.wi),
+            }
+        };
+        EvalSample {
+            wi: s.wi,
+            pdf: s.pdf,
+            f,
+        }
+    }
+}
 
 /// True when `a` and `b` are the same BRDF object: same address **and** same vtable (a
 /// wrapper struct may share its first field's address). A false "no" (one type with two

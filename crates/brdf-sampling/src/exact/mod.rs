@@ -62,6 +62,7 @@
 //! each quadrature uses the graded rule (`normalisation::Grading::Graded`: orders 5 and 3
 //! first, order 8 only on the pieces that need it).
 
+mod batch;
 mod chebyshev;
 mod density;
 mod fused;
@@ -1154,6 +1155,19 @@ impl ExactSet {
         audit: &mut Audit,
     ) -> Option<(DirSample, Option<f64>)> {
         let q = self.locate(wo)?;
+        Some(self.draw_located(&q, wo, u, audit))
+    }
+
+    /// [`ExactSet::draw_with_f`] at a query already located (`q = self.locate(wo)`).
+    #[inline]
+    fn draw_located(
+        &self,
+        q: &Query,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> (DirSample, Option<f64>) {
+        let q = *q;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
@@ -1182,7 +1196,7 @@ impl ExactSet {
                 None,
             ),
         };
-        Some(s)
+        s
     }
 
     /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
@@ -1669,26 +1683,22 @@ impl DirectionSampler for ExactSet {
     fn sample_eval(&self, brdf: &dyn Brdf, wo: &Vec3, u: &mut dyn UniformSource) -> EvalSample {
         let mut a = Audit::default();
         let Some((s, f)) = self.draw_with_f(wo, u, &mut a) else {
-            return EvalSample {
-                wi: Vec3::new(0.0, 0.0, 1.0),
-                pdf: 0.0,
-                f: 0.0,
-            };
+            return EvalSample::NONE;
         };
         self.counters.record(&a);
-        let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
-            0.0
-        } else {
-            match f {
-                Some(f) if fused::same_brdf(brdf, self.brdf.as_ref()) => f,
-                _ => brdf.eval(wo, &s.wi),
-            }
-        };
-        EvalSample {
-            wi: s.wi,
-            pdf: s.pdf,
-            f,
-        }
+        self.finish(brdf, wo, s, f)
+    }
+
+    /// Queries grouped by interval (a counting sort), each group drawn while its tree is
+    /// hot; see [`ExactSet::sample_eval_grouped`].
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut Vec<EvalSample>,
+    ) {
+        self.sample_eval_grouped(brdf, wos, u, out);
     }
 
     /// `f_r(ωo, ωi) cos θi / A(θo, δ)` above the horizon, 0 below.
