@@ -1171,7 +1171,7 @@ impl ExactSet {
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
-        let s = match drawn {
+        match drawn {
             Some((x, gx)) => {
                 let a = iv.normaliser(self.var, &q);
                 let v = iv.map.to_direction(x);
@@ -1195,8 +1195,7 @@ impl ExactSet {
                 },
                 None,
             ),
-        };
-        s
+        }
     }
 
     /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
