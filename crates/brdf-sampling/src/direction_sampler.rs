@@ -1,6 +1,6 @@
 //! The common shape of every direction sampler: `sample(wo, u) -> (wi, pdf)`, `pdf(wo, wi)`.
 
-use brdf::Vec3;
+use brdf::{Brdf, Vec3};
 
 use crate::PdfCells;
 use partition_sampler::UniformSource;
@@ -13,6 +13,39 @@ pub struct DirSample {
     pub wi: Vec3,
     /// Density of `wi` with respect to **solid angle**.
     pub pdf: f64,
+}
+
+/// One sampled incident direction with the BRDF value the estimator `f cos θi / pdf` needs: the
+/// result of [`DirectionSampler::sample_eval`] (Mitsuba's `eval_pdf_sample`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EvalSample {
+    /// The sampled direction `ωi`, as [`DirSample::wi`].
+    pub wi: Vec3,
+    /// Density of `wi` with respect to solid angle, as [`DirSample::pdf`].
+    pub pdf: f64,
+    /// `f_r(ωo, ωi)` of the BRDF passed to `sample_eval`; 0 for a sample that contributes
+    /// nothing (`pdf` 0 or `ωi` at or below the horizon), where the BRDF is not evaluated.
+    pub f: f64,
+}
+
+impl EvalSample {
+    /// The sample that contributes nothing (no direction for this `ωo`): `ωi` = the normal,
+    /// pdf 0, f 0.
+    pub const NONE: Self = Self {
+        wi: Vec3::new(0.0, 0.0, 1.0),
+        pdf: 0.0,
+        f: 0.0,
+    };
+
+    /// The estimator's weight `f cos θi / pdf` (0 for a sample that contributes nothing).
+    #[inline]
+    pub fn weight(&self) -> f64 {
+        if self.pdf > 0.0 && self.wi.z > 0.0 {
+            self.f * self.wi.z / self.pdf
+        } else {
+            0.0
+        }
+    }
 }
 
 /// A sampler of incident directions given an outgoing direction `ωo`.
@@ -32,6 +65,46 @@ pub trait DirectionSampler: Send + Sync {
     /// (e.g. read from a file) normalise them first, once, and evaluate the BRDF at the same
     /// unit vector.
     fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64;
+
+    /// Draws `ωi` for `wo` as [`sample`](DirectionSampler::sample) does — the same direction
+    /// and pdf from the same uniforms — together with `f_r(ωo, ωi)` of `brdf`: a fused
+    /// sample-and-evaluate. The default samples, then evaluates `brdf` once (not at all for a
+    /// sample that contributes nothing). Samplers that already evaluated `f` at the sampled
+    /// direction while sampling (rejection samplers: the accepted trial) return that value when
+    /// `brdf` is the very object they were built with (same address and type), so the estimator
+    /// pays no further evaluation; such an `f` may differ from `brdf.eval(wo, wi)` by rounding
+    /// (it was evaluated in the sampler's own frame).
+    fn sample_eval(&self, brdf: &dyn Brdf, wo: &Vec3, u: &mut dyn UniformSource) -> EvalSample {
+        let s = self.sample(wo, u);
+        let f = if s.pdf > 0.0 && s.wi.z > 0.0 {
+            brdf.eval(wo, &s.wi)
+        } else {
+            0.0
+        };
+        EvalSample {
+            wi: s.wi,
+            pdf: s.pdf,
+            f,
+        }
+    }
+
+    /// A batch of queries: `out` is cleared and receives one [`EvalSample`] per `wos[k]`, in
+    /// the caller's order, each distributed as [`sample_eval`](DirectionSampler::sample_eval)
+    /// at `wos[k]` (same law, same `f` contract). The results are a function of the queries and
+    /// of the uniforms `u` delivers — hence of the seed only — but a sampler may consume the
+    /// uniforms in its own order (queries grouped by its structure, so each group is served
+    /// while its tables are in cache), so they need not equal `wos.len()` consecutive
+    /// `sample_eval` calls. The default is that loop, in order.
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut Vec<EvalSample>,
+    ) {
+        out.clear();
+        out.extend(wos.iter().map(|wo| self.sample_eval(brdf, wo, u)));
+    }
 
     /// Draws `n` directions for one `wo` as a batch. The default draws `n` independent samples;
     /// batch-mode samplers (stratified leaf allocation) override it. Each returned pdf is the

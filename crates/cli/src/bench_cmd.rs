@@ -2,7 +2,9 @@
 //! one BRDF in one run — "which sampler is fastest for my material".
 //!
 //! One sample is `sample(ωo, u) -> (ωi, pdf)` **plus the one evaluation `f_r(ωo, ωi)`** the
-//! estimator `f cos / pdf` needs. Queries are either one fixed `ωo` (`--theta-o/--phi-o`) or a
+//! estimator `f cos / pdf` needs, drawn together through the fused
+//! [`DirectionSampler::sample_eval`] (a rejection sampler returns the `f` of its accepted
+//! trial; the others evaluate once). Queries are either one fixed `ωo` (`--theta-o/--phi-o`) or a
 //! fresh `ωo` per query (`--queries random`: uniform in solid angle over θo ∈ [0°, 89°], as
 //! when ωo changes from pixel to pixel). Samples are split into fixed chunks, each with its own
 //! generator seeded from `(seed, chunk)`, so the samples do not depend on the thread count.
@@ -19,7 +21,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::DirectionSampler;
+use brdf_sampling::{DirectionSampler, EvalSample};
 use clap::{Args, ValueEnum};
 use partition_sampler::chunk_seed;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -84,6 +86,11 @@ pub(crate) struct BenchArgs {
     /// Seed of the random streams.
     #[arg(long, default_value_t = 1, value_parser = values::seed)]
     seed: u64,
+    /// Draw each chunk's queries (4096) in one batch call (`sample_eval_batch`: samplers that
+    /// have a batch path group the queries, e.g. `adaptive-exact` by interval) instead of one
+    /// query at a time.
+    #[arg(long)]
+    batch: bool,
     /// Also write the results as JSON (a list, one object per sampler) here, atomically.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -111,6 +118,8 @@ struct BenchRecord {
     threads: usize,
     /// `fixed` or `random`.
     queries: Queries,
+    /// Whether the queries went through the batch path (`--batch`).
+    batch: bool,
     /// Build time, seconds (wall).
     build_seconds: f64,
     /// Bytes of the sampler's precomputed structures.
@@ -135,8 +144,9 @@ fn query(queries: Queries, fixed: &Vec3, rng: &mut Xoshiro256PlusPlus) -> Vec3 {
     }
 }
 
-/// Draws `n` samples (and their `f`) in seeded chunks; returns Σ f cos / pdf and the
-/// evaluations counted on the worker threads.
+/// Draws `n` samples (and their `f`) in seeded chunks — one query at a time, or with `batch`
+/// a chunk's queries in one [`DirectionSampler::sample_eval_batch`] call; returns
+/// Σ f cos / pdf and the evaluations counted on the worker threads.
 fn run_samples(
     sampler: &dyn DirectionSampler,
     brdf: &dyn Brdf,
@@ -144,6 +154,7 @@ fn run_samples(
     fixed: &Vec3,
     n: usize,
     seed: u64,
+    batch: bool,
 ) -> (f64, u64) {
     let chunks = n.div_ceil(CHUNK);
     (0..chunks)
@@ -153,11 +164,16 @@ fn run_samples(
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
             let before = thread_evaluations();
             let mut sum = 0.0;
-            for _ in 0..len {
-                let wo = query(queries, fixed, &mut rng);
-                let s = sampler.sample(&wo, &mut rng);
-                if s.pdf > 0.0 && s.wi.z > 0.0 {
-                    sum += brdf.eval(&wo, &s.wi) * s.wi.z / s.pdf;
+            if batch {
+                // The chunk's queries first, then one batch call (the sampler may group them).
+                let wos: Vec<Vec3> = (0..len).map(|_| query(queries, fixed, &mut rng)).collect();
+                let mut out = Vec::with_capacity(len);
+                sampler.sample_eval_batch(brdf, &wos, &mut rng, &mut out);
+                sum = out.iter().map(EvalSample::weight).sum();
+            } else {
+                for _ in 0..len {
+                    let wo = query(queries, fixed, &mut rng);
+                    sum += sampler.sample_eval(brdf, &wo, &mut rng).weight();
                 }
             }
             (sum, thread_evaluations() - before)
@@ -243,6 +259,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
                     &fixed,
                     count_n,
                     args.seed,
+                    args.batch,
                 );
                 e as f64 / count_n as f64
             })
@@ -264,6 +281,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
                     &fixed,
                     n,
                     args.seed,
+                    args.batch,
                 );
                 let ns = started.elapsed().as_secs_f64() * 1e9 / n as f64;
                 runs[k].push(ns);
@@ -287,6 +305,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
             samples: n,
             threads,
             queries: args.queries,
+            batch: args.batch,
             build_seconds: s.build_seconds,
             bytes_used: s.sampler.bytes_used(),
             mean_weight: means[k],
@@ -312,9 +331,12 @@ fn print_table(args: &BenchArgs, records: &[BenchRecord], threads: usize) {
     };
     println!("brdf       {}", args.spec);
     println!("queries    {queries}");
+    if args.batch {
+        println!("batches    {CHUNK} queries per sample_eval_batch call");
+    }
     println!(
         "timing     {} samples per run, median of {} interleaved run{}, {threads} thread{}; \
-         a sample = sample(ωo, u) + the estimator's f(ωo, ωi)",
+         a sample = sample_eval(ωo, u) -> (ωi, pdf, f(ωo, ωi)), the estimator's f included",
         args.n,
         args.repeat,
         if args.repeat == 1 { "" } else { "s" },
@@ -381,7 +403,17 @@ mod tests {
                 .num_threads(t)
                 .build()
                 .unwrap()
-                .install(|| run_samples(&sampler, brdf.as_ref(), Queries::Random, &wo, 20_000, 3))
+                .install(|| {
+                    run_samples(
+                        &sampler,
+                        brdf.as_ref(),
+                        Queries::Random,
+                        &wo,
+                        20_000,
+                        3,
+                        false,
+                    )
+                })
         };
         let (s1, e1) = on(1);
         let (s2, e2) = on(2);

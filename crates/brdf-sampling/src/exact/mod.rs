@@ -63,8 +63,10 @@
 //! each quadrature uses the graded rule (`normalisation::Grading::Graded`: orders 5 and 3
 //! first, order 8 only on the pieces that need it).
 
+mod batch;
 mod chebyshev;
 mod density;
+mod fused;
 mod tabulated;
 
 use std::sync::Arc;
@@ -77,7 +79,7 @@ use partition_sampler::{
 };
 use rayon::prelude::*;
 
-use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
@@ -1146,25 +1148,61 @@ impl ExactSet {
     /// One direction; `audit` receives the trials.
     #[inline]
     fn draw(&self, wo: &Vec3, u: &mut dyn UniformSource, audit: &mut Audit) -> Option<DirSample> {
+        self.draw_with_f(wo, u, audit).map(|(s, _)| s)
+    }
+
+    /// [`ExactSet::draw`] and the `f_r` of the accepted trial, evaluated in the interval's
+    /// frame at the served `ωo` (`None` when no trial was accepted or the query was served
+    /// at another `ωo`, above [`THETA_TOP_DEG`]).
+    #[inline]
+    fn draw_with_f(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> Option<(DirSample, Option<f64>)> {
         let q = self.locate(wo)?;
+        Some(self.draw_located(&q, wo, u, audit))
+    }
+
+    /// [`ExactSet::draw_with_f`] at a query already located (`q = self.locate(wo)`).
+    #[inline]
+    fn draw_located(
+        &self,
+        q: &Query,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> (DirSample, Option<f64>) {
+        let q = *q;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
         let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
-        let s = match drawn {
+        match drawn {
             Some((x, gx)) => {
                 let a = iv.normaliser(self.var, &q);
                 let v = iv.map.to_direction(x);
-                DirSample {
+                let s = DirSample {
                     wi: q.turn.apply(&v),
                     pdf: iv.map.area_to_solid_angle(gx / a, &v),
-                }
+                };
+                // `g` is `f` (projected map) or `2 f cos θi` (equal-area map, `v.z > 0` where
+                // a trial is accepted: `g > 0`).
+                let f = match iv.map {
+                    DiscMap::Projected => gx,
+                    DiscMap::EqualArea => gx / (2.0 * v.z),
+                };
+                let served = q.wo == *wo;
+                (s, (served && f.is_finite()).then_some(f))
             }
-            None => DirSample {
-                wi: Vec3::new(0.0, 0.0, 1.0),
-                pdf: 0.0,
-            },
-        };
-        Some(s)
+            None => (
+                DirSample {
+                    wi: Vec3::new(0.0, 0.0, 1.0),
+                    pdf: 0.0,
+                },
+                None,
+            ),
+        }
     }
 
     /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
@@ -1663,6 +1701,29 @@ impl DirectionSampler for ExactSet {
                 pdf: 0.0,
             },
         }
+    }
+
+    /// The accepted trial's `f` when `brdf` is the set's own BRDF object and the query was
+    /// served at its own `ωo` (θo ≤ [`THETA_TOP_DEG`]); otherwise one evaluation of `brdf`.
+    fn sample_eval(&self, brdf: &dyn Brdf, wo: &Vec3, u: &mut dyn UniformSource) -> EvalSample {
+        let mut a = Audit::default();
+        let Some((s, f)) = self.draw_with_f(wo, u, &mut a) else {
+            return EvalSample::NONE;
+        };
+        self.counters.record(&a);
+        self.finish(brdf, wo, s, f)
+    }
+
+    /// Queries grouped by interval (a counting sort), each group drawn while its tree is
+    /// hot; see [`ExactSet::sample_eval_grouped`].
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut Vec<EvalSample>,
+    ) {
+        self.sample_eval_grouped(brdf, wos, u, out);
     }
 
     /// `f_r(ωo, ωi) cos θi / A(θo, δ)` above the horizon, 0 below.
