@@ -107,7 +107,7 @@ pub fn draw<P: Copy + Send>(
         .map(|c| {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
             let len = DRAW_CHUNK.min(n - c * DRAW_CHUNK);
-            (0..len).map(|_| sampler.sample(&mut rng)).collect()
+            sampler.sample_many(len, &mut rng)
         })
         .collect();
     chunks.concat()
@@ -300,10 +300,16 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         .chain(batches.iter().flatten())
         .copied()
         .collect();
-    out.push(match pdf_consistency(&all, &pdf, plan.pdf_rel_tol) {
-        Ok(o) => renamed(o, names::PDF_CONSISTENCY),
-        Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
-    });
+    // The pdfs re-evaluated in one call (a sampler may batch them), checked by sample index.
+    let again = sampler.pdf_many(&all.iter().map(|s| s.0).collect::<Vec<P>>());
+    let indexed: Vec<(usize, f64)> = all.iter().enumerate().map(|(i, s)| (i, s.1)).collect();
+    let again_at = |i: usize| again[i];
+    out.push(
+        match pdf_consistency(&indexed, &again_at, plan.pdf_rel_tol) {
+            Ok(o) => renamed(o, names::PDF_CONSISTENCY),
+            Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
+        },
+    );
     match exact {
         Some(exact) => out.extend(exact.normalisation_tests(plan)),
         None => out.push(
