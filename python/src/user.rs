@@ -168,11 +168,20 @@ impl DirectionSampler for PySampler {
         })
     }
 
+    /// Independent draws (a Python sampler has no stratified batch mode): one call.
+    fn sample_batch(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
+        self.sample_many(wo, n, u)
+    }
+
     fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
         self.call_pdf(wo, wi).unwrap_or_else(|e| {
             self.record("pdf", e);
             vec![f64::NAN; wi.len()]
         })
+    }
+
+    fn prefers_batches(&self) -> bool {
+        true
     }
 
     fn bytes_used(&self) -> usize {

@@ -55,6 +55,10 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
             .collect()
     }
 
+    fn prefers_batches(&self) -> bool {
+        self.sampler.prefers_batches()
+    }
+
     fn pdf_many(&self, points: &[Dir3]) -> Vec<f64> {
         let wi: Vec<Vec3> = points.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         self.sampler.pdf_many(&self.wo, &wi)

@@ -51,6 +51,13 @@ pub trait SamplerUnderTest<P>: Send + Sync {
         points.iter().map(|p| self.pdf(p.clone())).collect()
     }
 
+    /// Whether pdf queries should come in batches ([`Self::pdf_many`]) wherever the suite can
+    /// arrange it, including its quadratures (e.g. a sampler written in Python, for which one
+    /// call per point costs far more than the arithmetic). `false` by default.
+    fn prefers_batches(&self) -> bool {
+        false
+    }
+
     /// Cumulative count of rejection trials with `f > M_i` (bound violations), for samplers
     /// that audit their bounds; `None` otherwise.
     fn bound_violations(&self) -> Option<u64> {

@@ -54,6 +54,13 @@ pub trait DirectionSampler: Send + Sync {
         wi.iter().map(|w| self.pdf(wo, w)).collect()
     }
 
+    /// Whether callers should batch pdf queries through [`Self::pdf_many`] wherever they can
+    /// (a sampler for which one call per point is expensive, e.g. one written in Python); the
+    /// validation suite then serves its quadratures from batched values. `false` by default.
+    fn prefers_batches(&self) -> bool {
+        false
+    }
+
     /// Cumulative count of trials that found the density above its bound (samplers with an
     /// audited bound, e.g. the adaptive sets); `None` for samplers that have no bound to audit.
     fn bound_violations(&self) -> Option<u64> {

@@ -17,6 +17,8 @@ use validation::{ValidateConfig, run_with};
 struct CosinePower {
     n: f64,
     scale: f64,
+    /// Asks the suite for batched pdf queries (as a Python sampler does).
+    batched: bool,
 }
 
 impl DirectionSampler for CosinePower {
@@ -36,12 +38,20 @@ impl DirectionSampler for CosinePower {
         if wi.x > 0.5 { self.scale * p } else { p }
     }
 
+    fn prefers_batches(&self) -> bool {
+        self.batched
+    }
+
     fn bytes_used(&self) -> usize {
         0
     }
 }
 
 fn entry(name: &'static str, scale: f64) -> SamplerEntry {
+    entry_with(name, scale, false)
+}
+
+fn entry_with(name: &'static str, scale: f64, batched: bool) -> SamplerEntry {
     SamplerEntry::direction(
         name,
         "cos² lobe about the normal (test)",
@@ -50,7 +60,13 @@ fn entry(name: &'static str, scale: f64) -> SamplerEntry {
             ..Capabilities::default()
         },
         Support::Hemisphere,
-        move |_| Ok(Arc::new(CosinePower { n: 2.0, scale })),
+        move |_| {
+            Ok(Arc::new(CosinePower {
+                n: 2.0,
+                scale,
+                batched,
+            }))
+        },
     )
 }
 
@@ -97,4 +113,29 @@ fn the_builtin_run_does_not_know_user_samplers() {
     };
     let err = validation::run(&config, &|_| {}).unwrap_err().to_string();
     assert!(err.contains("unknown sampler `byo-correct`"), "{err}");
+}
+
+/// The suite's quadratures served from batched pdf values (what a Python sampler asks for)
+/// give exactly the statistics of one query per point.
+#[test]
+fn batched_pdf_queries_give_the_same_statistics() {
+    let registry = Registry::builtin()
+        .with(entry("byo-direct", 1.02))
+        .with(entry_with("byo-batched", 1.02, true));
+    let direct = validate(&registry, "byo-direct");
+    let batched = validate(&registry, "byo-batched");
+    let stats = |r: &validation::ValidationReport| -> Vec<(String, u64, Option<u64>)> {
+        r.tests
+            .iter()
+            .map(|t| {
+                (
+                    t.test.clone(),
+                    t.statistic.to_bits(),
+                    t.p_value.map(f64::to_bits),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(stats(&direct), stats(&batched));
+    assert!(!batched.passed);
 }
