@@ -43,6 +43,9 @@ impl PointKey for [f64; 3] {
     }
 }
 
+/// A pdf as the quadratures take it.
+type PdfFn<'f, P> = dyn Fn(P) -> f64 + Sync + 'f;
+
 /// Most passes of a quadrature over batched pdf values before falling back to single queries.
 const MAX_BATCH_PASSES: usize = 12;
 
@@ -89,7 +92,7 @@ impl<'a, P: PointKey + Send + Sync> BatchedPdf<'a, P> {
     }
 
     /// `f` run with the sampler's pdf (see the type's documentation).
-    pub(crate) fn run<R>(&self, f: &dyn Fn(&(dyn Fn(P) -> f64 + Sync)) -> R) -> R {
+    pub(crate) fn run<R>(&self, f: &dyn Fn(&PdfFn<'_, P>) -> R) -> R {
         if !self.sampler.prefers_batches() {
             return f(&|p| self.sampler.pdf(p));
         }
