@@ -19,6 +19,7 @@ mod options;
 mod planar;
 mod runs;
 mod threads;
+mod user;
 
 use pyo3::prelude::*;
 

@@ -10,6 +10,7 @@ use validation::ValidateConfig;
 
 use crate::errors::{invalid, value_error};
 use crate::threads::install;
+use crate::user::{check_errors, registry_with};
 
 fn write(path: &Path, bytes: &[u8]) -> PyResult<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -24,7 +25,7 @@ fn write(path: &Path, bytes: &[u8]) -> PyResult<()> {
 /// design.md §5); `json` / `report` write the CLI's `--json` / `--report` files. Empty lists
 /// take the tier's defaults (`quick`: the CI tier).
 #[pyfunction]
-#[pyo3(signature = (samplers, brdfs, theta_o, samples = None, seed = 1, quick = true, mutants = false, alpha = 0.01, json = None, report = None, sets = Vec::new()))]
+#[pyo3(signature = (samplers, brdfs, theta_o, samples = None, seed = 1, quick = true, mutants = false, alpha = 0.01, json = None, report = None, sets = Vec::new(), user = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn validate_json(
     py: Python<'_>,
@@ -39,7 +40,9 @@ pub(crate) fn validate_json(
     json: Option<PathBuf>,
     report: Option<PathBuf>,
     sets: Vec<PathBuf>,
+    user: Vec<(String, Py<PyAny>)>,
 ) -> PyResult<String> {
+    let (registry, wrapped) = registry_with(py, user)?;
     let base = if quick {
         ValidateConfig::quick()
     } else {
@@ -70,8 +73,9 @@ pub(crate) fn validate_json(
         ..base
     };
     let rep = py
-        .detach(|| install(|| validation::run(&config, &|_| {}).map_err(Box::new)))
+        .detach(|| install(|| validation::run_with(&registry, &config, &|_| {}).map_err(Box::new)))
         .map_err(|e| value_error(e.as_ref()))?;
+    check_errors(&wrapped)?;
     let text = rep.to_json();
     if let Some(p) = &json {
         write(p, text.as_bytes())?;
@@ -88,7 +92,7 @@ pub(crate) fn validate_json(
 /// CLI's `--quick`, looking for ../shared from `root`) or ``"custom"``; non-empty lists and
 /// given counts override it.
 #[pyfunction]
-#[pyo3(signature = (samplers, brdfs, theta_o, lights, preset = "quick", n_grid = None, repetitions = None, seed = 1, shard = None, out = None, root = None))]
+#[pyo3(signature = (samplers, brdfs, theta_o, lights, preset = "quick", n_grid = None, repetitions = None, seed = 1, shard = None, out = None, root = None, user = Vec::new(), variance_samples = None, timing_samples = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn study_json(
     py: Python<'_>,
@@ -103,7 +107,11 @@ pub(crate) fn study_json(
     shard: Option<String>,
     out: Option<PathBuf>,
     root: Option<PathBuf>,
+    user: Vec<(String, Py<PyAny>)>,
+    variance_samples: Option<usize>,
+    timing_samples: Option<usize>,
 ) -> PyResult<String> {
+    let (registry, wrapped) = registry_with(py, user)?;
     let (mut config, notes) = match preset {
         "quick" => StudyConfig::quick(root.as_deref()),
         "custom" => {
@@ -121,6 +129,12 @@ pub(crate) fn study_json(
     if !samplers.is_empty() {
         config.samplers = samplers;
     }
+    // Python samplers join the selection (or the preset's samplers).
+    for s in &wrapped {
+        if !config.samplers.iter().any(|n| n == s.name()) {
+            config.samplers.push(s.name().to_owned());
+        }
+    }
     if !brdfs.is_empty() {
         config.brdfs = brdfs;
     }
@@ -136,14 +150,21 @@ pub(crate) fn study_json(
     if let Some(r) = repetitions {
         config.repetitions = r;
     }
+    if let Some(v) = variance_samples {
+        config.variance_samples = v;
+    }
+    if let Some(t) = timing_samples {
+        config.timing_samples = t;
+    }
     config.seed = seed;
     let shard = shard
         .as_deref()
         .map(Shard::parse)
         .transpose()
         .map_err(|e| value_error(&e))?;
-    let plan = StudyPlan::new(config, notes).map_err(|e| value_error(&e))?;
+    let plan = StudyPlan::with_registry(config, notes, &registry).map_err(|e| value_error(&e))?;
     let results = py.detach(|| install(|| plan.run(shard, &|_| {})));
+    check_errors(&wrapped)?;
     let text = results.to_json();
     if let Some(dir) = &out {
         let plots = py

@@ -47,6 +47,23 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
             .collect()
     }
 
+    fn sample_many(&self, n: usize, u: &mut dyn UniformSource) -> Vec<(Dir3, f64)> {
+        self.sampler
+            .sample_many(&self.wo, n, u)
+            .iter()
+            .map(|s| (dir_of(&s.wi), s.pdf))
+            .collect()
+    }
+
+    fn prefers_batches(&self) -> bool {
+        self.sampler.prefers_batches()
+    }
+
+    fn pdf_many(&self, points: &[Dir3]) -> Vec<f64> {
+        let wi: Vec<Vec3> = points.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+        self.sampler.pdf_many(&self.wo, &wi)
+    }
+
     fn bound_violations(&self) -> Option<u64> {
         self.sampler.bound_violations()
     }

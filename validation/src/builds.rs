@@ -30,10 +30,7 @@ pub struct StandaloneCase {
 
 /// Whether the entry is tested per (BRDF, `θo`) (direction and disc samplers).
 pub fn uses_brdf(entry: &SamplerEntry) -> bool {
-    matches!(
-        entry.constructor,
-        Constructor::AdaptiveSet { .. } | Constructor::Direction { .. } | Constructor::Disc(_)
-    )
+    entry.is_direction() || matches!(entry.constructor, Constructor::Disc(_))
 }
 
 /// The test domain of a direction sampler: the hemisphere, or the sphere when its samples may

@@ -1,5 +1,8 @@
 //! Runs every test of the suite on one subject.
 
+use std::collections::{HashMap, HashSet};
+use std::sync::{Mutex, RwLock};
+
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -22,6 +25,98 @@ pub const DRAW_CHUNK: usize = 4096;
 /// declared normaliser error ([`SamplerUnderTest::normaliser_rel_err`], e.g. a Richardson
 /// estimate, which is an estimate, not a bound).
 pub const DECLARED_ERROR_FACTOR: f64 = 3.0;
+
+/// A point whose coordinates key the batched pdf cache ([`BatchedPdf`]).
+pub(crate) trait PointKey: Copy {
+    /// The bit patterns of the coordinates (unused ones 0).
+    fn key(&self) -> [u64; 3];
+}
+
+impl PointKey for [f64; 2] {
+    fn key(&self) -> [u64; 3] {
+        [self[0].to_bits(), self[1].to_bits(), 0]
+    }
+}
+
+impl PointKey for [f64; 3] {
+    fn key(&self) -> [u64; 3] {
+        [self[0].to_bits(), self[1].to_bits(), self[2].to_bits()]
+    }
+}
+
+/// A pdf as the quadratures take it.
+type PdfFn<'f, P> = dyn Fn(P) -> f64 + Sync + 'f;
+
+/// Most passes of a quadrature over batched pdf values before falling back to single queries.
+const MAX_BATCH_PASSES: usize = 12;
+
+/// The pdf of a sampler that prefers batched queries
+/// ([`SamplerUnderTest::prefers_batches`], e.g. one written in Python), served to the suite's
+/// quadratures (which ask one point at a time) from values evaluated in batches: a quadrature
+/// is run with the values known so far (0 for the others, whose points are recorded), the
+/// recorded points are evaluated in one [`SamplerUnderTest::pdf_many`] call, and the
+/// quadrature is run again, until a pass asks for no unknown point. That last pass saw the
+/// sampler's own value at every point it asked for, so its result is exactly the one of
+/// single queries. Samplers that do not prefer batches are queried directly.
+pub(crate) struct BatchedPdf<'a, P> {
+    sampler: &'a dyn SamplerUnderTest<P>,
+    values: RwLock<HashMap<[u64; 3], f64>>,
+    missing: Mutex<(HashSet<[u64; 3]>, Vec<P>)>,
+}
+
+impl<'a, P: PointKey + Send + Sync> BatchedPdf<'a, P> {
+    pub(crate) fn new(sampler: &'a dyn SamplerUnderTest<P>) -> Self {
+        Self {
+            sampler,
+            values: Default::default(),
+            missing: Default::default(),
+        }
+    }
+
+    fn lookup(&self, p: P) -> f64 {
+        let key = p.key();
+        if let Some(&v) = self
+            .values
+            .read()
+            .ok()
+            .and_then(|m| m.get(&key).copied())
+            .as_ref()
+        {
+            return v;
+        }
+        if let Ok(mut missing) = self.missing.lock()
+            && missing.0.insert(key)
+        {
+            missing.1.push(p);
+        }
+        0.0
+    }
+
+    /// `f` run with the sampler's pdf (see the type's documentation).
+    pub(crate) fn run<R>(&self, f: &dyn Fn(&PdfFn<'_, P>) -> R) -> R {
+        if !self.sampler.prefers_batches() {
+            return f(&|p| self.sampler.pdf(p));
+        }
+        for _ in 0..MAX_BATCH_PASSES {
+            let r = f(&|p| self.lookup(p));
+            let points = match self.missing.lock() {
+                Ok(mut m) => std::mem::take(&mut *m).1,
+                Err(_) => break,
+            };
+            if points.is_empty() {
+                return r;
+            }
+            let got = self.sampler.pdf_many(&points);
+            let Ok(mut values) = self.values.write() else {
+                break;
+            };
+            for (p, v) in points.iter().zip(got) {
+                values.insert(p.key(), v);
+            }
+        }
+        f(&|p| self.sampler.pdf(p))
+    }
+}
 
 fn renamed(mut o: TestOutcome, name: &str) -> TestOutcome {
     o.name = name.to_owned();
@@ -71,7 +166,7 @@ pub fn draw<P: Copy + Send>(
         .map(|c| {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
             let len = DRAW_CHUNK.min(n - c * DRAW_CHUNK);
-            (0..len).map(|_| sampler.sample(&mut rng)).collect()
+            sampler.sample_many(len, &mut rng)
         })
         .collect();
     chunks.concat()
@@ -178,7 +273,7 @@ fn singular_params<P: Copy + Send + Sync>(
 /// With `exact` (a sampler that declares where its pdf is piecewise constant), the χ², KS and
 /// normalisation tests are its exact versions, followed by the check of the declaration
 /// ([`crate::cells`]); otherwise they integrate the pdf by adaptive quadrature.
-pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
+pub(crate) fn run_subject<P: PointKey + Send + Sync + 'static>(
     s: &Subject<P>,
     binning: &dyn Binning<Point = P>,
     plan: &Plan,
@@ -192,7 +287,7 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     let batches = draw_batches(sampler, plan.batch_size, plan.batches, stream_seed(seed, 2));
     let violations_after = sampler.bound_violations();
 
-    let pdf = |p: P| sampler.pdf(p);
+    let batched = BatchedPdf::new(sampler);
     let points: Vec<P> = singles.iter().map(|s| s.0).collect();
     let batch_points: Vec<P> = batches.iter().flatten().map(|s| s.0).collect();
     let opts = &plan.quadrature;
@@ -203,7 +298,7 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         out.extend(exact.distribution_tests(&points, &batch_points, axis_names, plan, alpha));
     } else {
         let n_max = points.len().max(batch_points.len()) as u64;
-        match expected_masses_with(&pdf, binning, n_max, opts) {
+        match batched.run(&|pdf| expected_masses_with(pdf, binning, n_max, opts)) {
             Ok(table) => {
                 out.push(chi_square(
                     names::CHI_SQUARE,
@@ -228,9 +323,11 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         let singular = singular_params(binning, &sampler.singular_points());
         for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
             out.push(
-                match ks_projection_test_with_singularities(
-                    binning, &pdf, &points, axis, alpha, opts, &singular,
-                ) {
+                match batched.run(&|pdf| {
+                    ks_projection_test_with_singularities(
+                        binning, pdf, &points, axis, alpha, opts, &singular,
+                    )
+                }) {
                     Ok(o) => renamed(o, name),
                     Err(e) => error_outcome(name, e),
                 },
@@ -242,14 +339,22 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
         .chain(batches.iter().flatten())
         .copied()
         .collect();
-    out.push(match pdf_consistency(&all, &pdf, plan.pdf_rel_tol) {
-        Ok(o) => renamed(o, names::PDF_CONSISTENCY),
-        Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
-    });
+    // The pdfs re-evaluated in one call (a sampler may batch them), checked by sample index.
+    let again = sampler.pdf_many(&all.iter().map(|s| s.0).collect::<Vec<P>>());
+    let indexed: Vec<(usize, f64)> = all.iter().enumerate().map(|(i, s)| (i, s.1)).collect();
+    let again_at = |i: usize| again[i];
+    out.push(
+        match pdf_consistency(&indexed, &again_at, plan.pdf_rel_tol) {
+            Ok(o) => renamed(o, names::PDF_CONSISTENCY),
+            Err(e) => error_outcome(names::PDF_CONSISTENCY, e),
+        },
+    );
     match exact {
         Some(exact) => out.extend(exact.normalisation_tests(plan)),
         None => out.push(
-            match normalisation(binning, &pdf, 1.0, plan.normalisation_tolerance, opts) {
+            match batched
+                .run(&|pdf| normalisation(binning, pdf, 1.0, plan.normalisation_tolerance, opts))
+            {
                 Ok(o) => renamed(o, names::NORMALISATION),
                 Err(e) => error_outcome(names::NORMALISATION, e),
             },
@@ -257,7 +362,9 @@ pub(crate) fn run_subject<P: Copy + Send + Sync + 'static>(
     }
     let target = s.target.as_ref();
     out.push(
-        match support_coverage(binning, target, &pdf, plan.support_resolution, opts) {
+        match batched
+            .run(&|pdf| support_coverage(binning, target, pdf, plan.support_resolution, opts))
+        {
             Ok(o) => renamed(o, names::SUPPORT),
             Err(e) => error_outcome(names::SUPPORT, e),
         },

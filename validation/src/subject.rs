@@ -36,6 +36,28 @@ pub trait SamplerUnderTest<P>: Send + Sync {
         (0..n).map(|_| self.sample(u)).collect()
     }
 
+    /// `n` one-sample draws: exactly what `n` calls of [`Self::sample`] return (the same
+    /// uniforms in the same order). Override only to batch the work (e.g. a sampler written in
+    /// Python, called once per chunk of [`crate::DRAW_CHUNK`] draws).
+    fn sample_many(&self, n: usize, u: &mut dyn UniformSource) -> Vec<(P, f64)> {
+        (0..n).map(|_| self.sample(u)).collect()
+    }
+
+    /// [`Self::pdf`] of every point, in order (override only to batch the work).
+    fn pdf_many(&self, points: &[P]) -> Vec<f64>
+    where
+        P: Clone,
+    {
+        points.iter().map(|p| self.pdf(p.clone())).collect()
+    }
+
+    /// Whether pdf queries should come in batches ([`Self::pdf_many`]) wherever the suite can
+    /// arrange it, including its quadratures (e.g. a sampler written in Python, for which one
+    /// call per point costs far more than the arithmetic). `false` by default.
+    fn prefers_batches(&self) -> bool {
+        false
+    }
+
     /// Cumulative count of rejection trials with `f > M_i` (bound violations), for samplers
     /// that audit their bounds; `None` otherwise.
     fn bound_violations(&self) -> Option<u64> {

@@ -30,7 +30,7 @@ use crate::report::{BuildWarning, MutantRecord, ShardInfo, TestRecord, Validatio
 use crate::seeding::{case_seed, label_hash};
 use crate::subject::AnySubject;
 use crate::targets::{BrdfReferences, brdf_direction_subject, brdf_disc_subject};
-use samplers::SamplerEntry;
+use samplers::{Registry, SamplerEntry};
 
 /// Progress of a run, reported once at the start and once per finished case.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,17 +54,17 @@ pub enum ProgressEvent {
 }
 
 /// The cases of one run, resolved from a [`ValidateConfig`].
-struct Resolved {
+struct Resolved<'r> {
     plan: Plan,
     brdfs: Vec<(String, Arc<dyn Brdf>)>,
     angles: Vec<f64>,
-    samplers: Vec<&'static SamplerEntry>,
+    samplers: Vec<&'r SamplerEntry>,
     sets: Vec<LoadedSet>,
     /// Specs run at [`PRESET_THETA_O`] only (the full tier's default preset fits).
     few_angles: Vec<String>,
 }
 
-impl Resolved {
+impl Resolved<'_> {
     /// Whether `spec` runs at `theta` (every angle of the run, except for the full tier's
     /// preset fits, which run at the run's angles that are in [`PRESET_THETA_O`]).
     fn runs(&self, spec: &str, theta: f64) -> bool {
@@ -106,7 +106,10 @@ fn merl_specs(dir: &Path) -> Vec<String> {
     files
 }
 
-fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
+fn resolve<'r>(
+    registry: &'r Registry,
+    config: &ValidateConfig,
+) -> Result<Resolved<'r>, ValidationError> {
     if !(config.alpha > 0.0 && config.alpha < 1.0) {
         return Err(ValidationError::BadAlpha(config.alpha));
     }
@@ -133,12 +136,12 @@ fn resolve(config: &ValidateConfig) -> Result<Resolved, ValidationError> {
         return Err(ValidationError::BadAngle(bad));
     }
     let sets = load_sets(&config.sets)?;
-    let mut entries: Vec<&'static SamplerEntry> = Vec::new();
+    let mut entries: Vec<&SamplerEntry> = Vec::new();
     if config.samplers.is_empty() && sets.is_empty() {
-        entries.extend(samplers::samplers().iter());
+        entries.extend(registry.entries().iter());
     } else {
         for name in &config.samplers {
-            let e = samplers::find(name)?;
+            let e = registry.find(name)?;
             if !entries.iter().any(|x| x.name == e.name) {
                 entries.push(e);
             }
@@ -227,11 +230,11 @@ impl CaseResult {
 /// standalone case.
 enum Job<'a> {
     Brdf {
-        entry: &'static SamplerEntry,
+        entry: &'a SamplerEntry,
         brdf: usize,
     },
     Standalone {
-        entry: &'static SamplerEntry,
+        entry: &'a SamplerEntry,
         case: &'a StandaloneCase,
     },
     /// A saved set (index into the run's sets), with its own BRDF.
@@ -486,7 +489,22 @@ pub fn run(
     config: &ValidateConfig,
     progress: &(dyn Fn(ProgressEvent) + Sync),
 ) -> Result<ValidationReport, ValidationError> {
-    run_shard(config, None, progress)
+    run_with(&Registry::builtin(), config, progress)
+}
+
+/// [`run`] with the samplers of `registry` (names in `config.samplers` are looked up there;
+/// an empty selection runs all of its entries): a sampler added with
+/// [`samplers::Registry::with`] — from a crate outside the workspace, or from Python — runs
+/// the same suite as the built-in ones. Mutants and saved sets are the built-in ones.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(
+    registry: &Registry,
+    config: &ValidateConfig,
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
+    run_shard_with(registry, config, None, progress)
 }
 
 /// Runs the cases of one shard of a validation (all of them with `None`, as [`run`] does).
@@ -506,16 +524,29 @@ pub fn run_shard(
     shard: Option<Shard>,
     progress: &(dyn Fn(ProgressEvent) + Sync),
 ) -> Result<ValidationReport, ValidationError> {
-    let r = resolve(config)?;
+    run_shard_with(&Registry::builtin(), config, shard, progress)
+}
+
+/// [`run_shard`] with the samplers of `registry` (see [`run_with`]).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_shard_with(
+    registry: &Registry,
+    config: &ValidateConfig,
+    shard: Option<Shard>,
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
+    let r = resolve(registry, config)?;
     let seed = config.seed;
 
     // Standalone samplers' cases are built up front (cheap), so the total is known.
-    let standalone: Vec<(&'static SamplerEntry, Result<Vec<StandaloneCase>, String>)> = r
+    let standalone: Vec<(&SamplerEntry, Result<Vec<StandaloneCase>, String>)> = r
         .samplers
         .iter()
         .filter_map(|e| standalone_cases(e).map(|cases| (*e, cases.map_err(|err| err.to_string()))))
         .collect();
-    let brdf_entries: Vec<&'static SamplerEntry> = r
+    let brdf_entries: Vec<&SamplerEntry> = r
         .samplers
         .iter()
         .copied()
@@ -530,7 +561,7 @@ pub fn run_shard(
     }
     // The plan's case labels in the fixed order (their index is the case's number).
     let mut labels: Vec<String> = Vec::new();
-    let mut failed_builds: Vec<(&'static SamplerEntry, &String)> = Vec::new();
+    let mut failed_builds: Vec<(&SamplerEntry, &String)> = Vec::new();
     for (entry, cases) in &standalone {
         match cases {
             Ok(cases) => jobs.extend(cases.iter().map(|case| Job::Standalone { entry, case })),

@@ -113,6 +113,27 @@ pub trait DirectionSampler: Send + Sync {
         (0..n).map(|_| self.sample(wo, u)).collect()
     }
 
+    /// `n` one-sample draws at `wo`: exactly what `n` calls of [`Self::sample`] return (the
+    /// same uniforms consumed in the same order), unlike [`Self::sample_batch`], which may
+    /// stratify. Override only to batch the work (e.g. one call into Python for all `n`); the
+    /// validation suite draws its one-sample sets through it.
+    fn sample_many(&self, wo: &Vec3, n: usize, u: &mut dyn UniformSource) -> Vec<DirSample> {
+        (0..n).map(|_| self.sample(wo, u)).collect()
+    }
+
+    /// [`Self::pdf`] at `wo` for every direction of `wi`, in order. Override only to batch the
+    /// work; the validation suite's pdf-consistency check calls it.
+    fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
+        wi.iter().map(|w| self.pdf(wo, w)).collect()
+    }
+
+    /// Whether callers should batch pdf queries through [`Self::pdf_many`] wherever they can
+    /// (a sampler for which one call per point is expensive, e.g. one written in Python); the
+    /// validation suite then serves its quadratures from batched values. `false` by default.
+    fn prefers_batches(&self) -> bool {
+        false
+    }
+
     /// Cumulative count of trials that found the density above its bound (samplers with an
     /// audited bound, e.g. the adaptive sets); `None` for samplers that have no bound to audit.
     fn bound_violations(&self) -> Option<u64> {

@@ -43,6 +43,15 @@ pub enum RegistryError {
         /// The names of the expected kind.
         candidates: String,
     },
+    /// A sampler added at run time ([`crate::SamplerEntry::direction`]) could not be built: its
+    /// own error.
+    #[error("sampler `{name}`: {source}")]
+    User {
+        /// The sampler's registered name.
+        name: &'static str,
+        /// Its build closure's error.
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// A saved set's variant and mixture flag match no registered sampler.
     #[error("the saved set ({variant:?}, mixture {mixture}) matches no registered sampler")]
     UnregisteredSet {

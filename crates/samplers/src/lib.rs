@@ -37,16 +37,18 @@
 
 mod entries;
 mod error;
+mod registry;
 mod request;
 
 pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, quadtree_disc_density};
 pub use error::{NotApplicable, RegistryError};
+pub use registry::Registry;
 pub use request::{BuiltDirection, DirectionRequest};
 
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DiscBrdf, QuadTreeSet, Variant};
+use brdf_sampling::{DirectionSampler, DiscBrdf, QuadTreeSet, Variant};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
 use partition_sampler::{QuadTreeSampler, Rect, SampledGridDensity};
 
@@ -59,8 +61,9 @@ pub enum Support {
     Sphere,
 }
 
-/// What a sampler can do, for listings and for choosing what to run it on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a sampler can do, for listings and for choosing what to run it on (all `false` by
+/// default).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Capabilities {
     /// The reported pdf is the exact density of the drawn samples (up to a declared numerical
     /// normaliser), so a poor fit costs variance, never bias.
@@ -93,6 +96,14 @@ impl Capabilities {
 /// Builds a direction sampler (other than an adaptive set) for a request.
 pub type DirectionBuild = fn(&DirectionRequest<'_>) -> Result<BuiltDirection, RegistryError>;
 
+/// Builds a direction sampler from a closure (an entry made at run time, e.g. by a crate outside
+/// the workspace or by the Python bindings: see [`SamplerEntry::direction`]).
+pub type SharedDirectionBuild =
+    Arc<dyn Fn(&DirectionRequest<'_>) -> Result<BuiltDirection, RegistryError> + Send + Sync>;
+
+/// The error a user's build closure may return ([`SamplerEntry::direction`]).
+pub type UserError = Box<dyn std::error::Error + Send + Sync>;
+
 /// The disc sampler of `x ↦ f_r(ωo, h⁻¹(x))` (pdf w.r.t. area on the unit disc).
 pub type DiscSampler = QuadTreeSampler<SampledGridDensity<DiscBrdf>>;
 
@@ -110,7 +121,7 @@ pub type GridSampler = partition_sampler::PiecewiseConstant2D;
 pub type GridBuild = fn(usize, usize, Vec<f64>, Rect) -> Result<GridSampler, RegistryError>;
 
 /// How a registered sampler is built.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub enum Constructor {
     /// An adaptive quadtree set of `brdf-sampling` (a direction sampler on Ω that can be saved
     /// with `build --out` and loaded with `--set`).
@@ -127,6 +138,14 @@ pub enum Constructor {
         /// Its constructor.
         build: DirectionBuild,
     },
+    /// A direction sampler of a BRDF built by a closure (entries made at run time:
+    /// [`SamplerEntry::direction`]); tested and studied exactly like [`Constructor::Direction`].
+    SharedDirection {
+        /// Where its samples may land.
+        support: Support,
+        /// Its constructor.
+        build: SharedDirectionBuild,
+    },
     /// A planar sampler on the unit disc for one `(BRDF, ωo)`.
     Disc(DiscBuild),
     /// A sampler of a lat-long environment map.
@@ -139,7 +158,9 @@ impl Constructor {
     /// `direction`, `disc`, `envmap` or `grid`.
     pub fn kind(&self) -> &'static str {
         match self {
-            Constructor::AdaptiveSet { .. } | Constructor::Direction { .. } => "direction",
+            Constructor::AdaptiveSet { .. }
+            | Constructor::Direction { .. }
+            | Constructor::SharedDirection { .. } => "direction",
             Constructor::Disc(_) => "disc",
             Constructor::EnvMap(_) => "envmap",
             Constructor::Grid(_) => "grid",
@@ -150,14 +171,15 @@ impl Constructor {
     pub fn support(&self) -> Option<Support> {
         match self {
             Constructor::AdaptiveSet { .. } => Some(Support::Hemisphere),
-            Constructor::Direction { support, .. } => Some(*support),
+            Constructor::Direction { support, .. }
+            | Constructor::SharedDirection { support, .. } => Some(*support),
             _ => None,
         }
     }
 }
 
 /// One registered sampler.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct SamplerEntry {
     /// The name given to `--sampler`.
     pub name: &'static str,
@@ -180,6 +202,56 @@ impl std::fmt::Debug for SamplerEntry {
 }
 
 impl SamplerEntry {
+    /// A direction sampler of a BRDF built by `build` (a closure, so it may capture state, e.g.
+    /// a Python object), to add to a [`Registry`] with [`Registry::with`]. `build` gets the
+    /// request (the BRDF, the options) and returns the sampler or its own error
+    /// ([`RegistryError::User`]).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use samplers::{Capabilities, Registry, SamplerEntry, Support};
+    ///
+    /// // A new name for the registry's cosine sampler, built by a closure.
+    /// let entry = SamplerEntry::direction(
+    ///     "my-cosine",
+    ///     "cosine-weighted hemisphere, wrapped",
+    ///     Capabilities { exact_pdf: true, ..Capabilities::default() },
+    ///     Support::Hemisphere,
+    ///     |request| Ok(samplers::build_direction("cosine", request)?.sampler),
+    /// );
+    /// let registry = Registry::builtin().with(entry);
+    /// assert!(registry.find("my-cosine")?.is_direction());
+    /// assert!(samplers::find("my-cosine").is_err()); // the built-in registry is unchanged
+    /// # Ok::<(), samplers::RegistryError>(())
+    /// ```
+    pub fn direction<F>(
+        name: &'static str,
+        summary: &'static str,
+        capabilities: Capabilities,
+        support: Support,
+        build: F,
+    ) -> Self
+    where
+        F: Fn(&DirectionRequest<'_>) -> Result<Arc<dyn DirectionSampler>, UserError>
+            + Send
+            + Sync
+            + 'static,
+    {
+        Self {
+            name,
+            summary,
+            capabilities,
+            constructor: Constructor::SharedDirection {
+                support,
+                build: Arc::new(move |request: &DirectionRequest<'_>| {
+                    build(request)
+                        .map(BuiltDirection::plain)
+                        .map_err(|source| RegistryError::User { name, source })
+                }),
+            },
+        }
+    }
+
     /// Whether this is a direction sampler of a BRDF.
     pub fn is_direction(&self) -> bool {
         self.constructor.kind() == "direction"
@@ -197,8 +269,8 @@ impl SamplerEntry {
         if self.is_direction() {
             self.applicability(request.brdf.as_ref())?;
         }
-        match self.constructor {
-            Constructor::AdaptiveSet { variant, mixture } => {
+        match &self.constructor {
+            &Constructor::AdaptiveSet { variant, mixture } => {
                 let options = brdf_sampling::SetOptions {
                     mixture: request.options.mixture || mixture,
                     ..*request.options
@@ -213,6 +285,7 @@ impl SamplerEntry {
                 Ok(BuiltDirection::from_set(set))
             }
             Constructor::Direction { build, .. } => build(request),
+            Constructor::SharedDirection { build, .. } => build(request),
             other => Err(self.wrong_kind("direction", other.kind())),
         }
     }
@@ -241,7 +314,7 @@ impl SamplerEntry {
         brdf: &Arc<dyn Brdf>,
         wo: &Vec3,
     ) -> Result<DiscSampler, RegistryError> {
-        match self.constructor {
+        match &self.constructor {
             Constructor::Disc(build) => build(brdf, wo),
             other => Err(self.wrong_kind("disc", other.kind())),
         }
@@ -253,7 +326,7 @@ impl SamplerEntry {
         map: &EnvMap,
         options: &AdaptiveOptions,
     ) -> Result<EnvMapSampler, RegistryError> {
-        match self.constructor {
+        match &self.constructor {
             Constructor::EnvMap(build) => build(map, options),
             other => Err(self.wrong_kind("envmap", other.kind())),
         }
@@ -267,7 +340,7 @@ impl SamplerEntry {
         values: Vec<f64>,
         domain: Rect,
     ) -> Result<GridSampler, RegistryError> {
-        match self.constructor {
+        match &self.constructor {
             Constructor::Grid(build) => build(width, height, values, domain),
             other => Err(self.wrong_kind("grid", other.kind())),
         }
@@ -290,7 +363,11 @@ pub fn samplers() -> &'static [SamplerEntry] {
 
 /// The names of the samplers of one kind (`direction`, `disc`, `envmap`, `grid`), comma-separated.
 pub fn names_of_kind(kind: &str) -> String {
-    SAMPLERS
+    names_of_kind_in(SAMPLERS, kind)
+}
+
+pub(crate) fn names_of_kind_in(entries: &[SamplerEntry], kind: &str) -> String {
+    entries
         .iter()
         .filter(|e| e.constructor.kind() == kind)
         .map(|e| e.name)
@@ -360,14 +437,19 @@ pub fn load_set(
 
 /// The registered name closest to `name` (edit distance ≤ 3, or a name containing it).
 fn closest(name: &str) -> Option<&'static str> {
-    let best = SAMPLERS
+    closest_in(SAMPLERS, name)
+}
+
+/// The name in `entries` closest to `name` (edit distance ≤ 3, or a name containing it).
+pub(crate) fn closest_in(entries: &[SamplerEntry], name: &str) -> Option<&'static str> {
+    let best = entries
         .iter()
         .map(|e| (edit_distance(name, e.name), e.name))
         .min()?;
     if best.0 <= 3 {
         return Some(best.1);
     }
-    SAMPLERS
+    entries
         .iter()
         .map(|e| e.name)
         .find(|n| !name.is_empty() && n.contains(name))

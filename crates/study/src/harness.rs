@@ -33,7 +33,7 @@ use estimators::{LocalFrame, MisHeuristic, MisPair};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
-use samplers::{DirectionRequest, SamplerEntry};
+use samplers::{DirectionRequest, Registry, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
@@ -128,7 +128,7 @@ type LightBuild = Result<Arc<EnvMapSampler>, String>;
 pub struct StudyPlan {
     pub(crate) config: StudyConfig,
     notes: Vec<String>,
-    pub(crate) entries: Vec<&'static SamplerEntry>,
+    pub(crate) entries: Vec<SamplerEntry>,
     pub(crate) brdfs: Vec<StudyBrdf>,
     pub(crate) lights: Vec<Arc<Light>>,
     /// The map samplers of the light and MIS estimators.
@@ -153,21 +153,34 @@ impl StudyPlan {
     ///
     /// Errors: the first bad setting or name.
     pub fn new(config: StudyConfig, notes: Vec<String>) -> Result<Self, StudyError> {
+        Self::with_registry(config, notes, &Registry::builtin())
+    }
+
+    /// [`StudyPlan::new`] with the samplers of `registry`: a direction sampler added with
+    /// [`samplers::Registry::with`] (from a crate outside the workspace, or from Python) is
+    /// studied beside the built-in ones, its cost measured as it is.
+    ///
+    /// Errors: as [`StudyPlan::new`].
+    pub fn with_registry(
+        config: StudyConfig,
+        notes: Vec<String>,
+        registry: &Registry,
+    ) -> Result<Self, StudyError> {
         config.check()?;
         let entries = config
             .samplers
             .iter()
             .map(|name| {
-                let e = samplers::find(name)?;
+                let e = registry.find(name)?;
                 if !e.is_direction() {
                     return Err(StudyError::from(samplers::RegistryError::WrongKind {
                         name: e.name,
                         expected: "direction",
                         found: e.constructor.kind(),
-                        candidates: samplers::names_of_kind("direction"),
+                        candidates: registry.names_of_kind("direction"),
                     }));
                 }
-                Ok(e)
+                Ok(e.clone())
             })
             .collect::<Result<Vec<_>, StudyError>>()?;
         let brdfs = config

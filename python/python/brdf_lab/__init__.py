@@ -111,13 +111,55 @@ def _names(x: Any, what: str) -> list:
         else:
             raise TypeError(
                 f"{what} must be registry names / specs (str) or brdf_lab.Brdf; "
-                f"got {type(item).__name__} (validating your own sampler object is issue 31)"
+                f"got {type(item).__name__}"
             )
     return out
 
 
+def _is_user_sampler(x: Any) -> bool:
+    return callable(getattr(x, "sample", None)) and callable(getattr(x, "pdf", None))
+
+
+def _user_name(obj: Any) -> str:
+    name = getattr(obj, "name", None)
+    return name if isinstance(name, str) and name else type(obj).__name__
+
+
+def _user_pairs(d: dict) -> list:
+    out = []
+    for name, obj in d.items():
+        if not _is_user_sampler(obj):
+            raise TypeError(f"sampler {name!r} has no sample(wo, u) and pdf(wo, wi) methods")
+        out.append((str(name), obj))
+    return out
+
+
+def _samplers(x: Any) -> tuple:
+    """The selected names (registry names and Python samplers' names, in order) and the
+    (name, object) pairs of the Python samplers: objects with ``sample(wo, u)`` and
+    ``pdf(wo, wi)`` (named by their ``name`` attribute, else their class), alone, in a list,
+    or by name in a dict."""
+    if isinstance(x, dict):
+        user = _user_pairs(x)
+        return [n for n, _ in user], user
+    items = [] if x is None else list(x) if isinstance(x, (list, tuple)) else [x]
+    names, user = [], []
+    for item in items:
+        if isinstance(item, str):
+            names.append(item)
+        elif _is_user_sampler(item):
+            user.append((_user_name(item), item))
+            names.append(user[-1][0])
+        else:
+            raise TypeError(
+                "samplers must be registry names (str) or objects with sample(wo, u) and "
+                f"pdf(wo, wi); got {type(item).__name__}"
+            )
+    return names, user
+
+
 def validate(
-    sampler: Union[str, Sequence[str], None] = None,
+    sampler: Any = None,
     brdf: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
     theta_o: Optional[Iterable[float]] = None,
     samples: Optional[int] = None,
@@ -131,15 +173,23 @@ def validate(
     sets: Sequence[PathLike] = (),
 ) -> ValidationResult:
     """Run brdf-lab's validation suite (χ², KS, consistency, normalisation, unbiasedness) on
-    registry samplers × BRDF specs × θo (degrees), like ``brdf-lab validate``.
+    samplers × BRDF specs × θo (degrees), like ``brdf-lab validate``.
+
+    ``sampler``: a registry name, or any object with ``sample(wo, u) -> (wi, pdf)`` (or
+    ``(wi, pdf, f)``) and ``pdf(wo, wi) -> pdf`` on NumPy batches (``wo`` (3,), ``u`` (N, 2)
+    uniforms, ``wi`` (N, 3), pdfs per unit solid angle; named by its ``name`` attribute, else
+    its class), or a list of these, or a dict ``{name: object}``. Python samplers run the same
+    suite as the built-in ones, with draws batched into few calls; an exception they raise is
+    raised here as ``ValueError``.
 
     ``None`` / empty selections take the tier's defaults (``quick=True``: the CI tier).
     ``json`` / ``report`` write the CLI's ``--json`` / ``--report`` files. Returns a
     :class:`ValidationResult`; raises ``ValueError`` for bad input (unknown sampler, bad
     spec, bad angle, too few samples). Failing samplers are reported, not raised.
     """
+    names, user = _samplers(sampler)
     text = _native.validate_json(
-        _names(sampler, "sampler"),
+        names,
         _names(brdf, "brdf"),
         [float(t) for t in (theta_o or [])],
         samples,
@@ -150,6 +200,7 @@ def validate(
         None if json is None else os.fspath(json),
         None if report is None else os.fspath(report),
         [os.fspath(s) for s in sets],
+        user,
     )
     raw = _json.loads(text)
     return ValidationResult(
@@ -163,7 +214,7 @@ def validate(
 
 
 def study(
-    samplers: Union[str, Sequence[str], None] = None,
+    samplers: Any = None,
     brdfs: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
     theta_o: Optional[Iterable[float]] = None,
     lights: Union[str, Sequence[str], None] = None,
@@ -175,6 +226,9 @@ def study(
     shard: Optional[str] = None,
     out: Optional[PathLike] = None,
     root: Optional[PathLike] = None,
+    extra_samplers: Optional[dict] = None,
+    variance_samples: Optional[int] = None,
+    timing_samples: Optional[int] = None,
 ) -> StudyResult:
     """Run a variance-versus-cost study (``brdf-lab study``): samplers × BRDFs × θo × lights.
 
@@ -182,9 +236,15 @@ def study(
     ``../shared`` is looked for), ``"custom"`` the CLI's default grid; given arguments override
     it. ``out`` writes ``results.json``, ``results.csv``, ``report.md`` and ``plots/`` like the
     CLI (without the sphere images). ``shard="K/N"`` runs one shard.
+
+    ``samplers`` may hold Python sampler objects (as for :func:`validate`), and
+    ``extra_samplers={name: object}`` adds some to the preset's samplers: they are studied
+    beside the built-in ones, their cost (one Python call per sample) measured as it is.
     """
+    names, user = _samplers(samplers)
+    user += _user_pairs(extra_samplers or {})
     text = _native.study_json(
-        _names(samplers, "samplers"),
+        names,
         _names(brdfs, "brdfs"),
         [float(t) for t in (theta_o or [])],
         _names(lights, "lights"),
@@ -195,6 +255,9 @@ def study(
         shard,
         None if out is None else os.fspath(out),
         None if root is None else os.fspath(root),
+        user,
+        variance_samples,
+        timing_samples,
     )
     raw = _json.loads(text)
     return StudyResult(

@@ -2,7 +2,7 @@
 
 import os
 from dataclasses import dataclass
-from typing import Any, Iterable, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, Iterable, Optional, Protocol, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -129,8 +129,14 @@ def samplers() -> list: ...
 def option_names() -> dict: ...
 def set_num_threads(n: Optional[int] = None) -> None: ...
 def num_threads() -> int: ...
+class UserSampler(Protocol):
+    """A sampler written in Python (see :func:`validate`)."""
+
+    def sample(self, wo: np.ndarray, u: np.ndarray) -> tuple: ...
+    def pdf(self, wo: np.ndarray, wi: np.ndarray) -> np.ndarray: ...
+
 def validate(
-    sampler: Union[str, Sequence[str], None] = None,
+    sampler: Union[str, UserSampler, Sequence[Union[str, UserSampler]], Dict[str, UserSampler], None] = None,
     brdf: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
     theta_o: Optional[Iterable[float]] = None,
     samples: Optional[int] = None,
@@ -144,7 +150,7 @@ def validate(
     sets: Sequence[PathLike] = (),
 ) -> ValidationResult: ...
 def study(
-    samplers: Union[str, Sequence[str], None] = None,
+    samplers: Union[str, UserSampler, Sequence[Union[str, UserSampler]], Dict[str, UserSampler], None] = None,
     brdfs: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
     theta_o: Optional[Iterable[float]] = None,
     lights: Union[str, Sequence[str], None] = None,
@@ -156,4 +162,7 @@ def study(
     shard: Optional[str] = None,
     out: Optional[PathLike] = None,
     root: Optional[PathLike] = None,
+    extra_samplers: Optional[Dict[str, UserSampler]] = None,
+    variance_samples: Optional[int] = None,
+    timing_samples: Optional[int] = None,
 ) -> StudyResult: ...

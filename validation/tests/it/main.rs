@@ -4,6 +4,7 @@
 //! test command compiles and links one binary here instead of one per file (docs/validation.md,
 //! "What the test command runs").
 
+mod byo;
 mod errors;
 mod quick_cornell;
 mod quick_tier;
