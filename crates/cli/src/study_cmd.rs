@@ -64,6 +64,10 @@ pub(crate) struct StudyArgs {
     /// Samples per pixel of the equal-samples sphere images, in 1 ..= 65536.
     #[arg(long, default_value_t = 64, value_parser = values::int(1usize, MAX_SPP), allow_negative_numbers = true)]
     spp: usize,
+    /// Pixels per sphere side in the sphere sheets, in 16 ..= 512; default 128 (80 with --quick,
+    /// to keep it within its three minutes).
+    #[arg(long, value_parser = values::int(MIN_SPHERE_PX, MAX_SPHERE_PX), allow_negative_numbers = true)]
+    sphere_px: Option<usize>,
     /// Output directory (checked before any work; the outputs are written to a temporary
     /// directory beside it and moved in at the end, so a failed run leaves nothing).
     #[arg(long, default_value = "study-out")]
@@ -92,10 +96,22 @@ struct MergeArgs {
     /// Samples per pixel of the equal-samples sphere images, in 1 ..= 65536.
     #[arg(long, default_value_t = 64, value_parser = values::int(1usize, MAX_SPP), allow_negative_numbers = true)]
     spp: usize,
+    /// Pixels per sphere side in the sphere sheets, in 16 ..= 512.
+    #[arg(long, default_value_t = SPHERE_PX, value_parser = values::int(MIN_SPHERE_PX, MAX_SPHERE_PX), allow_negative_numbers = true)]
+    sphere_px: usize,
 }
 
 /// Largest `--spp` (the equal-samples images take `spp` samples per pixel and sampler).
 const MAX_SPP: usize = 65_536;
+
+/// Default pixels per sphere side of the sphere sheets (issue 28: ≥ 128 px per sphere).
+const SPHERE_PX: usize = 128;
+/// Pixels per sphere side of `--quick`'s sheets (its three-minute budget).
+const QUICK_SPHERE_PX: usize = 80;
+/// Smallest `--sphere-px`.
+const MIN_SPHERE_PX: usize = 16;
+/// Largest `--sphere-px`.
+const MAX_SPHERE_PX: usize = 512;
 
 /// Runs `brdf-lab study`.
 pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
@@ -149,9 +165,15 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     let results = plan.run(shard, &|n| bar.inc(n));
     let render = images
         .then(|| {
+            let default_px = if args.quick {
+                QUICK_SPHERE_PX
+            } else {
+                SPHERE_PX
+            };
             let cfg = study::RenderConfig {
                 spp: args.spp,
                 seed: args.seed,
+                sphere_px: args.sphere_px.unwrap_or(default_px),
                 ..study::RenderConfig::default()
             };
             render_sheet(&plan, &cfg, &|n| bar.inc(n))
@@ -193,6 +215,7 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
         let cfg = study::RenderConfig {
             spp: args.spp,
             seed: merged.config.seed,
+            sphere_px: args.sphere_px,
             ..study::RenderConfig::default()
         };
         let bar = progress::bar(1 + 2 * plan.config().samplers.len() as u64, "images");
