@@ -557,14 +557,19 @@ impl Problem<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::srbf::vmf::vmf_sample;
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};
 
-    /// A lat-long grid of the whole sphere with exact solid-angle weights.
-    fn sphere_target(f: impl Fn(&Vec3) -> f64, w: usize, h: usize) -> FitTarget {
+    /// A lat-long grid of the whole sphere with exact solid-angle weights (also used by the
+    /// Levenberg–Marquardt tests).
+    pub(in crate::srbf) fn sphere_target(
+        f: impl Fn(&Vec3) -> f64,
+        w: usize,
+        h: usize,
+    ) -> FitTarget {
         let (mut d, mut a, mut v) = (Vec::new(), Vec::new(), Vec::new());
         for y in 0..h {
             let (t0, t1) = (

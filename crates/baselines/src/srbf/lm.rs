@@ -284,23 +284,7 @@ pub(crate) fn refine(
 mod tests {
     use super::*;
 
-    /// Exact solid-angle weights of a `w × h` lat-long grid of the sphere.
-    fn sphere_target(f: impl Fn(&Vec3) -> f64, w: usize, h: usize) -> FitTarget {
-        let (mut d, mut a, mut v) = (Vec::new(), Vec::new(), Vec::new());
-        for y in 0..h {
-            let pi = std::f64::consts::PI;
-            let (t0, t1) = (pi * y as f64 / h as f64, pi * (y + 1) as f64 / h as f64);
-            let t = 0.5 * (t0 + t1);
-            for x in 0..w {
-                let p = std::f64::consts::TAU * (x as f64 + 0.5) / w as f64;
-                let dir = Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
-                a.push(std::f64::consts::TAU / w as f64 * (t0.cos() - t1.cos()));
-                v.push(f(&dir));
-                d.push(dir);
-            }
-        }
-        FitTarget::new(d, a, v).unwrap()
-    }
+    use crate::srbf::fit::tests::sphere_target;
 
     #[test]
     fn recovers_a_mixture_from_a_perturbed_start_and_holds_bounds() {
