@@ -39,17 +39,6 @@ pub(crate) enum Grading {
     Graded,
 }
 
-/// `∫_{[a, b]} g` by the rule mapped to `[a, b]`.
-fn integrate_1d(rule: &GaussLegendre, a: f64, b: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
-    let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
-    rule.nodes()
-        .iter()
-        .zip(rule.weights())
-        .map(|(x, w)| w * g(c + h * x))
-        .sum::<f64>()
-        * h
-}
-
 /// `∫_{rect ∩ D} f dA` by the iterated rule (see the module docs).
 fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
     let chord = |x: f64| (1.0 - x * x).max(0.0).sqrt();
@@ -57,7 +46,7 @@ fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
         let half = chord(x);
         let (ya, yb) = (rect.y0.max(-half), rect.y1.min(half));
         if yb > ya {
-            integrate_1d(rule, ya, yb, |y| f.eval([x, y]))
+            rule.integrate(ya, yb, |y| f.eval([x, y]))
         } else {
             0.0
         }
@@ -82,7 +71,7 @@ fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
         .map(|w| {
             let (a, b) = (w[0].max(-1.0), w[1].min(1.0));
             if b > a {
-                integrate_1d(rule, a.asin(), b.asin(), |t| inner(t.sin()) * t.cos())
+                rule.integrate(a.asin(), b.asin(), |t| inner(t.sin()) * t.cos())
             } else {
                 0.0
             }

@@ -27,6 +27,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use crate::brdf::Brdf;
 use crate::geometry::Vec3;
 use crate::merl::{MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H};
+use crate::quadrature::GaussLegendre;
 
 /// [`MerlBrdf::albedo_in_bins`]: the integral, its error estimate and the lookups it cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -145,13 +146,13 @@ impl MerlBrdf {
             })
             .chain(std::iter::once(FRAC_PI_2))
             .collect();
-        // 2-point Gauss nodes ±1/√3 and the midpoint of [a, b].
-        let g = 1.0 / 3.0f64.sqrt();
+        // The 2-point Gauss rule (`crate::quadrature`, the workspace's one home of Gauss–Legendre
+        // nodes) and the midpoint rule on [a, b].
+        let gauss = GaussLegendre::new(2);
         let mut piece = |a: f64, b: f64, evaluations: &mut u64| -> Piece {
-            let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
             let mut ring = |t: f64| self.ring(&wo, t, &edges, &mut roots, evaluations);
-            let value = h * (ring(c - g * h) + ring(c + g * h));
-            let mid = 2.0 * h * ring(c);
+            let value = gauss.integrate(a, b, &mut ring);
+            let mid = (b - a) * ring(0.5 * (a + b));
             Piece {
                 a,
                 b,
