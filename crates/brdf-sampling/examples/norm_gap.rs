@@ -3,7 +3,13 @@
 //! item 4).
 //!
 //! `cargo run --release -p brdf-sampling --example norm_gap -- --spec SPEC [--angles 180]
-//!   [--n 1024] [--check-n 2048] [--adaptive] [--at θ,θ,…] [--write-merl PATH]`
+//!   [--n 1024] [--check-n 2048] [--ref-every 16] [--adaptive] [--at θ,θ,…] [--write-merl PATH]`
+//!
+//! `--ref-every K`: the adaptive reference quadrature (`reference_albedo`, 4·10⁶ evaluations,
+//! its own error estimate printed) at every K-th angle (0: never), a second reference where
+//! the midpoint rule is too coarse (sharp lobes). The node rule's own value at each angle
+//! (`ExactSet::node_rule_at`, no interpolation) splits the gap into the quadrature's part and
+//! the interpolation's.
 //!
 //! `SPEC` is a model spec (`rgl:PATH`, `cornell:PATH`, `merl:PATH`, …) or `merl(SPEC)`: the
 //! model `SPEC` tabulated in the MERL layout (nearest-bin lookup, `MerlBrdf::tabulate`).
@@ -89,6 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n: usize = arg(&args, "--n").unwrap_or(1024);
     let check_n: usize = arg(&args, "--check-n").unwrap_or(2048);
     let with_adaptive = args.iter().any(|a| a == "--adaptive");
+    let ref_every: usize = arg(&args, "--ref-every").unwrap_or(16);
     let brdf: Arc<dyn Brdf> =
         if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
             Arc::new(MerlBrdf::tabulate(&*parse_spec(inner)?))
@@ -148,10 +155,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         angles = list.split(',').filter_map(|v| v.parse().ok()).collect();
     }
     let merl = brdf.as_any().and_then(|a| a.downcast_ref::<MerlBrdf>());
-    println!("| θo ° | A (fine) | Â | A/Â − 1 | declared | ref. quad. A/Â − 1 | in bins A/Â − 1 |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| θo ° | A (fine) | Â | A/Â − 1 | declared | node rule at θo: A/N − 1 (its estimate) | interpolation N/Â − 1 | ref. quad. A/Â − 1 | in bins A/Â − 1 |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
     let (mut worst, mut worst_at, mut worst_check, mut under) = (0.0f64, 0.0, 0.0f64, 0usize);
     let mut worst_adaptive = 0.0f64;
+    let (mut worst_ref, mut worst_ref_vs_fine) = (0.0f64, 0.0f64);
     for (k, &t) in angles.iter().enumerate() {
         let wo = direction_from_angles(t, 0.0);
         let a = fine_albedo(brdf.as_ref(), &wo, n);
@@ -180,11 +190,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 set.report().max_integral_rel_err.unwrap_or(f64::NAN)
             );
         }
-        let r = if k % 16 == 0 {
-            reference_albedo(brdf.as_ref(), &wo).map_or(f64::NAN, |r| r.value / a_hat - 1.0)
+        let (r, r_err) = if ref_every > 0 && k % ref_every == 0 {
+            reference_albedo(brdf.as_ref(), &wo).map_or((f64::NAN, f64::NAN), |r| {
+                (r.value / a_hat - 1.0, r.abs_err / r.value)
+            })
         } else {
-            f64::NAN
+            (f64::NAN, f64::NAN)
         };
+        if r.is_finite() {
+            worst_ref = worst_ref.max(r.abs());
+            worst_ref_vs_fine = worst_ref_vs_fine.max(((r + 1.0) / (gap + 1.0) - 1.0).abs());
+        }
         // MERL layout: also the table integrated over its own bins to 1e-6 (a second
         // reference, `MerlBrdf::albedo_in_bins`; the set's nodes use it at 1e-5).
         let bins = merl.map_or(String::new(), |m| {
@@ -195,12 +211,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 b.abs_err / b.value
             )
         });
-        println!("| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {r:+.2e} |{bins}");
+        // The gap split into the node rule's own error (the rule run at θo itself, no
+        // interpolation) and the interpolation's (`ExactSet::node_rule_at`).
+        let (node, node_err) = exact.node_rule_at(&wo).unwrap_or((f64::NAN, f64::NAN));
+        println!(
+            "| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {:+.2e} ({node_err:.1e}) | {:+.2e} | {r:+.2e} (±{r_err:.0e}) |{bins}",
+            a / node - 1.0,
+            node / a_hat - 1.0
+        );
     }
     println!(
         "{spec}: max |A/Â − 1| = {worst:.2e} at θo = {worst_at:.3}° over {} angles; declared error below the gap at {under} of them; fine rule n = {n} vs {check_n}: max rel. difference {worst_check:.1e}",
         angles.len()
     );
+    if worst_ref > 0.0 {
+        println!(
+            "{spec}: reference quadrature: max |A_ref/Â − 1| = {worst_ref:.2e}; max |A_ref/A_fine − 1| = {worst_ref_vs_fine:.1e}"
+        );
+    }
     if adaptive.is_some() {
         println!("{spec}: adaptive (nearest slice) max |∫pdf − 1| = {worst_adaptive:.2e}");
     }

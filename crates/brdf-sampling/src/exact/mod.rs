@@ -67,6 +67,7 @@ mod batch;
 mod chebyshev;
 mod density;
 mod fused;
+mod probe;
 mod tabulated;
 
 use std::sync::Arc;
@@ -84,7 +85,6 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::Turn;
-use crate::normalisation::{Grading, per_leaf_quadrature};
 use crate::options::{OptionsError, SetOptions};
 use crate::set::layout_for;
 
@@ -746,9 +746,8 @@ pub(crate) fn theta_kinks(brdf: &dyn Brdf) -> Vec<f64> {
     };
     let eps = 1e-6;
     let mut k: Vec<f64> = rgl
-        .theta_slices()
-        .iter()
-        .copied()
+        .theta_kinks() // the slices, and σ's nodes above the last one (issue 27)
+        .into_iter()
         .filter(|t| t.is_finite() && *t > eps && *t < std::f64::consts::FRAC_PI_2 - eps)
         .collect();
     k.sort_by(f64::total_cmp);
@@ -1542,12 +1541,13 @@ fn build_interval(
                         d,
                         map,
                     );
-                    let r = per_leaf_quadrature(
+                    // The graded leaf quadrature, its budget by the BRDF (`tabulated.rs`).
+                    let r = tabulated::node_quadrature(
+                        brdf.as_ref(),
                         &q,
                         tree.leaves(),
                         tree.integral(),
                         mirror_y,
-                        Grading::Graded,
                     );
                     let r = Normaliser {
                         total: r.total,

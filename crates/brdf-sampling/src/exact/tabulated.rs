@@ -5,10 +5,51 @@
 //! at a node, and no interpolation in θo can repair that. [`brdf::MerlBrdf::albedo_in_bins`]
 //! integrates the table over its bins instead (exact rings of constant half-vector angle, an
 //! adaptive rule across them), to [`MERL_REL_TOL`] within [`MERL_BUDGET`] lookups.
+//!
+//! The other nodes keep the leaf quadrature of the interval's tree ([`node_quadrature`]), with
+//! a larger budget for the RGL tables ([`RGL_NODE_BUDGET`]): their bilinear interpolants have
+//! kinks along the cells of the warped square and of the `ndf` grid, which no leaf follows.
 
-use brdf::{Brdf, MerlBrdf};
+use brdf::{Brdf, MerlBrdf, RglBrdf};
+use partition_sampler::{Density, LeafInfo};
 
 use crate::disc::count_evaluations;
+use crate::normalisation::{EVALUATION_BUDGET, Grading, LeafIntegrals, TOL, adaptive_quadrature};
+
+/// Evaluation budget of one RGL normaliser node (the leaf quadrature's default is
+/// [`EVALUATION_BUDGET`]). At 16 000 the nodes of `paper_white` and `colodur_napoli_4f` were
+/// up to 1.0·10⁻⁴ and 8.9·10⁻⁵ off (the rule run at the query itself against two independent
+/// references that agree to 10⁻⁶; docs/benchmarks.md §13.10): the kinks of the interpolant
+/// cross the leaves everywhere, and the rule's error falls about like `1/budget`.
+pub(crate) const RGL_NODE_BUDGET: u64 = 48_000;
+
+/// The evaluation budget of a leaf-quadrature normaliser node of `brdf`.
+pub(crate) fn node_budget(brdf: &dyn Brdf) -> u64 {
+    if brdf.as_any().is_some_and(|a| a.is::<RglBrdf>()) {
+        RGL_NODE_BUDGET
+    } else {
+        EVALUATION_BUDGET
+    }
+}
+
+/// A normaliser node by the graded leaf quadrature of the interval's tree: `f` (the slice's
+/// density of `brdf`) over `leaves`, to `TOL · scale` within [`node_budget`] evaluations.
+pub(crate) fn node_quadrature(
+    brdf: &dyn Brdf,
+    f: &dyn Density,
+    leaves: impl Iterator<Item = LeafInfo>,
+    scale: f64,
+    mirror: bool,
+) -> LeafIntegrals {
+    adaptive_quadrature(
+        f,
+        leaves,
+        TOL * scale,
+        mirror,
+        node_budget(brdf),
+        Grading::Graded,
+    )
+}
 
 /// Relative error target of a MERL normaliser node. Its estimate is the 2-point Gauss rule's
 /// difference from the midpoint rule, summed over the pieces: conservative, the actual error

@@ -270,6 +270,37 @@ impl RglBrdf {
         self.tables.theta.values()
     }
 
+    /// The outgoing polar angles (radians, increasing, inside `(0, π/2)`) where the albedo
+    /// `A(θo) = ∫ f_r cos θi dσ` has its kinks: the interior slice angles (the tables are
+    /// blended linearly in θo between them), and, above the last interior slice, the θ of
+    /// `σ`'s grid nodes when the file applies the `D/(4σ)` factor. `σ` is bilinear in
+    /// `u = √(2θ/π)`, so `A ∝ 1/σ(θo)` has a kink at each of its nodes; below the last slice
+    /// they are 0.7–1.4° apart and their kinks small beside the slices', above it (no slice up
+    /// to 90°) they are the only kinks, ~1.4° apart: the normaliser table of a set interpolated
+    /// across them was 1–3·10⁻⁴ off (issue 27, docs/benchmarks.md §13.10).
+    pub fn theta_kinks(&self) -> Vec<f64> {
+        let eps = 1e-6;
+        let top = FRAC_PI_2 - eps;
+        let mut k: Vec<f64> = self
+            .theta_slices()
+            .iter()
+            .copied()
+            .filter(|t| t.is_finite() && *t > eps && *t < top)
+            .collect();
+        let last = k.iter().copied().fold(0.0, f64::max);
+        if self.tables.jacobian {
+            let nx = self.tables.sigma.size().0;
+            k.extend(
+                (1..nx.saturating_sub(1))
+                    .map(|i| u_to_theta(i as f64 / (nx - 1) as f64))
+                    .filter(|&t| t > last + eps && t < top),
+            );
+        }
+        k.sort_by(f64::total_cmp);
+        k.dedup_by(|a, b| (*a - *b).abs() <= eps);
+        k
+    }
+
     /// The VNDF warp (half-vector `u_m` from the warped square, conditioned on `θo`).
     pub fn vndf(&self) -> &Warp2D {
         &self.tables.vndf
