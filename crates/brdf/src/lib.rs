@@ -39,6 +39,7 @@
 
 pub mod analytic;
 mod brdf;
+pub mod counting;
 pub mod fresnel;
 mod geometry;
 pub mod measured;
@@ -54,6 +55,7 @@ mod test_support;
 
 pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, Outgoing, luminance};
 pub use analytic::{AnalyticLobes, SpecularLobe};
+pub use counting::{CountingBrdf, thread_evaluations};
 pub use geometry::{
     Vec3, angles_of, direction_from_angles, direction_from_radians, half_vector, mirror,
     reflect_about, rotate_y, rotate_z,

@@ -279,22 +279,10 @@ impl Figure {
                 let (y0, y1) = (y0 / 1.3, y1 * 1.3);
                 if *x_linear {
                     let pad = ((x1 - x0) * 0.05).max(1.0);
-                    let mut chart = ChartBuilder::on(&plot)
-                        .margin(12)
-                        .x_label_area_size(45)
-                        .y_label_area_size(70)
+                    let mut chart = lines_chart(&plot)
                         .build_cartesian_2d(x0 - pad..x1 + pad, (y0..y1).log_scale())
                         .map_err(|x| e(&x))?;
-                    chart
-                        .configure_mesh()
-                        .x_desc(x_label.as_str())
-                        .y_desc(y_label.as_str())
-                        .x_label_formatter(&|v| tick(*v))
-                        .y_label_formatter(&|v| tick(*v))
-                        .label_style(("sans-serif", 14))
-                        .axis_desc_style(("sans-serif", 16))
-                        .draw()
-                        .map_err(|x| e(&x))?;
+                    lines_mesh(&mut chart, x_label, y_label).map_err(|x| e(&x))?;
                     let n = series.len().max(1) as f64;
                     for (k, s) in series.iter().enumerate() {
                         // Spread the series a little along x so that whiskers do not overlap.
@@ -308,22 +296,10 @@ impl Figure {
                         draw_series(&root, &mut chart, &moved_s, y0, true).map_err(|x| e(&x))?;
                     }
                 } else {
-                    let mut chart = ChartBuilder::on(&plot)
-                        .margin(12)
-                        .x_label_area_size(45)
-                        .y_label_area_size(70)
+                    let mut chart = lines_chart(&plot)
                         .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), (y0..y1).log_scale())
                         .map_err(|x| e(&x))?;
-                    chart
-                        .configure_mesh()
-                        .x_desc(x_label.as_str())
-                        .y_desc(y_label.as_str())
-                        .x_label_formatter(&|v| tick(*v))
-                        .y_label_formatter(&|v| tick(*v))
-                        .label_style(("sans-serif", 14))
-                        .axis_desc_style(("sans-serif", 16))
-                        .draw()
-                        .map_err(|x| e(&x))?;
+                    lines_mesh(&mut chart, x_label, y_label).map_err(|x| e(&x))?;
                     for s in series {
                         draw_series(&root, &mut chart, s, y0, false).map_err(|x| e(&x))?;
                     }
@@ -429,6 +405,40 @@ impl Figure {
 
 /// Draws one series on `chart`: its interval (a translucent band, or whiskers when
 /// `whiskers`), its line (dashed for batch modes) and its markers (drawn on `root` in pixels).
+/// The chart builder of a lines figure (either x axis): margins and label areas.
+fn lines_chart<'a, 'b, DB: DrawingBackend>(
+    plot: &'a DrawingArea<DB, Shift>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(plot);
+    builder
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70);
+    builder
+}
+
+/// The mesh of a lines figure (either x axis): axis descriptions, tick labels, fonts.
+fn lines_mesh<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    x_label: &str,
+    y_label: &str,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+}
+
 fn draw_series<DB: DrawingBackend, X, Y>(
     root: &DrawingArea<DB, Shift>,
     chart: &mut ChartContext<'_, DB, plotters::coord::cartesian::Cartesian2d<X, Y>>,

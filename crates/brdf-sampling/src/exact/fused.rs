@@ -48,61 +48,18 @@ pub(super) fn same_brdf(a: &dyn Brdf, b: &dyn Brdf) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use std::cell::Cell;
     use std::sync::Arc;
 
-    use brdf::{Brdf, Outgoing, Vec3, parse_spec};
+    use brdf::{Brdf, Vec3, parse_spec};
     use partition_sampler::UniformSource;
     use rand::SeedableRng;
     use rand::rngs::Xoshiro256PlusPlus;
 
     use crate::{DirectionSampler, ExactOptions, ExactSet};
 
-    thread_local! {
-        static EVALS: Cell<u64> = const { Cell::new(0) };
-    }
-
-    fn evals() -> u64 {
-        EVALS.with(Cell::get)
-    }
-
-    /// Counts `eval` and `eval_prepared` on the calling thread; forwards everything else.
-    struct Counted(Arc<dyn Brdf>);
-
-    impl Brdf for Counted {
-        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-            EVALS.with(|c| c.set(c.get() + 1));
-            self.0.eval(wo, wi)
-        }
-        fn prepare(&self, wo: &Vec3) -> Outgoing {
-            self.0.prepare(wo)
-        }
-        fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
-            EVALS.with(|c| c.set(c.get() + 1));
-            self.0.eval_prepared(q, wi)
-        }
-        fn is_isotropic(&self) -> bool {
-            self.0.is_isotropic()
-        }
-        fn is_mirror_symmetric(&self) -> bool {
-            self.0.is_mirror_symmetric()
-        }
-        fn is_half_turn_symmetric(&self) -> bool {
-            self.0.is_half_turn_symmetric()
-        }
-        fn is_reciprocal(&self) -> bool {
-            self.0.is_reciprocal()
-        }
-        fn conserves_energy(&self) -> bool {
-            self.0.conserves_energy()
-        }
-        fn bounded_at_horizon(&self) -> bool {
-            self.0.bounded_at_horizon()
-        }
-        fn name(&self) -> &str {
-            self.0.name()
-        }
-    }
+    // The counting wrapper (`eval`, `eval_rgb` and `eval_prepared` on the calling thread).
+    use brdf::CountingBrdf as Counted;
+    use brdf::thread_evaluations as evals;
 
     /// Outgoing directions of the test: random θo up to past the served top (89.99°), a few
     /// at and below the horizon.

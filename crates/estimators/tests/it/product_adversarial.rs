@@ -24,7 +24,7 @@
 //! `issue_27_bias_is_gone_and_its_mutant_is_detected` runs the pre-fix mixture in CI.
 //!
 //! The 10⁶-sample check of the issue's own 256 × 128 cases is `full_adversarial_cases`
-//! (ignored; `cargo test -p estimators --release --test product_adversarial -- --ignored`).
+//! (ignored; `cargo test -p estimators --release --test it product_adversarial -- --ignored`).
 
 use baselines::srbf::{EnvSrbf, fit_envmap};
 use baselines::{CosineHemisphere, SrbfOptions, SrbfSampler};

@@ -2,7 +2,7 @@
 //! directory): sets build from the measured-data lookup, samples follow the sampler's own pdf
 //! (chi-square, α = 1e-4), pdfs are consistent, no bound is violated, and a saved set reloads.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 

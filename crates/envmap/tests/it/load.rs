@@ -6,8 +6,7 @@ use std::path::Path;
 
 use envmap::{EnvMap, EnvMapError, MapFormat};
 
-#[path = "../benches/support/mod.rs"]
-mod support;
+use crate::support;
 
 // ---------------------------------------------------------------- a tiny RGBE writer
 

@@ -2,7 +2,7 @@
 //! agrees with an independent converged reference within 4 standard errors.
 //!
 //! `reduced_*` runs in CI (small maps and fits, every estimator tested); `full_tier_*` (ignored; run with
-//! `cargo test -p estimators --release --test srbf_product -- --ignored`) covers the three maps of
+//! `cargo test -p estimators --release --test it srbf_product -- --ignored`) covers the three maps of
 //! `../shared/data/envmaps`, the procedural sky, four BRDFs (diffuse, glossy, sharp,
 //! MERL-layout) and three normals each; there the single-technique estimators are reported, not
 //! tested

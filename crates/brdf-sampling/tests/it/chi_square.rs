@@ -3,7 +3,7 @@
 //! seeds), pdf consistency (relative 1e-9), samples on the upper unit hemisphere, zero bound
 //! violations, ∫ pdf dσ = 1 by quadrature, and the L1 distance to the normalised `f cos`.
 
-mod common;
+use crate::common;
 
 use brdf_sampling::{DirectionSampler, QuadTreeSet, Variant};
 use common::*;

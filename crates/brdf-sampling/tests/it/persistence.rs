@@ -1,6 +1,6 @@
 //! Save / load of quadtree sets: round trip, typed errors, BRDF re-attachment checks.
 
-mod common;
+use crate::common;
 
 use brdf_sampling::{DirectionSampler, QuadTreeSet, SET_FORMAT_VERSION, SetFileError, Variant};
 use common::*;

@@ -6,7 +6,7 @@
 //! An anisotropic BRDF with a term odd in `x` is the negative control: the same checker must
 //! flag it.
 
-mod common;
+use crate::common;
 
 use brdf::{Brdf, MerlBrdf, Vec3, models, parse_spec, rotate_z};
 use common::{close, direction_pairs};

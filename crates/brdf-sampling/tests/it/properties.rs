@@ -3,7 +3,7 @@
 //! `pdf = 0` below the horizon, and `pdf > 0` wherever `f_r cos > 0` for BRDFs whose support
 //! is the whole hemisphere for every `ωo` (so the slice approximation keeps full support).
 
-mod common;
+use crate::common;
 
 use std::sync::OnceLock;
 

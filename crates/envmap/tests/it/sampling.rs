@@ -12,8 +12,7 @@ use partition_sampler::{QuadTreeBuilder, Rect, Sampler2D, TabulatedDensity};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
-#[path = "../benches/support/mod.rs"]
-mod support;
+use crate::support;
 
 /// Significance level of every chi-square test in this file.
 const ALPHA: f64 = 1e-3;

@@ -5,7 +5,7 @@
 //! `|f(ωo', M ωi') − f(ωo', ωi')| ≤ 10⁻¹² max(1, |f|)` (the half-slice property samplers use).
 //! A chiral but isotropic BRDF is the negative control: the same checker must flag it.
 
-mod common;
+use crate::common;
 
 use brdf::{Brdf, Isotropy, Vec3, models, parse_spec, rotate_z};
 use common::{close, direction_pairs};

@@ -3,7 +3,7 @@
 //! forgets the azimuthal rotation, and leaf bounds that are too low (coarse image map, no
 //! safety factor). The honest sampler passes the same checks.
 
-mod common;
+use crate::common;
 
 use brdf::Vec3;
 use brdf_sampling::{DirSample, DirectionSampler, QuadTreeSet, SetOptions, SliceChoice, Variant};

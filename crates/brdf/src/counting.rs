@@ -1,0 +1,125 @@
+//! A BRDF wrapper that counts evaluations on the calling thread: what the study's cost column,
+//! `brdf-lab bench` and the samplers' tests count BRDF evaluations with.
+
+use std::cell::Cell;
+use std::sync::Arc;
+
+use crate::{AnalyticLobes, Brdf, Outgoing, Vec3};
+
+thread_local! {
+    static EVALUATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Evaluations of every [`CountingBrdf`] made so far on the calling thread.
+pub fn thread_evaluations() -> u64 {
+    EVALUATIONS.with(Cell::get)
+}
+
+/// Forwards everything to the wrapped BRDF (its `prepare` too) and counts each `eval` /
+/// `eval_rgb` / `eval_prepared` call in a
+/// thread-local counter ([`thread_evaluations`]). Samplers are built on it, so the study
+/// counts the BRDF evaluations a sampler makes per sample whatever the sampler is.
+///
+/// ```
+/// use std::sync::Arc;
+/// use brdf::{Brdf, CountingBrdf, direction_from_angles, parse_spec, thread_evaluations};
+///
+/// let counted = CountingBrdf(Arc::from(parse_spec("lambert")?));
+/// let wo = direction_from_angles(10.0, 0.0);
+/// let before = thread_evaluations();
+/// let _ = counted.eval(&wo, &wo);
+/// assert_eq!(thread_evaluations() - before, 1);
+/// # Ok::<(), brdf::SpecError>(())
+/// ```
+pub struct CountingBrdf(pub Arc<dyn Brdf>);
+
+impl Brdf for CountingBrdf {
+    #[inline]
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval(wo, wi)
+    }
+    #[inline]
+    fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval_rgb(wo, wi)
+    }
+    /// Forwarded, so a sampler keeps the wrapped model's prepared fast path (not counted: it
+    /// is no evaluation).
+    #[inline]
+    fn prepare(&self, wo: &Vec3) -> Outgoing {
+        self.0.prepare(wo)
+    }
+    #[inline]
+    fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval_prepared(q, wi)
+    }
+    fn is_isotropic(&self) -> bool {
+        self.0.is_isotropic()
+    }
+    fn is_mirror_symmetric(&self) -> bool {
+        self.0.is_mirror_symmetric()
+    }
+    fn is_half_turn_symmetric(&self) -> bool {
+        self.0.is_half_turn_symmetric()
+    }
+    fn is_reciprocal(&self) -> bool {
+        self.0.is_reciprocal()
+    }
+    fn conserves_energy(&self) -> bool {
+        self.0.conserves_energy()
+    }
+    fn bounded_at_horizon(&self) -> bool {
+        self.0.bounded_at_horizon()
+    }
+    fn analytic_lobes(&self) -> Option<AnalyticLobes> {
+        self.0.analytic_lobes()
+    }
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        self.0.as_any()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forwards_what_samplers_ask_of_the_brdf() {
+        // The `analytic` sampler reads the model's lobes and format-specific samplers downcast
+        // the BRDF: a wrapper that dropped either made those samplers refuse counted BRDFs.
+        let phong = CountingBrdf(Arc::from(crate::parse_spec("phong:n=50").unwrap()));
+        assert!(phong.analytic_lobes().is_some());
+        assert_eq!(
+            phong.analytic_lobes(),
+            crate::parse_spec("phong:n=50").unwrap().analytic_lobes()
+        );
+        let inner = crate::parse_spec("lambert").unwrap();
+        let lambert = CountingBrdf(Arc::from(crate::parse_spec("lambert").unwrap()));
+        assert_eq!(lambert.as_any().is_some(), inner.as_any().is_some());
+    }
+
+    #[test]
+    fn counts_each_evaluation_on_this_thread() {
+        let b = CountingBrdf(Arc::from(crate::parse_spec("lambert").unwrap()));
+        let wo = crate::direction_from_angles(10.0, 0.0);
+        let before = thread_evaluations();
+        let _ = b.eval(&wo, &wo);
+        let _ = b.eval_rgb(&wo, &wo);
+        assert_eq!(thread_evaluations() - before, 2);
+        // The prepared route is counted once and gives the wrapped model's value.
+        let phong = crate::parse_spec("phong:n=20").unwrap();
+        let counted = CountingBrdf(Arc::from(crate::parse_spec("phong:n=20").unwrap()));
+        let wi = crate::direction_from_angles(25.0, 180.0);
+        let before = thread_evaluations();
+        let q = counted.prepare(&wo);
+        assert_eq!(counted.eval_prepared(&q, &wi), phong.eval(&wo, &wi));
+        assert_eq!(thread_evaluations() - before, 1);
+        let other = std::thread::spawn(thread_evaluations).join().unwrap();
+        assert_eq!(other, 0);
+    }
+}
