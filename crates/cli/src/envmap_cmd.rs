@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, EnvSample, LeafChoice};
-use partition_sampler::{PAR_CHUNK, Sample2, Sampler2D, TreeParams, chunk_seed};
+use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, EnvSample, LaneRng, LeafChoice};
+use partition_sampler::{PAR_CHUNK, Sample2, Sampler2D, TreeParams, UniformSource, chunk_seed};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -260,7 +260,7 @@ const CONSUMER_BATCH: usize = 256;
 /// Draws `len` samples from `rng` and consumes them (sums their pdfs): one `sample_uv` call per
 /// sample, or (`block`) [`Sampler2D::sample_into`] on a reused buffer of [`CONSUMER_BATCH`].
 /// Both give the same samples.
-fn consume(sampler: &EnvMapSampler, len: usize, rng: &mut Xoshiro256PlusPlus, block: bool) -> f64 {
+fn consume<U: UniformSource>(sampler: &EnvMapSampler, len: usize, rng: &mut U, block: bool) -> f64 {
     if !block {
         return (0..len).map(|_| sampler.sample_uv(rng).pdf).sum();
     }
@@ -281,14 +281,18 @@ fn consume(sampler: &EnvMapSampler, len: usize, rng: &mut Xoshiro256PlusPlus, bl
 
 /// Draws `n` samples on all threads and consumes them (sums their pdfs) without storing them,
 /// as a renderer would: fixed chunks of [`PAR_CHUNK`] with generators seeded from (seed, chunk),
-/// so the samples are a function of the seed only.
-fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64, block: bool) -> f64 {
+/// so the samples are a function of the seed only. `lanes`: the chunks' generators are
+/// [`LaneRng`]s (the batch path's lane-parallel generator; `block` is then implied).
+fn consume_par(sampler: &EnvMapSampler, n: usize, seed: u64, block: bool, lanes: bool) -> f64 {
     use rayon::prelude::*;
     let chunks = n.div_ceil(PAR_CHUNK);
     let sums: Vec<f64> = (0..chunks)
         .into_par_iter()
         .map(|c| {
             let len = PAR_CHUNK.min(n - c * PAR_CHUNK);
+            if lanes {
+                return consume(sampler, len, &mut LaneRng::for_chunk(seed, c as u64), true);
+            }
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
             consume(sampler, len, &mut rng, block)
         })
@@ -316,11 +320,11 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
     let threads = rayon::current_num_threads();
     println!();
     println!(
-        "compare    {n} samples per variant (--samples clamped to [10^5, 4·10^6] for the timings), median of 5 builds; M/s on 1 thread and on {}, 'one' = one sample_uv call per sample, 'blk' = sample_into on buffers of {CONSUMER_BATCH} (same samples; consumed, not stored)",
+        "compare    {n} samples per variant (--samples clamped to [10^5, 4·10^6] for the timings), median of 5 builds; M/s on 1 thread and on {}, 'one' = one sample_uv call per sample, 'blk' = sample_into on buffers of {CONSUMER_BATCH} (same samples; consumed, not stored), 'lane' = 'blk' drawn from the lane-parallel generator LaneRng (other samples, same law)",
         counted(threads, "thread")
     );
     println!(
-        "{:<24} {:<8} {:>10} {:>12} {:>10} {:>11} {:>11} {:>11} {:>11}",
+        "{:<24} {:<8} {:>10} {:>12} {:>10} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
         "sampler",
         "leaves",
         "build ms",
@@ -330,6 +334,8 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
         "M/s 1 blk",
         format!("M/s {threads} one"),
         format!("M/s {threads} blk"),
+        "M/s 1 lane",
+        format!("M/s {threads} lane"),
     );
     let pb = progress::bar(variants.len() as u64, "comparing");
     let mut rows = Vec::new();
@@ -344,18 +350,27 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
         }
         let Some(sampler) = sampler else { continue };
         builds.sort_by(f64::total_cmp);
-        let mut rates = [0.0; 4];
-        let mut sinks = [0.0; 4];
-        for (k, (parallel, block)) in [(false, false), (false, true), (true, false), (true, true)]
-            .into_iter()
-            .enumerate()
+        let mut rates = [0.0; 6];
+        let mut sinks = [0.0; 6];
+        for (k, (parallel, block, lanes)) in [
+            (false, false, false),
+            (false, true, false),
+            (true, false, false),
+            (true, true, false),
+            (false, true, true),
+            (true, true, true),
+        ]
+        .into_iter()
+        .enumerate()
         {
             let t = Instant::now();
-            sinks[k] = if parallel {
-                consume_par(&sampler, n, args.seed, block)
-            } else {
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(args.seed);
-                consume(&sampler, n, &mut rng, block)
+            sinks[k] = match (parallel, lanes) {
+                (true, _) => consume_par(&sampler, n, args.seed, block, lanes),
+                (false, true) => consume(&sampler, n, &mut LaneRng::seed_from_u64(args.seed), true),
+                (false, false) => {
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(args.seed);
+                    consume(&sampler, n, &mut rng, block)
+                }
             };
             rates[k] = n as f64 / t.elapsed().as_secs_f64() / 1e6;
         }
@@ -370,7 +385,7 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
             (true, LeafChoiceName::Descent) => "descent",
         };
         rows.push(format!(
-            "{:<24} {:<8} {:>10.3} {:>12.1} {:>10} {:>11.2} {:>11.2} {:>11.2} {:>11.2}",
+            "{:<24} {:<8} {:>10.3} {:>12.1} {:>10} {:>11.2} {:>11.2} {:>11.2} {:>11.2} {:>11.2} {:>11.2}",
             entry.name,
             leaf_name,
             builds[builds.len() / 2],
@@ -380,6 +395,8 @@ fn compare(map: &EnvMap, args: &EnvmapArgs) -> CliResult<()> {
             rates[1],
             rates[2],
             rates[3],
+            rates[4],
+            rates[5],
         ));
         pb.inc(1);
     }

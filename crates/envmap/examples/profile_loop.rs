@@ -1,10 +1,12 @@
 //! A bare sampling loop for profilers (`perf stat` / `perf record`): builds one sampler for one
 //! map and draws N planar samples on one thread, one `sample_uv` call per sample (`one`,
-//! default) or with `sample_into` on a reused buffer of 256 (`block`; the same samples).
+//! default) or with `sample_into` on a reused buffer of 256 (`block`; the same samples), or
+//! `block` fed by the lane-parallel generator [`envmap::LaneRng`] (`lane`; other samples,
+//! same law).
 //! Prints wall time and the thread's CPU time per sample (from `/proc/thread-self/stat`,
 //! Linux; the figure to quote on a loaded machine).
 //!
-//! `cargo run --release -p envmap --example profile_loop -- [MAP|sky] [adaptive|adaptive-descent|adaptive-paper|pwc] [N] [N_MAX] [one|block]`
+//! `cargo run --release -p envmap --example profile_loop -- [MAP|sky] [adaptive|adaptive-descent|adaptive-paper|pwc] [N] [N_MAX] [one|block|lane]`
 
 use std::time::Instant;
 
@@ -54,13 +56,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(20_000_000);
-    let block = match args.get(4).map(String::as_str).unwrap_or("one") {
-        "one" => false,
-        "block" => true,
-        other => return Err(format!("unknown mode {other} (one|block)").into()),
+    let mode = args.get(4).map(String::as_str).unwrap_or("one");
+    let (block, lanes) = match mode {
+        "one" => (false, false),
+        "block" => (true, false),
+        "lane" => (true, true),
+        other => return Err(format!("unknown mode {other} (one|block|lane)").into()),
     };
     let s = EnvMapSampler::new(&map, kind)?;
-    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(1);
+    let mut xoshiro = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(1);
+    let mut lane_rng = envmap::LaneRng::seed_from_u64(1);
+    let draw: &mut dyn FnMut(&EnvMapSampler, &mut [Sample2]) = if lanes {
+        &mut |s, out| s.sample_into(&mut lane_rng, out)
+    } else {
+        &mut |s, out| s.sample_into(&mut xoshiro, out)
+    };
     let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
     let mut acc = 0.0;
@@ -72,13 +82,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut left = n;
         while left > 0 {
             let k = left.min(buf.len());
-            s.sample_into(&mut rng, &mut buf[..k]);
+            draw(&s, &mut buf[..k]);
             acc += buf[..k].iter().map(|x| x.pdf).sum::<f64>();
             left -= k;
         }
     } else {
         for _ in 0..n {
-            acc += s.sample_uv(&mut rng).pdf;
+            acc += s.sample_uv(&mut xoshiro).pdf;
         }
     }
     let secs = t.elapsed().as_secs_f64();
@@ -87,7 +97,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "{} samples ({}) in {secs:.3} s: {:.2} M samples/s wall; thread CPU {}",
         n,
-        if block { "block" } else { "one" },
+        mode,
         n as f64 / secs / 1e6,
         cpu.map_or("n/a".to_string(), |c| format!(
             "{c:.2} s = {:.1} ns/sample",

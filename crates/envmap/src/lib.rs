@@ -49,6 +49,7 @@
 
 mod error;
 mod format;
+pub mod lanes;
 pub mod latlong;
 mod load;
 mod map;
@@ -57,6 +58,7 @@ mod sky;
 
 pub use error::EnvMapError;
 pub use format::MapFormat;
+pub use lanes::LaneRng;
 pub use map::{EnvMap, MAX_PIXELS, luminance};
 pub use partition_sampler::{LeafChoice, Scheme, TreeParams};
 pub use sampler::{AdaptiveOptions, EnvMapSampler, EnvSample, SamplerKind};

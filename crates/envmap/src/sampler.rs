@@ -10,6 +10,7 @@ use partition_sampler::{
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::lanes::LaneRng;
 use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
 use crate::{EnvMap, EnvMapError};
 
@@ -255,6 +256,27 @@ impl EnvMapSampler {
     /// result depends only on `(n, seed)`, never on the thread count.
     pub fn sample_uv_par(&self, n: usize, seed: u64) -> Vec<Sample2> {
         distributions::sample_par(self, n, seed)
+    }
+
+    /// `n` planar samples drawn in parallel through the lane-parallel generator: fixed chunks
+    /// of `distributions::PAR_CHUNK`, each drawn by [`Sampler2D::sample_into`] from
+    /// [`LaneRng::for_chunk`]`(seed, chunk)`. The same law as [`EnvMapSampler::sample_uv_par`]
+    /// (other uniforms, so other samples); a function of `(n, seed)` only, whatever the
+    /// thread count.
+    pub fn sample_uv_par_lanes(&self, n: usize, seed: u64) -> Vec<Sample2> {
+        let mut out = vec![
+            Sample2 {
+                point: [0.0, 0.0],
+                pdf: 0.0
+            };
+            n
+        ];
+        out.par_chunks_mut(distributions::PAR_CHUNK)
+            .enumerate()
+            .for_each(|(chunk, slot)| {
+                self.sample_into(&mut LaneRng::for_chunk(seed, chunk as u64), slot)
+            });
+        out
     }
 
     /// `n` directions drawn in parallel: [`EnvMapSampler::sample_uv_par`] completed (also in

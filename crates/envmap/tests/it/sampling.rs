@@ -264,6 +264,49 @@ fn parallel_batches_are_reproducible() {
     }
 }
 
+/// The batch path through the lane-parallel generator (`sample_uv_par_lanes`, `LaneRng`): the
+/// same law as the serial path (chi-square at `ALPHA` against the exact masses for the adaptive
+/// sampler, the midpoint masses for the CDF), every sample's pdf equal to the pdf query, and
+/// the batch a function of `(n, seed)` whatever the thread count.
+#[test]
+fn lane_batches_have_the_target_law_and_are_reproducible() {
+    let map = small_map();
+    let (w, h) = (map.width(), map.height());
+    for (kind, masses) in [
+        (
+            adaptive(Scheme::Envelope, LeafChoice::Alias),
+            exact_masses(&map),
+        ),
+        (SamplerKind::PiecewiseConstant, midpoint_masses(&map)),
+    ] {
+        let s = EnvMapSampler::new(&map, kind).unwrap();
+        let batch = s.sample_uv_par_lanes(300_000, 40);
+        let mut counts = vec![0u64; w * h * SUB];
+        for x in &batch {
+            let p = x.point;
+            let col = ((p[0] * w as f64) as usize).min(w - 1);
+            let row = ((p[1] * (h * SUB) as f64) as usize).min(h * SUB - 1);
+            counts[row * w + col] += 1;
+            assert_eq!(x.pdf, s.pdf_uv(p[0], p[1]), "{kind:?}");
+        }
+        let p = chi_square_p(&counts, &masses);
+        assert!(p > ALPHA, "{kind:?}: p = {p}");
+        let n = 10_000;
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| s.sample_uv_par_lanes(n, 4));
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap()
+            .install(|| s.sample_uv_par_lanes(n, 4));
+        assert_eq!(one, two, "{kind:?}");
+        assert_ne!(s.sample_uv_par_lanes(n, 5), one);
+    }
+}
+
 #[test]
 fn builder_errors_are_typed() {
     let map = small_map();
