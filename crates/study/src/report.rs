@@ -31,7 +31,7 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
         cfg.samplers.join(", "),
         cfg.brdfs
             .iter()
-            .map(|b| format!("`{b}`"))
+            .map(|b| format!("`{}`", crate::short_brdf(b)))
             .collect::<Vec<_>>()
             .join(", "),
         cfg.theta_o_deg
@@ -313,7 +313,7 @@ pub(crate) fn verdicts(s: &mut String, rankings: &[Ranking]) {
     for (r, o) in rankings.iter().zip(&outcomes) {
         let title = format!(
             "{} at θo = {}° under {}",
-            r.brdf,
+            crate::short_brdf(&r.brdf),
             r.theta_o,
             short_light(&r.light)
         );
@@ -557,9 +557,10 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                     }
                     let _ = writeln!(
                         s,
-                        "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{brdf}` is {}.",
+                        "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{}` is {}.",
                         estimator.trim_start_matches("mis-"),
                         crate::short_light(light),
+                        crate::short_brdf(brdf),
                         parts.join("; ")
                     );
                 }
@@ -574,7 +575,7 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
             s,
             "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** (tied: {}; rows {}).",
             crate::short_light(&r.light),
-            r.brdf,
+            crate::short_brdf(&r.brdf),
             r.theta_o,
             r.best,
             list(&r.tied),
@@ -661,5 +662,57 @@ mod tests {
         assert!(sentences[1].contains("(rows 2, 3;"), "{}", sentences[1]);
         assert!(sentences[3].contains("(rows 7, 8;"), "{}", sentences[3]);
         assert!(sentences[3].contains("the best adaptive sampler, adaptive-mixture, is 2.00× ["));
+    }
+
+    /// Measured files and maps are named by their short names in every line of the report
+    /// (header, warnings, verdicts, tables) and in results.csv; the full path is kept in
+    /// results.json only, and no output has a `../` path.
+    #[test]
+    fn the_report_and_csv_name_measured_files_without_their_paths() {
+        let spec = "rgl:/data/team/shared/data/measured/rgl/paper_white_rgb.bsdf";
+        let map = "envmap:/data/team/shared/data/envmaps/grace_probe_latlong.hdr";
+        let mut cells = vec![
+            cell(0, "adaptive", spec, 1.0, 0.05, 100.0, 0.02),
+            cell(1, "cosine", spec, 4.0, 0.2, 100.0, 0.02),
+        ];
+        for c in &mut cells {
+            c.light = map.into();
+        }
+        let config = crate::StudyConfig::new(
+            vec!["adaptive".into(), "cosine".into()],
+            vec![spec.into()],
+            vec![30.0],
+            vec![map.into()],
+        );
+        let mut results = StudyResults {
+            schema: crate::SCHEMA.into(),
+            config,
+            shard: None,
+            total_cells: 2,
+            notes: Vec::new(),
+            build_warnings: vec!["sampler srbf on rgl:paper_white_rgb: a warning".into()],
+            lights: vec![crate::LightInfo {
+                spec: map.into(),
+                description: "a map".into(),
+            }],
+            cells,
+            runs: Vec::new(),
+            rankings: Vec::new(),
+        };
+        results.rankings = crate::ranking::rankings(&results);
+        assert_eq!(results.rankings.len(), 1);
+        let md = report_markdown(&results, &ReportAssets::default());
+        assert!(md.contains("`rgl:paper_white_rgb`"), "{md}");
+        assert!(
+            md.contains("* rgl:paper_white_rgb at θo = 30° under envmap:grace_probe_latlong.hdr"),
+            "{md}"
+        );
+        let csv = results.to_csv();
+        for (name, text) in [("report.md", &md), ("results.csv", &csv)] {
+            assert!(!text.contains("/data/team"), "{name} has a path");
+            assert!(!text.contains("../"), "{name} has a ../ path");
+        }
+        assert!(csv.contains(",rgl:paper_white_rgb,"));
+        assert!(results.to_json().contains(spec));
     }
 }
