@@ -518,11 +518,24 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
     }
     s.push_str("\n### Inside MIS and light sampling\n\n");
     s.push_str("Estimators as renderers use them, under the maps: each BRDF sampler inside multiple importance sampling with a map sampler (one draw of each per sample; balance or power heuristic), and each map sampler alone; same efficiency, intervals and Šidák rule as above, comparisons per (BRDF, θo, map, estimator, map sampler).\n\n");
-    let list = |v: &[String]| {
-        if v.is_empty() {
-            "none".to_string()
-        } else {
-            v.join(", ")
+    // The tied samplers with their ratio's interval, or (none tied) the runner-up's: every
+    // "best" rests on an interval.
+    let list = |r: &Ranking| {
+        let tied: Vec<String> = r
+            .entries
+            .iter()
+            .filter(|e| e.verdict == Verdict::Tied)
+            .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
+            .collect();
+        match (tied.is_empty(), r.entries.get(1)) {
+            (false, _) => format!("tied: {}", tied.join(", ")),
+            (true, Some(e)) => format!(
+                "none tied; the runner-up {}{} is {} less efficient",
+                e.sampler,
+                marks(e),
+                ratio_text(e)
+            ),
+            (true, None) => "the only one ranked".to_string(),
         }
     };
     let cfg = &results.config;
@@ -540,10 +553,10 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                         })
                         .map(|r| {
                             format!(
-                                "at θo = {}° **{}** (tied: {}; rows {})",
+                                "at θo = {}° **{}** ({}; rows {})",
                                 r.theta_o,
                                 r.best,
-                                list(&r.tied),
+                                list(r),
                                 r.rows()
                                     .iter()
                                     .map(usize::to_string)
@@ -573,12 +586,12 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
     {
         let _ = writeln!(
             s,
-            "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** (tied: {}; rows {}).",
+            "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** ({}; rows {}).",
             crate::short_light(&r.light),
             crate::short_brdf(&r.brdf),
             r.theta_o,
             r.best,
-            list(&r.tied),
+            list(r),
             r.rows()
                 .iter()
                 .map(usize::to_string)
@@ -678,6 +691,14 @@ mod tests {
         for c in &mut cells {
             c.light = map.into();
         }
+        // The same two samplers inside MIS with a map sampler: a comparison of its own.
+        for i in 0..2 {
+            let mut c = cells[i].clone();
+            c.index = 2 + i;
+            c.estimator = "mis-balance".into();
+            c.light_sampler = Some("envmap-cdf".into());
+            cells.push(c);
+        }
         let config = crate::StudyConfig::new(
             vec!["adaptive".into(), "cosine".into()],
             vec![spec.into()],
@@ -688,7 +709,7 @@ mod tests {
             schema: crate::SCHEMA.into(),
             config,
             shard: None,
-            total_cells: 2,
+            total_cells: 4,
             notes: Vec::new(),
             build_warnings: vec!["sampler srbf on rgl:paper_white_rgb: a warning".into()],
             lights: vec![crate::LightInfo {
@@ -700,8 +721,18 @@ mod tests {
             rankings: Vec::new(),
         };
         results.rankings = crate::ranking::rankings(&results);
-        assert_eq!(results.rankings.len(), 1);
+        assert_eq!(results.rankings.len(), 2);
         let md = report_markdown(&results, &ReportAssets::default());
+        // The MIS sentence names the best with the runner-up's ratio and its interval.
+        let mis = md
+            .lines()
+            .find(|l| l.starts_with("* Inside MIS (balance)"))
+            .unwrap_or_else(|| panic!("{md}"));
+        assert!(
+            mis.contains("for `rgl:paper_white_rgb` is at θo = 30° **adaptive** (none tied; the runner-up cosine is 4.00× [")
+                && mis.contains("] less efficient; rows 2, 3)"),
+            "{mis}"
+        );
         assert!(md.contains("`rgl:paper_white_rgb`"), "{md}");
         assert!(
             md.contains("* rgl:paper_white_rgb at θo = 30° under envmap:grace_probe_latlong.hdr"),
