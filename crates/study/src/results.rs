@@ -404,6 +404,20 @@ impl StudyResults {
                 _ => return fail("every input must be a shard K/N of the same N".into()),
             }
         }
+        // Every shard is required, even one without cells (more shards than BRDFs): a merge
+        // of an incomplete set is refused whatever the shards hold.
+        if let Some(f) = first.shard
+            && seen_shards.len() != f.count
+        {
+            let missing: Vec<String> = (1..=f.count)
+                .filter(|k| !seen_shards.contains(k))
+                .map(|k| format!("{k}/{}", f.count))
+                .collect();
+            return fail(format!(
+                "the shards do not cover every cell once (missing shards: {})",
+                missing.join(", ")
+            ));
+        }
         let mut cells: Vec<CellResult> =
             parts.iter().flat_map(|p| p.cells.iter().cloned()).collect();
         cells.sort_by_key(|c| c.index);

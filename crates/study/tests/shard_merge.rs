@@ -122,6 +122,22 @@ fn merge_refuses_incomplete_or_repeated_shards() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("given twice"), "{err}");
+    // Three shards of two BRDFs: shard 3 has no cell, but a merge without it is refused.
+    let (s1, s2) = (
+        run(Some(Shard { index: 1, count: 3 }), 1),
+        run(Some(Shard { index: 2, count: 3 }), 1),
+    );
+    assert_eq!(s1.cells.len() + s2.cells.len(), 16);
+    let err = StudyResults::merge(vec![s1.clone(), s2.clone()])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("missing shards: 3/3"), "{err}");
+    let s3 = run(Some(Shard { index: 3, count: 3 }), 1);
+    assert!(s3.cells.is_empty());
+    assert_eq!(
+        StudyResults::merge(vec![s1, s2, s3]).unwrap().cells.len(),
+        16
+    );
     let mut other = run(Some(Shard { index: 2, count: 2 }), 1);
     other.config.seed += 1;
     let err = StudyResults::merge(vec![a, other]).unwrap_err().to_string();
