@@ -54,8 +54,9 @@ pub(crate) struct StudyArgs {
     /// Seed of the study; cell i uses a stream seeded from (seed, i).
     #[arg(long, default_value_t = 1, value_parser = values::seed, allow_negative_numbers = true)]
     seed: u64,
-    /// Run only every N-th cell, starting at the K-th (K/N, 1 ≤ K ≤ N); merge the shards'
-    /// directories with `brdf-lab study merge`.
+    /// Run only the cells of every N-th BRDF, starting at the K-th (K/N, 1 ≤ K ≤ N), so that
+    /// a shard builds only its own BRDFs' samplers; merge the shards' directories with
+    /// `brdf-lab study merge`.
     #[arg(long)]
     shard: Option<String>,
     /// Skip the sphere images (always skipped for a shard; `study merge` renders them).
@@ -223,7 +224,16 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
         bar.finish_and_clear();
         Some(r)
     };
-    write_outputs(staging.path(), &merged, render.as_ref(), None)?;
+    // A `--paper` study's tables are not made by its shards: the merge makes them.
+    let tables = if merged.config.preset == "paper" {
+        let bar = progress::bar(4, "paper tables");
+        let t = study::paper_tables(&|n| bar.inc(n)).map_err(CliError::input)?;
+        bar.finish_and_clear();
+        Some(t)
+    } else {
+        None
+    };
+    write_outputs(staging.path(), &merged, render.as_ref(), tables.as_deref())?;
     staging.commit()?;
     summary(&args.out, &merged);
     Ok(())
@@ -391,7 +401,14 @@ fn write_outputs(
 ) -> CliResult<()> {
     let mut assets = study::ReportAssets::default();
     if let Some((r, note)) = render {
-        let section = write_images(dir, r)?;
+        // Measured files by their short names: full paths are for results.json only.
+        let section = results
+            .config
+            .brdfs
+            .iter()
+            .fold(write_images(dir, r)?, |sec, b| {
+                sec.replace(&format!("`{b}`"), &format!("`{}`", study::short_brdf(b)))
+            });
         assets.sections.push(match note {
             // After the section's heading line.
             Some(n) => match section.split_once('\n') {

@@ -36,6 +36,9 @@ pub(crate) struct Tally {
     pub top: usize,
     /// Geometric mean of best / this over the comparisons with a finite ratio.
     pub geo_ratio: f64,
+    /// 95 % interval of `geo_ratio` from the entries' `se(ln E)` (the best's and this one's,
+    /// in quadrature; 0 where this one is the best, whose ratio is 1 by definition).
+    pub geo_ci: (f64, f64),
     /// Its cells (results.csv `index`).
     pub rows: Vec<usize>,
 }
@@ -43,8 +46,13 @@ pub(crate) struct Tally {
 /// The tallies of every sampler over `rankings`, recommended first (most often best or
 /// tied, then the smaller geometric-mean ratio, then the name).
 pub(crate) fn tallies(rankings: &[&Ranking]) -> Vec<Tally> {
-    let mut by: BTreeMap<String, (Tally, f64, usize)> = BTreeMap::new();
+    let mut by: BTreeMap<String, (Tally, f64, usize, f64)> = BTreeMap::new();
     for r in rankings {
+        let se_best = r
+            .entries
+            .first()
+            .and_then(|b| b.se_log_efficiency)
+            .unwrap_or(0.0);
         for e in &r.entries {
             let t = by.entry(e.sampler.clone()).or_insert_with(|| {
                 (
@@ -54,10 +62,12 @@ pub(crate) fn tallies(rankings: &[&Ranking]) -> Vec<Tally> {
                         best: 0,
                         top: 0,
                         geo_ratio: 1.0,
+                        geo_ci: (1.0, 1.0),
                         rows: Vec::new(),
                     },
                     0.0,
                     0,
+                    0.0,
                 )
             });
             t.0.ranked += 1;
@@ -71,17 +81,24 @@ pub(crate) fn tallies(rankings: &[&Ranking]) -> Vec<Tally> {
             if let Some(x) = e.ratio.filter(|x| *x > 0.0 && x.is_finite()) {
                 t.1 += x.ln();
                 t.2 += 1;
+                if e.verdict != Verdict::Best {
+                    let se = e.se_log_efficiency.unwrap_or(0.0);
+                    t.3 += se * se + se_best * se_best;
+                }
             }
         }
     }
     let mut v: Vec<Tally> = by
         .into_values()
-        .map(|(mut t, sum, n)| {
-            t.geo_ratio = if n > 0 {
-                (sum / n as f64).exp()
+        .map(|(mut t, sum, n, var)| {
+            if n > 0 {
+                let (m, h) = (sum / n as f64, 1.96 * var.sqrt() / n as f64);
+                t.geo_ratio = m.exp();
+                t.geo_ci = ((m - h).exp(), (m + h).exp());
             } else {
-                f64::INFINITY
-            };
+                t.geo_ratio = f64::INFINITY;
+                t.geo_ci = (f64::INFINITY, f64::INFINITY);
+            }
             t
         })
         .collect();
@@ -164,25 +181,29 @@ pub(crate) fn sentence(
     }
     if !all_tied.is_empty() && all_tied.len() + 1 == t.len() {
         return Some(format!(
-            "For **{what}** **no sampler stands out**: all {} samplers are best or tied with the best in {} of {} comparisons (the intervals are too wide to separate them); the tie-break (geometric mean of best / this) prefers {} ({:.2}, best in {}) (rows {}).",
+            "For **{what}** **no sampler stands out**: all {} samplers are best or tied with the best in {} of {} comparisons (the intervals are too wide to separate them); the tie-break (geometric mean of best / this) prefers {} ({:.2} [{:.2}, {:.2}], 95 %; best in {}) (rows {}).",
             t.len(),
             y.top,
             n,
             y.label,
             y.geo_ratio,
+            y.geo_ci.0,
+            y.geo_ci.1,
             y.best,
             rows_text(&y.rows)
         ));
     }
     let mut s = format!(
-        "For **{what}** use **{}**: best or tied with the best in {} of {} comparisons (best in {}, significantly worse in {}; geometric mean of best / {} = {:.2})",
+        "For **{what}** use **{}**: best or tied with the best in {} of {} comparisons (best in {}, significantly worse in {}; geometric mean of best / {} = {:.2} [{:.2}, {:.2}], 95 %)",
         y.label,
         y.top,
         n,
         y.best,
         y.ranked - y.top,
         y.label,
-        y.geo_ratio
+        y.geo_ratio,
+        y.geo_ci.0,
+        y.geo_ci.1
     );
     if tied.is_empty() {
         s.push_str("; no other sampler is as often best or tied");
@@ -391,6 +412,18 @@ mod tests {
             "{line}"
         );
         assert!(line.contains("runner-up cosine (1/3)"), "{line}");
+        // The tie-break's geometric mean carries its 95 % interval (the one comparison in
+        // which analytic is not best: ratio 1.02 of three).
+        let t = tallies(&rankings.iter().collect::<Vec<_>>());
+        let (g, (lo, hi)) = (t[0].geo_ratio, t[0].geo_ci);
+        assert!((g - 1.02f64.powf(1.0 / 3.0)).abs() < 1e-9, "{g}");
+        assert!(lo < g && g < hi && hi / lo < 1.1, "{lo} {g} {hi}");
+        assert!(
+            line.contains(&format!(
+                "geometric mean of best / analytic = {g:.2} [{lo:.2}, {hi:.2}], 95 %)"
+            )),
+            "{line}"
+        );
         assert!(line.contains("(rows 0, 3, 6; runner-up 1, 4, 7)"), "{line}");
         assert!(line.contains("Materials: phong, ggx, blinn."), "{line}");
         // A comparison in which everything is tied: no sampler stands out.

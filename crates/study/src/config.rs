@@ -127,7 +127,7 @@ pub fn shared_measured(root: Option<&std::path::Path>) -> (Vec<String>, Vec<Stri
             let spec = format!("{reader}:{}", f.display());
             match brdf::parse_spec(&spec) {
                 Ok(_) => specs.push(spec),
-                Err(e) => notes.push(format!("{spec} is not studied: {e}")),
+                Err(e) => notes.push(format!("{} is not studied: {e}", crate::short_brdf(&spec))),
             }
         }
     }
@@ -265,14 +265,14 @@ impl StudyConfig {
         match measured {
             Some(spec) => brdfs.push(spec),
             None => notes.push(
-                "no readable measured BRDF found (../shared/data/merl, ../shared/data/measured, or their readers are not registered yet); the quick study uses analytic models only".to_string(),
+                "no readable measured BRDF found (shared/data/merl or shared/data/measured beside the repository, or their readers are not registered yet); the quick study uses analytic models only".to_string(),
             ),
         }
         let light = match find_candidate(root, &MAP_CANDIDATES) {
             Some(p) => format!("envmap:{}", p.display()),
             None => {
                 notes.push(format!(
-                    "no environment map file found (looked for ../{}); the quick study uses the built-in procedural sky instead",
+                    "no environment map file found (looked for {} beside the repository); the quick study uses the built-in procedural sky instead",
                     MAP_CANDIDATES[0]
                 ));
                 "sky".into()
@@ -325,7 +325,7 @@ impl StudyConfig {
             Some(p) => format!("envmap:{}", p.display()),
             None => {
                 notes.push(format!(
-                    "no environment map file found (looked for ../{}); the study uses the built-in procedural sky instead",
+                    "no environment map file found (looked for {} beside the repository); the study uses the built-in procedural sky instead",
                     MAP_CANDIDATES[0]
                 ));
                 "sky".into()
@@ -414,7 +414,8 @@ fn find_candidate(root: Option<&std::path::Path>, candidates: &[&str]) -> Option
         .map(|p| std::fs::canonicalize(&p).unwrap_or(p))
 }
 
-/// One part of a study run on its own: cells `i` with `i % count == index - 1`.
+/// One part of a study run on its own: the cells of the BRDFs `b` (config order) with
+/// `b % count == index - 1` (`StudyPlan::shard_brdfs`).
 pub use distributions::Shard;
 
 /// One cell of the grid.

@@ -21,7 +21,8 @@
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
 //! `distributions::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
-//! depend on the thread count or on which shard runs it.
+//! depend on the thread count or on which shard runs it. A shard `K/N` runs every cell of the
+//! BRDFs `b` with `b mod N = K − 1` (not every N-th cell), so its builds are its own.
 
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -78,7 +79,7 @@ fn build_warnings<'a>(
             notes.push(format!(
                 "sampler {} on {}: {w}",
                 sampler_name(*s),
-                brdf_spec(*b)
+                crate::short_brdf(brdf_spec(*b))
             ));
         }
     }
@@ -383,10 +384,34 @@ impl StudyPlan {
             + 2 * cells.len()) as u64
     }
 
+    /// The cells of `shard`: those of the BRDFs `b` (index in the config's order) with
+    /// `b mod N = K − 1`, so that a shard builds only its own BRDFs' samplers and computes only
+    /// their references (the build is most of a measured BRDF's cost). A shard with no BRDF
+    /// (N larger than the number of BRDFs) has no cells.
     fn selected(&self, shard: Option<Shard>) -> Vec<&PlanCell> {
         self.cells
             .iter()
-            .filter(|c| shard.is_none_or(|s| s.contains(c.spec.index)))
+            .filter(|c| shard.is_none_or(|s| s.contains(c.brdf)))
+            .collect()
+    }
+
+    /// The BRDFs (specs, in config order) whose cells `shard` runs (all for `None`).
+    pub fn shard_brdfs(&self, shard: Option<Shard>) -> Vec<&str> {
+        self.brdfs
+            .iter()
+            .enumerate()
+            .filter(|(b, _)| shard.is_none_or(|s| s.contains(*b)))
+            .map(|(_, b)| b.spec.as_str())
+            .collect()
+    }
+
+    /// The `(sampler, BRDF spec)` pairs [`StudyPlan::run`] builds for `shard` (all for
+    /// `None`), each once: the shards of a study build disjoint sets whose union is the whole
+    /// run's.
+    pub fn shard_builds(&self, shard: Option<Shard>) -> Vec<(&str, &str)> {
+        self.builds(&self.selected(shard))
+            .into_iter()
+            .map(|(s, b)| (self.entries[s].name, self.brdfs[b].spec.as_str()))
             .collect()
     }
 

@@ -462,11 +462,14 @@ pub fn compare_rankings(a: &[Ranking], b: &[Ranking]) -> RankingComparison {
             out.best_compatible += 1;
         }
         let title = format!(
-            "{} at θo = {}° under {} ({})",
-            ra.brdf,
+            "{} at θo = {}° under {} ({}{})",
+            crate::short_brdf(&ra.brdf),
             ra.theta_o,
             crate::short_light(&ra.light),
-            ra.estimator
+            ra.estimator,
+            ra.light_sampler
+                .as_deref()
+                .map_or(String::new(), |l| format!(" with {l}"))
         );
         for (x, y) in &pa {
             if pb.iter().any(|(bx, by)| bx == y && by == x) {

@@ -31,7 +31,7 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
         cfg.samplers.join(", "),
         cfg.brdfs
             .iter()
-            .map(|b| format!("`{b}`"))
+            .map(|b| format!("`{}`", crate::short_brdf(b)))
             .collect::<Vec<_>>()
             .join(", "),
         cfg.theta_o_deg
@@ -313,7 +313,7 @@ pub(crate) fn verdicts(s: &mut String, rankings: &[Ranking]) {
     for (r, o) in rankings.iter().zip(&outcomes) {
         let title = format!(
             "{} at θo = {}° under {}",
-            r.brdf,
+            crate::short_brdf(&r.brdf),
             r.theta_o,
             short_light(&r.light)
         );
@@ -518,11 +518,24 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
     }
     s.push_str("\n### Inside MIS and light sampling\n\n");
     s.push_str("Estimators as renderers use them, under the maps: each BRDF sampler inside multiple importance sampling with a map sampler (one draw of each per sample; balance or power heuristic), and each map sampler alone; same efficiency, intervals and Šidák rule as above, comparisons per (BRDF, θo, map, estimator, map sampler).\n\n");
-    let list = |v: &[String]| {
-        if v.is_empty() {
-            "none".to_string()
-        } else {
-            v.join(", ")
+    // The tied samplers with their ratio's interval, or (none tied) the runner-up's: every
+    // "best" rests on an interval.
+    let list = |r: &Ranking| {
+        let tied: Vec<String> = r
+            .entries
+            .iter()
+            .filter(|e| e.verdict == Verdict::Tied)
+            .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
+            .collect();
+        match (tied.is_empty(), r.entries.get(1)) {
+            (false, _) => format!("tied: {}", tied.join(", ")),
+            (true, Some(e)) => format!(
+                "none tied; the runner-up {}{} is {} less efficient",
+                e.sampler,
+                marks(e),
+                ratio_text(e)
+            ),
+            (true, None) => "the only one ranked".to_string(),
         }
     };
     let cfg = &results.config;
@@ -540,10 +553,10 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                         })
                         .map(|r| {
                             format!(
-                                "at θo = {}° **{}** (tied: {}; rows {})",
+                                "at θo = {}° **{}** ({}; rows {})",
                                 r.theta_o,
                                 r.best,
-                                list(&r.tied),
+                                list(r),
                                 r.rows()
                                     .iter()
                                     .map(usize::to_string)
@@ -557,9 +570,10 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                     }
                     let _ = writeln!(
                         s,
-                        "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{brdf}` is {}.",
+                        "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{}` is {}.",
                         estimator.trim_start_matches("mis-"),
                         crate::short_light(light),
+                        crate::short_brdf(brdf),
                         parts.join("; ")
                     );
                 }
@@ -572,12 +586,12 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
     {
         let _ = writeln!(
             s,
-            "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** (tied: {}; rows {}).",
+            "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** ({}; rows {}).",
             crate::short_light(&r.light),
-            r.brdf,
+            crate::short_brdf(&r.brdf),
             r.theta_o,
             r.best,
-            list(&r.tied),
+            list(r),
             r.rows()
                 .iter()
                 .map(usize::to_string)
@@ -661,5 +675,75 @@ mod tests {
         assert!(sentences[1].contains("(rows 2, 3;"), "{}", sentences[1]);
         assert!(sentences[3].contains("(rows 7, 8;"), "{}", sentences[3]);
         assert!(sentences[3].contains("the best adaptive sampler, adaptive-mixture, is 2.00× ["));
+    }
+
+    /// Measured files and maps are named by their short names in every line of the report
+    /// (header, warnings, verdicts, tables) and in results.csv; the full path is kept in
+    /// results.json only, and no output has a `../` path.
+    #[test]
+    fn the_report_and_csv_name_measured_files_without_their_paths() {
+        let spec = "rgl:/data/team/shared/data/measured/rgl/paper_white_rgb.bsdf";
+        let map = "envmap:/data/team/shared/data/envmaps/grace_probe_latlong.hdr";
+        let mut cells = vec![
+            cell(0, "adaptive", spec, 1.0, 0.05, 100.0, 0.02),
+            cell(1, "cosine", spec, 4.0, 0.2, 100.0, 0.02),
+        ];
+        for c in &mut cells {
+            c.light = map.into();
+        }
+        // The same two samplers inside MIS with a map sampler: a comparison of its own.
+        for i in 0..2 {
+            let mut c = cells[i].clone();
+            c.index = 2 + i;
+            c.estimator = "mis-balance".into();
+            c.light_sampler = Some("envmap-cdf".into());
+            cells.push(c);
+        }
+        let config = crate::StudyConfig::new(
+            vec!["adaptive".into(), "cosine".into()],
+            vec![spec.into()],
+            vec![30.0],
+            vec![map.into()],
+        );
+        let mut results = StudyResults {
+            schema: crate::SCHEMA.into(),
+            config,
+            shard: None,
+            total_cells: 4,
+            notes: Vec::new(),
+            build_warnings: vec!["sampler srbf on rgl:paper_white_rgb: a warning".into()],
+            lights: vec![crate::LightInfo {
+                spec: map.into(),
+                description: "a map".into(),
+            }],
+            cells,
+            runs: Vec::new(),
+            rankings: Vec::new(),
+        };
+        results.rankings = crate::ranking::rankings(&results);
+        assert_eq!(results.rankings.len(), 2);
+        let md = report_markdown(&results, &ReportAssets::default());
+        // The MIS sentence names the best with the runner-up's ratio and its interval.
+        let mis = md
+            .lines()
+            .find(|l| l.starts_with("* Inside MIS (balance)"))
+            .unwrap_or_else(|| panic!("{md}"));
+        assert!(
+            mis.contains("for `rgl:paper_white_rgb` is at θo = 30° **adaptive** (none tied; the runner-up cosine is 4.00× [")
+                && mis.contains("] less efficient; rows 2, 3)"),
+            "{mis}"
+        );
+        assert!(md.contains("`rgl:paper_white_rgb`"), "{md}");
+        assert!(
+            md.contains("* rgl:paper_white_rgb at θo = 30° under envmap:grace_probe_latlong.hdr"),
+            "{md}"
+        );
+        let csv = results.to_csv();
+        for (name, text) in [("report.md", &md), ("results.csv", &csv)] {
+            assert!(!text.contains("/data/team"), "{name} has a path");
+            assert!(!text.contains("../"), "{name} has a ../ path");
+        }
+        assert!(csv.contains(",rgl:paper_white_rgb,"));
+        assert!(results.to_json().contains(spec));
     }
 }

@@ -305,7 +305,9 @@ impl StudyResults {
     }
 
     /// The CSV form: one row per cell and N; timing columns are marked `[timing]` in the
-    /// header. Fields are quoted where needed (BRDF specs contain commas).
+    /// header. Fields are quoted where needed (BRDF specs contain commas). Measured files and
+    /// map lights are named by their short names ([`crate::short_brdf`],
+    /// [`crate::short_light`]); the full paths are in `results.json` only.
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
             "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],estimator_wall_ns[timing],efficiency[timing],estimator,light_sampler\n",
@@ -333,9 +335,9 @@ impl StudyResults {
                     c.index.to_string(),
                     quote(&c.sampler),
                     c.mode.as_str().to_string(),
-                    quote(&c.brdf),
+                    quote(&crate::short_brdf(&c.brdf)),
                     num(c.theta_o_deg),
-                    quote(&c.light),
+                    quote(&crate::short_light(&c.light)),
                     quote(c.status.as_deref().unwrap_or("")),
                     num(c.reference.value),
                     num(c.reference.abs_err),
@@ -401,6 +403,20 @@ impl StudyResults {
                 (None, _) if parts.len() == 1 => {}
                 _ => return fail("every input must be a shard K/N of the same N".into()),
             }
+        }
+        // Every shard is required, even one without cells (more shards than BRDFs): a merge
+        // of an incomplete set is refused whatever the shards hold.
+        if let Some(f) = first.shard
+            && seen_shards.len() != f.count
+        {
+            let missing: Vec<String> = (1..=f.count)
+                .filter(|k| !seen_shards.contains(k))
+                .map(|k| format!("{k}/{}", f.count))
+                .collect();
+            return fail(format!(
+                "the shards do not cover every cell once (missing shards: {})",
+                missing.join(", ")
+            ));
         }
         let mut cells: Vec<CellResult> =
             parts.iter().flat_map(|p| p.cells.iter().cloned()).collect();

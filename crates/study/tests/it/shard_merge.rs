@@ -1,4 +1,4 @@
-//! A study run whole, run as three shards and merged, and run on one or two threads gives the
+//! A study run whole, run as two shards (one BRDF each) and merged, and run on one or two threads gives the
 //! same numbers (timings excepted).
 
 use study::{Shard, StudyConfig, StudyPlan, StudyResults};
@@ -30,15 +30,31 @@ fn run(shard: Option<Shard>, threads: usize) -> StudyResults {
 }
 
 #[test]
-fn one_run_equals_three_merged_shards_and_any_thread_count() {
+fn one_run_equals_two_merged_shards_and_any_thread_count() {
     let whole = run(None, 2);
     // 3 samplers (adaptive-paper twice: one-sample and batch) × 2 BRDFs × 2 angles.
     assert_eq!(whole.cells.len(), 16);
     assert!(whole.cells.iter().all(|c| c.ok() && c.timing.is_some()));
-    let shards: Vec<StudyResults> = (1..=3)
-        .map(|k| run(Some(Shard { index: k, count: 3 }), 1))
-        .collect();
-    assert!(shards.iter().all(|s| s.cells.len() < 16));
+    // Two shards, one BRDF each: each builds only its own BRDF's samplers, so the two
+    // shards' builds are disjoint and together the whole run's (N shards cost ≈ 1/N).
+    let plan = StudyPlan::new(tiny(), Vec::new()).unwrap();
+    let shard = |k| Some(Shard { index: k, count: 2 });
+    assert_eq!(plan.shard_brdfs(shard(1)), ["phong:n=20"]);
+    assert_eq!(plan.shard_brdfs(shard(2)), ["lambert"]);
+    let (b1, b2) = (plan.shard_builds(shard(1)), plan.shard_builds(shard(2)));
+    assert_eq!(b1.len(), 3);
+    assert_eq!(b2.len(), 3);
+    assert!(b1.iter().all(|(_, b)| *b == "phong:n=20"));
+    assert!(b2.iter().all(|(_, b)| *b == "lambert"));
+    let (mut union, mut all) = ([b1, b2].concat(), plan.shard_builds(None));
+    union.sort_unstable();
+    all.sort_unstable();
+    assert_eq!(union, all);
+    let shards: Vec<StudyResults> = (1..=2).map(|k| run(shard(k), 1)).collect();
+    for (s, brdf) in shards.iter().zip(["phong:n=20", "lambert"]) {
+        assert_eq!(s.cells.len(), 8);
+        assert!(s.cells.iter().all(|c| c.brdf == brdf));
+    }
     // Through JSON, as `study merge` reads them.
     let reread: Vec<StudyResults> = shards
         .iter()
@@ -59,7 +75,22 @@ fn one_run_equals_three_merged_shards_and_any_thread_count() {
     assert!(shards.iter().all(|s| s.rankings.is_empty()));
     assert_eq!(whole.rankings.len(), 4);
     assert_eq!(merged.rankings.len(), 4);
-    assert_eq!(merged.runs.len(), 3);
+    assert_eq!(merged.runs.len(), 2);
+    // The merged rankings and report are the single run's: given the single run's timings
+    // (the only measured numbers), the merged results rank and report exactly as it does.
+    let mut same = merged.clone();
+    for (c, w) in same.cells.iter_mut().zip(&whole.cells) {
+        c.timing = w.timing;
+    }
+    same.runs = whole.runs.clone();
+    same.rankings = study::rankings(&same);
+    assert_eq!(same.rankings, whole.rankings);
+    assert_eq!(same, whole);
+    let assets = study::ReportAssets::default();
+    assert_eq!(
+        study::report_markdown(&same, &assets),
+        study::report_markdown(&whole, &assets)
+    );
     let json: serde_json::Value = serde_json::from_str(&whole.to_json()).unwrap();
     for r in json["rankings"].as_array().unwrap() {
         for key in [
@@ -91,6 +122,22 @@ fn merge_refuses_incomplete_or_repeated_shards() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("given twice"), "{err}");
+    // Three shards of two BRDFs: shard 3 has no cell, but a merge without it is refused.
+    let (s1, s2) = (
+        run(Some(Shard { index: 1, count: 3 }), 1),
+        run(Some(Shard { index: 2, count: 3 }), 1),
+    );
+    assert_eq!(s1.cells.len() + s2.cells.len(), 16);
+    let err = StudyResults::merge(vec![s1.clone(), s2.clone()])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("missing shards: 3/3"), "{err}");
+    let s3 = run(Some(Shard { index: 3, count: 3 }), 1);
+    assert!(s3.cells.is_empty());
+    assert_eq!(
+        StudyResults::merge(vec![s1, s2, s3]).unwrap().cells.len(),
+        16
+    );
     let mut other = run(Some(Shard { index: 2, count: 2 }), 1);
     other.config.seed += 1;
     let err = StudyResults::merge(vec![a, other]).unwrap_err().to_string();
