@@ -31,7 +31,9 @@ pub(crate) fn lobatto_nodes(a: f64, b: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Barycentric interpolation at `t` of `values` given at `lobatto_nodes(a, b, n)`.
+/// Barycentric interpolation at `t` of `values` given at `lobatto_nodes(a, b, n)` (the
+/// tables evaluate the same polynomial by its Chebyshev series; kept as the tests' reference).
+#[cfg(test)]
 pub(crate) fn interpolate(nodes: &[f64], values: &[f64], t: f64) -> f64 {
     let n = nodes.len();
     if n == 1 {
@@ -129,6 +131,29 @@ pub(crate) fn clenshaw(series: &[f64], x: f64) -> f64 {
     x * y1 - y2 + series.first().copied().unwrap_or(0.0)
 }
 
+/// `Σ_k Σ_l c[k · nd + l] T_k(x) T_l(y)`: Clenshaw's recurrence along `y` for all `k` at once
+/// (the rows' recurrences side by side, which the compiler keeps in vector registers), then
+/// along `x`. At most 32 θ coefficients (the table's node limit).
+#[inline]
+fn tensor_clenshaw(c: &[f64], nd: usize, x: f64, y: f64) -> f64 {
+    const MAX: usize = 32;
+    let nt = (c.len() / nd).min(MAX);
+    let (mut y1, mut y2) = ([0.0f64; MAX], [0.0f64; MAX]);
+    let y2x = 2.0 * y;
+    for l in (1..nd).rev() {
+        for k in 0..nt {
+            let v = y2x * y1[k] - y2[k] + c[k * nd + l];
+            y2[k] = y1[k];
+            y1[k] = v;
+        }
+    }
+    let mut rows = [0.0f64; MAX];
+    for k in 0..nt {
+        rows[k] = y * y1[k] - y2[k] + c[k * nd];
+    }
+    clenshaw(&rows[..nt], x)
+}
+
 /// A tensor Chebyshev–Lobatto table over `θ ∈ [θ_a, θ_b]` × `δ ∈ [−h, h]` (one δ node when the
 /// BRDF is isotropic).
 #[derive(Debug, Clone, PartialEq)]
@@ -137,13 +162,78 @@ pub(crate) struct ChebyshevTable {
     pub(crate) delta: Vec<f64>,
     /// `values[i · delta.len() + k]` at `(theta[i], delta[k])`.
     pub(crate) values: Vec<f64>,
-    /// One δ node: the θ interpolant as a Chebyshev series ([`chebyshev_series`]), evaluated by
-    /// Clenshaw's recurrence (the same polynomial as the barycentric formula, without its
-    /// `n` divisions per query); empty otherwise.
+    /// The interpolant as a Chebyshev series ([`chebyshev_series`]), evaluated by Clenshaw's
+    /// recurrence (the same polynomial as the barycentric formula, without its divisions per
+    /// query). One δ node: the θ series, trimmed ([`trimmed`]). Several: the tensor series,
+    /// `series[k · delta.len() + l]` the coefficient of `T_k(x) T_l(y)`, untrimmed.
     series: Vec<f64>,
     /// `(θ_a + θ_b)/2` and `2/(θ_b − θ_a)` (0 for a one-point interval): `x = (θ − centre)·scale`.
     centre: f64,
     scale: f64,
+    /// The same for δ: `y = (δ − delta_centre)·delta_scale`.
+    delta_centre: f64,
+    delta_scale: f64,
+    /// One δ node: the trimmed series in the monomial basis, `p(x) = Σ_i power[i] xⁱ`, kept
+    /// only where the conversion is well conditioned ([`monomial_of`]); empty otherwise.
+    power: Vec<f64>,
+}
+
+/// Bound on the conditioning of [`monomial_of`] accepted: `Σ_k |b_k| ‖T_k‖₁ ≤ POWER_COND ·
+/// min |v|`, so Horner's rule in the monomial basis (rounding `≤ 2n ε Σ|a_i|` on `[−1, 1]`)
+/// stays within ≈ `2n · 64 · ε ≈ 5·10⁻¹³` of the Chebyshev form, relative to the smallest value.
+const POWER_COND: f64 = 64.0;
+
+/// The monomial coefficients `a_i` of `Σ_k b_k T_k(x)` (`series`), or `None` when the
+/// conversion would lose more than [`POWER_COND`] · ε relative to `min_abs` (the smallest
+/// value the polynomial interpolates). `T_k`'s coefficients are integers, exact in `f64` for
+/// the ≤ 32 terms of a table.
+fn monomial_of(series: &[f64], min_abs: f64) -> Option<Vec<f64>> {
+    let n = series.len();
+    let mut out = vec![0.0; n];
+    let (mut prev, mut cur) = (vec![0.0; n], vec![0.0; n]);
+    let mut cond = 0.0;
+    for (k, &b) in series.iter().enumerate() {
+        // cur = T_k: T_0 = 1, T_1 = x, T_k = 2x T_{k−1} − T_{k−2}.
+        let next: Vec<f64> = match k {
+            0 => {
+                let mut t = vec![0.0; n];
+                t[0] = 1.0;
+                t
+            }
+            1 => {
+                let mut t = vec![0.0; n];
+                t[1] = 1.0;
+                t
+            }
+            _ => (0..n)
+                .map(|i| if i > 0 { 2.0 * cur[i - 1] } else { 0.0 } - prev[i])
+                .collect(),
+        };
+        prev = std::mem::replace(&mut cur, next);
+        cond += b.abs() * cur.iter().map(|c| c.abs()).sum::<f64>();
+        for (o, c) in out.iter_mut().zip(&cur) {
+            *o += b * c;
+        }
+    }
+    (cond <= POWER_COND * min_abs).then_some(out)
+}
+
+/// The tensor Chebyshev series of `values` (`values[i · nd + k]` at the Lobatto nodes `i` of
+/// θ and `k` of δ): [`chebyshev_series`] along δ for every θ node, then along θ for every δ
+/// coefficient; `out[k · nd + l]` multiplies `T_k(x) T_l(y)`.
+fn tensor_series(values: &[f64], nd: usize) -> Vec<f64> {
+    let nt = values.len() / nd;
+    let rows: Vec<Vec<f64>> = (0..nt)
+        .map(|i| chebyshev_series(&values[i * nd..(i + 1) * nd]))
+        .collect();
+    let mut out = vec![0.0; nt * nd];
+    for l in 0..nd {
+        let col: Vec<f64> = rows.iter().map(|r| r[l]).collect();
+        for (k, c) in chebyshev_series(&col).into_iter().enumerate() {
+            out[k * nd + l] = c;
+        }
+    }
+    out
 }
 
 impl ChebyshevTable {
@@ -151,38 +241,50 @@ impl ChebyshevTable {
     /// from [`lobatto_nodes`]).
     pub(crate) fn new(theta: Vec<f64>, delta: Vec<f64>, values: Vec<f64>) -> Self {
         let (lo, hi) = (theta[theta.len() - 1], theta[0]);
+        let (dlo, dhi) = (delta[delta.len() - 1], delta[0]);
         let series = if delta.len() == 1 {
             trimmed(chebyshev_series(&values), &values)
+        } else {
+            tensor_series(&values, delta.len())
+        };
+        let min_abs = values.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
+        let power = if delta.len() == 1 {
+            monomial_of(&series, min_abs).unwrap_or_default()
         } else {
             Vec::new()
         };
         Self {
+            power,
             series,
             centre: 0.5 * (lo + hi),
             scale: if hi > lo { 2.0 / (hi - lo) } else { 0.0 },
+            delta_centre: 0.5 * (dlo + dhi),
+            delta_scale: if dhi > dlo { 2.0 / (dhi - dlo) } else { 0.0 },
             theta,
             delta,
             values,
         }
     }
 
-    /// The interpolant at `(θ, δ)` (arguments outside the box are clamped to it).
+    /// The interpolant at `(θ, δ)` (arguments outside the box are clamped to it). One δ node:
+    /// Horner's rule on [`Self::power`] when it was kept, else Clenshaw's recurrence; a tensor
+    /// table: [`tensor_clenshaw`], out of line.
+    #[inline]
     pub(crate) fn eval(&self, theta: f64, delta: f64) -> f64 {
-        let nd = self.delta.len();
-        let (lo, hi) = (self.theta[self.theta.len() - 1], self.theta[0]);
-        let t = theta.clamp(lo, hi);
-        if nd == 1 {
-            let x = ((t - self.centre) * self.scale).clamp(-1.0, 1.0);
+        let x = ((theta - self.centre) * self.scale).clamp(-1.0, 1.0);
+        if self.delta.len() == 1 {
+            if !self.power.is_empty() {
+                return self.power.iter().rev().fold(0.0, |acc, &a| acc * x + a);
+            }
             return clenshaw(&self.series, x);
         }
-        let (dlo, dhi) = (self.delta[nd - 1], self.delta[0]);
-        let d = delta.clamp(dlo, dhi);
-        let mut rows = [0.0f64; 32];
-        let n = self.theta.len().min(32);
-        for (i, r) in rows.iter_mut().enumerate().take(n) {
-            *r = interpolate(&self.delta, &self.values[i * nd..(i + 1) * nd], d);
-        }
-        interpolate(&self.theta[..n], &rows[..n], t)
+        self.eval_tensor(x, delta)
+    }
+
+    #[inline(never)]
+    fn eval_tensor(&self, x: f64, delta: f64) -> f64 {
+        let y = ((delta - self.delta_centre) * self.delta_scale).clamp(-1.0, 1.0);
+        tensor_clenshaw(&self.series, self.delta.len(), x, y)
     }
 
     /// Relative interpolation-error estimate: the larger of [`Self::rel_tail_theta`] and
@@ -228,7 +330,11 @@ impl ChebyshevTable {
 
     /// Bytes held.
     pub(crate) fn bytes_used(&self) -> usize {
-        8 * (self.theta.capacity() + self.delta.capacity() + self.values.capacity())
+        8 * (self.theta.capacity()
+            + self.delta.capacity()
+            + self.values.capacity()
+            + self.series.capacity()
+            + self.power.capacity())
     }
 }
 
@@ -250,6 +356,40 @@ mod tests {
         let table = ChebyshevTable::new(nodes, vec![0.0], quartic);
         assert_eq!(table.series.len(), 5, "{:?}", table.series);
         assert!((table.eval(0.37, 0.0) - (1.0 + 0.37f64.powi(4))).abs() < 1e-14);
+    }
+
+    /// A smooth normaliser-like table takes the monomial (Horner) path and agrees with the
+    /// Chebyshev form and with the barycentric interpolant to 1e-13 relative; a table of wild
+    /// values keeps the Chebyshev form.
+    #[test]
+    fn monomial_form_is_the_same_polynomial_where_kept() {
+        let f = |c: f64| (0.3 + c).powf(1.7) * (1.0 + 0.2 * c * c);
+        let nodes = lobatto_nodes(0.05, 0.9, 9);
+        let values: Vec<f64> = nodes.iter().map(|&c| f(c)).collect();
+        let table = ChebyshevTable::new(nodes.clone(), vec![0.0], values.clone());
+        assert!(!table.power.is_empty(), "smooth table: monomial form kept");
+        for k in 0..=200 {
+            let t = 0.05 + 0.85 * k as f64 / 200.0;
+            let x = ((t - table.centre) * table.scale).clamp(-1.0, 1.0);
+            let (horner, cheb) = (table.eval(t, 0.0), clenshaw(&table.series, x));
+            assert!(
+                (horner - cheb).abs() <= 1e-13 * cheb.abs(),
+                "{t}: {horner} vs {cheb}"
+            );
+            let bary = interpolate(&nodes, &values, t);
+            assert!(
+                (horner - bary).abs() <= 1e-13 * bary.abs(),
+                "{t}: {horner} vs {bary}"
+            );
+        }
+        let wild: Vec<f64> = (0..17)
+            .map(|j| if j % 2 == 0 { 10.0 } else { 0.1 })
+            .collect();
+        let table = ChebyshevTable::new(lobatto_nodes(0.0, 1.0, 17), vec![0.0], wild);
+        assert!(
+            table.power.is_empty(),
+            "ill-conditioned: Chebyshev form kept"
+        );
     }
 
     #[test]
@@ -300,6 +440,37 @@ mod tests {
                 "{} vs {}", table.eval(t, 0.0), exact);
             for (j, &x) in nodes.iter().enumerate() {
                 prop_assert!((table.eval(x, 0.0) - values[j]).abs() <= 1e-12 * 10.0 * n as f64);
+            }
+        }
+    }
+
+    proptest! {
+        /// The tensor series of a two-angle table is the tensor barycentric interpolant (δ rows
+        /// first, then θ) at any point of the box, and the value at every node.
+        #[test]
+        fn tensor_series_is_the_tensor_interpolant(a in -1.0f64..1.0, w in 0.01f64..2.0,
+                                                   h in 0.01f64..1.0,
+                                                   nt in 2usize..12, nd in 2usize..12,
+                                                   v in proptest::collection::vec(0.1f64..10.0, 144),
+                                                   s in 0.0f64..1.0, r in 0.0f64..1.0) {
+            let theta = lobatto_nodes(a, a + w, nt);
+            let delta = lobatto_nodes(-h, h, nd);
+            let values = v[..nt * nd].to_vec();
+            let table = ChebyshevTable::new(theta.clone(), delta.clone(), values.clone());
+            let reference = |t: f64, d: f64| {
+                let rows: Vec<f64> = (0..nt)
+                    .map(|i| interpolate(&delta, &values[i * nd..(i + 1) * nd], d))
+                    .collect();
+                interpolate(&theta, &rows, t)
+            };
+            let (t, d) = (a + s * w, -h + 2.0 * h * r);
+            let tol = 1e-12 * 10.0 * (nt * nd) as f64;
+            prop_assert!((table.eval(t, d) - reference(t, d)).abs() <= tol,
+                "{} vs {}", table.eval(t, d), reference(t, d));
+            for (i, &ti) in theta.iter().enumerate() {
+                for (k, &dk) in delta.iter().enumerate() {
+                    prop_assert!((table.eval(ti, dk) - values[i * nd + k]).abs() <= tol);
+                }
             }
         }
     }

@@ -69,6 +69,7 @@ mod density;
 mod fused;
 mod probe;
 mod tabulated;
+mod walk;
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -338,6 +339,8 @@ fn cos_not_speculated(v: f64) -> f64 {
 /// the cell was split in azimuth there).
 struct Cell {
     phi: f64,
+    /// `(cos, sin)` of `phi`: a query's rotation from the cell's frame without trigonometry.
+    phi_turn: Turn,
     /// Upper θ edges of the strips (radians), increasing; the last is π/2.
     upper: Vec<f64>,
     /// The same edges as search keys ([`TableVar::key`]), increasing.
@@ -400,6 +403,7 @@ impl Cell {
         let intervals = members.into_iter().map(|(_, _, iv)| iv).collect();
         Self {
             phi,
+            phi_turn: Turn::from_angle(phi),
             upper,
             keys,
             guide,
@@ -1126,7 +1130,7 @@ impl ExactSet {
             if delta > 0.5 * self.period {
                 delta -= self.period;
             }
-            (k, Turn::from_angle(rot), delta)
+            (k, walk::turn_from_cell(wo, self.cells[k].phi_turn), delta)
         };
         let var = match self.var {
             TableVar::Cos => cos,
