@@ -1,11 +1,18 @@
 //! Tests of the exact sampler: normaliser against the independent albedo reference, samples
 //! against the exact law at off-centre angles, and the audit of a bound that is too low.
 
+use super::grid::theta_kinks;
+use super::layout::{GUIDE_LEN, guided_interval, interval_guide};
 use super::*;
+use crate::direction_sampler::DirectionSampler;
 use crate::reference_albedo;
 use brdf::parse_spec;
+use brdf::{Brdf, Vec3};
+use partition_sampler::UniformSource;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use std::sync::Arc;
 
 fn small(spec: &str) -> (Arc<dyn Brdf>, ExactOptions) {
     let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
