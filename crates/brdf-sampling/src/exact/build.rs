@@ -83,27 +83,27 @@ impl ExactSet {
 
 /// What every interval of a build shares: the grid of edges, the azimuth cells, the table
 /// variable and the build's switches.
-struct Plan {
-    isotropic: bool,
-    grid: Grid,
+pub(super) struct Plan {
+    pub(super) isotropic: bool,
+    pub(super) grid: Grid,
     /// Initial intervals per cell.
-    n0: u64,
+    pub(super) n0: u64,
     /// Azimuth period of the cells (2π, or π for half-turn-symmetric BRDFs).
-    period: f64,
+    pub(super) period: f64,
     /// The cells' centre azimuths (radians).
-    phis: Vec<f64>,
-    var: TableVar,
+    pub(super) phis: Vec<f64>,
+    pub(super) var: TableVar,
     /// Keep the bound nodes' values for the children.
-    cache: bool,
+    pub(super) cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
-    min_width: f64,
+    pub(super) min_width: f64,
     /// Integrate the normaliser nodes in the BRDF's own table cells (`tabulated.rs`).
-    table_nodes: bool,
+    pub(super) table_nodes: bool,
 }
 
 impl Plan {
     /// The plan of `brdf`'s set (see [`ExactSet::build_with`] for `cache` and `follow_kinks`).
-    fn new(
+    pub(super) fn new(
         brdf: &dyn Brdf,
         options: &ExactOptions,
         cache: Option<bool>,
@@ -166,7 +166,7 @@ impl Plan {
     }
 
     /// The context of `job`'s build.
-    fn context(&self, job: &Job) -> IntervalContext {
+    pub(super) fn context(&self, job: &Job) -> IntervalContext {
         let grid = self.grid;
         IntervalContext {
             grid,

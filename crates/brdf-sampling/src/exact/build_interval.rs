@@ -447,6 +447,7 @@ pub(super) fn build_interval(
         TableOutcome::Split => None,
         TableOutcome::Table(table, quad_err) => Some(finish_interval(
             brdf,
+            job,
             ctx,
             &span,
             &envelope,
@@ -471,6 +472,7 @@ pub(super) fn build_interval(
 #[allow(clippy::too_many_arguments)]
 fn finish_interval(
     brdf: &Arc<dyn Brdf>,
+    job: &Job,
     ctx: &IntervalContext,
     span: &Span,
     envelope: &IntervalEnvelope,
@@ -479,24 +481,8 @@ fn finish_interval(
     quad_err: f64,
     evaluations: u64,
 ) -> Result<Interval, ExactError> {
-    let plain = Arc::new(IntervalEnvelope {
-        brdf: Arc::clone(brdf),
-        nodes: envelope
-            .nodes
-            .iter()
-            .map(|n| EnvelopeNode::new(n.key, n.wo, n.delta, None, false))
-            .collect(),
-        evaluations: Default::default(),
-    });
-    let f = DiscBrdf::with_map(plain, span.centre(ctx.phi_k), span.map);
-    let volume = tree.volume();
-    // The table holds A · cos θ.
-    let worst_trials = table
-        .values
-        .iter()
-        .enumerate()
-        .map(|(k, ac)| volume * ctx.var.cos(table.theta[k / table.delta.len()]) / ac)
-        .fold(0.0, f64::max);
+    let f = sampler_density(brdf, ctx, span, &envelope.nodes);
+    let worst_trials = worst_trials(&table, tree.volume(), ctx.var);
     let norm_err = quad_err + table.rel_tail();
     let shape = *tree.shape();
     let sampler =
@@ -507,6 +493,8 @@ fn finish_interval(
             }
         })?;
     Ok(Interval {
+        num: job.num,
+        dnum: job.dnum,
         theta: [span.theta_a, span.theta_b],
         delta: ctx.delta,
         tree: sampler,
@@ -517,6 +505,49 @@ fn finish_interval(
         quad_err,
         evaluations,
     })
+}
+
+/// The density a kept interval's tree is attached to: the envelope of its bound `nodes` without
+/// their values, on its disc.
+fn sampler_density(
+    brdf: &Arc<dyn Brdf>,
+    ctx: &IntervalContext,
+    span: &Span,
+    nodes: &[EnvelopeNode],
+) -> DiscBrdf {
+    let plain = Arc::new(IntervalEnvelope {
+        brdf: Arc::clone(brdf),
+        nodes: nodes
+            .iter()
+            .map(|n| EnvelopeNode::new(n.key, n.wo, n.delta, None, false))
+            .collect(),
+        evaluations: Default::default(),
+    });
+    DiscBrdf::with_map(plain, span.centre(ctx.phi_k), span.map)
+}
+
+/// The disc map and sampler density of `job`'s interval as its build made them, without
+/// building it (to re-attach a stored tree; `ctx.cache` off).
+pub(super) fn stored_density(
+    brdf: &Arc<dyn Brdf>,
+    options: &ExactOptions,
+    job: &Job,
+    ctx: &IntervalContext,
+) -> (DiscMap, DiscBrdf) {
+    let span = Span::new(brdf.as_ref(), options, job, ctx);
+    let nodes = bound_nodes(brdf, job, ctx, &span, delta_node_count(options, ctx.delta));
+    (span.map, sampler_density(brdf, ctx, &span, &nodes))
+}
+
+/// The largest mean trials `Σ V_i / A` (`volume / A`) over the nodes of `table` (which holds
+/// `A · cos θ` over the table variable `var`).
+pub(super) fn worst_trials(table: &ChebyshevTable, volume: f64, var: TableVar) -> f64 {
+    table
+        .values
+        .iter()
+        .enumerate()
+        .map(|(k, ac)| volume * var.cos(table.theta[k / table.delta.len()]) / ac)
+        .fold(0.0, f64::max)
 }
 
 /// The axis to halve (`Some(true)`: δ) should the interval's mean trials exceed the cap, if it

@@ -11,6 +11,9 @@ use super::grid::TableVar;
 
 /// One built interval.
 pub(super) struct Interval {
+    /// Its θ and δ numerators ([`Grid`](super::grid::Grid); kept for saving the set).
+    pub(super) num: [u64; 2],
+    pub(super) dnum: [u64; 2],
     /// Its θ range (radians).
     pub(super) theta: [f64; 2],
     /// Its azimuth offsets from the cell's centre (radians; `[0, 0]` for isotropic BRDFs).

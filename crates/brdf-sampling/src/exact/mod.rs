@@ -76,6 +76,7 @@ mod jobs;
 mod layout;
 mod lookup;
 mod options;
+mod persist;
 mod report;
 mod sampler;
 mod set;
@@ -83,6 +84,7 @@ mod tabulated;
 
 pub use error::ExactError;
 pub use options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+pub use persist::EXACT_FORMAT_VERSION;
 pub use report::{CellLayout, ExactReport};
 pub use set::ExactSet;
 

@@ -18,7 +18,7 @@ pub const MAX_DELTA_NODE_SPACING_DEG: f64 = 11.25;
 /// Settings of [`ExactSet`](crate::ExactSet). `set` supplies the tree parameters, image map, safety factor,
 /// disc-map policy and symmetries (its slice counts are unused: the intervals and azimuth cells
 /// adapt).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ExactOptions {
     /// The quadtree settings shared with the other adaptive sets.
     pub set: SetOptions,
