@@ -456,17 +456,24 @@ fn load_sets(paths: &[PathBuf]) -> Result<Vec<LoadedSet>, ValidationError> {
             let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
             let (entry, built) =
                 samplers::load_set(&bytes, None).map_err(|e| fail(e.to_string()))?;
-            let set = built
-                .set
-                .ok_or_else(|| fail("not an adaptive set".into()))?;
+            // A quadtree set knows its spec; an `adaptive-exact` file records it.
+            let (spec, brdf) = match (&built.set, &built.exact) {
+                (Some(set), _) => (set.spec().to_owned(), Arc::clone(set.brdf())),
+                (None, Some(exact)) => (
+                    brdf_sampling::ExactSet::stored_spec(&bytes)
+                        .map_err(|e| fail(e.to_string()))?,
+                    Arc::clone(exact.brdf()),
+                ),
+                (None, None) => return Err(fail("not an adaptive set".into())),
+            };
             let file = path.file_name().map_or_else(
                 || path.display().to_string(),
                 |f| f.to_string_lossy().into_owned(),
             );
             Ok(LoadedSet {
                 label: format!("{} (set {file})", entry.name),
-                spec: set.spec().to_owned(),
-                brdf: Arc::clone(set.brdf()),
+                spec,
+                brdf,
                 sampler: built.sampler,
             })
         })

@@ -54,7 +54,7 @@ struct Stored {
 }
 
 /// `f_r` at 32 fixed direction pairs (half of them near the mirror direction).
-fn probes(brdf: &dyn Brdf) -> Vec<f64> {
+pub(crate) fn probes(brdf: &dyn Brdf) -> Vec<f64> {
     (0..32u32)
         .map(|k| {
             let to = 3.0 + f64::from((k * 37) % 84);
@@ -71,28 +71,81 @@ fn probes(brdf: &dyn Brdf) -> Vec<f64> {
 }
 
 fn decode(bytes: &[u8]) -> Result<Stored, SetFileError> {
-    let (Some(magic), Some(version)) = (bytes.get(0..4), bytes.get(4..8)) else {
+    decode_payload(payload(bytes, MAGIC, SET_FORMAT_VERSION)?)
+}
+
+/// The payload of `bytes` after the header `magic` + `version` (little-endian `u32`).
+pub(crate) fn payload<'a>(
+    bytes: &'a [u8],
+    magic: &[u8; 4],
+    version: u32,
+) -> Result<&'a [u8], SetFileError> {
+    let (Some(found_magic), Some(found)) = (bytes.get(0..4), bytes.get(4..8)) else {
         return Err(SetFileError::Truncated);
     };
-    if magic != MAGIC {
+    if found_magic != magic {
         return Err(SetFileError::BadMagic);
     }
-    let found = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
-    if found != SET_FORMAT_VERSION {
+    let found = u32::from_le_bytes([found[0], found[1], found[2], found[3]]);
+    if found != version {
         return Err(SetFileError::UnsupportedVersion {
             found,
-            expected: SET_FORMAT_VERSION,
+            expected: version,
         });
     }
-    postcard::from_bytes(&bytes[8..]).map_err(|e| match e {
+    Ok(&bytes[8..])
+}
+
+/// The postcard decoding of a payload (a short one is [`SetFileError::Truncated`]).
+pub(crate) fn decode_payload<T: serde::de::DeserializeOwned>(
+    payload: &[u8],
+) -> Result<T, SetFileError> {
+    postcard::from_bytes(payload).map_err(|e| match e {
         postcard::Error::DeserializeUnexpectedEnd => SetFileError::Truncated,
         other => SetFileError::Decode(other.to_string()),
     })
 }
 
+/// `magic`, `version` and the postcard encoding of `stored`.
+pub(crate) fn encode<T: Serialize>(magic: &[u8; 4], version: u32, stored: &T) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(magic);
+    out.extend_from_slice(&version.to_le_bytes());
+    // Serialising plain data into a Vec cannot fail.
+    if let Ok(payload) = postcard::to_allocvec(stored) {
+        out.extend_from_slice(&payload);
+    }
+    out
+}
+
+/// Checks that `brdf` reproduces the `stored` probe values ([`probes`], relative
+/// [`PROBE_TOLERANCE`]).
+pub(crate) fn check_probes(stored: &[f64], brdf: &dyn Brdf) -> Result<(), SetFileError> {
+    let found = probes(brdf);
+    for (probe, (&a, &b)) in stored.iter().zip(&found).enumerate() {
+        let ok = a == b || (a - b).abs() <= PROBE_TOLERANCE * a.abs().max(b.abs());
+        if !ok {
+            return Err(SetFileError::BrdfMismatch {
+                name: brdf.name().to_string(),
+                probe,
+                stored: a,
+                found: b,
+            });
+        }
+    }
+    if stored.len() != found.len() {
+        return Err(SetFileError::Corrupt(format!(
+            "{} probes, expected {}",
+            stored.len(),
+            found.len()
+        )));
+    }
+    Ok(())
+}
+
 /// `Σ volume / Σ f(centre) · area` over the leaves: the mean trials per sample if the density
 /// were its value at each leaf's centre (infinite when it vanishes at every centre).
-fn estimated_mean_trials(s: &QuadTreeSampler<SliceDensity>) -> f64 {
+pub(crate) fn estimated_mean_trials(s: &QuadTreeSampler<SliceDensity>) -> f64 {
     use partition_sampler::Density;
     let (mut volume, mut mass) = (0.0, 0.0);
     for leaf in s.tree().leaves() {
@@ -126,14 +179,7 @@ impl QuadTreeSet {
                 .collect(),
             trees: self.trees.iter().map(|t| t.tree().to_bytes()).collect(),
         };
-        let mut out = Vec::new();
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&SET_FORMAT_VERSION.to_le_bytes());
-        // Serialising plain data into a Vec cannot fail.
-        if let Ok(payload) = postcard::to_allocvec(&stored) {
-            out.extend_from_slice(&payload);
-        }
-        out
+        encode(MAGIC, SET_FORMAT_VERSION, &stored)
     }
 
     /// The BRDF spec recorded in stored bytes (to parse the BRDF before
@@ -158,25 +204,7 @@ impl QuadTreeSet {
                 given: spec.trim().to_string(),
             });
         }
-        let found = probes(brdf.as_ref());
-        for (probe, (&a, &b)) in s.probes.iter().zip(&found).enumerate() {
-            let ok = a == b || (a - b).abs() <= PROBE_TOLERANCE * a.abs().max(b.abs());
-            if !ok {
-                return Err(SetFileError::BrdfMismatch {
-                    name: brdf.name().to_string(),
-                    probe,
-                    stored: a,
-                    found: b,
-                });
-            }
-        }
-        if s.probes.len() != found.len() {
-            return Err(SetFileError::Corrupt(format!(
-                "{} probes, expected {}",
-                s.probes.len(),
-                found.len()
-            )));
-        }
+        check_probes(&s.probes, brdf.as_ref())?;
         s.options
             .validate()
             .map_err(|e| SetFileError::Corrupt(format!("options: {e}")))?;

@@ -202,10 +202,7 @@ struct Subject {
 fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject> {
     let (built, elapsed) = brdf_args::build(name, &args.spec, brdf, &args.set)?;
     let build_seconds = elapsed.as_secs_f64();
-    let sampler: Arc<dyn DirectionSampler> = match built {
-        brdf_args::Built::Set(s) => s,
-        brdf_args::Built::Other(s) => s,
-    };
+    let sampler: Arc<dyn DirectionSampler> = built.shared();
     Ok(Subject {
         name: name.to_string(),
         sampler,

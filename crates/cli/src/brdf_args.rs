@@ -186,7 +186,12 @@ pub(crate) fn load_set(
 ) -> CliResult<(String, Arc<dyn Brdf>, Built, &'static str)> {
     let fail = |why: String| CliError::input(format!("--set {}: {why}", display_path(path)));
     let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
-    let spec = QuadTreeSet::stored_spec(&bytes).map_err(|e| fail(e.to_string()))?;
+    let stored = if brdf_sampling::ExactSet::is_stored(&bytes) {
+        brdf_sampling::ExactSet::stored_spec(&bytes)
+    } else {
+        QuadTreeSet::stored_spec(&bytes)
+    };
+    let spec = stored.map_err(|e| fail(e.to_string()))?;
     if let Some(given) = given_spec
         && given.trim() != spec
     {
@@ -247,6 +252,8 @@ pub(crate) fn outgoing(args: &BrdfArgs) -> CliResult<Vec3> {
 pub(crate) enum Built {
     /// An adaptive quadtree set.
     Set(Arc<QuadTreeSet>),
+    /// An `adaptive-exact` set.
+    Exact(Arc<brdf_sampling::ExactSet>),
     /// Any other sampler.
     Other(Arc<dyn DirectionSampler>),
 }
@@ -255,16 +262,37 @@ impl Built {
     pub(crate) fn sampler(&self) -> &dyn DirectionSampler {
         match self {
             Built::Set(s) => s.as_ref(),
+            Built::Exact(s) => s.as_ref(),
             Built::Other(s) => s.as_ref(),
+        }
+    }
+
+    /// The bytes that save the sampler (`spec`: its BRDF spec), for the samplers that can be
+    /// saved (adaptive quadtree sets, `adaptive-exact`).
+    pub(crate) fn to_bytes(&self, spec: &str) -> Option<Vec<u8>> {
+        match self {
+            Built::Set(s) => Some(s.to_bytes()),
+            Built::Exact(s) => Some(s.to_bytes(spec)),
+            Built::Other(_) => None,
+        }
+    }
+
+    /// The sampler as a shared direction sampler.
+    pub(crate) fn shared(&self) -> Arc<dyn DirectionSampler> {
+        match self {
+            Built::Set(s) => Arc::clone(s) as Arc<dyn DirectionSampler>,
+            Built::Exact(s) => Arc::clone(s) as Arc<dyn DirectionSampler>,
+            Built::Other(s) => Arc::clone(s),
         }
     }
 }
 
 impl From<samplers::BuiltDirection> for Built {
     fn from(b: samplers::BuiltDirection) -> Self {
-        match b.set {
-            Some(set) => Built::Set(set),
-            None => Built::Other(b.sampler),
+        match (b.set, b.exact) {
+            (Some(set), _) => Built::Set(set),
+            (None, Some(exact)) => Built::Exact(exact),
+            (None, None) => Built::Other(b.sampler),
         }
     }
 }

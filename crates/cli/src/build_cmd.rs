@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::brdf_args::{self, Built, Given, SamplerArgs};
+use crate::brdf_args::{self, Given, SamplerArgs};
 use crate::error::{CliError, CliResult};
 use crate::values::display_path;
 
@@ -14,11 +14,12 @@ pub(crate) struct BuildArgs {
     /// BRDF: `name` or `name:key=value,...` or `merl:PATH`.
     #[arg(long = "brdf")]
     spec: String,
-    /// `adaptive` (default), `adaptive-paper`, … or another built direction sampler such as
-    /// `adaptive-exact` (reported, not saved).
+    /// `adaptive` (default), `adaptive-paper`, …, `adaptive-exact` or another built direction
+    /// sampler (reported, not saved).
     #[arg(long, default_value = "adaptive")]
     sampler: String,
-    /// Save the set here (postcard with a format-version header; written atomically).
+    /// Save the set (or the `adaptive-exact` sampler) here (postcard with a format-version
+    /// header; written atomically); `--set FILE` loads it in the other commands.
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
@@ -32,7 +33,7 @@ pub(crate) fn run(args: &BuildArgs, given: &Given) -> CliResult<()> {
     let entry = samplers::find(&args.sampler).map_err(CliError::input)?;
     let is_set = matches!(entry.constructor, samplers::Constructor::AdaptiveSet { .. });
     let buildable = is_set || entry.is_direction() && entry.capabilities.needs_build;
-    let saveable = is_set || args.out.is_none();
+    let saveable = is_set || entry.name == "adaptive-exact" || args.out.is_none();
     if !(buildable && saveable) {
         let sets: Vec<&str> = samplers::samplers()
             .iter()
@@ -40,7 +41,7 @@ pub(crate) fn run(args: &BuildArgs, given: &Given) -> CliResult<()> {
             .map(|e| e.name)
             .collect();
         return Err(CliError::input(format!(
-            "--sampler {}: `build` makes (and `--out` saves) adaptive quadtree sets ({}); other built direction samplers are built and reported without --out",
+            "--sampler {}: `build` makes (and `--out` saves) adaptive quadtree sets ({}) and adaptive-exact; other built direction samplers are built and reported without --out",
             args.sampler,
             sets.join(", ")
         )));
@@ -61,8 +62,7 @@ pub(crate) fn run(args: &BuildArgs, given: &Given) -> CliResult<()> {
     for line in brdf_args::report_lines(built.sampler()) {
         println!("{line}");
     }
-    if let (Some(path), Built::Set(set)) = (&args.out, &built) {
-        let bytes = set.to_bytes();
+    if let (Some(path), Some(bytes)) = (&args.out, built.to_bytes(&args.spec)) {
         crate::output::write_atomically(path, |w| w.write_all(&bytes))?;
         println!("wrote      {} ({} bytes)", display_path(path), bytes.len());
     }

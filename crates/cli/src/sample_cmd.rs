@@ -131,8 +131,8 @@ pub(crate) fn run(args: &SampleArgs, given: &Given) -> CliResult<()> {
     for line in brdf_args::set_report_lines(&built) {
         eprintln!("{line}");
     }
-    if let brdf_args::Built::Other(s) = &built {
-        for line in brdf_args::report_lines(s.as_ref()) {
+    if !matches!(built, brdf_args::Built::Set(_)) {
+        for line in brdf_args::report_lines(built.sampler()) {
             eprintln!("{line}");
         }
     }

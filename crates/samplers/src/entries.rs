@@ -84,7 +84,7 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                     &brdf_sampling::ExactOptions::with_set(*r.options),
                     r.progress,
                 )?;
-                Ok(BuiltDirection::plain(Arc::new(set)))
+                Ok(BuiltDirection::from_exact(set))
             },
         },
     },

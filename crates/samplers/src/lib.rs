@@ -403,7 +403,8 @@ pub fn build_direction(
     find(name)?.build_direction(request)
 }
 
-/// Reads a set saved by `build --out` ([`QuadTreeSet::to_bytes`]) back, re-attached to
+/// Reads a sampler saved by `build --out` ([`QuadTreeSet::to_bytes`], or
+/// [`brdf_sampling::ExactSet::to_bytes`] for `adaptive-exact`, told apart by the magic) back, re-attached to
 /// `brdf` (the BRDF of the stored spec when `None`), with the registry entry it was built as.
 ///
 /// Errors: [`RegistryError::SetFile`] for a bad file or a BRDF that does not match it,
@@ -412,7 +413,12 @@ pub fn load_set(
     bytes: &[u8],
     brdf: Option<(Arc<dyn Brdf>, &str)>,
 ) -> Result<(&'static SamplerEntry, BuiltDirection), RegistryError> {
-    let stored = QuadTreeSet::stored_spec(bytes)?;
+    let exact = brdf_sampling::ExactSet::is_stored(bytes);
+    let stored = if exact {
+        brdf_sampling::ExactSet::stored_spec(bytes)?
+    } else {
+        QuadTreeSet::stored_spec(bytes)?
+    };
     let (brdf, spec) = match brdf {
         Some((b, s)) => (b, s.to_string()),
         None => {
@@ -423,6 +429,11 @@ pub fn load_set(
             (Arc::from(b), stored)
         }
     };
+    if exact {
+        let set = brdf_sampling::ExactSet::from_bytes(bytes, brdf, &spec)?;
+        let entry = find("adaptive-exact")?;
+        return Ok((entry, BuiltDirection::from_exact(set)));
+    }
     let set = QuadTreeSet::from_bytes(bytes, brdf, &spec)?;
     let (variant, mixture) = (set.variant(), set.options().mixture);
     let entry = SAMPLERS

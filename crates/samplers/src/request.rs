@@ -75,12 +75,18 @@ pub struct BuiltDirection {
     /// The same sampler as an adaptive quadtree set, when it is one (for its report and for
     /// saving it).
     pub set: Option<Arc<QuadTreeSet>>,
+    /// The same sampler as an `adaptive-exact` set, when it is one (for saving it).
+    pub exact: Option<Arc<brdf_sampling::ExactSet>>,
 }
 
 impl BuiltDirection {
     /// A sampler that is not an adaptive set.
     pub fn plain(sampler: Arc<dyn DirectionSampler>) -> Self {
-        Self { sampler, set: None }
+        Self {
+            sampler,
+            set: None,
+            exact: None,
+        }
     }
 
     /// An adaptive set.
@@ -89,6 +95,27 @@ impl BuiltDirection {
         Self {
             sampler: Arc::clone(&set) as Arc<dyn DirectionSampler>,
             set: Some(set),
+            exact: None,
+        }
+    }
+
+    /// An `adaptive-exact` set.
+    pub fn from_exact(set: brdf_sampling::ExactSet) -> Self {
+        let set = Arc::new(set);
+        Self {
+            sampler: Arc::clone(&set) as Arc<dyn DirectionSampler>,
+            set: None,
+            exact: Some(set),
+        }
+    }
+
+    /// The bytes that save this sampler (`spec`: the BRDF spec it was built from), for the
+    /// samplers that can be saved: adaptive quadtree sets and `adaptive-exact`.
+    pub fn to_bytes(&self, spec: &str) -> Option<Vec<u8>> {
+        match (&self.set, &self.exact) {
+            (Some(set), _) => Some(set.to_bytes()),
+            (None, Some(exact)) => Some(exact.to_bytes(spec)),
+            (None, None) => None,
         }
     }
 

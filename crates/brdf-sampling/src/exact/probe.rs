@@ -7,7 +7,9 @@
 
 use brdf::{Vec3, direction_from_radians};
 
-use super::{ExactSet, TableVar, tabulated};
+use super::grid::TableVar;
+use super::set::ExactSet;
+use super::tabulated;
 
 impl ExactSet {
     /// `(A, relative error estimate)` at `wo` by the rule the set's normaliser nodes use, at
@@ -26,7 +28,7 @@ impl ExactSet {
         let iv = self.interval(&q);
         let phi_k = self.cells[q.cell].phi;
         let d = q.delta;
-        let density = super::QueryDensity::new(
+        let density = super::density::QueryDensity::new(
             self.brdf.as_ref(),
             direction_from_radians(theta, phi_k + d),
             d,

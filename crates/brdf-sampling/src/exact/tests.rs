@@ -1,11 +1,18 @@
 //! Tests of the exact sampler: normaliser against the independent albedo reference, samples
 //! against the exact law at off-centre angles, and the audit of a bound that is too low.
 
+use super::grid::theta_kinks;
+use super::layout::{GUIDE_LEN, guided_interval, interval_guide};
 use super::*;
+use crate::direction_sampler::DirectionSampler;
 use crate::reference_albedo;
 use brdf::parse_spec;
+use brdf::{Brdf, Vec3};
+use partition_sampler::UniformSource;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use std::sync::Arc;
 
 fn small(spec: &str) -> (Arc<dyn Brdf>, ExactOptions) {
     let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
@@ -254,6 +261,23 @@ fn anisotropic_cells_are_split_in_azimuth_and_searched_by_both_angles() {
         strips.iter().any(|&n| n > 1) && strips.iter().min() < strips.iter().max(),
         "azimuth splits per strip: {strips:?}"
     );
+    // Saved and loaded (issue 29 item 5): the same layout, interval of every query, samples
+    // and pdfs, azimuth splits included.
+    let spec = "ward:alpha_x=0.1,alpha_y=0.3";
+    let back = ExactSet::from_bytes(&set.to_bytes(spec), Arc::clone(&brdf), spec).unwrap();
+    assert_eq!(back.layout(), layout);
+    let (mut r1, mut r2) = (
+        Xoshiro256PlusPlus::seed_from_u64(5),
+        Xoshiro256PlusPlus::seed_from_u64(5),
+    );
+    for k in 0..400 {
+        let wo = brdf::direction_from_angles(89.9 * (k as f64 + 0.5) / 400.0, 137.5 * k as f64);
+        let (a, b) = (set.sample(&wo, &mut r1), back.sample(&wo, &mut r2));
+        assert_eq!(a, b, "loaded set, query {k}");
+        assert_eq!(set.pdf(&wo, &a.wi), back.pdf(&wo, &b.wi));
+        let (qa, qb) = (set.locate(&wo).unwrap(), back.locate(&wo).unwrap());
+        assert_eq!((qa.cell, qa.interval), (qb.cell, qb.interval));
+    }
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
     let mut queries: Vec<(f64, f64)> = (0..3000)
         .map(|_| (rng.next_uniform() * 89.9, rng.next_uniform() * 360.0))

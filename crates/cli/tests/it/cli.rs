@@ -853,6 +853,92 @@ fn sets_written_by_build_are_used_by_sample_and_eval() {
     usage(&["sample", "--set", &samples, "-n", "10"], "s.csv");
 }
 
+/// `build --sampler adaptive-exact --out FILE` saves the sampler (issue 29 item 5); `sample`,
+/// `eval` and `validate` load it with `--set`, and the loaded sampler draws the same samples
+/// as a fresh build with the same seed. A truncated file is refused with its reason (exit 2).
+#[test]
+fn adaptive_exact_is_saved_by_build_and_loaded_by_set() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |name: &str| dir.path().join(name).to_str().expect("p").to_string();
+    let (set, loaded, fresh, evals) = (p("phong.exact"), p("l.csv"), p("f.csv"), p("e.csv"));
+    let o = brdf_lab(&[
+        "build",
+        "--brdf",
+        "phong:n=50",
+        "--sampler",
+        "adaptive-exact",
+        "--out",
+        &set,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("wrote"));
+    let at = [
+        "--theta-o",
+        "37",
+        "--phi-o",
+        "20",
+        "-n",
+        "500",
+        "--seed",
+        "7",
+    ];
+    let run = |args: &[&str]| {
+        let mut v = args.to_vec();
+        v.extend(at);
+        brdf_lab(&v)
+    };
+    let o = run(&["sample", "--set", &set, "--out", &loaded]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "sample",
+        "--brdf",
+        "phong:n=50",
+        "--sampler",
+        "adaptive-exact",
+        "--out",
+        &fresh,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (a, b) = (read_csv(Path::new(&loaded)), read_csv(Path::new(&fresh)));
+    assert_eq!(a.1.len(), 500);
+    assert_eq!(a, b, "loaded and freshly built samples differ");
+    let o = brdf_lab(&[
+        "eval",
+        "--set",
+        &set,
+        "--dirs",
+        &loaded,
+        "--out",
+        &evals,
+        "--theta-o",
+        "37",
+        "--phi-o",
+        "20",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (s, e) in a.1.iter().zip(&read_csv(Path::new(&evals)).1) {
+        assert!((s[3] - e[4]).abs() <= 1e-12 * s[3], "{s:?} vs {e:?}");
+    }
+    let o = brdf_lab(&[
+        "validate",
+        "--quick",
+        "--set",
+        &set,
+        "--theta-o",
+        "40",
+        "--samples",
+        "20000",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let bytes = std::fs::read(&set).expect("set");
+    let cut = p("cut.exact");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).expect("write");
+    assert_input_error(
+        &["sample", "--set", &cut, "-n", "10", "--theta-o", "37"],
+        "truncated",
+    );
+}
+
 #[test]
 fn validate_checks_a_set_written_by_build() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -1,0 +1,615 @@
+//! One interval's build: bound nodes, envelope tree, split axis and normaliser table.
+
+use std::sync::Arc;
+
+use brdf::{Brdf, direction_from_radians, rotate_z};
+use partition_sampler::{
+    GridOptions, LeafChoice, QuadTree, QuadTreeBuilder, QuadTreeSampler, Scheme, TreeParams,
+};
+
+use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
+use crate::error::SetError;
+use crate::image_map::{Counted, EvalCounter, SliceImageMap};
+
+use super::chebyshev::{ChebyshevTable, lobatto_nodes};
+use super::density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryDensity};
+use super::error::ExactError;
+use super::grid::{Grid, TableVar};
+use super::interval::Interval;
+use super::jobs::{Inheritance, Job, Normaliser, NormaliserKey};
+use super::options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+use super::tabulated;
+
+/// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
+/// moving mirror direction (see [`peak_track`]).
+const PEAK_TRACK_THETAS: usize = 65;
+
+/// Azimuth offsets per anisotropic interval for the same track (at least; 4 per bound node
+/// spacing).
+const PEAK_TRACK_DELTAS: usize = 9;
+
+/// The peak track of an interval `[ta, tb]` of cell `phi_k` (azimuth offsets `deltas`): for
+/// every outgoing direction `(θ, φ_k + δ)` of a fine grid, its mirror direction's point in the
+/// interval's frame and disc map, and the member density there (`QueryDensity`).
+fn peak_track<'a>(
+    brdf: &'a dyn Brdf,
+    ta: f64,
+    tb: f64,
+    phi_k: f64,
+    deltas: &[f64],
+    map: DiscMap,
+) -> Vec<crate::image_map::TrackPoint<'a>> {
+    let mut track = Vec::new();
+    for n in 0..PEAK_TRACK_THETAS {
+        let t = ta + (tb - ta) * n as f64 / (PEAK_TRACK_THETAS - 1) as f64;
+        for &d in deltas {
+            let wo = direction_from_radians(t, phi_k + d);
+            let g = QueryDensity::new(brdf, wo, d, map);
+            // `g` evaluates f(ωo, R_d v): its peak is at v = R_{−d} mirror(ωo).
+            let at = map.to_disc(&rotate_z(&brdf::mirror(&wo), -d));
+            track.push(crate::image_map::TrackPoint {
+                at,
+                density: Box::new(move |p| g.at(p)),
+            });
+        }
+    }
+    track
+}
+
+/// What one interval's build needs besides its [`Job`].
+pub(super) struct IntervalContext {
+    pub(super) grid: Grid,
+    /// The cell's centre azimuth.
+    pub(super) phi_k: f64,
+    /// The interval's azimuth offsets `[δ_a, δ_b]` from the cell's centre (`[0, 0]`:
+    /// isotropic).
+    pub(super) delta: [f64; 2],
+    /// The set's table variable.
+    pub(super) var: TableVar,
+    /// Keep the bound nodes' values for the children.
+    pub(super) cache: bool,
+    /// Narrowest interval (radians, θ and azimuth).
+    pub(super) min_width: f64,
+    /// Integrate the normaliser nodes in the BRDF's own table cells (the MERL layout,
+    /// `tabulated.rs`) instead of on the tree's leaves.
+    pub(super) table_nodes: bool,
+}
+
+/// One interval's build: the interval (`None`: to be split) and what its children can reuse.
+pub(super) struct Built {
+    pub(super) interval: Option<Interval>,
+    pub(super) inheritance: Inheritance,
+    /// The axis to halve should its mean trials exceed the cap (`Some(true)`: δ; `None`: that
+    /// axis is at its narrowest), see [`split_axis`].
+    pub(super) axis: Option<bool>,
+}
+
+/// Where and on which disc map one interval is built: its clamped θ range and the names its
+/// errors carry.
+struct Span {
+    /// The interval's θ range clamped to [`THETA_TOP_DEG`] (radians).
+    ta: f64,
+    tb: f64,
+    /// The interval's θ edges (radians, not clamped).
+    theta_a: f64,
+    theta_b: f64,
+    map: DiscMap,
+    isotropic: bool,
+    /// The tree mirrors `y` (isotropic, mirror-symmetric BRDF and symmetries on).
+    mirror_y: bool,
+    /// The slice number of errors (`θ_a` in millidegrees) and the angles they report.
+    slice: usize,
+    theta_deg: f64,
+    phi_deg: f64,
+}
+
+impl Span {
+    fn new(brdf: &dyn Brdf, options: &ExactOptions, job: &Job, ctx: &IntervalContext) -> Self {
+        let grid = ctx.grid;
+        let isotropic = grid.half == 0.0;
+        let top = THETA_TOP_DEG.to_radians();
+        let theta_b = grid.edge(job.num[1]);
+        let (ta, tb) = (grid.edge(job.num[0]).min(top), theta_b.min(top));
+        let set = &options.set;
+        let map = set
+            .disc_map
+            .map_for(brdf, theta_b.to_degrees(), set.equal_area_from_deg);
+        Self {
+            ta,
+            tb,
+            theta_a: grid.edge(job.num[0]),
+            theta_b,
+            map,
+            isotropic,
+            mirror_y: set.symmetries && brdf.is_mirror_symmetric() && isotropic,
+            slice: (ta.to_degrees() * 1000.0) as usize,
+            theta_deg: 0.5 * (ta + tb).to_degrees(),
+            phi_deg: ctx.phi_k.to_degrees(),
+        }
+    }
+
+    /// The outgoing direction the interval's disc is centred on.
+    fn centre(&self, phi_k: f64) -> brdf::Vec3 {
+        direction_from_radians(0.5 * (self.ta + self.tb), phi_k)
+    }
+}
+
+/// `n` δ nodes of `job`'s interval as exact rationals (see `Grid::delta_of`): a node a split
+/// interval shares with its child is the same `f64`, whatever the two node counts.
+fn delta_nodes(grid: &Grid, job: &Job, isotropic: bool, n: usize) -> Vec<f64> {
+    if isotropic {
+        vec![0.0]
+    } else {
+        let (a, b, m) = (job.dnum[0], job.dnum[1], n as u64 - 1);
+        (0..n as u64)
+            .map(|k| grid.delta_of(a * m + (b - a) * k, m))
+            .collect()
+    }
+}
+
+/// δ bound nodes of an interval `[δ_a, δ_b]`: at most [`MAX_DELTA_NODE_SPACING_DEG`] apart
+/// in azimuth, and at least [`ExactOptions::phi_bound_nodes`].
+fn delta_node_count(options: &ExactOptions, [da, db]: [f64; 2]) -> usize {
+    options
+        .phi_bound_nodes
+        .max(((db - da).to_degrees() / MAX_DELTA_NODE_SPACING_DEG - 1e-9).ceil() as usize + 1)
+}
+
+/// The bound nodes of `job`'s interval (θ major, `n_delta` δ nodes each), with the values its
+/// parent left for the ones that cache.
+fn bound_nodes(
+    brdf: &Arc<dyn Brdf>,
+    job: &Job,
+    ctx: &IntervalContext,
+    span: &Span,
+    n_delta: usize,
+) -> Vec<EnvelopeNode> {
+    let (grid, top) = (ctx.grid, THETA_TOP_DEG.to_radians());
+    let mut nodes = Vec::new();
+    for n in 0..=grid.m {
+        let (num, t) = grid.node(job.num, n);
+        // Nodes past the top angle sit at it (no longer the shared rational: not cached).
+        let (t, cacheable) = if t > top {
+            (top, false)
+        } else {
+            (t, ctx.cache)
+        };
+        for d in delta_nodes(&grid, job, span.isotropic, n_delta) {
+            let key = (num, d.to_bits());
+            let inherited = job
+                .inherited
+                .nodes
+                .iter()
+                .find(|(k, _)| *k == key && cacheable)
+                .map(|(_, v)| Arc::clone(v));
+            let wo = direction_from_radians(t, ctx.phi_k + d);
+            nodes.push(EnvelopeNode::new(
+                key,
+                brdf.prepare(&wo),
+                d,
+                inherited,
+                cacheable,
+            ));
+        }
+    }
+    nodes
+}
+
+/// The envelope tree of an interval: the image map of the envelope `f` (with the peak track
+/// of the members' mirror directions at the azimuth offsets `track_deltas`) and the tree built
+/// on it. Returns the tree and the points the image map evaluated.
+fn envelope_tree(
+    brdf: &dyn Brdf,
+    options: &ExactOptions,
+    ctx: &IntervalContext,
+    span: &Span,
+    f: &DiscBrdf,
+    track_deltas: &[f64],
+) -> Result<(QuadTree, u64), ExactError> {
+    let set = &options.set;
+    let (slice, theta_deg, phi_deg) = (span.slice, span.theta_deg, span.phi_deg);
+    let counter = EvalCounter::new();
+    let grid_options = GridOptions {
+        refinement: set.grid_refinement,
+        mirror_y: span.mirror_y,
+        ..GridOptions::default()
+    };
+    let image = SliceImageMap::new(
+        Counted {
+            f,
+            counter: &counter,
+        },
+        set.grid,
+        set.safety_factor,
+        set.dilation_for(brdf),
+        &grid_options,
+    )
+    .map_err(|source| SetError::Density {
+        slice,
+        theta_deg,
+        phi_deg,
+        source,
+    })?;
+    // The members' peaks: the mirror direction of every outgoing direction of the interval
+    // moves with θo (and δ), and a cusp there (Beard–Maxwell) falls between the bound nodes'.
+    let image = image.with_track(peak_track(
+        brdf,
+        span.ta,
+        span.tb,
+        ctx.phi_k,
+        track_deltas,
+        span.map,
+    ));
+    let params = TreeParams {
+        scheme: Scheme::Envelope,
+        leaf_choice: LeafChoice::Alias,
+        ..set.tree
+    };
+    let tree = QuadTreeBuilder::from_params(params)
+        .build_tree(&image)
+        .map_err(|source| SetError::Tree {
+            slice,
+            theta_deg,
+            phi_deg,
+            source,
+        })?;
+    drop(image);
+    Ok((tree, counter.total()))
+}
+
+/// The normaliser table of an interval, or the verdict that it is to be split.
+enum TableOutcome {
+    /// `A · cos θo` at the Chebyshev nodes and the largest quadrature error estimate.
+    Table(ChebyshevTable, f64),
+    /// A node's mean trials `ΣV/A` exceed the cap (and the interval can be split).
+    Split,
+}
+
+/// The normaliser at the Chebyshev nodes, by the leaf quadrature of `tree`; the δ nodes double
+/// (Lobatto-nested) while their tail exceeds the tolerance. Every node integrated goes to
+/// `normalisers` (the children's inheritance). The ends and the middle come first: a node
+/// whose mean trials exceed the cap decides a split (when `axis` allows one), and the other
+/// nodes' quadratures are not needed.
+#[allow(clippy::too_many_arguments)]
+fn normaliser_table(
+    brdf: &dyn Brdf,
+    options: &ExactOptions,
+    job: &Job,
+    ctx: &IntervalContext,
+    span: &Span,
+    tree: &QuadTree,
+    axis: Option<bool>,
+    normalisers: &mut Vec<(NormaliserKey, Normaliser)>,
+) -> Result<TableOutcome, ExactError> {
+    let (var, [da, db]) = (ctx.var, ctx.delta);
+    let (va, vb) = (var.of(span.ta), var.of(span.tb));
+    // Nodes integrated in the table's cells are exact to ~1e-6 but cost ~10⁵ lookups each;
+    // `A(θo)` of the MERL layout interpolates to < 1e-5 on 5 of them (`tabulated.rs`).
+    let n_theta = if ctx.table_nodes {
+        options.normaliser_nodes.min(tabulated::TABLE_NODES)
+    } else {
+        options.normaliser_nodes
+    };
+    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), n_theta);
+    let volume = tree.volume();
+    let nt = theta_nodes.len();
+    let mut nd = options.phi_normaliser_nodes;
+    loop {
+        let delta_nodes = if span.isotropic {
+            vec![0.0]
+        } else {
+            lobatto_nodes(da, db, nd)
+        };
+        // The nodes the parent integrated first (the split test costs nothing there), then the
+        // ends and the middle.
+        let known = |own: &[(NormaliserKey, Normaliser)], i: usize, d: f64| {
+            let key = (theta_nodes[i].to_bits(), d.to_bits());
+            job.inherited
+                .normalisers
+                .iter()
+                .chain(own)
+                .find(|(k, _)| *k == key)
+                .map(|(_, n)| *n)
+        };
+        let mut order: Vec<(usize, usize)> = [0, nt - 1, nt / 2]
+            .into_iter()
+            .chain((1..nt - 1).filter(|&i| i != nt / 2))
+            .flat_map(|i| (0..delta_nodes.len()).map(move |j| (i, j)))
+            .collect();
+        order.sort_by_key(|&(i, j)| known(normalisers.as_slice(), i, delta_nodes[j]).is_none());
+        let mut values = vec![0.0; nt * delta_nodes.len()];
+        let mut quad_err = 0.0f64;
+        for (i, j) in order {
+            let (t, cos, d) = (
+                var.theta(theta_nodes[i]),
+                var.cos(theta_nodes[i]),
+                delta_nodes[j],
+            );
+            let r = match known(normalisers.as_slice(), i, d) {
+                Some(r) => r,
+                None => {
+                    let r = integrate_node(brdf, ctx, span, tree, t, d);
+                    normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
+                    r
+                }
+            };
+            if !(r.total.is_finite() && r.total > 0.0) {
+                return Err(ExactError::Normaliser {
+                    value: r.total,
+                    theta_deg: t.to_degrees(),
+                    phi_deg: (ctx.phi_k + d).to_degrees(),
+                });
+            }
+            if axis.is_some() && volume / r.total > options.max_trials {
+                return Ok(TableOutcome::Split);
+            }
+            quad_err = quad_err.max(r.rel_err);
+            values[i * delta_nodes.len() + j] = r.total * cos;
+        }
+        let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
+        // Interpolation below the quadrature's own error is noise: no refinement past it.
+        let floor = options.normaliser_tol.max(quad_err);
+        if span.isotropic || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
+            return Ok(TableOutcome::Table(table, quad_err));
+        }
+        nd = 2 * nd - 1;
+    }
+}
+
+/// `A` at the outgoing direction `(t, φ_k + d)`: over the BRDF's own bins for the MERL layout
+/// (`tabulated.rs`), by the leaf quadrature of `tree` otherwise.
+fn integrate_node(
+    brdf: &dyn Brdf,
+    ctx: &IntervalContext,
+    span: &Span,
+    tree: &QuadTree,
+    t: f64,
+    d: f64,
+) -> Normaliser {
+    if ctx.table_nodes {
+        let (total, rel_err) = tabulated::table_normaliser(brdf, t).unwrap_or((f64::NAN, 0.0));
+        return Normaliser { total, rel_err };
+    }
+    let q = QueryDensity::new(brdf, direction_from_radians(t, ctx.phi_k + d), d, span.map);
+    // The graded leaf quadrature, its budget by the BRDF (`tabulated.rs`).
+    let r = tabulated::node_quadrature(brdf, &q, tree.leaves(), tree.integral(), span.mirror_y);
+    Normaliser {
+        total: r.total,
+        rel_err: r.rel_err,
+    }
+}
+
+/// Builds the tree and normaliser table of one interval (`None`: its mean trials exceed the cap
+/// at a normaliser node, and it can be split), and returns its bound nodes' values (empty
+/// unless `ctx.cache`) for its children should it be split.
+pub(super) fn build_interval(
+    brdf: &Arc<dyn Brdf>,
+    options: &ExactOptions,
+    job: &Job,
+    ctx: &IntervalContext,
+) -> Result<Built, ExactError> {
+    let span = Span::new(brdf.as_ref(), options, job, ctx);
+    let n_delta = delta_node_count(options, ctx.delta);
+    let nodes = bound_nodes(brdf, job, ctx, &span, n_delta);
+    let n_nodes = nodes.len() as u64;
+    let envelope = Arc::new(IntervalEnvelope {
+        brdf: Arc::clone(brdf),
+        nodes,
+        evaluations: Default::default(),
+    });
+    let centre = span.centre(ctx.phi_k);
+    let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, span.map);
+    let track = delta_nodes(
+        &ctx.grid,
+        job,
+        span.isotropic,
+        PEAK_TRACK_DELTAS.max(4 * n_delta - 3),
+    );
+    let (tree, points) = envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?;
+    drop(f);
+    let axis_from = crate::disc::thread_evaluations();
+    let axis = split_axis(
+        brdf.as_ref(),
+        job,
+        ctx,
+        &envelope.nodes,
+        &tree,
+        span.map,
+        options.max_trials,
+    );
+    let axis_evals = crate::disc::thread_evaluations() - axis_from;
+    // Node evaluations: the cached nodes counted their misses, the others every point.
+    let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
+    let build_evals = points * (n_nodes - cached)
+        + envelope
+            .evaluations
+            .load(std::sync::atomic::Ordering::Relaxed);
+    let before = crate::disc::thread_evaluations();
+    let mut normalisers = Vec::new();
+    let outcome = normaliser_table(
+        brdf.as_ref(),
+        options,
+        job,
+        ctx,
+        &span,
+        &tree,
+        axis,
+        &mut normalisers,
+    )?;
+    let quad_evals = crate::disc::thread_evaluations() - before;
+    let interval = match outcome {
+        TableOutcome::Split => None,
+        TableOutcome::Table(table, quad_err) => Some(finish_interval(
+            brdf,
+            job,
+            ctx,
+            &span,
+            &envelope,
+            tree,
+            table,
+            quad_err,
+            build_evals + axis_evals + quad_evals,
+        )?),
+    };
+    Ok(Built {
+        axis,
+        interval,
+        inheritance: Inheritance {
+            nodes: values_of(envelope),
+            normalisers,
+        },
+    })
+}
+
+/// The built interval: its tree attached to the envelope without its node values (they go to
+/// the children), and the worst mean trials and error estimate of its table.
+#[allow(clippy::too_many_arguments)]
+fn finish_interval(
+    brdf: &Arc<dyn Brdf>,
+    job: &Job,
+    ctx: &IntervalContext,
+    span: &Span,
+    envelope: &IntervalEnvelope,
+    tree: QuadTree,
+    table: ChebyshevTable,
+    quad_err: f64,
+    evaluations: u64,
+) -> Result<Interval, ExactError> {
+    let f = sampler_density(brdf, ctx, span, &envelope.nodes);
+    let worst_trials = worst_trials(&table, tree.volume(), ctx.var);
+    let norm_err = quad_err + table.rel_tail();
+    let shape = *tree.shape();
+    let sampler =
+        QuadTreeSampler::from_parts(tree, SliceDensity { f, shape }).map_err(|source| {
+            SetError::Attach {
+                slice: span.slice,
+                source,
+            }
+        })?;
+    Ok(Interval {
+        num: job.num,
+        dnum: job.dnum,
+        theta: [span.theta_a, span.theta_b],
+        delta: ctx.delta,
+        tree: sampler,
+        map: span.map,
+        table,
+        worst_trials,
+        norm_err,
+        quad_err,
+        evaluations,
+    })
+}
+
+/// The density a kept interval's tree is attached to: the envelope of its bound `nodes` without
+/// their values, on its disc.
+fn sampler_density(
+    brdf: &Arc<dyn Brdf>,
+    ctx: &IntervalContext,
+    span: &Span,
+    nodes: &[EnvelopeNode],
+) -> DiscBrdf {
+    let plain = Arc::new(IntervalEnvelope {
+        brdf: Arc::clone(brdf),
+        nodes: nodes
+            .iter()
+            .map(|n| EnvelopeNode::new(n.key, n.wo, n.delta, None, false))
+            .collect(),
+        evaluations: Default::default(),
+    });
+    DiscBrdf::with_map(plain, span.centre(ctx.phi_k), span.map)
+}
+
+/// The disc map and sampler density of `job`'s interval as its build made them, without
+/// building it (to re-attach a stored tree; `ctx.cache` off).
+pub(super) fn stored_density(
+    brdf: &Arc<dyn Brdf>,
+    options: &ExactOptions,
+    job: &Job,
+    ctx: &IntervalContext,
+) -> (DiscMap, DiscBrdf) {
+    let span = Span::new(brdf.as_ref(), options, job, ctx);
+    let nodes = bound_nodes(brdf, job, ctx, &span, delta_node_count(options, ctx.delta));
+    (span.map, sampler_density(brdf, ctx, &span, &nodes))
+}
+
+/// The largest mean trials `Σ V_i / A` (`volume / A`) over the nodes of `table` (which holds
+/// `A · cos θ` over the table variable `var`).
+pub(super) fn worst_trials(table: &ChebyshevTable, volume: f64, var: TableVar) -> f64 {
+    table
+        .values
+        .iter()
+        .enumerate()
+        .map(|(k, ac)| volume * var.cos(table.theta[k / table.delta.len()]) / ac)
+        .fold(0.0, f64::max)
+}
+
+/// The axis to halve (`Some(true)`: δ) should the interval's mean trials exceed the cap, if it
+/// can be halved along it: θ for isotropic BRDFs; for anisotropic cells the axis along which
+/// the bound nodes' densities overlap least. With `g_ij` the density at θ node `i` and δ node
+/// `j` and `(c, d)` the middle nodes, the losses `∫ max_i g_id / ∫ g_cd` (θ) and
+/// `∫ max_j g_cj / ∫ g_cd` (δ) are compared, by the midpoint rule on 2 × 2 points per leaf
+/// of the interval's tree. At grazing angles the lobe changes with θo, not with δ: the θ loss
+/// wins, and an interval at its narrowest θ is kept rather than cut in azimuth for nothing.
+fn split_axis(
+    brdf: &dyn Brdf,
+    job: &Job,
+    ctx: &IntervalContext,
+    nodes: &[EnvelopeNode],
+    tree: &partition_sampler::QuadTree,
+    map: DiscMap,
+    max_trials: f64,
+) -> Option<bool> {
+    let (grid, min_width) = (&ctx.grid, ctx.min_width);
+    if grid.half == 0.0 || !job.can_split_delta(grid, min_width) {
+        return job.can_split_along(grid, min_width, false);
+    }
+    let n_theta = grid.m as usize + 1;
+    let n_delta = nodes.len() / n_theta;
+    let (c, d) = (n_theta / 2, n_delta / 2);
+    let g: Vec<QueryDensity> = nodes
+        .iter()
+        .map(|n| QueryDensity::new(brdf, *n.wo.wo(), n.delta, map))
+        .collect();
+    let (mut centre, mut theta, mut delta) = (0.0, 0.0, 0.0);
+    for leaf in tree.leaves() {
+        let r = leaf.rect;
+        let w = 0.25 * (r.x1 - r.x0) * (r.y1 - r.y0);
+        for (a, b) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
+            let p = [r.x0 + a * (r.x1 - r.x0), r.y0 + b * (r.y1 - r.y0)];
+            let at = |i: usize, j: usize| g[i * n_delta + j].at(p);
+            let mid = at(c, d);
+            let others = |n: usize, skip: usize, f: &dyn Fn(usize) -> f64| {
+                (0..n).filter(|&k| k != skip).map(f).fold(mid, f64::max)
+            };
+            centre += w * mid;
+            theta += w * others(n_theta, c, &|i| at(i, d));
+            delta += w * others(n_delta, d, &|j| at(c, j));
+        }
+    }
+    // θ unless the azimuth loses clearly more (the axis of the isotropic sets; near grazing
+    // the mean trials of a single node exceed the cap, and only θ splits take the interval
+    // away from the top angle where the bounds cannot follow the lobe).
+    let by_delta = centre > 0.0
+        && delta > theta
+        && delta > (1.0 + MIN_DELTA_LOSS) * centre
+        && tree.volume() / delta <= max_trials;
+    job.can_split_along(grid, min_width, by_delta)
+}
+
+/// Relative overlap loss along δ below which an interval is not cut in azimuth
+/// ([`split_axis`]).
+const MIN_DELTA_LOSS: f64 = 0.1;
+
+/// The values the caching nodes of a built interval know, for its children.
+fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)> {
+    match Arc::try_unwrap(envelope) {
+        Ok(env) => env
+            .nodes
+            .into_iter()
+            .filter(|n| n.caches())
+            .map(EnvelopeNode::into_values)
+            .collect(),
+        Err(_) => Vec::new(),
+    }
+}

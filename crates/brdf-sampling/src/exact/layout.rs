@@ -1,0 +1,152 @@
+//! The azimuth cells of a set: θ strips, their intervals and the guided interval search.
+
+use crate::layout::Turn;
+
+use super::grid::{Grid, TableVar};
+use super::interval::Interval;
+
+/// One azimuth cell: its centre and its intervals. The cell is cut into θ **strips** at every
+/// interval's θ edges; a strip holds the intervals that cover it, ordered by δ (one, unless
+/// the cell was split in azimuth there).
+pub(super) struct Cell {
+    pub(super) phi: f64,
+    /// `(cos, sin)` of `phi`: a query's rotation from the cell's frame without trigonometry.
+    pub(super) phi_turn: Turn,
+    /// Upper θ edges of the strips (radians), increasing; the last is π/2.
+    pub(super) upper: Vec<f64>,
+    /// The same edges as search keys ([`TableVar::key`]), increasing.
+    pub(super) keys: Vec<f64>,
+    /// Guide table over the keys `[0, range]`: `guide[g]` is the strip of the key
+    /// `g · range / GUIDE_LEN`, where the search for any key of bucket `g` starts (see
+    /// [`Cell::interval_of`]).
+    pub(super) guide: Vec<u32>,
+    pub(super) range: f64,
+    /// Strip `s` holds the intervals `members[strips[s]..strips[s + 1]]`; empty when every
+    /// strip holds one interval, the strip's own index (no azimuth split in the cell).
+    pub(super) strips: Vec<u32>,
+    /// Upper δ edge of each strip entry, increasing within a strip.
+    pub(super) delta_upper: Vec<f64>,
+    /// The interval of each strip entry.
+    pub(super) members: Vec<u32>,
+    /// The intervals, ordered by θ, then δ.
+    pub(super) intervals: Vec<Interval>,
+}
+
+/// An interval with its θ and δ numerators ([`Grid`]).
+pub(super) type Placed = ([u64; 2], [u64; 2], Interval);
+
+/// Buckets of a cell's guide table.
+pub(super) const GUIDE_LEN: usize = 256;
+
+impl Cell {
+    /// The cell of centre `phi` tiled by `members` (θ numerators, δ numerators and interval,
+    /// ordered by θ then δ; see [`Grid`]).
+    pub(super) fn new(phi: f64, members: Vec<Placed>, grid: &Grid, var: TableVar) -> Self {
+        let mut edges: Vec<u64> = members.iter().map(|(num, _, _)| num[1]).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let upper: Vec<f64> = edges.iter().map(|&e| grid.edge(e)).collect();
+        let mut keys: Vec<f64> = upper.iter().map(|&t| var.key(var.of(t))).collect();
+        // Monotone despite rounding (the search needs sorted keys).
+        for i in 1..keys.len() {
+            keys[i] = keys[i].max(keys[i - 1]);
+        }
+        let range = var.key_range();
+        let guide = interval_guide(&keys, range);
+        let (mut strips, mut delta_upper, mut entries) = (vec![0u32], Vec::new(), Vec::new());
+        let mut lower = 0u64;
+        for &e in &edges {
+            let mut strip: Vec<(u64, usize)> = members
+                .iter()
+                .enumerate()
+                .filter(|(_, (num, _, _))| num[0] <= lower && num[1] >= e)
+                .map(|(i, (_, dnum, _))| (dnum[1], i))
+                .collect();
+            strip.sort_unstable();
+            for (d, i) in strip {
+                delta_upper.push(grid.delta(d));
+                entries.push(i as u32);
+            }
+            strips.push(entries.len() as u32);
+            lower = e;
+        }
+        let plain = entries.len() == edges.len();
+        let intervals = members.into_iter().map(|(_, _, iv)| iv).collect();
+        Self {
+            phi,
+            phi_turn: Turn::from_angle(phi),
+            upper,
+            keys,
+            guide,
+            range,
+            strips: if plain { Vec::new() } else { strips },
+            delta_upper: if plain { Vec::new() } else { delta_upper },
+            members: if plain { Vec::new() } else { entries },
+            intervals,
+        }
+    }
+
+    /// The interval of the search key `key` and azimuth offset `delta`.
+    #[inline]
+    pub(super) fn interval_of(&self, key: f64, delta: f64) -> usize {
+        let s = guided_interval(&self.keys, &self.guide, self.range, key);
+        if self.strips.is_empty() {
+            return s;
+        }
+        let (mut j, last) = (self.strips[s] as usize, self.strips[s + 1] as usize - 1);
+        while j < last && self.delta_upper[j] < delta {
+            j += 1;
+        }
+        self.members[j] as usize
+    }
+
+    /// The intervals of strip `s`, ordered by δ.
+    pub(super) fn strip(&self, s: usize) -> Vec<usize> {
+        if self.strips.is_empty() {
+            return vec![s];
+        }
+        (self.strips[s]..self.strips[s + 1])
+            .map(|j| self.members[j as usize] as usize)
+            .collect()
+    }
+
+    /// Per strip, its intervals' azimuth edges (degrees, absolute).
+    pub(super) fn phi_edges_deg(&self) -> Vec<Vec<f64>> {
+        (0..self.upper.len())
+            .map(|s| {
+                let ivs = self.strip(s);
+                let deg = |d: f64| (self.phi + d).to_degrees();
+                let mut e = vec![deg(self.intervals[ivs[0]].delta[0])];
+                e.extend(ivs.iter().map(|&i| deg(self.intervals[i].delta[1])));
+                e
+            })
+            .collect()
+    }
+}
+
+/// The guide table of the interval edges `upper` (increasing, not empty) over `[0, range]`:
+/// entry `g` is the interval of `g · range / GUIDE_LEN`.
+pub(super) fn interval_guide(upper: &[f64], range: f64) -> Vec<u32> {
+    let step = range / GUIDE_LEN as f64;
+    let last = upper.len().saturating_sub(1);
+    (0..GUIDE_LEN)
+        .map(|g| upper.partition_point(|&u| u < g as f64 * step).min(last) as u32)
+        .collect()
+}
+
+/// The first interval whose upper edge is ≥ `x` (the last one when none is): the binary search
+/// `upper.partition_point(|u| u < x)`, by a scan from the guide table's bucket of `x` (usually
+/// zero or one step; down only if rounding put `x` in the bucket above its own).
+#[inline]
+pub(super) fn guided_interval(upper: &[f64], guide: &[u32], range: f64, x: f64) -> usize {
+    let last = upper.len() - 1;
+    let g = ((x * (GUIDE_LEN as f64 / range)) as usize).min(GUIDE_LEN - 1);
+    let mut i = (guide[g] as usize).min(last);
+    while i > 0 && upper[i - 1] >= x {
+        i -= 1;
+    }
+    while i < last && upper[i] < x {
+        i += 1;
+    }
+    i
+}

@@ -1,0 +1,193 @@
+//! Locating a query (cell, interval, rotation) and drawing one direction.
+
+use brdf::{Vec3, direction_from_radians};
+use partition_sampler::{Audit, UniformSource};
+
+use crate::direction_sampler::DirSample;
+use crate::disc::DiscMap;
+use crate::layout::Turn;
+
+use super::density::QueryDensity;
+use super::grid::TableVar;
+use super::interval::{Interval, Query};
+use super::options::THETA_TOP_DEG;
+use super::set::ExactSet;
+
+impl ExactSet {
+    /// The tabulated normaliser `A(θo, δ) = ∫ f_r(ωo, ·) cos θi dσ` used by the pdf at `wo`
+    /// (`None` below the horizon).
+    pub fn normaliser(&self, wo: &Vec3) -> Option<f64> {
+        let q = self.locate(wo)?;
+        Some(self.interval(&q).normaliser(self.var, &q))
+    }
+
+    pub(super) fn interval(&self, q: &Query) -> &Interval {
+        &self.cells[q.cell].intervals[q.interval]
+    }
+
+    /// Cell, interval, θo, δ and rotation of `wo`; `None` at or below the horizon.
+    #[inline]
+    pub(super) fn locate(&self, wo: &Vec3) -> Option<Query> {
+        if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
+            return None;
+        }
+        let mut served = *wo;
+        if wo.z < self.top_cos {
+            // f_r at grazing θo may diverge (1/cos θo factors) where no bound node was put:
+            // serve the direction at `top` (same azimuth) instead, so that the bounds hold and
+            // the pdf stays normalised; the law differs from f_r(ωo, ·) cos θi only there.
+            let top = THETA_TOP_DEG.to_radians();
+            let (s, r) = (top.sin(), (wo.x * wo.x + wo.y * wo.y).sqrt());
+            served = Vec3::new(wo.x / r * s, wo.y / r * s, self.top_cos);
+        }
+        let wo = &served;
+        let cos = wo.z.min(1.0);
+        let (cell, turn, delta) = if self.isotropic {
+            // The rotation that takes the frame's ωo (at φ = 0) to the query's, without
+            // trigonometry: (cos φo, sin φo) = (x, y)/r.
+            let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
+            let turn = if r > 0.0 {
+                Turn {
+                    cos: wo.x / r,
+                    sin: wo.y / r,
+                }
+            } else {
+                Turn::IDENTITY
+            };
+            (0, turn, 0.0)
+        } else {
+            let phi = wo.y.atan2(wo.x);
+            let n = self.cells.len();
+            let step = self.period / n as f64;
+            let k = ((phi.rem_euclid(self.period) / step).round() as usize) % n;
+            let rot = phi - self.cells[k].phi;
+            let mut delta = rot.rem_euclid(self.period);
+            if delta > 0.5 * self.period {
+                delta -= self.period;
+            }
+            (
+                k,
+                super::walk::turn_from_cell(wo, self.cells[k].phi_turn),
+                delta,
+            )
+        };
+        let var = match self.var {
+            TableVar::Cos => cos,
+            TableVar::Theta => cos.acos(),
+        };
+        let interval = self.cells[cell].interval_of(self.var.key(var), delta);
+        Some(Query {
+            cell,
+            interval,
+            wo: served,
+            var,
+            cos,
+            delta,
+            turn,
+        })
+    }
+
+    /// One direction; `audit` receives the trials.
+    #[inline]
+    pub(super) fn draw(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> Option<DirSample> {
+        self.draw_with_f(wo, u, audit).map(|(s, _)| s)
+    }
+
+    /// [`ExactSet::draw`] and the `f_r` of the accepted trial, evaluated in the interval's
+    /// frame at the served `ωo` (`None` when no trial was accepted or the query was served
+    /// at another `ωo`, above [`THETA_TOP_DEG`]).
+    #[inline]
+    pub(super) fn draw_with_f(
+        &self,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> Option<(DirSample, Option<f64>)> {
+        let q = self.locate(wo)?;
+        Some(self.draw_located(&q, wo, u, audit))
+    }
+
+    /// [`ExactSet::draw_with_f`] at a query already located (`q = self.locate(wo)`).
+    #[inline]
+    pub(super) fn draw_located(
+        &self,
+        q: &Query,
+        wo: &Vec3,
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+    ) -> (DirSample, Option<f64>) {
+        let q = *q;
+        let iv = self.interval(&q);
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
+        let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
+        match drawn {
+            Some((x, gx)) => {
+                let a = iv.normaliser(self.var, &q);
+                let v = iv.map.to_direction(x);
+                let s = DirSample {
+                    wi: q.turn.apply(&v),
+                    pdf: iv.map.area_to_solid_angle(gx / a, &v),
+                };
+                // `g` is `f` (projected map) or `2 f cos θi` (equal-area map, `v.z > 0` where
+                // a trial is accepted: `g > 0`).
+                let f = match iv.map {
+                    DiscMap::Projected => gx,
+                    DiscMap::EqualArea => gx / (2.0 * v.z),
+                };
+                let served = q.wo == *wo;
+                (s, (served && f.is_finite()).then_some(f))
+            }
+            None => (
+                DirSample {
+                    wi: Vec3::new(0.0, 0.0, 1.0),
+                    pdf: 0.0,
+                },
+                None,
+            ),
+        }
+    }
+
+    /// Draws `per_interval` samples at outgoing directions uniform in every interval (θ
+    /// and φ uniform in the interval's ranges) on the calling thread, and counts trials,
+    /// BRDF evaluations, violations and exhausted samples (also added to the trees' counts).
+    pub fn measure_cost(&self, per_interval: usize, seed: u64) -> crate::CostMeasurement {
+        use rand::SeedableRng;
+        let before = crate::disc::thread_evaluations();
+        let mut total = Audit::default();
+        let mut index = 0u64;
+        for c in &self.cells {
+            for iv in &c.intervals {
+                let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(
+                    partition_sampler::chunk_seed(seed, index),
+                );
+                index += 1;
+                let ([lo, hi], [da, db]) = (iv.theta, iv.delta);
+                let mut a = Audit::default();
+                for _ in 0..per_interval {
+                    let theta = lo + rng.next_uniform() * (hi - lo);
+                    let phi = if self.isotropic {
+                        0.0
+                    } else {
+                        c.phi + da + rng.next_uniform() * (db - da)
+                    };
+                    let wo = direction_from_radians(theta, phi);
+                    let _ = self.draw(&wo, &mut rng, &mut a);
+                }
+                iv.tree.record_audit(&a);
+                total.merge(&a);
+            }
+        }
+        crate::CostMeasurement {
+            samples: total.samples,
+            trials: total.trials,
+            evaluations: crate::disc::thread_evaluations() - before,
+            violations: total.violations,
+            exhausted: total.exhausted,
+        }
+    }
+}
