@@ -183,6 +183,48 @@ impl DirectionSampler {
     }
 }
 
+/// `f = 1`: the BRDF handed to a batch call when the caller evaluates `eval_rgb` itself (a
+/// luminance `f` would be wasted).
+struct NoEval;
+
+impl brdf::Brdf for NoEval {
+    fn eval(&self, _wo: &Vec3, _wi: &Vec3) -> f64 {
+        1.0
+    }
+}
+
+/// One chunk of `sample` with every uniform from `rng`: its above-horizon queries (queries
+/// `first..first + pdf.len()` of `wo`) in one `sample_eval_batch` call, written into the
+/// chunk's output slices (below-horizon queries keep their zeros). `f` is the batch's (the
+/// sampler's own accepted-trial value where it has one) or, with `rgb`, `eval_rgb`.
+fn batch_chunk(
+    sampler: &dyn brdf_sampling::DirectionSampler,
+    brdf: &dyn brdf::Brdf,
+    wo: &crate::arrays::Dirs,
+    first: usize,
+    rgb: bool,
+    rng: &mut dyn UniformSource,
+    (wi, pdf, f): (&mut [f64], &mut [f64], &mut [f64]),
+) {
+    let (ks, wos): (Vec<usize>, Vec<Vec3>) = (0..pdf.len())
+        .map(|j| (j, *wo.get(first + j)))
+        .filter(|(_, o)| above(o))
+        .unzip();
+    let mut out = Vec::with_capacity(wos.len());
+    sampler.sample_eval_batch(if rgb { &NoEval } else { brdf }, &wos, rng, &mut out);
+    for ((&j, o), s) in ks.iter().zip(&wos).zip(&out) {
+        wi[3 * j..3 * j + 3].copy_from_slice(&[s.wi.x, s.wi.y, s.wi.z]);
+        pdf[j] = s.pdf;
+        if s.pdf > 0.0 && s.wi.z > 0.0 {
+            if rgb {
+                f[3 * j..3 * j + 3].copy_from_slice(&brdf.eval_rgb(o, &s.wi));
+            } else {
+                f[j] = s.f;
+            }
+        }
+    }
+}
+
 /// Whether `wo` lies strictly above the horizon.
 #[inline]
 fn above(wo: &Vec3) -> bool {
@@ -243,7 +285,10 @@ impl DirectionSampler {
     /// `seed`: this call's seed; by default the sampler's seed and a call counter, so
     /// successive calls draw fresh streams and a re-created sampler repeats them. The output
     /// never depends on the thread count. Queries with `wo` at or below the horizon give
-    /// ``wi = 0, pdf = 0, f = 0``.
+    /// ``wi = 0, pdf = 0, f = 0``. With an int `u` each chunk of `PAR_CHUNK` queries is one
+    /// batch call of the sampler (`sample_eval_batch`: a sampler may serve the queries grouped
+    /// by its structure, and a rejection sampler returns the `f` of its accepted trial); with
+    /// given uniforms each row is its own query's, so queries are served one by one.
     #[pyo3(signature = (wo, u, seed = None, rgb = false))]
     fn sample<'py>(
         &self,
@@ -284,6 +329,20 @@ impl DirectionSampler {
                     .enumerate()
                     .for_each(|(c, ((wi_c, pdf_c), f_c))| {
                         let mut rng = chunk_rng(seed, c as u64);
+                        if let UArg::Count(_) = &u {
+                            // Every uniform from the chunk's generator: the chunk's queries in
+                            // one batch call (see `batch_chunk`).
+                            batch_chunk(
+                                sampler.as_ref(),
+                                brdf.as_ref(),
+                                &wo,
+                                c * PAR_CHUNK,
+                                rgb,
+                                &mut rng,
+                                (wi_c, pdf_c, f_c),
+                            );
+                            return;
+                        }
                         for j in 0..pdf_c.len() {
                             let k = c * PAR_CHUNK + j;
                             let o = wo.get(k);

@@ -162,6 +162,30 @@ def test_sample_pdf_matches_pdf_of_the_sample(name, spec, rng):
     np.testing.assert_allclose(f[above], b.eval(wo[above], wi[above]), rtol=1e-12)
 
 
+@pytest.mark.parametrize("name", ["adaptive-exact", "adaptive", "cosine"])
+def test_int_u_batch_path_outputs_follow_their_own_query(name, rng):
+    # With an int u every chunk of PAR_CHUNK queries is one sample_eval_batch call, which
+    # adaptive-exact serves grouped by interval: each output must still be its own query's
+    # (pdf and f at that query's wo), below-horizon queries zeros, rgb f the model's eval_rgb.
+    spec = "ggx:alpha=0.2"
+    s = brdf_lab.DirectionSampler(name, spec, seed=4, slices=12)
+    n = 2 * brdf_lab.PAR_CHUNK + 33
+    wo = np.stack([direction(t, p) for t, p in rng.uniform([0, 0], [85, 360], size=(n, 2))])
+    wo[::97] = [0.0, 0.0, -1.0]
+    wi, pdf, f = s.sample(wo, n, seed=8)
+    below = wo[:, 2] <= 0
+    assert np.all(pdf[below] == 0) and np.all(f[below] == 0) and np.all(wi[below] == 0)
+    ok = pdf > 0
+    assert ok[~below].mean() > 0.9
+    np.testing.assert_allclose(s.pdf(wo[ok], wi[ok]), pdf[ok], rtol=1e-9)
+    b = brdf_lab.Brdf(spec)
+    up = ok & (wi[:, 2] > 0)
+    np.testing.assert_allclose(f[up], b.eval(wo[up], wi[up]), rtol=1e-9)
+    wi2, _, frgb = s.sample(wo, n, seed=8, rgb=True)
+    np.testing.assert_array_equal(wi2, wi)
+    np.testing.assert_allclose(frgb[up], b.eval_rgb(wo[up], wi[up]), rtol=1e-12)
+
+
 def test_save_and_load_round_trip(tmp_path, rng):
     s = brdf_lab.DirectionSampler("adaptive", "phong:n=20", seed=4, slices=6)
     assert s.can_save

@@ -16,6 +16,9 @@ pub enum EstimatorError {
         /// z.
         z: f64,
     },
+    /// Frame axes that are not an orthonormal right-handed triple.
+    #[error("the frame's axes must be orthonormal and right-handed (t × b = n)")]
+    NotOrthonormal,
     /// The outgoing direction is not above the local horizon.
     #[error("the outgoing direction must be above the horizon (cos θo = {cos_theta})")]
     BelowHorizon {

@@ -7,6 +7,10 @@
 //!   balance or power heuristic ([`MisHeuristic`], Veach 1997); the per-sample terms
 //!   ([`mis_brdf_term`], [`mis_light_term`]) and the one-value-per-call forms a renderer or
 //!   the study averages itself ([`MisPair`], [`light_value`]);
+//! * [`Batch`] — the batch path: many query points (a row of pixels) × `spp` samples in one
+//!   [`brdf_sampling::DirectionSampler::sample_eval_batch`] call, BRDF sampling or MIS with any
+//!   [`LightTechnique`], for luminance or RGB values ([`Radiance`]); the per-sample terms
+//!   ([`brdf_value`], [`mis_term`]) are the ones every estimator here uses;
 //! * [`estimate_srbf_product`] — SRBF product importance sampling (Tsai et al. 2008) of the
 //!   fits of `baselines::srbf`;
 //! * [`Estimate`] — the estimate, its standard error, and whether that standard error can be
@@ -42,6 +46,7 @@
 // Validation is written `if !(x > 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod batch;
 mod driver;
 mod error;
 mod estimate;
@@ -51,6 +56,7 @@ mod product;
 mod scene;
 
 pub use baselines::srbf::ProductSettings;
+pub use batch::{Batch, LightTechnique, Query, Radiance, brdf_value, mis_term};
 pub use driver::{ProductExperiment, ProductOutcome};
 pub use error::EstimatorError;
 pub use estimate::{Estimate, HEAVY_TAIL_SHARE, UNCERTAIN_VARIANCE, tail_threshold};

@@ -11,12 +11,13 @@
 use std::time::Instant;
 
 use brdf::Vec3;
-use brdf_sampling::DirectionSampler;
+use brdf_sampling::{DirectionSampler, EvalSample};
 use envmap::EnvMapSampler;
 use partition_sampler::UniformSource;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
+use crate::batch::{LightTechnique, Radiance, brdf_value, mis_term, mis_term_with};
 use crate::estimate::{Estimate, Moments};
 use crate::{EstimatorError, LocalFrame, ProductScene};
 
@@ -35,7 +36,15 @@ pub(crate) fn check_samples(
     Ok(())
 }
 
-/// `(1/N) Σ g/p` with a BRDF direction sampler (local frame).
+/// Queries per [`DirectionSampler::sample_eval_batch`] call of the one-point estimators.
+pub(crate) const CHUNK: usize = 4096;
+
+/// `(1/N) Σ g/p` with a BRDF direction sampler (local frame), drawn on the batch path
+/// ([`DirectionSampler::sample_eval_batch`], [`CHUNK`] samples of `scene.wo` per call) with
+/// the scene's BRDF, whose `f` the integrand uses: a sampler that evaluated `f` while sampling
+/// (a rejection sampler built on that very BRDF object) saves the integrand's evaluation. For
+/// a sampler without its own batch path the values are those of `N` calls of
+/// [`DirectionSampler::sample`] with the same seed.
 pub fn estimate_brdf(
     scene: &ProductScene<'_>,
     sampler: &dyn DirectionSampler,
@@ -44,10 +53,39 @@ pub fn estimate_brdf(
     seed: u64,
 ) -> Result<Estimate, EstimatorError> {
     check_samples("brdf", n, 2)?;
-    Ok(one_sample_estimate(scene, name, n, seed, |rng| {
-        let s = sampler.sample(&scene.wo, rng);
-        (s.wi, s.pdf)
-    }))
+    let start = Instant::now();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut m = Moments::default();
+    brdf_chunks(scene, sampler, n, &mut rng, |s| {
+        m.push(brdf_value(s, |s| scene.integrand_with_f(&s.wi, s.f)));
+    });
+    Ok(Estimate::from_parts(
+        name,
+        m.mean(),
+        n,
+        start.elapsed().as_secs_f64(),
+        &[(&m, 1.0 / n as f64)],
+    ))
+}
+
+/// `n` samples of `sampler` at `scene.wo` with the scene's BRDF, [`CHUNK`] per batch call,
+/// each handed to `each` in order.
+fn brdf_chunks(
+    scene: &ProductScene<'_>,
+    sampler: &dyn DirectionSampler,
+    n: usize,
+    rng: &mut Xoshiro256PlusPlus,
+    mut each: impl FnMut(&EvalSample),
+) {
+    let wos = vec![scene.wo; CHUNK.min(n)];
+    let mut out = Vec::with_capacity(wos.len());
+    let mut left = n;
+    while left > 0 {
+        let k = left.min(CHUNK);
+        sampler.sample_eval_batch(scene.brdf, &wos[..k], rng, &mut out);
+        out.iter().for_each(&mut each);
+        left -= k;
+    }
 }
 
 /// `(1/N) Σ g/p` with an environment-map sampler (world directions turned into the frame).
@@ -155,12 +193,7 @@ pub fn mis_brdf_term(
     n_light: f64,
     light_pdf: impl FnOnce() -> f64,
 ) -> f64 {
-    if g > 0.0 && brdf_pdf > 0.0 {
-        let w = heuristic.weight(n_brdf * brdf_pdf, n_light * light_pdf());
-        w * g / brdf_pdf
-    } else {
-        0.0
-    }
+    mis_term(heuristic, g, brdf_pdf, n_brdf, n_light, light_pdf)
 }
 
 /// The MIS contribution of a light-sampled direction: `w_light · g / p_light`, `brdf_pdf`
@@ -174,12 +207,7 @@ pub fn mis_light_term(
     n_brdf: f64,
     brdf_pdf: impl FnOnce() -> f64,
 ) -> f64 {
-    if g > 0.0 && light_pdf > 0.0 {
-        let w = heuristic.weight(n_light * light_pdf, n_brdf * brdf_pdf());
-        w * g / light_pdf
-    } else {
-        0.0
-    }
+    mis_term(heuristic, g, light_pdf, n_light, n_brdf, brdf_pdf)
 }
 
 /// MIS of a BRDF sampler and a map sampler: `⌈N/2⌉` and `⌊N/2⌋` samples,
@@ -204,9 +232,12 @@ pub fn estimate_mis(
         })
     };
     let mut ma = Moments::default();
-    for _ in 0..na {
-        let s = brdf_sampler.sample(&scene.wo, &mut rng);
-        let g = scene.integrand(&s.wi);
+    brdf_chunks(scene, brdf_sampler, na, &mut rng, |s| {
+        let g = if s.wi.z > 0.0 {
+            scene.integrand_with_f(&s.wi, s.f)
+        } else {
+            0.0
+        };
         ma.push(mis_brdf_term(
             heuristic,
             g,
@@ -215,7 +246,7 @@ pub fn estimate_mis(
             nb as f64,
             || light_pdf(&s.wi),
         ));
-    }
+    });
     let mut mb = Moments::default();
     for _ in 0..nb {
         let s = light_sampler.sample(&mut rng);
@@ -255,22 +286,32 @@ pub fn light_value(
     }
 }
 
-/// A renderer's MIS sample: one draw of the BRDF sampler and one of the map sampler, equal
-/// counts (`n_brdf = n_light`), so that the mean of `N` values is [`estimate_mis`]'s estimator
-/// with `N` samples of each technique. Directions are local to `frame`; the map is world-space.
-#[derive(Clone, Copy)]
-pub struct MisPair<'a> {
+/// A renderer's MIS sample: one draw of the BRDF sampler and one of the light technique,
+/// equal counts (`n_brdf = n_light`), so that the mean of `N` values is [`estimate_mis`]'s
+/// estimator with `N` samples of each technique. Directions are local to `frame`; the light
+/// (an environment-map sampler by default, any [`LightTechnique`]) is world-space. The values
+/// may be luminances or RGB ([`Radiance`]); the terms are [`mis_term`]'s.
+pub struct MisPair<'a, L: LightTechnique + ?Sized = EnvMapSampler> {
     /// The BRDF technique.
     pub brdf_sampler: &'a dyn DirectionSampler,
     /// The light technique.
-    pub light_sampler: &'a EnvMapSampler,
+    pub light_sampler: &'a L,
     /// The shading frame.
     pub frame: LocalFrame,
     /// The weights.
     pub heuristic: MisHeuristic,
 }
 
-impl std::fmt::Debug for MisPair<'_> {
+// Copy whatever `L` is (the fields are references): no `L: Copy` bound as a derive would add.
+impl<L: LightTechnique + ?Sized> Clone for MisPair<'_, L> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<L: LightTechnique + ?Sized> Copy for MisPair<'_, L> {}
+
+impl<L: LightTechnique + ?Sized> std::fmt::Debug for MisPair<'_, L> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("MisPair")
             .field("frame", &self.frame)
@@ -279,47 +320,60 @@ impl std::fmt::Debug for MisPair<'_> {
     }
 }
 
-impl MisPair<'_> {
+impl<L: LightTechnique + ?Sized> MisPair<'_, L> {
     /// `w_b g(ω_b)/p_b(ω_b) + w_l g(ω_l)/p_l(ω_l)` for one BRDF draw `ω_b` (first) and one
     /// light draw `ω_l` from `rng`; `g` is the integrand at a local direction (0 below the
     /// horizon).
-    pub fn value(&self, wo: &Vec3, g: impl Fn(&Vec3) -> f64, rng: &mut dyn UniformSource) -> f64 {
+    pub fn value<V: Radiance>(
+        &self,
+        wo: &Vec3,
+        g: impl Fn(&Vec3) -> V,
+        rng: &mut dyn UniformSource,
+    ) -> V {
         let h = self.heuristic;
-        self.value_with(wo, g, rng, |own, other| h.weight(own, other))
+        self.value_with(wo, g, rng, &|own, other| h.weight(own, other))
     }
 
     /// [`Self::value`] with the weight `weight(own, other)` (the tests give it broken ones).
-    fn value_with(
+    fn value_with<V: Radiance>(
         &self,
         wo: &Vec3,
-        g: impl Fn(&Vec3) -> f64,
+        g: impl Fn(&Vec3) -> V,
         rng: &mut dyn UniformSource,
-        weight: impl Fn(f64, f64) -> f64,
-    ) -> f64 {
+        weight: &impl Fn(f64, f64) -> f64,
+    ) -> V {
         let s = self.brdf_sampler.sample(wo, rng);
-        let gb = g(&s.wi);
-        let a = if gb > 0.0 && s.pdf > 0.0 {
-            let w = self.frame.to_world(&s.wi);
-            weight(s.pdf, self.light_sampler.pdf_sa([w.x, w.y, w.z])) * gb / s.pdf
-        } else {
-            0.0
+        let a = mis_term_with(
+            g(&s.wi),
+            s.pdf,
+            1.0,
+            1.0,
+            || self.light_sampler.pdf_world(&self.frame.to_world(&s.wi)),
+            weight,
+        );
+        let Some((d, pl)) = self.light_sampler.sample_world(rng) else {
+            return a;
         };
-        let l = self.light_sampler.sample(rng);
-        let wi = self.frame.to_local(&Vec3::from(l.direction));
-        let gl = g(&wi);
-        let b = if gl > 0.0 && l.pdf_sa > 0.0 {
-            weight(l.pdf_sa, self.brdf_sampler.pdf(wo, &wi)) * gl / l.pdf_sa
-        } else {
-            0.0
-        };
-        a + b
+        let wi = self.frame.to_local(&d);
+        let b = mis_term_with(
+            g(&wi),
+            pl,
+            1.0,
+            1.0,
+            || self.brdf_sampler.pdf(wo, &wi),
+            weight,
+        );
+        a.plus(b)
     }
 
     /// The two draws alone (no integrand, no weights): the sampling cost of [`Self::value`].
     pub fn draw(&self, wo: &Vec3, rng: &mut dyn UniformSource) -> (Vec3, Vec3) {
         let s = self.brdf_sampler.sample(wo, rng);
-        let l = self.light_sampler.sample(rng);
-        (s.wi, self.frame.to_local(&Vec3::from(l.direction)))
+        let l = self
+            .light_sampler
+            .sample_world(rng)
+            .map_or(Vec3::zeros(), |(d, _)| self.frame.to_local(&d));
+        (s.wi, l)
     }
 }
 
@@ -411,7 +465,7 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         let p = pair(MisHeuristic::Balance);
         let values: Vec<f64> = (0..n)
-            .map(|_| p.value_with(&wo, g, &mut rng, broken))
+            .map(|_| p.value_with(&wo, g, &mut rng, &broken))
             .collect();
         let z = z_of(&values);
         assert!(z.abs() > 4.0, "broken weight not caught: z = {z}");

@@ -51,6 +51,23 @@ impl LocalFrame {
         }
     }
 
+    /// The frame of the given axes (world space): `t`, `b`, `n` must be orthonormal and
+    /// right-handed (`t × b = n`) to within 1e-9.
+    ///
+    /// Errors: [`EstimatorError::NotOrthonormal`] otherwise (or for a non-finite component).
+    pub fn from_axes(t: Vec3, b: Vec3, n: Vec3) -> Result<Self, EstimatorError> {
+        let tol = 1e-9;
+        let ok = (t.norm() - 1.0).abs() < tol
+            && (b.norm() - 1.0).abs() < tol
+            && (n.norm() - 1.0).abs() < tol
+            && t.dot(&b).abs() < tol
+            && (t.cross(&b) - n).norm() < tol;
+        if !ok {
+            return Err(EstimatorError::NotOrthonormal);
+        }
+        Ok(Self { t, b, n })
+    }
+
     /// A world direction in local coordinates (`z` along the normal).
     pub fn to_local(&self, w: &Vec3) -> Vec3 {
         Vec3::new(w.dot(&self.t), w.dot(&self.b), w.dot(&self.n))
@@ -110,6 +127,14 @@ impl<'a> ProductScene<'a> {
         let w = self.frame.to_world(wi);
         let (u, v) = direction_to_uv([w.x, w.y, w.z]);
         luminance(self.map.radiance_uv(u, v))
+    }
+
+    /// [`Self::integrand`] with `f = f_r(ωo, ωi)` already known (a batch sample's `f`).
+    pub fn integrand_with_f(&self, wi: &Vec3, f: f64) -> f64 {
+        if !(wi.z > 0.0) || f == 0.0 {
+            return 0.0;
+        }
+        self.radiance(wi) * f * wi.z
     }
 
     /// The integrand `L(ωi)·f_r(ωo, ωi)·cos⁺θi` at the local direction `wi` (0 below the horizon).

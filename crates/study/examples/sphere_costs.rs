@@ -1,0 +1,76 @@
+//! The study's sphere images alone (no variance cells): equal-samples and equal-time images of
+//! the `--quick` study's BRDFs (or those given) under one light, every registered preferred
+//! sampler, with the cost table (coherent vs random ωo). docs/benchmarks.md §21.
+//!
+//! ```text
+//! cargo run --release -p study --example sphere_costs -- LIGHT [PX] [SPP] [BRDF ...]
+//! ```
+//! e.g. `LIGHT = envmap:PATH/grace_probe_latlong.hdr`, `PX = 80`, `SPP = 64`.
+
+use study::{RenderConfig, StudyConfig, StudyPlan};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(light) = args.first().cloned() else {
+        eprintln!("sphere_costs: usage: sphere_costs LIGHT [PX] [SPP] [BRDF ...]");
+        std::process::exit(2);
+    };
+    let number = |k: usize, default: usize| -> usize {
+        args.get(k)
+            .map_or(Ok(default), |s| s.parse())
+            .unwrap_or_else(|e| {
+                eprintln!("sphere_costs: argument {k}: {e}");
+                std::process::exit(2);
+            })
+    };
+    let (px, spp) = (number(1, 80), number(2, 64));
+    let brdfs: Vec<String> = if args.len() > 3 {
+        args[3..].to_vec()
+    } else {
+        study::QUICK_BRDFS.iter().map(|s| s.to_string()).collect()
+    };
+    let samplers = StudyConfig::quick(None).0.samplers;
+    let config = StudyConfig::new(samplers, brdfs, vec![30.0], vec![light]);
+    let plan = StudyPlan::new(config, Vec::new()).unwrap_or_else(|e| {
+        eprintln!("sphere_costs: {e}");
+        std::process::exit(1);
+    });
+    let cfg = RenderConfig {
+        sphere_px: px,
+        spp,
+        reference_spp: 512,
+        light: 0,
+        seed: 1,
+    };
+    let render = plan.render(&cfg, &|_| {}).unwrap_or_else(|e| {
+        eprintln!("sphere_costs: {e}");
+        std::process::exit(1);
+    });
+    println!("{}", render.markdown(&[]));
+    // Per sphere: each sampler's relative error at equal time, best first.
+    let w = render.reference.width;
+    for (b, spec) in render.brdfs.iter().enumerate() {
+        let cols = |i: usize| i % w / px == b;
+        let mut rows: Vec<(String, usize, f64)> = render
+            .images
+            .iter()
+            .filter(|i| i.kind == "equal time")
+            .map(|i| {
+                let idx: Vec<usize> = (0..i.rgb.len()).filter(|&p| cols(p)).collect();
+                let img: Vec<[f64; 3]> = idx.iter().map(|&p| i.rgb[p]).collect();
+                let reference: Vec<[f64; 3]> =
+                    idx.iter().map(|&p| render.reference.rgb[p]).collect();
+                (
+                    i.sampler.clone(),
+                    i.spp,
+                    study::relative_error(&img, &reference),
+                )
+            })
+            .collect();
+        rows.sort_by(|a, b| a.2.total_cmp(&b.2));
+        println!("sphere `{spec}`, equal time (sampler, spp, rel. error):");
+        for (name, spp, e) in rows {
+            println!("  {name:<24} {spp:>5} {:>8.3} %", 100.0 * e);
+        }
+    }
+}
