@@ -581,10 +581,12 @@ mod tests {
 
     /// Runs `cdf` pass by pass as the validation suite's batched passes do: NaN at the points
     /// not known yet, then those points evaluated, until a pass meets no unknown point.
+    type Pdf<'a> = dyn Fn([f64; 3]) -> f64 + Sync + 'a;
+
     fn replay(
         known: &RwLock<HashMap<[u64; 3], f64>>,
-        pdf: &(dyn Fn([f64; 3]) -> f64 + Sync),
-        cdf: &dyn Fn(&(dyn Fn([f64; 3]) -> f64 + Sync)) -> TabulatedCdf,
+        pdf: &Pdf<'_>,
+        cdf: &dyn Fn(&Pdf<'_>) -> TabulatedCdf,
     ) -> (TabulatedCdf, usize) {
         for pass in 1.. {
             let missing: Mutex<Vec<[f64; 3]>> = Mutex::default();
