@@ -1,14 +1,14 @@
 //! Runs every test of the suite on one subject.
 
-use std::collections::{HashMap, HashSet};
 use std::sync::{Mutex, RwLock};
 
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
+use rustc_hash::{FxHashMap, FxHashSet};
 use stats::{
-    Axis, Binning, TestOutcome, expected_masses_with, ks_projection_test_with_singularities,
-    normalisation, pdf_consistency, support_coverage,
+    Axis, Binning, MarginalMemo, TestOutcome, expected_masses_with, ks_projection_test_with_memo,
+    ks_projection_test_with_singularities, normalisation, pdf_consistency, support_coverage,
 };
 
 use crate::cells::{CellModel, ExactTests};
@@ -47,21 +47,27 @@ impl PointKey for [f64; 3] {
 /// A pdf as the quadratures take it.
 type PdfFn<'f, P> = dyn Fn(P) -> f64 + Sync + 'f;
 
-/// Most passes of a quadrature over batched pdf values before falling back to single queries.
-const MAX_BATCH_PASSES: usize = 12;
+/// Most passes of a quadrature over batched pdf values before falling back to single queries
+/// (a safety net: every pass but the last evaluates at least one new point, and a run of the
+/// suite's quadratures on the broken twin of `validation/tests/it/byo.rs` takes at most a few
+/// hundred passes).
+const MAX_BATCH_PASSES: usize = 4096;
 
 /// The pdf of a sampler that prefers batched queries
 /// ([`SamplerUnderTest::prefers_batches`], e.g. one written in Python), served to the suite's
-/// quadratures (which ask one point at a time) from values evaluated in batches: a quadrature
-/// is run with the values known so far (0 for the others, whose points are recorded), the
-/// recorded points are evaluated in one [`SamplerUnderTest::pdf_many`] call, and the
-/// quadrature is run again, until a pass asks for no unknown point. That last pass saw the
-/// sampler's own value at every point it asked for, so its result is exactly the one of
-/// single queries. Samplers that do not prefer batches are queried directly.
+/// quadratures (which ask one point at a time) from values evaluated in batches, level by
+/// level: a quadrature is run with the values known so far and NaN for the others (whose
+/// points are recorded); the recorded points are evaluated in one
+/// [`SamplerUnderTest::pdf_many`] call, and the quadrature is run again, until a pass asks for
+/// no unknown point. The quadratures of `stats` stop refining a cell (or slab) whose estimate
+/// is not finite, so a pass records exactly the next refinement level of every cell still
+/// refining (all cells of one level in one batched call), never the speculative levels below
+/// an unknown value that a finite stand-in (e.g. 0) would trigger. The last pass saw the
+/// sampler's own value at every point it asked for, so its result is exactly (bit for bit) the
+/// one of single queries. Samplers that do not prefer batches are queried directly.
 pub(crate) struct BatchedPdf<'a, P> {
     sampler: &'a dyn SamplerUnderTest<P>,
-    values: RwLock<HashMap<[u64; 3], f64>>,
-    missing: Mutex<(HashSet<[u64; 3]>, Vec<P>)>,
+    values: RwLock<FxHashMap<[u64; 3], f64>>,
 }
 
 impl<'a, P: PointKey + Send + Sync> BatchedPdf<'a, P> {
@@ -69,27 +75,7 @@ impl<'a, P: PointKey + Send + Sync> BatchedPdf<'a, P> {
         Self {
             sampler,
             values: Default::default(),
-            missing: Default::default(),
         }
-    }
-
-    fn lookup(&self, p: P) -> f64 {
-        let key = p.key();
-        if let Some(&v) = self
-            .values
-            .read()
-            .ok()
-            .and_then(|m| m.get(&key).copied())
-            .as_ref()
-        {
-            return v;
-        }
-        if let Ok(mut missing) = self.missing.lock()
-            && missing.0.insert(key)
-        {
-            missing.1.push(p);
-        }
-        0.0
     }
 
     /// `f` run with the sampler's pdf (see the type's documentation).
@@ -98,9 +84,29 @@ impl<'a, P: PointKey + Send + Sync> BatchedPdf<'a, P> {
             return f(&|p| self.sampler.pdf(p));
         }
         for _ in 0..MAX_BATCH_PASSES {
-            let r = f(&|p| self.lookup(p));
-            let points = match self.missing.lock() {
-                Ok(mut m) => std::mem::take(&mut *m).1,
+            // The known values are read-only during a pass: one read lock for the whole pass,
+            // none per query.
+            let missing: Mutex<(FxHashSet<[u64; 3]>, Vec<P>)> = Mutex::default();
+            let r = {
+                let Ok(values) = self.values.read() else {
+                    break;
+                };
+                let lookup = |p: P| -> f64 {
+                    let key = p.key();
+                    if let Some(&v) = values.get(&key) {
+                        return v;
+                    }
+                    if let Ok(mut m) = missing.lock()
+                        && m.0.insert(key)
+                    {
+                        m.1.push(p);
+                    }
+                    f64::NAN
+                };
+                f(&lookup)
+            };
+            let points = match missing.into_inner() {
+                Ok(m) => m.1,
                 Err(_) => break,
             };
             if points.is_empty() {
@@ -322,11 +328,20 @@ pub(crate) fn run_subject<P: PointKey + Send + Sync + 'static>(
         }
         let singular = singular_params(binning, &sampler.singular_points());
         for (axis, name) in [Axis::U, Axis::V].into_iter().zip(axis_names) {
+            // The marginals of the projection CDF finished in one batched pass are kept for
+            // the next (each pass then refines only those still refining).
+            let memo = MarginalMemo::default();
             out.push(
                 match batched.run(&|pdf| {
-                    ks_projection_test_with_singularities(
-                        binning, pdf, &points, axis, alpha, opts, &singular,
-                    )
+                    if sampler.prefers_batches() {
+                        ks_projection_test_with_memo(
+                            binning, pdf, &points, axis, alpha, opts, &singular, &memo,
+                        )
+                    } else {
+                        ks_projection_test_with_singularities(
+                            binning, pdf, &points, axis, alpha, opts, &singular,
+                        )
+                    }
                 }) {
                     Ok(o) => renamed(o, name),
                     Err(e) => error_outcome(name, e),

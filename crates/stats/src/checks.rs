@@ -4,7 +4,9 @@
 use rayon::prelude::*;
 
 use crate::binning::{Axis, Binning, histogram};
-use crate::cdf::{project, projection_cdf_with_singularities};
+use crate::cdf::{
+    MarginalMemo, project, projection_cdf_with_memo, projection_cdf_with_singularities,
+};
 use crate::chi_square::{ChiSquareResult, DEFAULT_MIN_EXPECTED, chi_square_gof};
 use crate::error::StatsError;
 use crate::ks::ks_onesample;
@@ -73,6 +75,49 @@ pub fn ks_projection_test_with_singularities<B: Binning + ?Sized>(
     opts: &QuadratureOptions,
     singular: &[[f64; 2]],
 ) -> Result<TestOutcome, StatsError> {
+    ks_projection(binning, pdf, points, axis, alpha, opts, singular, None)
+}
+
+/// [`ks_projection_test_with_singularities`] with the CDF's marginals reused from (and kept in)
+/// `memo` ([`MarginalMemo`]; for runs repeated pass by pass over batched pdf values). The same
+/// outcome as without it when the memo belongs to the same inputs.
+///
+/// # Errors
+/// As [`ks_projection_test`].
+#[allow(clippy::too_many_arguments)]
+pub fn ks_projection_test_with_memo<B: Binning + ?Sized>(
+    binning: &B,
+    pdf: &(dyn Fn(B::Point) -> f64 + Sync),
+    points: &[B::Point],
+    axis: Axis,
+    alpha: f64,
+    opts: &QuadratureOptions,
+    singular: &[[f64; 2]],
+    memo: &MarginalMemo,
+) -> Result<TestOutcome, StatsError> {
+    ks_projection(
+        binning,
+        pdf,
+        points,
+        axis,
+        alpha,
+        opts,
+        singular,
+        Some(memo),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn ks_projection<B: Binning + ?Sized>(
+    binning: &B,
+    pdf: &(dyn Fn(B::Point) -> f64 + Sync),
+    points: &[B::Point],
+    axis: Axis,
+    alpha: f64,
+    opts: &QuadratureOptions,
+    singular: &[[f64; 2]],
+    memo: Option<&MarginalMemo>,
+) -> Result<TestOutcome, StatsError> {
     if points.is_empty() {
         return Err(StatsError::TooFewSamples { needed: 1, got: 0 });
     }
@@ -87,8 +132,11 @@ pub fn ks_projection_test_with_singularities<B: Binning + ?Sized>(
             format!("{} samples outside the domain", proj.outside),
         ));
     }
-    let cdf =
-        projection_cdf_with_singularities(binning, pdf, axis, points.len() as u64, opts, singular)?;
+    let n = points.len() as u64;
+    let cdf = match memo {
+        Some(memo) => projection_cdf_with_memo(binning, pdf, axis, n, opts, singular, memo)?,
+        None => projection_cdf_with_singularities(binning, pdf, axis, n, opts, singular)?,
+    };
     let r = ks_onesample(&proj.values, &|x| cdf.eval(x))?;
     Ok(r.outcome(&name, alpha))
 }

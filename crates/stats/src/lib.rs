@@ -72,11 +72,12 @@ pub use binning::{
 };
 pub use calibration::{Calibration, calibrate};
 pub use cdf::{
-    Projection, TabulatedCdf, project, projection_cdf, projection_cdf_with_singularities,
+    MarginalMemo, Projection, TabulatedCdf, project, projection_cdf, projection_cdf_with_memo,
+    projection_cdf_with_singularities,
 };
 pub use cells::{CellRow, PiecewiseConstant};
 pub use checks::{
-    COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test,
+    COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test, ks_projection_test_with_memo,
     ks_projection_test_with_singularities, mean_z_test, normalisation, pdf_consistency,
     support_coverage,
 };

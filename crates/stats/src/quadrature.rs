@@ -11,6 +11,17 @@
 //! `accuracy · √max(N m, 1) / N` in mass, i.e. an expected-count error of
 //! `accuracy · √max(E, 1)` — a fixed fraction of the Poisson noise `√E`, so the quadrature gets
 //! more accurate as `N` grows — never below `rel_floor · m`.
+//!
+//! **Non-finite values stop refinement.** A cell (or 1D piece, or projection-CDF slab) whose
+//! refined estimate is not finite is accepted as it is, without evaluating the integrand any
+//! deeper. Callers rely on it: the validation suite serves the pdf of a sampler that prefers
+//! batched queries (e.g. one written in Python) by running a quadrature with NaN at the points
+//! not evaluated yet, evaluating the points it asked for in one batch, and running it again;
+//! thanks to this rule a pass asks for the next refinement level of every cell still refining
+//! and nothing below an unknown value (a level-synchronous quadrature, one batched call per
+//! level), and the last pass, which meets no unknown point, is the direct quadrature's result
+//! bit for bit. (A pass may stop a refinement early where a NaN meets values already known,
+//! e.g. from another test; only the last pass's result is used.)
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -497,7 +508,7 @@ fn integrate_patches<B: Binning + ?Sized>(
 }
 
 /// The `i`-th of `k` equal parts of `r`.
-fn split(r: [f64; 2], k: usize, i: usize) -> [f64; 2] {
+pub(crate) fn split(r: [f64; 2], k: usize, i: usize) -> [f64; 2] {
     let at = |j: usize| {
         if j == k {
             r[1]
@@ -644,5 +655,49 @@ mod tests {
         let r = integrate_1d(&f, [0.0, 1.0], 1e-12, &rule, 40, 1);
         assert!(r.converged);
         assert!((r.value - (0.045 + 0.245)).abs() < 1e-11, "{}", r.value);
+    }
+
+    /// The rule the level-synchronous batched passes of the validation suite rely on (module
+    /// docs): a non-finite estimate stops refinement at once. Without it, a NaN cell would be
+    /// refined to `max_depth` (4^10 times the evaluations).
+    #[test]
+    fn non_finite_values_stop_refinement_at_once() {
+        use crate::binning::SphereBinning;
+        use std::sync::atomic::{AtomicU64, Ordering};
+        let bins = SphereBinning::hemisphere(3, 4).unwrap();
+        let opts = QuadratureOptions::default();
+        let k = 1u64 << opts.min_depth;
+        let per_cell = (opts.order * opts.order) as u64;
+        let patches: u64 = (0..bins.n_bins())
+            .map(|b| bins.bin_patches(b).len() as u64)
+            .sum();
+        let initial = patches * k * k * per_cell;
+        let calls = AtomicU64::new(0);
+        let nan = |_: [f64; 3]| {
+            calls.fetch_add(1, Ordering::Relaxed);
+            f64::NAN
+        };
+        let t = integrate_bins(&nan, &bins, 1e-9, &opts).unwrap();
+        // The initial cells, then one level of children, and no further.
+        assert_eq!(t.evaluations, 5 * initial);
+        assert!(calls.load(Ordering::Relaxed) <= 5 * initial);
+        assert_eq!(t.unconverged_bins, bins.n_bins());
+        // A finite pdf with a jump refines far deeper (the count above is not a cap).
+        let jump = |d: [f64; 3]| if d[0] > 0.5 { 1.02 } else { 1.0 };
+        let t = integrate_bins(&jump, &bins, 1e-9, &opts).unwrap();
+        assert!(t.evaluations > 50 * initial, "{}", t.evaluations);
+
+        let rule = GaussLegendre::new(5);
+        let r = integrate_1d(&|_| f64::NAN, [0.0, 1.0], 1e-12, &rule, 40, 4);
+        assert_eq!(r.evaluations, 4 * 3 * 5);
+        assert!(!r.converged);
+
+        // The projection CDF (KS tests): refused, after a bounded number of calls (a NaN
+        // marginal refined to the inner depth of 20 would cost > 10^8 calls).
+        calls.store(0, Ordering::Relaxed);
+        let cdf = crate::cdf::projection_cdf(&bins, &nan, crate::Axis::U, 20_000, &opts);
+        assert!(cdf.is_err());
+        let n = calls.load(Ordering::Relaxed);
+        assert!(n < 1_000_000, "{n} calls");
     }
 }
