@@ -727,7 +727,7 @@ impl Render {
             "Spheres, left to right: {}; under `{}`; {}×{} pixels per sphere, orthographic camera, direct lighting, no shadows. Reference: {} ({:.1} s †). Relative error = mean over pixels with non-null reference luminance of |Y − Y_ref| / Y_ref. Equal time: samples per pixel scaled by the measured time per sample (†) to the `adaptive` sampler's budget of {} spp.\n",
             self.brdfs
                 .iter()
-                .map(|b| format!("`{b}`"))
+                .map(|b| format!("`{}`", crate::short_brdf(b)))
                 .collect::<Vec<_>>()
                 .join(", "),
             crate::short_light(&self.light),
