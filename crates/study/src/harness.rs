@@ -454,7 +454,7 @@ impl StudyPlan {
     /// samplers sharing one are derived from it afterwards), the structures on
     /// `rayon::current_num_threads()` workers at once, each build alone in a one-thread pool
     /// ([`Self::build_here`]). Calls `progress(1)` per pair.
-    fn build_all(&self, list: &[(usize, usize)], progress: ProgressFn<'_>) {
+    pub(crate) fn build_all(&self, list: &[(usize, usize)], progress: ProgressFn<'_>) {
         let mut own = Vec::new();
         let mut derived = Vec::new();
         for &(s, b) in list {
