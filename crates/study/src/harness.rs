@@ -103,6 +103,80 @@ fn shared_structure(entry: &SamplerEntry) -> Option<(Variant, bool)> {
     }
 }
 
+/// An adaptive set derived from a shared build: the set itself in every respect but its
+/// memory, which is that of the set as built (the copy's vectors may hold less spare capacity),
+/// so the shared structure reports the same bytes for every sampler that uses it.
+struct SharedSet {
+    set: Arc<QuadTreeSet>,
+    bytes: usize,
+}
+
+impl DirectionSampler for SharedSet {
+    fn sample(&self, wo: &Vec3, u: &mut dyn distributions::UniformSource) -> DirSample {
+        self.set.sample(wo, u)
+    }
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        self.set.pdf(wo, wi)
+    }
+    fn sample_eval(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        u: &mut dyn distributions::UniformSource,
+    ) -> brdf_sampling::EvalSample {
+        self.set.sample_eval(brdf, wo, u)
+    }
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn distributions::UniformSource,
+        out: &mut Vec<brdf_sampling::EvalSample>,
+    ) {
+        self.set.sample_eval_batch(brdf, wos, u, out);
+    }
+    fn sample_batch(
+        &self,
+        wo: &Vec3,
+        n: usize,
+        u: &mut dyn distributions::UniformSource,
+    ) -> Vec<DirSample> {
+        self.set.sample_batch(wo, n, u)
+    }
+    fn sample_many(
+        &self,
+        wo: &Vec3,
+        n: usize,
+        u: &mut dyn distributions::UniformSource,
+    ) -> Vec<DirSample> {
+        self.set.sample_many(wo, n, u)
+    }
+    fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
+        self.set.pdf_many(wo, wi)
+    }
+    fn prefers_batches(&self) -> bool {
+        self.set.prefers_batches()
+    }
+    fn bound_violations(&self) -> Option<u64> {
+        self.set.bound_violations()
+    }
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        self.set.normaliser_rel_err(wo)
+    }
+    fn pdf_cells(&self, wo: &Vec3) -> Option<brdf_sampling::PdfCells> {
+        self.set.pdf_cells(wo)
+    }
+    fn build_report(&self) -> Option<String> {
+        self.set.build_report()
+    }
+    fn bytes_used(&self) -> usize {
+        self.bytes
+    }
+    fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
+        self.set.singular_directions(wo)
+    }
+}
+
 /// A rayon pool of one thread (`None` if the platform cannot start one): a build run inside
 /// it runs every parallel part on that thread.
 fn one_thread_pool() -> Option<rayon::ThreadPool> {
@@ -438,10 +512,16 @@ impl StudyPlan {
                     QuadTreeSet::from_bytes(&set.to_bytes(), Arc::clone(set.brdf()), set.spec())
                         .map(|copy| {
                             let mixture = mixture || SetOptions::default().mixture;
-                            (
-                                BuiltDirection::from_set(copy.with_mixture(mixture)),
-                                seconds,
-                            )
+                            let copy = Arc::new(copy.with_mixture(mixture));
+                            let sampler = Arc::new(SharedSet {
+                                set: Arc::clone(&copy),
+                                bytes: built.sampler.bytes_used(),
+                            });
+                            let built = BuiltDirection {
+                                sampler,
+                                set: Some(copy),
+                            };
+                            (built, seconds)
                         })
                         .map_err(|e| format!("cannot build: copying the shared structure: {e}"))
                 }
@@ -1446,6 +1526,9 @@ mod shared_build_tests {
                     .unwrap()
             };
             assert_ne!(first(&shared, a), first(&shared, b));
+            // One structure, one memory figure.
+            let bytes = |s: &str| shared.cells.iter().find(|c| c.sampler == s).unwrap().bytes;
+            assert_eq!(bytes(a), bytes(b));
         }
     }
 }
