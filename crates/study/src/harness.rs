@@ -19,6 +19,13 @@
 //!   cells (run 1 of every cell, then run 2, …), on the thread's CPU clock where the platform
 //!   has one (and the wall clock beside); the median and the spread are kept.
 //!
+//! Builds: each `(sampler, BRDF)` is built once, and samplers that build the same structure
+//! (the adaptive sets of one variant, nearest slice or two-slice mixture) share one build;
+//! the builds run on every core at once, each alone in a one-thread pool, and a build's time
+//! is the CPU time of the thread that ran it (wall time where the platform has no thread
+//! clock), so it is neither inflated by the builds beside it nor hidden by parallelism. A
+//! shared build's time is reported for every sampler that uses it.
+//!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
 //! `distributions::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it. A shard `K/N` runs every cell of the
@@ -28,13 +35,13 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirSample, DirectionSampler, SetOptions};
+use brdf_sampling::{DirSample, DirectionSampler, QuadTreeSet, SetOptions, Variant};
 use envmap::{AdaptiveOptions, EnvMapSampler};
 use estimators::{LocalFrame, MisHeuristic, MisPair};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
-use samplers::{DirectionRequest, Registry, SamplerEntry};
+use samplers::{BuiltDirection, Constructor, DirectionRequest, Registry, SamplerEntry};
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
@@ -84,6 +91,97 @@ fn build_warnings<'a>(
         }
     }
     notes
+}
+
+/// The structure a sampler's build shares with others, with its own slice rule: the adaptive
+/// sets of one variant (`adaptive` and `adaptive-mixture`, `adaptive-paper` and
+/// `adaptive-paper-mixture`) build the same trees and differ only in how a sample picks its
+/// slice (nearest or the two-slice mixture), so one build serves all of them.
+fn shared_structure(entry: &SamplerEntry) -> Option<(Variant, bool)> {
+    match entry.constructor {
+        Constructor::AdaptiveSet { variant, mixture } => Some((variant, mixture)),
+        _ => None,
+    }
+}
+
+/// An adaptive set derived from a shared build: the set itself in every respect but its
+/// memory, which is that of the set as built (the copy's vectors may hold less spare capacity),
+/// so the shared structure reports the same bytes for every sampler that uses it.
+struct SharedSet {
+    set: Arc<QuadTreeSet>,
+    bytes: usize,
+}
+
+impl DirectionSampler for SharedSet {
+    fn sample(&self, wo: &Vec3, u: &mut dyn distributions::UniformSource) -> DirSample {
+        self.set.sample(wo, u)
+    }
+    fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        self.set.pdf(wo, wi)
+    }
+    fn sample_eval(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        u: &mut dyn distributions::UniformSource,
+    ) -> brdf_sampling::EvalSample {
+        self.set.sample_eval(brdf, wo, u)
+    }
+    fn sample_eval_batch(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn distributions::UniformSource,
+        out: &mut Vec<brdf_sampling::EvalSample>,
+    ) {
+        self.set.sample_eval_batch(brdf, wos, u, out);
+    }
+    fn sample_batch(
+        &self,
+        wo: &Vec3,
+        n: usize,
+        u: &mut dyn distributions::UniformSource,
+    ) -> Vec<DirSample> {
+        self.set.sample_batch(wo, n, u)
+    }
+    fn sample_many(
+        &self,
+        wo: &Vec3,
+        n: usize,
+        u: &mut dyn distributions::UniformSource,
+    ) -> Vec<DirSample> {
+        self.set.sample_many(wo, n, u)
+    }
+    fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
+        self.set.pdf_many(wo, wi)
+    }
+    fn prefers_batches(&self) -> bool {
+        self.set.prefers_batches()
+    }
+    fn bound_violations(&self) -> Option<u64> {
+        self.set.bound_violations()
+    }
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        self.set.normaliser_rel_err(wo)
+    }
+    fn pdf_cells(&self, wo: &Vec3) -> Option<brdf_sampling::PdfCells> {
+        self.set.pdf_cells(wo)
+    }
+    fn build_report(&self) -> Option<String> {
+        self.set.build_report()
+    }
+    fn bytes_used(&self) -> usize {
+        self.bytes
+    }
+    fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
+        self.set.singular_directions(wo)
+    }
+}
+
+/// A rayon pool of one thread (`None` if the platform cannot start one): a build run inside
+/// it runs every parallel part on that thread.
+fn one_thread_pool() -> Option<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new().num_threads(1).build().ok()
 }
 
 /// What a cell's estimator samples.
@@ -137,6 +235,9 @@ pub struct StudyPlan {
     cells: Vec<PlanCell>,
     /// Samplers built so far, by `(sampler, BRDF)` index (the renderer reuses them).
     built: Mutex<Vec<((usize, usize), BuildOutcome)>>,
+    /// Whether samplers sharing a structure share its build (always, but for the test that
+    /// compares shared builds with separate ones).
+    share_builds: bool,
 }
 
 impl std::fmt::Debug for StudyPlan {
@@ -323,19 +424,50 @@ impl StudyPlan {
             light_entries,
             cells,
             built: Mutex::new(Vec::new()),
+            share_builds: true,
         })
     }
 
-    /// The sampler `s` built for BRDF `b` (cached), with its build time.
+    /// The sampler `s` built for BRDF `b` (cached), with its build time: derived from a
+    /// sibling's build when one shares its structure ([`shared_structure`]), else built alone
+    /// in a one-thread pool and timed on that thread's CPU clock ([`Self::build_here`]).
     pub(crate) fn build(&self, s: usize, b: usize) -> BuildOutcome {
-        let cached = self
-            .built
-            .lock()
-            .ok()
-            .and_then(|v| v.iter().find(|(k, _)| *k == (s, b)).map(|(_, r)| r.clone()));
-        if let Some(r) = cached {
+        if let Some(r) = self.cached(s, b) {
             return r;
         }
+        if let Some(r) = self.derive_from_sibling(s, b) {
+            return r;
+        }
+        match one_thread_pool() {
+            Some(pool) => pool.install(|| self.build_here(s, b)),
+            None => self.build_here(s, b),
+        }
+    }
+
+    /// The cached build of `(s, b)`, if any.
+    fn cached(&self, s: usize, b: usize) -> Option<BuildOutcome> {
+        self.built
+            .lock()
+            .ok()
+            .and_then(|v| v.iter().find(|(k, _)| *k == (s, b)).map(|(_, r)| r.clone()))
+    }
+
+    /// Caches `r` as the build of `(s, b)` (the first one stays) and returns it.
+    fn remember(&self, s: usize, b: usize, r: BuildOutcome) -> BuildOutcome {
+        if let Ok(mut v) = self.built.lock() {
+            if let Some((_, first)) = v.iter().find(|(k, _)| *k == (s, b)) {
+                return first.clone();
+            }
+            v.push(((s, b), r.clone()));
+        }
+        r
+    }
+
+    /// Builds `(s, b)` on the calling thread and caches it. Its time is the calling thread's
+    /// CPU time (the wall time where the platform has no thread clock): run inside a
+    /// one-thread rayon pool, every parallel part of the build runs on this thread, so the
+    /// figure is the build's whole CPU cost, not inflated by builds running beside it.
+    fn build_here(&self, s: usize, b: usize) -> BuildOutcome {
         let options = SetOptions {
             slices: self.config.slices,
             ..SetOptions::default()
@@ -343,20 +475,106 @@ impl StudyPlan {
         let brdf = &self.brdfs[b];
         let request =
             DirectionRequest::new(Arc::clone(&brdf.counted), &options).with_spec(&brdf.spec);
-        let start = Instant::now();
+        let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
         let entry = &self.entries[s];
         let r = if let Err(na) = entry.applicability(brdf.counted.as_ref()) {
             Err(format!("does not apply to this BRDF: {}", na.reason))
         } else {
             entry
                 .build_direction(&request)
-                .map(|d| (d, start.elapsed().as_secs_f64()))
+                .map(|d| {
+                    let wall = wall.elapsed().as_secs_f64();
+                    (d, cpu_or_wall(cpu, thread_cpu_seconds(), wall))
+                })
                 .map_err(|e| format!("cannot build: {e}"))
         };
-        if let Ok(mut v) = self.built.lock() {
-            v.push(((s, b), r.clone()));
+        self.remember(s, b, r)
+    }
+
+    /// `(s, b)` from the cached build of a sampler that shares its structure, if there is
+    /// one: the same trees (a copy with `s`'s slice rule), the same outcome when that build
+    /// failed, and the same build time (what `s` alone would have cost).
+    fn derive_from_sibling(&self, s: usize, b: usize) -> Option<BuildOutcome> {
+        if !self.share_builds {
+            return None;
         }
-        r
+        let (variant, mixture) = shared_structure(&self.entries[s])?;
+        let (sibling, outcome) = (0..self.entries.len())
+            .filter(|&o| o != s && shared_structure(&self.entries[o]).map(|v| v.0) == Some(variant))
+            .find_map(|o| Some((o, self.cached(o, b)?)))?;
+        let r = match outcome {
+            Err(e) => Err(e),
+            Ok((built, seconds)) => match &built.set {
+                None => Err(format!(
+                    "cannot build: the build of {} is not an adaptive set",
+                    self.entries[sibling].name
+                )),
+                Some(set) => {
+                    QuadTreeSet::from_bytes(&set.to_bytes(), Arc::clone(set.brdf()), set.spec())
+                        .map(|copy| {
+                            let mixture = mixture || SetOptions::default().mixture;
+                            let copy = Arc::new(copy.with_mixture(mixture));
+                            let sampler = Arc::new(SharedSet {
+                                set: Arc::clone(&copy),
+                                bytes: built.sampler.bytes_used(),
+                            });
+                            let built = BuiltDirection {
+                                sampler,
+                                set: Some(copy),
+                            };
+                            (built, seconds)
+                        })
+                        .map_err(|e| format!("cannot build: copying the shared structure: {e}"))
+                }
+            },
+        };
+        Some(self.remember(s, b, r))
+    }
+
+    /// Builds every `(sampler, BRDF)` of `list` not built yet: each structure once (the
+    /// samplers sharing one are derived from it afterwards), the structures on
+    /// `rayon::current_num_threads()` workers at once, each build alone in a one-thread pool
+    /// ([`Self::build_here`]). Calls `progress(1)` per pair.
+    pub(crate) fn build_all(&self, list: &[(usize, usize)], progress: ProgressFn<'_>) {
+        let mut own = Vec::new();
+        let mut derived = Vec::new();
+        for &(s, b) in list {
+            let shares = self.share_builds
+                && shared_structure(&self.entries[s]).is_some_and(|(v, _)| {
+                    own.iter().any(|&(o, ob): &(usize, usize)| {
+                        ob == b && shared_structure(&self.entries[o]).map(|x| x.0) == Some(v)
+                    })
+                });
+            if shares {
+                derived.push((s, b));
+            } else {
+                own.push((s, b));
+            }
+        }
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let workers = rayon::current_num_threads().clamp(1, own.len().max(1));
+        std::thread::scope(|scope| {
+            for _ in 0..workers {
+                scope.spawn(|| {
+                    let pool = one_thread_pool();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(&(s, b)) = own.get(i) else { break };
+                        if self.cached(s, b).is_none() {
+                            let _ = match &pool {
+                                Some(pool) => pool.install(|| self.build_here(s, b)),
+                                None => self.build_here(s, b),
+                            };
+                        }
+                        progress(1);
+                    }
+                });
+            }
+        });
+        for (s, b) in derived {
+            let _ = self.build(s, b);
+            progress(1);
+        }
     }
 
     /// The study's config.
@@ -459,15 +677,13 @@ impl StudyPlan {
     pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
         let clock = RunClock::start();
         let cells = self.selected(shard);
-        // Builds: one at a time, so build times are not inflated by each other.
-        let built: Vec<((usize, usize), BuildOutcome)> = self
-            .builds(&cells)
+        // Builds: each structure once, on every core, each timed on its own thread's CPU
+        // clock (`build_all`).
+        let list = self.builds(&cells);
+        self.build_all(&list, progress);
+        let built: Vec<((usize, usize), BuildOutcome)> = list
             .into_iter()
-            .map(|(s, b)| {
-                let r = self.build(s, b);
-                progress(1);
-                ((s, b), r)
-            })
+            .map(|(s, b)| ((s, b), self.build(s, b)))
             .collect();
         let light_built: Vec<((usize, usize), LightBuild)> = self
             .light_builds(&cells)
@@ -1257,5 +1473,89 @@ mod build_warning_tests {
             w,
             vec!["sampler srbf on phong: 2 of 2 fits hit the L-BFGS cap".to_string()]
         );
+    }
+}
+
+#[cfg(test)]
+mod shared_build_tests {
+    use super::*;
+
+    /// A small study of the four adaptive sets (two structures, two slice rules each). GGX at
+    /// 20 slices: enough trees that a copy's spare vector capacity (hence its memory figure)
+    /// differs from the set as built, so the test sees a wrong `bytes` too (≈ 1.5 s).
+    fn plan(share_builds: bool) -> StudyPlan {
+        let mut c = StudyConfig::new(
+            [
+                "adaptive",
+                "adaptive-mixture",
+                "adaptive-paper",
+                "adaptive-paper-mixture",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            vec!["ggx".into()],
+            vec![30.0, 50.0],
+            vec!["area:theta=20,phi=180,radius=15".into()],
+        );
+        c.n_grid = vec![4, 16];
+        c.repetitions = 8;
+        c.batch_repetitions = 8;
+        c.variance_samples = 400;
+        c.timing_samples = 8;
+        c.timing_repeats = 1;
+        c.slices = 20;
+        c.estimators = Vec::new();
+        let mut p = StudyPlan::new(c, Vec::new()).unwrap();
+        p.share_builds = share_builds;
+        p
+    }
+
+    /// Cell results without their timings (the only part that may differ between runs).
+    fn statistics(r: &StudyResults) -> Vec<CellResult> {
+        r.cells
+            .iter()
+            .map(|c| CellResult {
+                timing: None,
+                ..c.clone()
+            })
+            .collect()
+    }
+
+    fn build_seconds(r: &StudyResults, sampler: &str) -> f64 {
+        r.cells
+            .iter()
+            .find(|c| c.sampler == sampler)
+            .and_then(|c| c.timing.as_ref())
+            .map(|t| t.build_seconds)
+            .unwrap()
+    }
+
+    #[test]
+    fn a_shared_build_gives_the_cells_of_separate_builds() {
+        let shared = plan(true).run(None, &|_| {});
+        let separate = plan(false).run(None, &|_| {});
+        assert!(shared.cells.iter().all(|c| c.ok()), "{:?}", shared.cells);
+        assert_eq!(statistics(&shared), statistics(&separate));
+        // The shared build is one build: its time is reported for both of its samplers.
+        for (a, b) in [
+            ("adaptive", "adaptive-mixture"),
+            ("adaptive-paper", "adaptive-paper-mixture"),
+        ] {
+            assert_eq!(build_seconds(&shared, a), build_seconds(&shared, b));
+            assert!(build_seconds(&shared, a) > 0.0);
+            // The slice rules differ, so the check above compares different samplers.
+            let first = |r: &StudyResults, s: &str| {
+                r.cells
+                    .iter()
+                    .find(|c| c.sampler == s)
+                    .map(|c| c.variance.value)
+                    .unwrap()
+            };
+            assert_ne!(first(&shared, a), first(&shared, b));
+            // One structure, one memory figure.
+            let bytes = |s: &str| shared.cells.iter().find(|c| c.sampler == s).unwrap().bytes;
+            assert_eq!(bytes(a), bytes(b));
+        }
     }
 }

@@ -307,7 +307,12 @@ impl StudyPlan {
         let (width, height) = (self.brdfs.len() * px, px);
         let hits = hits(self.brdfs.len(), px);
         let brdfs: Vec<&dyn Brdf> = self.brdfs.iter().map(|b| b.raw.as_ref()).collect();
-        // Samplers per (sampler, BRDF); the reference sampler is `adaptive`.
+        // Samplers per (sampler, BRDF), built on every core first (cached); the reference
+        // sampler is `adaptive`.
+        let pairs: Vec<(usize, usize)> = (0..self.entries.len())
+            .flat_map(|s| (0..self.brdfs.len()).map(move |b| (s, b)))
+            .collect();
+        self.build_all(&pairs, &|_| {});
         let built: Vec<Vec<Option<std::sync::Arc<dyn DirectionSampler>>>> = (0..self.entries.len())
             .map(|s| {
                 (0..self.brdfs.len())
