@@ -521,6 +521,7 @@ impl StudyPlan {
                             let built = BuiltDirection {
                                 sampler,
                                 set: Some(copy),
+                                exact: None,
                             };
                             (built, seconds)
                         })
