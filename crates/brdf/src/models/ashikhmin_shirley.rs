@@ -16,9 +16,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-pub(crate) const NAME: &str = "ashikhmin-shirley";
+registry_entry! {
+    INFO: NAME = "ashikhmin-shirley", ["ashikhmin"], WhenParamsEqual, PARAMS,
+    AshikhminShirley::from_values,
+    "anisotropic Phong with Fresnel and coupled diffuse (Ashikhmin & Shirley 2000)"
+}
 
 model_params! {
     /// Parameters of [`AshikhminShirley`].

@@ -25,9 +25,14 @@ use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-pub(crate) const NAME: &str = "beard-maxwell";
+registry_entry! {
+    INFO: NAME = "beard-maxwell", ["beardmaxwell", "beard"], Always, PARAMS,
+    BeardMaxwell::from_values,
+    "painted surfaces: first-surface facets + volumetric terms (Maxwell, Beard et al. 1973)"
+}
 
 model_params! {
     /// Parameters of [`BeardMaxwell`].

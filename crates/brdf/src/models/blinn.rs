@@ -11,9 +11,14 @@
 use super::half_vector_lobe::half_vector_model;
 use super::model_params;
 use crate::params::Range;
+use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-pub(crate) const NAME: &str = "blinn";
+registry_entry! {
+    INFO: NAME = "blinn", ["blinn-phong"], Always, PARAMS,
+    Blinn::from_values,
+    "normalised Blinn–Phong half-vector lobe (Blinn 1977)"
+}
 
 model_params! {
     /// Parameters of [`Blinn`] (SPEC keys `n`, `ks`, `kd`).

@@ -18,9 +18,14 @@ use crate::brdf::Brdf;
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-pub(crate) const NAME: &str = "cook-torrance";
+registry_entry! {
+    INFO: NAME = "cook-torrance", ["torrance", "ct"], Always, PARAMS,
+    CookTorrance::from_values,
+    "Beckmann D, V-cavity G, dielectric Fresnel (Cook & Torrance 1982)"
+}
 
 model_params! {
     /// Parameters of [`CookTorrance`].

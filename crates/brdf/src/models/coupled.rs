@@ -23,9 +23,14 @@ use crate::fresnel::fresnel_schlick;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 
-pub(crate) const NAME: &str = "coupled";
+registry_entry! {
+    INFO: NAME = "coupled", ["kelemen", "kelemen-szirmay-kalos"], Always, PARAMS,
+    Coupled::from_values,
+    "coupled specular–matte microfacet model (Kelemen & Szirmay-Kalos 2001)"
+}
 
 /// Number of intervals of the albedo table.
 const TABLE_INTERVALS: usize = 256;

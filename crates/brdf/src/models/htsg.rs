@@ -56,11 +56,16 @@ use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use crate::special::{beckmann_lambda_with_erfc, erfc};
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::LazyLock;
 
-pub(crate) const NAME: &str = "htsg";
+registry_entry! {
+    INFO: NAME = "htsg", ["he", "he-torrance-sillion-greenberg"], Always, PARAMS,
+    Htsg::from_values,
+    "wave-optics directional diffuse, truncated series (He, Torrance, Sillion & Greenberg 1991)"
+}
 
 /// Below this `g` the Poisson series alone is used.
 const G_SERIES_ONLY: f64 = 150.0;

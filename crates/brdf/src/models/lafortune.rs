@@ -20,9 +20,14 @@ use super::{Properties, brdf_properties};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate, validate_key};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-pub(crate) const NAME: &str = "lafortune";
+registry_entry! {
+    INFO: NAME = "lafortune", [], WhenParamsEqual, PARAMS,
+    Lafortune::from_values,
+    "generalised cosine lobe (Cx xx' + Cy yy' + Cz zz')^n (Lafortune et al. 1997)"
+}
 
 /// Largest allowed `n · ln(max|C|)` (keeps `C^n` far from overflow).
 const MAX_LOG_LOBE: f64 = 600.0;

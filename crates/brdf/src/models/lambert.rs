@@ -7,9 +7,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::FRAC_1_PI;
 
-pub(crate) const NAME: &str = "lambert";
+registry_entry! {
+    INFO: NAME = "lambert", ["lambertian", "diffuse"], Always, PARAMS,
+    Lambert::from_values,
+    "ideal diffuse ρ/π (Lambert 1760)"
+}
 
 model_params! {
     /// Parameters of [`Lambert`].

@@ -13,9 +13,14 @@
 use super::half_vector_lobe::half_vector_model;
 use super::model_params;
 use crate::params::Range;
+use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-pub(crate) const NAME: &str = "lewis";
+registry_entry! {
+    INFO: NAME = "lewis", [], Always, PARAMS,
+    Lewis::from_values,
+    "Blinn lobe with Lewis' plausible normalisation (Lewis 1993)"
+}
 
 model_params! {
     /// Parameters of [`Lewis`] (SPEC keys `n`, `ks`, `kd`).

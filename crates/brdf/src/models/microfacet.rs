@@ -21,11 +21,21 @@ use crate::brdf::Brdf;
 use crate::fresnel::fresnel_schlick;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use crate::special::beckmann_lambda;
 use std::f64::consts::PI;
 
-pub(crate) const NAME_BECKMANN: &str = "beckmann";
-pub(crate) const NAME_GGX: &str = "ggx";
+registry_entry! {
+    INFO_BECKMANN: NAME_BECKMANN = "beckmann", [], WhenParamsEqual, PARAMS,
+    |v| Microfacet::from_values(v, NormalDistribution::Beckmann),
+    "Beckmann microfacet with Smith G (Walter et al. 2007), anisotropic α"
+}
+
+registry_entry! {
+    INFO_GGX: NAME_GGX = "ggx", ["trowbridge-reitz"], WhenParamsEqual, PARAMS,
+    |v| Microfacet::from_values(v, NormalDistribution::Ggx),
+    "GGX microfacet with Smith G (Walter et al. 2007), anisotropic α"
+}
 
 /// Microfacet normal distribution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

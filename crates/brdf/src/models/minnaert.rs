@@ -11,9 +11,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-pub(crate) const NAME: &str = "minnaert";
+registry_entry! {
+    INFO: NAME = "minnaert", [], Always, PARAMS,
+    Minnaert::from_values,
+    "lunar limb darkening ρ(k+1)/(2π)(cosθi cosθo)^(k−1) (Minnaert 1941)"
+}
 
 model_params! {
     /// Parameters of [`Minnaert`].

@@ -15,9 +15,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
 
-pub(crate) const NAME: &str = "oren-nayar";
+registry_entry! {
+    INFO: NAME = "oren-nayar", ["oren"], Always, PARAMS,
+    OrenNayar::from_values,
+    "rough diffuse, qualitative model (Oren & Nayar 1994)"
+}
 
 model_params! {
     /// Parameters of [`OrenNayar`].

@@ -12,9 +12,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-pub(crate) const NAME: &str = "phong";
+registry_entry! {
+    INFO: NAME = "phong", ["modified-phong"], Always, PARAMS,
+    Phong::from_values,
+    "modified energy-conserving Phong, kd/π + ks(n+2)/(2π) cos^n α (Phong 1975; Lafortune & Willems 1994)"
+}
 
 model_params! {
     /// Parameters of [`Phong`].

@@ -57,12 +57,17 @@ use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
+use crate::registry::registry_entry;
 use crate::special::ln_gamma_diff;
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 use std::sync::LazyLock;
 
-pub(crate) const NAME: &str = "poulin-fournier";
+registry_entry! {
+    INFO: NAME = "poulin-fournier", ["poulin"], Never, PARAMS,
+    PoulinFournier::from_values,
+    "anisotropic parallel cylinders with Phong surface (Poulin & Fournier 1990)"
+}
 
 /// Gauss–Legendre nodes/weights on [−1, 1] (12 points) for the specular panels (`n_exp < 10`).
 const GL_POINTS: usize = 12;

@@ -27,10 +27,20 @@ use super::{Properties, brdf_properties};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, ParamInfo, Range, defaults, param, validate};
+use crate::registry::registry_entry;
 use std::f64::consts::FRAC_1_PI;
 
-pub(crate) const NAME_SPECULAR: &str = "schlick-specular";
-pub(crate) const NAME_DIFFUSE: &str = "schlick-diffuse";
+registry_entry! {
+    INFO_DIFFUSE: NAME_DIFFUSE = "schlick-diffuse", ["schlick-d"], WhenParamsEqual, PARAMS_DIFFUSE,
+    Schlick::diffuse_from_values,
+    "Schlick glossy coat over a Lambertian base (Schlick 1994)"
+}
+
+registry_entry! {
+    INFO_SPECULAR: NAME_SPECULAR = "schlick-specular", ["schlick-s", "schlick"], WhenParamsEqual, PARAMS_SPECULAR,
+    Schlick::specular_from_values,
+    "Schlick single-slope glossy material (Schlick 1994)"
+}
 
 pub(crate) const PARAMS_SPECULAR: &[ParamInfo] = &[
     param(

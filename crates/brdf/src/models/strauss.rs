@@ -21,9 +21,14 @@ use super::{Properties, brdf_properties, model_common, model_params};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
+use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
 
-pub(crate) const NAME: &str = "strauss";
+registry_entry! {
+    INFO: NAME = "strauss", [], Always, PARAMS,
+    Strauss::from_values,
+    "smoothness/metalness artist model (Strauss 1990)"
+}
 
 const KF: f64 = 1.12;
 const KG: f64 = 1.01;
