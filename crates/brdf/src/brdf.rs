@@ -154,6 +154,47 @@ impl Outgoing {
     }
 }
 
+/// The [`Brdf`] methods other than the three evaluations (`prepare`, the property predicates,
+/// `analytic_lobes`, `name`, `as_any`), forwarded to `$inner`: what a wrapper passes through
+/// unchanged (the pointer impls below; [`CountingBrdf`](crate::CountingBrdf), which counts
+/// evaluations only). Used inside `impl Brdf for …` as `forward_brdf_queries!(self => inner)`.
+macro_rules! forward_brdf_queries {
+    ($self:ident => $inner:expr) => {
+        #[inline]
+        fn prepare(&$self, wo: &$crate::Vec3) -> $crate::Outgoing {
+            $inner.prepare(wo)
+        }
+        fn is_isotropic(&$self) -> bool {
+            $inner.is_isotropic()
+        }
+        fn is_mirror_symmetric(&$self) -> bool {
+            $inner.is_mirror_symmetric()
+        }
+        fn is_half_turn_symmetric(&$self) -> bool {
+            $inner.is_half_turn_symmetric()
+        }
+        fn is_reciprocal(&$self) -> bool {
+            $inner.is_reciprocal()
+        }
+        fn conserves_energy(&$self) -> bool {
+            $inner.conserves_energy()
+        }
+        fn bounded_at_horizon(&$self) -> bool {
+            $inner.bounded_at_horizon()
+        }
+        fn analytic_lobes(&$self) -> Option<$crate::AnalyticLobes> {
+            $inner.analytic_lobes()
+        }
+        fn name(&$self) -> &str {
+            $inner.name()
+        }
+        fn as_any(&$self) -> Option<&dyn std::any::Any> {
+            $inner.as_any()
+        }
+    };
+}
+pub(crate) use forward_brdf_queries;
+
 macro_rules! forward_brdf {
     ($($ty:ty),*) => {$(
         impl<T: Brdf + ?Sized> Brdf for $ty {
@@ -166,40 +207,10 @@ macro_rules! forward_brdf {
                 (**self).eval_rgb(wo, wi)
             }
             #[inline]
-            fn prepare(&self, wo: &Vec3) -> Outgoing {
-                (**self).prepare(wo)
-            }
-            #[inline]
             fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
                 (**self).eval_prepared(q, wi)
             }
-            fn is_isotropic(&self) -> bool {
-                (**self).is_isotropic()
-            }
-            fn is_mirror_symmetric(&self) -> bool {
-                (**self).is_mirror_symmetric()
-            }
-            fn is_half_turn_symmetric(&self) -> bool {
-                (**self).is_half_turn_symmetric()
-            }
-            fn is_reciprocal(&self) -> bool {
-                (**self).is_reciprocal()
-            }
-            fn conserves_energy(&self) -> bool {
-                (**self).conserves_energy()
-            }
-            fn bounded_at_horizon(&self) -> bool {
-                (**self).bounded_at_horizon()
-            }
-            fn analytic_lobes(&self) -> Option<AnalyticLobes> {
-                (**self).analytic_lobes()
-            }
-            fn name(&self) -> &str {
-                (**self).name()
-            }
-            fn as_any(&self) -> Option<&dyn std::any::Any> {
-                (**self).as_any()
-            }
+            forward_brdf_queries!(self => (**self));
         }
     )*};
 }

@@ -4,7 +4,7 @@
 use std::cell::Cell;
 use std::sync::Arc;
 
-use crate::{AnalyticLobes, Brdf, Outgoing, Vec3};
+use crate::{Brdf, Outgoing, Vec3};
 
 thread_local! {
     static EVALUATIONS: Cell<u64> = const { Cell::new(0) };
@@ -44,44 +44,14 @@ impl Brdf for CountingBrdf {
         EVALUATIONS.with(|c| c.set(c.get() + 1));
         self.0.eval_rgb(wo, wi)
     }
-    /// Forwarded, so a sampler keeps the wrapped model's prepared fast path (not counted: it
-    /// is no evaluation).
-    #[inline]
-    fn prepare(&self, wo: &Vec3) -> Outgoing {
-        self.0.prepare(wo)
-    }
     #[inline]
     fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
         EVALUATIONS.with(|c| c.set(c.get() + 1));
         self.0.eval_prepared(q, wi)
     }
-    fn is_isotropic(&self) -> bool {
-        self.0.is_isotropic()
-    }
-    fn is_mirror_symmetric(&self) -> bool {
-        self.0.is_mirror_symmetric()
-    }
-    fn is_half_turn_symmetric(&self) -> bool {
-        self.0.is_half_turn_symmetric()
-    }
-    fn is_reciprocal(&self) -> bool {
-        self.0.is_reciprocal()
-    }
-    fn conserves_energy(&self) -> bool {
-        self.0.conserves_energy()
-    }
-    fn bounded_at_horizon(&self) -> bool {
-        self.0.bounded_at_horizon()
-    }
-    fn analytic_lobes(&self) -> Option<AnalyticLobes> {
-        self.0.analytic_lobes()
-    }
-    fn name(&self) -> &str {
-        self.0.name()
-    }
-    fn as_any(&self) -> Option<&dyn std::any::Any> {
-        self.0.as_any()
-    }
+    // `prepare` is forwarded too (no evaluation, not counted), so a sampler keeps the wrapped
+    // model's prepared fast path.
+    crate::brdf::forward_brdf_queries!(self => self.0);
 }
 
 #[cfg(test)]

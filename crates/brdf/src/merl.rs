@@ -22,6 +22,7 @@
 
 use crate::brdf::{Brdf, luminance};
 use crate::geometry::{Vec3, both_above, rotate_y};
+use crate::models::Properties;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fs;
 use std::io::{BufWriter, Write};
@@ -268,23 +269,11 @@ impl MerlBrdf {
                 actual: bytes.len(),
             });
         }
-        let data = &bytes[HEADER_BYTES..];
-        let mut cells = vec![[0.0f64; 3]; CELLS];
-        for (k, chunk) in data.chunks_exact(8).enumerate() {
+        Self::from_channel_major(bytes[HEADER_BYTES..].chunks_exact(8).map(|chunk| {
             let mut b = [0u8; 8];
             b.copy_from_slice(chunk);
-            let v = f64::from_le_bytes(b);
-            let (channel, index) = (k / CELLS, k % CELLS);
-            if !v.is_finite() {
-                return Err(MerlError::NonFinite {
-                    channel,
-                    index,
-                    value: v,
-                });
-            }
-            cells[index][channel] = v * CHANNEL_SCALE[channel];
-        }
-        Ok(Self::from_cells(cells))
+            f64::from_le_bytes(b)
+        }))
     }
 
     /// Build from the raw stored table: `3 × 1,458,000` unscaled values, channel-major.
@@ -295,8 +284,14 @@ impl MerlBrdf {
                 actual: raw.len(),
             });
         }
+        Self::from_channel_major(raw.iter().copied())
+    }
+
+    /// The `3 × 1,458,000` unscaled stored values, channel-major (each one finite), scaled by
+    /// channel into cells.
+    fn from_channel_major(values: impl Iterator<Item = f64>) -> Result<Self, MerlError> {
         let mut cells = vec![[0.0f64; 3]; CELLS];
-        for (k, &v) in raw.iter().enumerate() {
+        for (k, v) in values.enumerate() {
             let (channel, index) = (k / CELLS, k % CELLS);
             if !v.is_finite() {
                 return Err(MerlError::NonFinite {
@@ -438,6 +433,16 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), MerlError> {
     result.map_err(io)
 }
 
+impl MerlBrdf {
+    /// Isotropic, half-turn symmetric and reciprocal: the lookup depends on `(θh, θd, φd)` only,
+    /// which a common rotation about the normal leaves unchanged, and the `φd` fold maps
+    /// `(ωo, ωi)` and `(ωi, ωo)` to the same bin (up to rounding at bin edges). Not
+    /// mirror-symmetric: the fold identifies `φd` with `φd + π`, not with `−φd`.
+    pub fn properties(&self) -> Properties {
+        Properties::ISOTROPIC | Properties::HALF_TURN_SYMMETRIC | Properties::RECIPROCAL
+    }
+}
+
 impl Brdf for MerlBrdf {
     /// Luminance of [`eval_rgb`](Brdf::eval_rgb).
     #[inline]
@@ -450,19 +455,7 @@ impl Brdf for MerlBrdf {
         let c = self.lookup_raw_rgb(wo, wi);
         [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)]
     }
-    fn is_isotropic(&self) -> bool {
-        true
-    }
-    // `is_mirror_symmetric` stays false: the φd fold identifies φd with φd + π, not with −φd.
-    /// The lookup depends on `(θh, θd, φd)` only, which a common rotation about the normal
-    /// (here by `π`) leaves unchanged (up to rounding at bin edges).
-    fn is_half_turn_symmetric(&self) -> bool {
-        true
-    }
-    /// The φd fold maps (ωo, ωi) and (ωi, ωo) to the same bin (up to rounding at bin edges).
-    fn is_reciprocal(&self) -> bool {
-        true
-    }
+    crate::models::brdf_properties!();
     fn name(&self) -> &str {
         "merl"
     }
