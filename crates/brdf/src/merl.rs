@@ -455,10 +455,7 @@ impl Brdf for MerlBrdf {
         let c = self.lookup_raw_rgb(wo, wi);
         [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)]
     }
-    crate::models::brdf_properties!();
-    fn name(&self) -> &str {
-        "merl"
-    }
+    crate::models::brdf_properties!("merl");
     /// For [`MerlBrdf::albedo_in_bins`] (the exact sampler's normaliser, issue 27).
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)

@@ -125,10 +125,7 @@ impl Brdf for Abc {
         out
     }
 
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }
 
 #[cfg(test)]

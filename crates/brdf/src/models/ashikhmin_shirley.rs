@@ -61,11 +61,9 @@ impl AshikhminShirley {
     /// Symmetries and energy: half-turn symmetric for all `nu, nv` (terms in `h_x²`, `h_y²`),
     /// isotropic and mirror-symmetric iff `nu = nv`; reciprocal; conserves energy.
     pub fn properties(&self) -> Properties {
-        Properties::HALF_TURN_SYMMETRIC
+        Properties::elliptical(self.params.nu == self.params.nv)
             | Properties::RECIPROCAL
             | Properties::CONSERVES_ENERGY
-            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
-                .when(self.params.nu == self.params.nv)
     }
 }
 
@@ -98,8 +96,5 @@ impl Brdf for AshikhminShirley {
         let diff = self.diff_scale * (1.0 - pow5(1.0 - 0.5 * ci)) * (1.0 - pow5(1.0 - 0.5 * co));
         spec + diff
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

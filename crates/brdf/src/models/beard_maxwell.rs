@@ -120,8 +120,5 @@ impl Brdf for BeardMaxwell {
         let vol = p.rd * FRAC_1_PI + 2.0 * p.rv * FRAC_1_PI / (ci + co);
         first + vol
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

@@ -91,7 +91,7 @@ impl Brdf for CookTorrance {
         let f = fresnel_dielectric(vh, self.params.ior);
         self.diffuse + self.params.ks * f * d * g / (4.0 * ci * co)
     }
-    brdf_properties!();
+    brdf_properties!(NAME);
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.kd,
@@ -102,8 +102,5 @@ impl Brdf for CookTorrance {
                 alpha_y: self.params.m,
             }),
         })
-    }
-    fn name(&self) -> &str {
-        NAME
     }
 }

@@ -211,8 +211,5 @@ impl Brdf for Coupled {
             * (1.0 - self.specular_albedo_at(wi.z));
         self.specular(wo, wi) + matte
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

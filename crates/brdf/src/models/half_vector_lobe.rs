@@ -91,7 +91,7 @@ macro_rules! half_vector_model {
             fn eval(&self, wo: &$crate::geometry::Vec3, wi: &$crate::geometry::Vec3) -> f64 {
                 self.lobe.eval(wo, wi)
             }
-            $crate::models::brdf_properties!();
+            $crate::models::brdf_properties!($name);
             fn analytic_lobes(&self) -> Option<$crate::AnalyticLobes> {
                 Some($crate::AnalyticLobes {
                     diffuse: self.params.kd,
@@ -100,9 +100,6 @@ macro_rules! half_vector_model {
                         exponent: self.params.n,
                     }),
                 })
-            }
-            fn name(&self) -> &str {
-                $name
             }
         }
     };

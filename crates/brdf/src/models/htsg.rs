@@ -452,10 +452,7 @@ impl Brdf for Htsg {
         let d = self.distribution(g, a);
         fres * geo * shadow * d / (PI * ci * co) + self.params.kd * FRAC_1_PI
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }
 
 #[cfg(test)]

@@ -169,10 +169,8 @@ impl Lafortune {
             .lobes
             .iter()
             .all(|l| l.cx.abs() <= 1.0 && l.cy.abs() <= 1.0 && l.cz.abs() <= 1.0);
-        Properties::HALF_TURN_SYMMETRIC
+        Properties::elliptical(self.params.lobes.iter().all(|l| l.cx == l.cy))
             | Properties::RECIPROCAL
-            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
-                .when(self.params.lobes.iter().all(|l| l.cx == l.cy))
             | Properties::CONSERVES_ENERGY.when(self.params.kd + ks <= 1.0 && bounded_lobes)
     }
 }
@@ -199,8 +197,5 @@ impl Brdf for Lafortune {
         }
         f
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

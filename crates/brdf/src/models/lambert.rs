@@ -54,15 +54,12 @@ impl Brdf for Lambert {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
         if both_above(wo, wi) { self.value } else { 0.0 }
     }
-    brdf_properties!();
+    brdf_properties!(NAME);
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: 1.0,
             specular: 0.0,
             lobe: None,
         })
-    }
-    fn name(&self) -> &str {
-        NAME
     }
 }

@@ -142,11 +142,9 @@ impl Microfacet {
     /// Symmetries and energy: half-turn symmetric for all `αx, αy`, isotropic and mirror-symmetric
     /// iff `αx = αy`; reciprocal; conserves energy (single scattering loses energy, never gains).
     pub fn properties(&self) -> Properties {
-        Properties::HALF_TURN_SYMMETRIC
+        Properties::elliptical(self.params.alpha_x == self.params.alpha_y)
             | Properties::RECIPROCAL
             | Properties::CONSERVES_ENERGY
-            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC)
-                .when(self.params.alpha_x == self.params.alpha_y)
     }
 }
 

@@ -69,8 +69,5 @@ impl Brdf for Minnaert {
         let c = (wi.z * wo.z).max(1e-300);
         self.scale * c.powf(self.params.k - 1.0)
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

@@ -79,8 +79,5 @@ impl Brdf for OrenNayar {
             self.a
         }
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }

@@ -77,7 +77,7 @@ impl Brdf for Phong {
         };
         self.diffuse + spec
     }
-    brdf_properties!();
+    brdf_properties!(NAME);
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.kd,
@@ -86,8 +86,5 @@ impl Brdf for Phong {
                 exponent: self.params.n,
             }),
         })
-    }
-    fn name(&self) -> &str {
-        NAME
     }
 }

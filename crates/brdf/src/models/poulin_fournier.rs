@@ -459,10 +459,7 @@ impl Brdf for PoulinFournier {
         }
         ((diffuse + spec) / (self.params.d * wi.z * wo.z)).max(0.0)
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }
 
 #[cfg(test)]

@@ -55,6 +55,17 @@ impl Properties {
         if condition { self } else { Self::NONE }
     }
 
+    /// The symmetries of an elliptically anisotropic model (terms in `x²`, `y²`, `x x'`, `y y'`
+    /// of the directions or of the half vector only): half-turn symmetric always, isotropic and
+    /// mirror-symmetric when its two axes are equal (`isotropic`).
+    pub const fn elliptical(isotropic: bool) -> Self {
+        if isotropic {
+            Self::ISOTROPIC_SYMMETRIC
+        } else {
+            Self::HALF_TURN_SYMMETRIC
+        }
+    }
+
     /// The properties a [`Brdf`](crate::Brdf) reports through its predicates (for any
     /// implementation, so tests can compare a model's declared flags with its trait answers).
     pub fn of(brdf: &dyn crate::Brdf) -> Self {
@@ -92,8 +103,15 @@ impl fmt::Debug for Properties {
 }
 
 /// The [`Brdf`](crate::Brdf) predicates of a model, from its inherent
-/// `fn properties(&self) -> Properties` (used inside `impl Brdf for …`).
+/// `fn properties(&self) -> Properties` (used inside `impl Brdf for …`), and with a name
+/// (`brdf_properties!(NAME)`) its [`Brdf::name`](crate::Brdf::name) too.
 macro_rules! brdf_properties {
+    ($name:expr) => {
+        $crate::models::brdf_properties!();
+        fn name(&self) -> &str {
+            $name
+        }
+    };
     () => {
         fn is_isotropic(&self) -> bool {
             self.properties()
@@ -134,6 +152,14 @@ mod tests {
         assert!(p.contains(Properties::ISOTROPIC | Properties::HALF_TURN_SYMMETRIC));
         assert!(!p.contains(Properties::RECIPROCAL));
         assert!(p.contains(Properties::NONE));
+        assert_eq!(
+            Properties::elliptical(true),
+            Properties::ISOTROPIC_SYMMETRIC
+        );
+        assert_eq!(
+            Properties::elliptical(false),
+            Properties::HALF_TURN_SYMMETRIC
+        );
         assert_eq!(
             format!("{p:?}"),
             "Properties(isotropic | mirror-symmetric | half-turn-symmetric)"

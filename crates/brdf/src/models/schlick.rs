@@ -165,9 +165,7 @@ impl Schlick {
     /// Symmetries: `A(w)` is even in `cos φh`, so half-turn symmetric; isotropic and mirror-symmetric
     /// iff `p = 1`; reciprocal; not energy-conserving (see the module docs).
     pub fn properties(&self) -> Properties {
-        Properties::HALF_TURN_SYMMETRIC
-            | Properties::RECIPROCAL
-            | (Properties::ISOTROPIC | Properties::MIRROR_SYMMETRIC).when(self.params.p == 1.0)
+        Properties::elliptical(self.params.p == 1.0) | Properties::RECIPROCAL
     }
 }
 

@@ -167,10 +167,7 @@ impl Brdf for Sgd {
         })
     }
 
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }
 
 #[cfg(test)]

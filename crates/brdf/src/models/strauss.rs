@@ -113,8 +113,5 @@ impl Brdf for Strauss {
         let spec = rj * cs * c.powf(self.exponent) * FRAC_1_PI / wi.z.max(1e-12);
         self.diffuse + spec.max(0.0)
     }
-    brdf_properties!();
-    fn name(&self) -> &str {
-        NAME
-    }
+    brdf_properties!(NAME);
 }
