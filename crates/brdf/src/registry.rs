@@ -32,7 +32,7 @@ enum Build {
 }
 
 /// A registry entry: everything `brdf-lab list` prints about a model, and how to build it.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 pub struct ModelInfo {
     /// Registry key (kebab-case), the `name` of a spec.
     pub name: &'static str,
@@ -47,15 +47,14 @@ pub struct ModelInfo {
     build: Build,
 }
 
-impl std::fmt::Debug for ModelInfo {
+/// The kind of build only (a function pointer's address says nothing to a reader).
+impl std::fmt::Debug for Build {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ModelInfo")
-            .field("name", &self.name)
-            .field("aliases", &self.aliases)
-            .field("summary", &self.summary)
-            .field("params", &self.params)
-            .field("isotropic", &self.isotropic)
-            .finish()
+        f.write_str(match self {
+            Build::Values(_) => "Values",
+            Build::File => "File",
+            Build::Preset => "Preset",
+        })
     }
 }
 
@@ -304,9 +303,7 @@ pub enum SpecError {
 }
 
 /// A built model as the registry hands it out.
-pub(crate) fn boxed<B: Brdf + 'static>(
-    built: Result<B, ParamError>,
-) -> Result<Box<dyn Brdf>, ParamError> {
+pub(crate) fn boxed<B: Brdf + 'static, E>(built: Result<B, E>) -> Result<Box<dyn Brdf>, E> {
     built.map(|m| Box::new(m) as Box<dyn Brdf>)
 }
 
@@ -379,6 +376,14 @@ static MODELS: &[ModelInfo] = &[
         "ABC model with the published fit of a MERL material, spec `abc:material=NAME` (Low, Kronander, Ynnerman & Unger 2012)",
     ),
 ];
+
+/// The trimmed `PATH` of a `NAME:PATH` spec, or `missing` when there is none.
+fn file_path(rest: Option<&str>, missing: SpecError) -> Result<&str, SpecError> {
+    match rest.map(str::trim) {
+        Some(path) if !path.is_empty() => Ok(path),
+        _ => Err(missing),
+    }
+}
 
 /// The preset names of a preset model (`sgd`, `abc`), `None` for other models.
 pub fn preset_names(model: &str) -> Option<Vec<&'static str>> {
@@ -473,35 +478,22 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
         None => (spec, None),
     };
     if name.eq_ignore_ascii_case("merl") {
-        let path = rest.map(str::trim).unwrap_or("");
-        if path.is_empty() {
-            return Err(SpecError::MissingPath);
-        }
+        let path = file_path(rest, SpecError::MissingPath)?;
         return Ok(Box::new(MerlBrdf::load(Path::new(path))?));
     }
     if name.eq_ignore_ascii_case("rgl") {
-        let path = rest.map(str::trim).unwrap_or("");
-        if path.is_empty() {
-            return Err(SpecError::MissingFile { model: "rgl" });
-        }
-        return RglBrdf::load(Path::new(path))
-            .map(|b| Box::new(b) as Box<dyn Brdf>)
-            .map_err(|source| SpecError::Rgl {
-                path: path.to_string(),
-                source,
-            });
+        let path = file_path(rest, SpecError::MissingFile { model: "rgl" })?;
+        return boxed(RglBrdf::load(Path::new(path))).map_err(|source| SpecError::Rgl {
+            path: path.to_string(),
+            source,
+        });
     }
     if name.eq_ignore_ascii_case("cornell") {
-        let path = rest.map(str::trim).unwrap_or("");
-        if path.is_empty() {
-            return Err(SpecError::MissingFile { model: "cornell" });
-        }
-        return CornellBrdf::load(Path::new(path))
-            .map(|b| Box::new(b) as Box<dyn Brdf>)
-            .map_err(|source| SpecError::Cornell {
-                path: path.to_string(),
-                source,
-            });
+        let path = file_path(rest, SpecError::MissingFile { model: "cornell" })?;
+        return boxed(CornellBrdf::load(Path::new(path))).map_err(|source| SpecError::Cornell {
+            path: path.to_string(),
+            source,
+        });
     }
     if name.eq_ignore_ascii_case("sgd") {
         return parse_preset("sgd", rest);

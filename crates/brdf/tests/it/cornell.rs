@@ -1,11 +1,10 @@
 //! Cornell `.brdf` reader: synthetic files with a known answer, the shared real files when
 //! `../shared` is present, malformed files (typed errors, never a panic).
 
+use crate::common::pairs_below_85;
 use brdf::measured::cornell::{self, CornellBrdf, CornellError, MIN_SAMPLES};
 use brdf::{Brdf, SpecError, Vec3, direction_from_angles, parse_spec, rotate_z};
 use proptest::prelude::*;
-use rand::rngs::Xoshiro256PlusPlus;
-use rand::{RngExt, SeedableRng};
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -39,18 +38,6 @@ fn synthetic(value: impl Fn(f64, f64, f64) -> f64) -> String {
     s
 }
 
-fn pairs(seed: u64, n: usize) -> Vec<(Vec3, Vec3)> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            (
-                direction_from_angles(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>()),
-                direction_from_angles(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>()),
-            )
-        })
-        .collect()
-}
-
 /// A constant spectrum gives a constant grey BRDF everywhere (the Gaussian weights average
 /// equal values), with its value as luminance.
 #[test]
@@ -58,7 +45,7 @@ fn constant_data_give_a_constant_brdf() {
     let b = CornellBrdf::parse(&synthetic(|_, _, _| 0.2)).expect("valid");
     assert_eq!(b.samples(), 900);
     assert_eq!(b.wavelengths().len(), WAVELENGTHS);
-    for (wo, wi) in pairs(1, 200) {
+    for (wo, wi) in pairs_below_85(1, 200) {
         let f = b.eval(&wo, &wi);
         assert!((f - 0.2).abs() < 2e-3, "{f}");
     }
@@ -90,7 +77,7 @@ fn declared_symmetries_hold() {
     .expect("valid");
     assert!(b.is_isotropic() && b.is_mirror_symmetric() && b.is_reciprocal());
     let m = |v: &Vec3| Vec3::new(v.x, -v.y, v.z);
-    for (k, (wo, wi)) in pairs(2, 300).iter().enumerate() {
+    for (k, (wo, wi)) in pairs_below_85(2, 300).iter().enumerate() {
         let f = b.eval(wo, wi);
         assert!(f.is_finite() && f >= 0.0);
         let a = 0.7 * k as f64;
@@ -231,7 +218,7 @@ fn shared_files_read() {
     for e in entries.filter_map(Result::ok) {
         let spec = format!("cornell:{}", e.path().display());
         let b = parse_spec(&spec).unwrap_or_else(|err| panic!("{spec}: {err}"));
-        for (wo, wi) in pairs(3, 500) {
+        for (wo, wi) in pairs_below_85(3, 500) {
             let f = b.eval_rgb(&wo, &wi);
             assert!(
                 f.iter().all(|v| v.is_finite() && *v >= 0.0),
@@ -315,7 +302,7 @@ proptest! {
         }
         let edited: Vec<String> = lines.iter().map(|l| l.join(" ")).collect();
         if let Ok(b) = CornellBrdf::parse(&edited.join("\n")) {
-            for (wo, wi) in pairs(4, 10) {
+            for (wo, wi) in pairs_below_85(4, 10) {
                 let v = b.eval(&wo, &wi);
                 prop_assert!(v.is_finite() && v >= 0.0, "{}", v);
             }

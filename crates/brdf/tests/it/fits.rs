@@ -2,22 +2,9 @@
 //! symmetries hold numerically, values are finite and non-negative, unknown names suggest close
 //! matches.
 
+use crate::common::pairs_below_85;
 use brdf::models::{Abc, Sgd};
 use brdf::{Brdf, SpecError, Vec3, direction_from_angles, parse_spec, preset_names, rotate_z};
-use rand::rngs::Xoshiro256PlusPlus;
-use rand::{RngExt, SeedableRng};
-
-fn pairs(seed: u64, n: usize) -> Vec<(Vec3, Vec3)> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            (
-                direction_from_angles(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>()),
-                direction_from_angles(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>()),
-            )
-        })
-        .collect()
-}
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(1e-300)
@@ -50,7 +37,7 @@ fn one_hundred_presets_each() {
 /// finite and ≥ 0.
 #[test]
 fn declared_symmetries_hold_for_every_preset() {
-    let ps = pairs(21, 60);
+    let ps = pairs_below_85(21, 60);
     for model in ["sgd", "abc"] {
         for n in preset_names(model).expect("presets") {
             let b = parse_spec(&format!("{model}:material={n}")).expect("builds");

@@ -1,7 +1,8 @@
 //! Shared by the symmetry checks (`mirror.rs`, `half_turn.rs`): seeded direction pairs and the
-//! relative comparison.
+//! relative comparison; and by the measured-format and fit tests (`rgl.rs`, `cornell.rs`,
+//! `fits.rs`): seeded pairs away from grazing.
 
-use brdf::{Vec3, direction_from_radians};
+use brdf::{Vec3, direction_from_angles, direction_from_radians};
 use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
 use std::f64::consts::TAU;
 
@@ -29,4 +30,12 @@ pub(crate) fn direction_pairs(seed: u64) -> Vec<(Vec3, Vec3)> {
 /// `|a − b| ≤ TOL · max(1, |a|)`.
 pub(crate) fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= TOL * a.abs().max(1.0)
+}
+
+/// `n` seeded pairs with θ uniform in [0°, 85°] and φ uniform in [0°, 360°] (in degrees, drawn
+/// θo, φo, θi, φi in that order).
+pub(crate) fn pairs_below_85(seed: u64, n: usize) -> Vec<(Vec3, Vec3)> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut dir = || direction_from_angles(85.0 * rng.random::<f64>(), 360.0 * rng.random::<f64>());
+    (0..n).map(|_| (dir(), dir())).collect()
 }
