@@ -164,24 +164,9 @@ macro_rules! forward_brdf_queries {
         fn prepare(&$self, wo: &$crate::Vec3) -> $crate::Outgoing {
             $inner.prepare(wo)
         }
-        fn is_isotropic(&$self) -> bool {
-            $inner.is_isotropic()
-        }
-        fn is_mirror_symmetric(&$self) -> bool {
-            $inner.is_mirror_symmetric()
-        }
-        fn is_half_turn_symmetric(&$self) -> bool {
-            $inner.is_half_turn_symmetric()
-        }
-        fn is_reciprocal(&$self) -> bool {
-            $inner.is_reciprocal()
-        }
-        fn conserves_energy(&$self) -> bool {
-            $inner.conserves_energy()
-        }
-        fn bounded_at_horizon(&$self) -> bool {
-            $inner.bounded_at_horizon()
-        }
+        $crate::brdf::forward_brdf_queries!(@predicates $self => $inner;
+            is_isotropic, is_mirror_symmetric, is_half_turn_symmetric, is_reciprocal,
+            conserves_energy, bounded_at_horizon);
         fn analytic_lobes(&$self) -> Option<$crate::AnalyticLobes> {
             $inner.analytic_lobes()
         }
@@ -191,6 +176,13 @@ macro_rules! forward_brdf_queries {
         fn as_any(&$self) -> Option<&dyn std::any::Any> {
             $inner.as_any()
         }
+    };
+    (@predicates $self:ident => $inner:expr; $($predicate:ident),+) => {
+        $(
+            fn $predicate(&$self) -> bool {
+                $inner.$predicate()
+            }
+        )+
     };
 }
 pub(crate) use forward_brdf_queries;

@@ -106,6 +106,13 @@ impl fmt::Debug for Properties {
 /// `fn properties(&self) -> Properties` (used inside `impl Brdf for …`), and with a name
 /// (`brdf_properties!(NAME)`) its [`Brdf::name`](crate::Brdf::name) too.
 macro_rules! brdf_properties {
+    (@has $($predicate:ident: $FLAG:ident),+) => {
+        $(
+            fn $predicate(&self) -> bool {
+                self.properties().contains($crate::models::Properties::$FLAG)
+            }
+        )+
+    };
     ($name:expr) => {
         $crate::models::brdf_properties!();
         fn name(&self) -> &str {
@@ -113,26 +120,12 @@ macro_rules! brdf_properties {
         }
     };
     () => {
-        fn is_isotropic(&self) -> bool {
-            self.properties()
-                .contains($crate::models::Properties::ISOTROPIC)
-        }
-        fn is_mirror_symmetric(&self) -> bool {
-            self.properties()
-                .contains($crate::models::Properties::MIRROR_SYMMETRIC)
-        }
-        fn is_half_turn_symmetric(&self) -> bool {
-            self.properties()
-                .contains($crate::models::Properties::HALF_TURN_SYMMETRIC)
-        }
-        fn is_reciprocal(&self) -> bool {
-            self.properties()
-                .contains($crate::models::Properties::RECIPROCAL)
-        }
-        fn conserves_energy(&self) -> bool {
-            self.properties()
-                .contains($crate::models::Properties::CONSERVES_ENERGY)
-        }
+        $crate::models::brdf_properties!(@has
+            is_isotropic: ISOTROPIC,
+            is_mirror_symmetric: MIRROR_SYMMETRIC,
+            is_half_turn_symmetric: HALF_TURN_SYMMETRIC,
+            is_reciprocal: RECIPROCAL,
+            conserves_energy: CONSERVES_ENERGY);
         fn bounded_at_horizon(&self) -> bool {
             !self
                 .properties()
