@@ -12,22 +12,15 @@
 //! only approximately); the tests confirm albedo ≤ 1 for `rs, rd ≤ 1` at the angles checked, and
 //! `conserves_energy()` reports true.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-registry_entry! {
-    INFO: NAME = "ashikhmin-shirley", ["ashikhmin"], WhenParamsEqual, PARAMS,
-    AshikhminShirley::from_values,
-    "anisotropic Phong with Fresnel and coupled diffuse (Ashikhmin & Shirley 2000)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`AshikhminShirley`].
-    pub struct AshikhminShirleyParams in PARAMS {
+    pub struct AshikhminShirleyParams in PARAMS for AshikhminShirley {
         /// Exponent along x.
         nu = [100.0] in Range::closed(0.0, 1e5), "Phong exponent along the tangent x";
         /// Exponent along y.
@@ -37,6 +30,8 @@ model_params! {
         /// Diffuse reflectance.
         rd = [0.6] in Range::closed(0.0, 1.0), "diffuse reflectance";
     }
+    registry INFO: NAME = "ashikhmin-shirley", ["ashikhmin"], WhenParamsEqual,
+        "anisotropic Phong with Fresnel and coupled diffuse (Ashikhmin & Shirley 2000)";
 }
 
 /// Ashikhmin–Shirley anisotropic Phong BRDF.
@@ -66,8 +61,6 @@ impl AshikhminShirley {
             | Properties::CONSERVES_ENERGY
     }
 }
-
-model_common!(AshikhminShirley(AshikhminShirleyParams));
 
 #[inline]
 fn pow5(x: f64) -> f64 {

@@ -20,23 +20,16 @@
 //! `ior ∈ (0, 100]` (default 0.2), `kappa ∈ [0, 100]` (default 3). Reciprocal and isotropic;
 //! not energy-conserving in general.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-registry_entry! {
-    INFO: NAME = "beard-maxwell", ["beardmaxwell", "beard"], Always, PARAMS,
-    BeardMaxwell::from_values,
-    "painted surfaces: first-surface facets + volumetric terms (Maxwell, Beard et al. 1973)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`BeardMaxwell`].
-    pub struct BeardMaxwellParams in PARAMS {
+    pub struct BeardMaxwellParams in PARAMS for BeardMaxwell {
         /// First-surface reflectance.
         rs = [0.7] in Range::closed(0.0, 1.0), "first-surface (specular) reflectance";
         /// Volumetric Lambertian reflectance.
@@ -54,6 +47,8 @@ model_params! {
         /// Extinction coefficient.
         kappa = [3.0] in Range::closed(0.0, 100.0), "refractive index, imaginary part";
     }
+    registry INFO: NAME = "beard-maxwell", ["beardmaxwell", "beard"], Always,
+        "painted surfaces: first-surface facets + volumetric terms (Maxwell, Beard et al. 1973)";
 }
 
 /// Beard–Maxwell painted-surface BRDF.
@@ -93,8 +88,6 @@ impl BeardMaxwell {
         Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL | Properties::UNBOUNDED_AT_HORIZON
     }
 }
-
-model_common!(BeardMaxwell(BeardMaxwellParams));
 
 impl Brdf for BeardMaxwell {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {

@@ -13,23 +13,16 @@
 //! `kd + ks ≤ 1`. Keys: `m ∈ [0.001, 2]` (RMS slope, default 0.2), `ior ∈ (1, 100]`
 //! (default 1.5), `ks ∈ [0, 1]` (default 0.8), `kd ∈ [0, 1]` (default 0.2). Reciprocal, isotropic.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-registry_entry! {
-    INFO: NAME = "cook-torrance", ["torrance", "ct"], Always, PARAMS,
-    CookTorrance::from_values,
-    "Beckmann D, V-cavity G, dielectric Fresnel (Cook & Torrance 1982)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`CookTorrance`].
-    pub struct CookTorranceParams in PARAMS {
+    pub struct CookTorranceParams in PARAMS for CookTorrance {
         /// RMS slope `m`.
         m = [0.2] in Range::closed(0.001, 2.0), "RMS microfacet slope (Beckmann)";
         /// Index of refraction.
@@ -39,6 +32,8 @@ model_params! {
         /// Diffuse albedo.
         kd = [0.2] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
+    registry INFO: NAME = "cook-torrance", ["torrance", "ct"], Always,
+        "Beckmann D, V-cavity G, dielectric Fresnel (Cook & Torrance 1982)";
 }
 
 /// Cook–Torrance BRDF.
@@ -71,8 +66,6 @@ impl CookTorrance {
             | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
-
-model_common!(CookTorrance(CookTorranceParams));
 
 impl Brdf for CookTorrance {
     #[inline]

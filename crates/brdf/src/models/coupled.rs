@@ -17,20 +17,13 @@
 //! false. Keys: `m ∈ [0.01, 1]` (default 0.2), `f0 ∈ [0, 1]` (default 0.1), `kd ∈ [0, 1]`
 //! (default 0.8). Isotropic.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_schlick;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
-
-registry_entry! {
-    INFO: NAME = "coupled", ["kelemen", "kelemen-szirmay-kalos"], Always, PARAMS,
-    Coupled::from_values,
-    "coupled specular–matte microfacet model (Kelemen & Szirmay-Kalos 2001)"
-}
 
 /// Number of intervals of the albedo table.
 const TABLE_INTERVALS: usize = 256;
@@ -42,9 +35,9 @@ fn node(i: usize) -> f64 {
     x * x
 }
 
-model_params! {
+model! {
     /// Parameters of [`Coupled`].
-    pub struct CoupledParams in PARAMS {
+    pub struct CoupledParams in PARAMS for Coupled {
         /// Beckmann RMS slope.
         m = [0.2] in Range::closed(0.01, 1.0), "RMS microfacet slope (Beckmann)";
         /// Schlick `f0`.
@@ -52,6 +45,8 @@ model_params! {
         /// Matte albedo.
         kd = [0.8] in Range::closed(0.0, 1.0), "matte albedo";
     }
+    registry INFO: NAME = "coupled", ["kelemen", "kelemen-szirmay-kalos"], Always,
+        "coupled specular–matte microfacet model (Kelemen & Szirmay-Kalos 2001)";
 }
 
 /// Kelemen–Szirmay-Kalos coupled specular–matte BRDF.
@@ -197,8 +192,6 @@ impl Coupled {
             | Properties::CONSERVES_ENERGY.when(self.max_raw_albedo <= 1.0 + 1e-9)
     }
 }
-
-model_common!(Coupled(CoupledParams));
 
 impl Brdf for Coupled {
     #[inline]

@@ -51,21 +51,14 @@
 //! `kd ∈ [0, 1]` (uniform diffuse albedo, default 0). Reciprocal and isotropic; energy
 //! conservation is not claimed (Kirchhoff approximation).
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use crate::special::{beckmann_lambda_with_erfc, erfc};
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::LazyLock;
-
-registry_entry! {
-    INFO: NAME = "htsg", ["he", "he-torrance-sillion-greenberg"], Always, PARAMS,
-    Htsg::from_values,
-    "wave-optics directional diffuse, truncated series (He, Torrance, Sillion & Greenberg 1991)"
-}
 
 /// Below this `g` the Poisson series alone is used.
 const G_SERIES_ONLY: f64 = 150.0;
@@ -212,9 +205,9 @@ fn lambert_w0(z: f64) -> f64 {
     w
 }
 
-model_params! {
+model! {
     /// Parameters of [`Htsg`].
-    pub struct HtsgParams in PARAMS {
+    pub struct HtsgParams in PARAMS for Htsg {
         /// RMS roughness σ0 in µm.
         sigma = [0.5] in Range::left_open(0.0, 10.0), "RMS surface height σ0 (µm)";
         /// Autocorrelation length τ in µm.
@@ -228,6 +221,8 @@ model_params! {
         /// Uniform diffuse albedo.
         kd = [0.0] in Range::closed(0.0, 1.0), "uniform-diffuse albedo";
     }
+    registry INFO: NAME = "htsg", ["he", "he-torrance-sillion-greenberg"], Always,
+        "wave-optics directional diffuse, truncated series (He, Torrance, Sillion & Greenberg 1991)";
 }
 
 /// He–Torrance–Sillion–Greenberg BRDF (directional-diffuse + uniform-diffuse).
@@ -428,8 +423,6 @@ impl Htsg {
         Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL
     }
 }
-
-model_common!(Htsg(HtsgParams));
 
 impl Brdf for Htsg {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {

@@ -3,25 +3,20 @@
 //! `f_r = ρ/π`. Parameter `rho ∈ [0, 1]` (default 0.8) is the albedo.
 //! Reciprocal, isotropic, energy-conserving (albedo = ρ exactly).
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::FRAC_1_PI;
 
-registry_entry! {
-    INFO: NAME = "lambert", ["lambertian", "diffuse"], Always, PARAMS,
-    Lambert::from_values,
-    "ideal diffuse ρ/π (Lambert 1760)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`Lambert`].
-    pub struct LambertParams in PARAMS {
+    pub struct LambertParams in PARAMS for Lambert {
         /// Albedo ρ ∈ [0, 1].
         rho = [0.8] in Range::closed(0.0, 1.0), "diffuse albedo ρ";
     }
+    registry INFO: NAME = "lambert", ["lambertian", "diffuse"], Always,
+        "ideal diffuse ρ/π (Lambert 1760)";
 }
 
 /// Lambertian BRDF `ρ/π`.
@@ -46,8 +41,6 @@ impl Lambert {
         Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL | Properties::CONSERVES_ENERGY
     }
 }
-
-model_common!(Lambert(LambertParams));
 
 impl Brdf for Lambert {
     #[inline]

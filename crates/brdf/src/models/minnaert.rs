@@ -7,27 +7,22 @@
 //! Values are finite for every direction strictly above the horizon (the product of cosines is
 //! clamped at 10⁻³⁰⁰ before the power, which only matters for subnormal inputs).
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::PI;
 
-registry_entry! {
-    INFO: NAME = "minnaert", [], Always, PARAMS,
-    Minnaert::from_values,
-    "lunar limb darkening ρ(k+1)/(2π)(cosθi cosθo)^(k−1) (Minnaert 1941)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`Minnaert`].
-    pub struct MinnaertParams in PARAMS {
+    pub struct MinnaertParams in PARAMS for Minnaert {
         /// Albedo.
         rho = [0.8] in Range::closed(0.0, 1.0), "albedo at normal incidence";
         /// Exponent k.
         k = [0.7] in Range::closed(0.0, 2.0), "Minnaert limb-darkening exponent";
     }
+    registry INFO: NAME = "minnaert", [], Always,
+        "lunar limb darkening ρ(k+1)/(2π)(cosθi cosθo)^(k−1) (Minnaert 1941)";
 }
 
 /// Minnaert BRDF.
@@ -57,8 +52,6 @@ impl Minnaert {
                 .when(!(self.params.k >= 1.0 || self.params.rho == 0.0))
     }
 }
-
-model_common!(Minnaert(MinnaertParams));
 
 impl Brdf for Minnaert {
     #[inline]

@@ -11,27 +11,22 @@
 //! small σ its albedo slightly exceeds ρ at grazing view (≈ 1.008 ρ for σ = 0.1 at θo = 89.9°),
 //! so `conserves_energy()` is true only for σ = 0.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
 
-registry_entry! {
-    INFO: NAME = "oren-nayar", ["oren"], Always, PARAMS,
-    OrenNayar::from_values,
-    "rough diffuse, qualitative model (Oren & Nayar 1994)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`OrenNayar`].
-    pub struct OrenNayarParams in PARAMS {
+    pub struct OrenNayarParams in PARAMS for OrenNayar {
         /// Albedo.
         rho = [0.8] in Range::closed(0.0, 1.0), "albedo ρ";
         /// Roughness σ in radians.
         sigma = [0.5] in Range::closed(0.0, FRAC_PI_2), "facet slope deviation σ (radians)";
     }
+    registry INFO: NAME = "oren-nayar", ["oren"], Always,
+        "rough diffuse, qualitative model (Oren & Nayar 1994)";
 }
 
 /// Oren–Nayar rough-diffuse BRDF (qualitative model).
@@ -63,8 +58,6 @@ impl OrenNayar {
             | Properties::CONSERVES_ENERGY.when(self.params.sigma == 0.0)
     }
 }
-
-model_common!(OrenNayar(OrenNayarParams));
 
 impl Brdf for OrenNayar {
     #[inline]

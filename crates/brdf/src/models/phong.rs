@@ -8,22 +8,15 @@
 //! The `(n+2)/(2π)` factor makes the specular lobe's albedo exactly `ks` at normal incidence and
 //! smaller elsewhere, so the model conserves energy iff `kd + ks ≤ 1`. Reciprocal and isotropic.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, PI};
 
-registry_entry! {
-    INFO: NAME = "phong", ["modified-phong"], Always, PARAMS,
-    Phong::from_values,
-    "modified energy-conserving Phong, kd/π + ks(n+2)/(2π) cos^n α (Phong 1975; Lafortune & Willems 1994)"
-}
-
-model_params! {
+model! {
     /// Parameters of [`Phong`].
-    pub struct PhongParams in PARAMS {
+    pub struct PhongParams in PARAMS for Phong {
         /// Cosine-lobe exponent `n ≥ 0`.
         n = [50.0] in Range::closed(0.0, 1e5), "specular exponent";
         /// Specular coefficient.
@@ -31,6 +24,8 @@ model_params! {
         /// Diffuse coefficient.
         kd = [0.3] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
+    registry INFO: NAME = "phong", ["modified-phong"], Always,
+        "modified energy-conserving Phong, kd/π + ks(n+2)/(2π) cos^n α (Phong 1975; Lafortune & Willems 1994)";
 }
 
 /// Modified Phong BRDF.
@@ -60,8 +55,6 @@ impl Phong {
             | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
-
-model_common!(Phong(PhongParams));
 
 impl Brdf for Phong {
     #[inline]

@@ -52,22 +52,15 @@
 //! anisotropic. Visible cylinder area projects exactly onto `d cosθ` per period, and masking
 //! only removes light, so the model conserves energy when `kd + ks ≤ 1`.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
 use crate::quadrature::GaussLegendre;
-use crate::registry::registry_entry;
 use crate::special::ln_gamma_diff;
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 use std::sync::LazyLock;
-
-registry_entry! {
-    INFO: NAME = "poulin-fournier", ["poulin"], Never, PARAMS,
-    PoulinFournier::from_values,
-    "anisotropic parallel cylinders with Phong surface (Poulin & Fournier 1990)"
-}
 
 /// Gauss–Legendre nodes/weights on [−1, 1] (12 points) for the specular panels (`n_exp < 10`).
 const GL_POINTS: usize = 12;
@@ -165,9 +158,9 @@ struct Lobe {
     u_whole: f64,
 }
 
-model_params! {
+model! {
     /// Parameters of [`PoulinFournier`].
-    pub struct PoulinFournierParams in PARAMS {
+    pub struct PoulinFournierParams in PARAMS for PoulinFournier {
         /// Centre spacing in cylinder radii.
         d = [2.0] in Range::closed(2.0, 100.0), "cylinder spacing in radii (2 = touching)";
         /// Local Phong exponent.
@@ -177,6 +170,8 @@ model_params! {
         /// Local diffuse albedo.
         kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo of the cylinder surface";
     }
+    registry INFO: NAME = "poulin-fournier", ["poulin"], Never,
+        "anisotropic parallel cylinders with Phong surface (Poulin & Fournier 1990)";
 }
 
 /// Poulin–Fournier parallel-cylinder anisotropic BRDF.
@@ -422,8 +417,6 @@ impl PoulinFournier {
             | Properties::CONSERVES_ENERGY.when(self.params.kd + self.params.ks <= 1.0)
     }
 }
-
-model_common!(PoulinFournier(PoulinFournierParams));
 
 impl Brdf for PoulinFournier {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {

@@ -17,25 +17,18 @@
 //! `t ∈ [0, 1]` (default 0), `c ∈ [0, 1]` (default 0.8). Isotropic; not reciprocal (`F` and
 //! the `1/cosθi` use the incidence angle only); not energy-conserving.
 
-use super::{Properties, brdf_properties, model_common, model_params};
+use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
-use crate::registry::registry_entry;
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
-
-registry_entry! {
-    INFO: NAME = "strauss", [], Always, PARAMS,
-    Strauss::from_values,
-    "smoothness/metalness artist model (Strauss 1990)"
-}
 
 const KF: f64 = 1.12;
 const KG: f64 = 1.01;
 
-model_params! {
+model! {
     /// Parameters of [`Strauss`].
-    pub struct StraussParams in PARAMS {
+    pub struct StraussParams in PARAMS for Strauss {
         /// Smoothness.
         s = [0.8] in Range::closed(0.0, 0.99), "smoothness";
         /// Metalness.
@@ -45,6 +38,8 @@ model_params! {
         /// Colour.
         c = [0.8] in Range::closed(0.0, 1.0), "surface colour (grey level)";
     }
+    registry INFO: NAME = "strauss", [], Always,
+        "smoothness/metalness artist model (Strauss 1990)";
 }
 
 /// Strauss BRDF.
@@ -91,8 +86,6 @@ impl Strauss {
         Properties::ISOTROPIC_SYMMETRIC | Properties::UNBOUNDED_AT_HORIZON
     }
 }
-
-model_common!(Strauss(StraussParams));
 
 impl Brdf for Strauss {
     #[inline]
