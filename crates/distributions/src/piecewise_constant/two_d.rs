@@ -236,6 +236,7 @@ impl Sampler2D for PiecewiseConstant2D {
         let w = self.width;
         let mut cols = [0.0f64; BLOCK];
         let mut rows = [(0usize, 0.0f64); BLOCK];
+        let mut guide_at = [0usize; BLOCK];
         let mut starts = [0u32; BLOCK];
         let mut firsts = [0.0f64; BLOCK];
         for chunk in out.chunks_mut(BLOCK) {
@@ -243,14 +244,21 @@ impl Sampler2D for PiecewiseConstant2D {
                 let u0 = clamp_unit(u.next_uniform());
                 let u1 = clamp_unit(u.next_uniform());
                 let (row, dv) = self.marginal.find(u1);
-                let g = guide_bucket(u0, w);
                 cols[j] = u0;
                 rows[j] = (row, dv);
-                starts[j] = self.conditional_guide[row * w + g];
+                guide_at[j] = row * w + guide_bucket(u0, w);
             }
-            // Second stage: the conditional entry each scan starts from, loaded for the whole
-            // block in a branch-free loop, so that these misses overlap too (in the scan loop
-            // below they would wait behind its data-dependent branches).
+            // The guide entries (4 bytes per cell, mostly out of cache on a large map), loaded
+            // for the whole block in a loop of a few instructions per sample, so that many of
+            // their misses are in flight at once (inside the loop above, whose generator and
+            // row search take tens of instructions per sample, few would be). Coarser guides
+            // (one entry per 4 or 16 cells, more of them cached, longer scans) measured
+            // slower: docs/benchmarks.md §20.2 (the second one).
+            for j in 0..chunk.len() {
+                starts[j] = self.conditional_guide[guide_at[j]];
+            }
+            // Then the conditional entry each scan starts from, the same way (in the scan
+            // loop below these misses would wait behind its data-dependent branches).
             for j in 0..chunk.len() {
                 firsts[j] = self.conditional[rows[j].0 * (w + 1) + starts[j] as usize][0];
             }
