@@ -7,6 +7,7 @@ use super::cdf::{
     cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, invert_cell, place,
     validate_values,
 };
+use super::error::{FORMAT_VERSION, check_version};
 
 /// One draw of a [`PiecewiseConstant1D`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -202,17 +203,10 @@ struct Table1DData {
     values: Vec<f64>,
 }
 
-const FORMAT_VERSION: u32 = 1;
-
 impl TryFrom<Table1DData> for PiecewiseConstant1D {
     type Error = PiecewiseConstantError;
     fn try_from(d: Table1DData) -> Result<Self, PiecewiseConstantError> {
-        if d.version != FORMAT_VERSION {
-            return Err(PiecewiseConstantError::FormatVersion {
-                found: d.version,
-                expected: FORMAT_VERSION,
-            });
-        }
+        check_version(d.version)?;
         Self::new(d.values, d.min, d.max)
     }
 }

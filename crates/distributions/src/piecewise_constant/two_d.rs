@@ -7,6 +7,7 @@ use super::cdf::{
     cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms,
     invert_in, place, scan_from, validate_values,
 };
+use super::error::{FORMAT_VERSION, check_version};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
 
 /// A density on a rectangle proportional to a `width × height` grid of non-negative values,
@@ -324,17 +325,10 @@ struct Table2DData {
     values: Vec<f64>,
 }
 
-const FORMAT_VERSION: u32 = 1;
-
 impl TryFrom<Table2DData> for PiecewiseConstant2D {
     type Error = PiecewiseConstantError;
     fn try_from(d: Table2DData) -> Result<Self, PiecewiseConstantError> {
-        if d.version != FORMAT_VERSION {
-            return Err(PiecewiseConstantError::FormatVersion {
-                found: d.version,
-                expected: FORMAT_VERSION,
-            });
-        }
+        check_version(d.version)?;
         let [x0, y0, x1, y1] = d.domain;
         Self::new(d.width, d.height, d.values, Rect { x0, y0, x1, y1 })
     }
