@@ -254,7 +254,7 @@ impl Sampler2D for PiecewiseConstant2D {
             // their misses are in flight at once (inside the loop above, whose generator and
             // row search take tens of instructions per sample, few would be). Coarser guides
             // (one entry per 4 or 16 cells, more of them cached, longer scans) measured
-            // slower: docs/benchmarks.md §20.2 (the second one).
+            // slower: docs/benchmarks.md §20.5.
             for j in 0..chunk.len() {
                 starts[j] = self.conditional_guide[guide_at[j]];
             }
