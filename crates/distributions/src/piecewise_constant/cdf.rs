@@ -16,18 +16,37 @@ pub fn clamp_unit(u: f64) -> f64 {
     }
 }
 
-/// Checks that every value is finite and non-negative; `width` names columns in errors.
-pub(crate) fn validate_values(values: &[f64], width: usize) -> Result<(), PiecewiseConstantError> {
-    for (i, &value) in values.iter().enumerate() {
-        let (column, row) = (i % width.max(1), i / width.max(1));
+/// Checks that every value is finite and non-negative, in 1D terms: the first offending
+/// cell's index and value, as [`PiecewiseConstantError::NonFiniteValue`] or
+/// [`PiecewiseConstantError::NegativeValue`] (a 2D table renames the index to its column and
+/// row with [`in_2d_terms`]).
+pub(crate) fn validate_values(values: &[f64]) -> Result<(), PiecewiseConstantError> {
+    for (index, &value) in values.iter().enumerate() {
         if !value.is_finite() {
-            return Err(PiecewiseConstantError::NonFinite { column, row, value });
+            return Err(PiecewiseConstantError::NonFiniteValue { index, value });
         }
         if !(value >= 0.0) {
-            return Err(PiecewiseConstantError::Negative { column, row, value });
+            return Err(PiecewiseConstantError::NegativeValue { index, value });
         }
     }
     Ok(())
+}
+
+/// A 1D cell error of a row-major `width`-column grid in 2D terms (column and row); other
+/// errors unchanged.
+pub(crate) fn in_2d_terms(e: PiecewiseConstantError, width: usize) -> PiecewiseConstantError {
+    let at = |index: usize| (index % width.max(1), index / width.max(1));
+    match e {
+        PiecewiseConstantError::NonFiniteValue { index, value } => {
+            let (column, row) = at(index);
+            PiecewiseConstantError::NonFinite { column, row, value }
+        }
+        PiecewiseConstantError::NegativeValue { index, value } => {
+            let (column, row) = at(index);
+            PiecewiseConstantError::Negative { column, row, value }
+        }
+        other => other,
+    }
 }
 
 /// Writes the normalised CDF of `values` (non-negative masses of `n` cells) into `cdf`

@@ -99,3 +99,18 @@ pub enum PiecewiseConstantError {
         expected: u32,
     },
 }
+
+/// The serialised tables' format version (1D and 2D alike: both store their inputs).
+pub(crate) const FORMAT_VERSION: u32 = 1;
+
+/// `Ok` when a serialised table's `version` is [`FORMAT_VERSION`].
+pub(crate) fn check_version(version: u32) -> Result<(), PiecewiseConstantError> {
+    if version == FORMAT_VERSION {
+        Ok(())
+    } else {
+        Err(PiecewiseConstantError::FormatVersion {
+            found: version,
+            expected: FORMAT_VERSION,
+        })
+    }
+}

@@ -3,7 +3,11 @@
 use serde::{Deserialize, Serialize};
 
 use super::PiecewiseConstantError;
-use super::cdf::{cell_of, clamp_unit, fill_cdf, find_cell, invert_cell, place, validate_values};
+use super::cdf::{
+    cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, invert_cell, place,
+    validate_values,
+};
+use super::error::{FORMAT_VERSION, check_version};
 
 /// One draw of a [`PiecewiseConstant1D`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,6 +36,11 @@ pub struct Sample1 {
 pub struct PiecewiseConstant1D {
     values: Vec<f64>,
     cdf: Vec<f64>,
+    /// Guide table of `cdf` (`n` entries, [`fill_guide`]): the search starts there instead of
+    /// a binary search (the same cell and position, bit for bit).
+    guide: Vec<u32>,
+    /// `Σ values`, as [`fill_cdf`] summed them (a 2D table's marginal gives it its total).
+    sum: f64,
     integral: f64,
     min: f64,
     max: f64,
@@ -55,22 +64,7 @@ impl PiecewiseConstant1D {
         if !(min.is_finite() && max.is_finite() && min < max) {
             return Err(PiecewiseConstantError::InvalidInterval { min, max });
         }
-        // One row: the 2D kernel's (column, 0) is the cell index.
-        validate_values(&values, values.len()).map_err(|e| match e {
-            PiecewiseConstantError::NonFinite { column, value, .. } => {
-                PiecewiseConstantError::NonFiniteValue {
-                    index: column,
-                    value,
-                }
-            }
-            PiecewiseConstantError::Negative { column, value, .. } => {
-                PiecewiseConstantError::NegativeValue {
-                    index: column,
-                    value,
-                }
-            }
-            other => other,
-        })?;
+        validate_values(&values)?;
         let mut cdf = vec![0.0; values.len() + 1];
         let sum = fill_cdf(&values, &mut cdf);
         if !sum.is_finite() {
@@ -79,6 +73,8 @@ impl PiecewiseConstant1D {
         if !(sum > 0.0) {
             return Err(PiecewiseConstantError::AllZero);
         }
+        let mut guide = vec![0u32; values.len()];
+        fill_guide(&cdf, &mut guide);
         let n = values.len() as f64;
         let integral = sum * (max - min) / n;
         if !(integral.is_finite() && integral > 0.0) {
@@ -87,6 +83,8 @@ impl PiecewiseConstant1D {
         Ok(Self {
             values,
             cdf,
+            guide,
+            sum,
             integral,
             min,
             max,
@@ -128,41 +126,71 @@ impl PiecewiseConstant1D {
     /// Warps one uniform `u ∈ [0,1)` (clamped into it) to a point, its pdf and its cell.
     #[inline]
     pub fn sample(&self, u: f64) -> Sample1 {
-        let (index, du) = find_cell(&self.cdf, clamp_unit(u));
-        let x = place(self.min, self.max, self.cell, self.inv_cell, index, du);
+        let (index, du) = self.find(u);
         Sample1 {
-            x,
+            x: self.place(index, du),
             pdf: self.values[index] / self.integral,
             index,
         }
     }
 
+    /// The cell `i` with `cdf[i] ≤ u < cdf[i+1]` of `u` (clamped into `[0, 1)`) and the
+    /// position of `u` inside it, from the guide table (the binary search's answer).
+    #[inline(always)]
+    pub(crate) fn find(&self, u: f64) -> (usize, f64) {
+        find_cell_guided(&self.cdf, &self.guide, clamp_unit(u))
+    }
+
+    /// The point at position `du ∈ [0, 1)` of cell `index`, in `[min, max)` and inside that
+    /// cell as [`Self::pdf`] locates it.
+    #[inline(always)]
+    pub(crate) fn place(&self, index: usize, du: f64) -> f64 {
+        place(self.min, self.max, self.cell, self.inv_cell, index, du)
+    }
+
+    /// `Σ values` (unnormalised, before the cell width).
+    pub(crate) fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// The cell of `x ∈ [min, max]` and the position of `x` inside it; `None` outside.
+    #[inline]
+    pub(crate) fn locate(&self, x: f64) -> Option<(usize, f64)> {
+        if !(x >= self.min && x <= self.max) {
+            return None;
+        }
+        Some(cell_of((x - self.min) * self.inv_cell, self.values.len()))
+    }
+
     /// Density at `x` with respect to length; 0 outside `[min, max]`.
     pub fn pdf(&self, x: f64) -> f64 {
-        if !(x >= self.min && x <= self.max) {
-            return 0.0;
+        match self.locate(x) {
+            Some((i, _)) => self.values[i] / self.integral,
+            None => 0.0,
         }
-        let (i, _) = cell_of((x - self.min) * self.inv_cell, self.values.len());
-        self.values[i] / self.integral
     }
 
     /// The `u` that [`Self::sample`] maps to `x`; `None` outside `[min, max]` or where the
     /// density is zero.
     pub fn invert(&self, x: f64) -> Option<f64> {
-        if !(x >= self.min && x <= self.max) {
-            return None;
-        }
-        let (i, du) = cell_of((x - self.min) * self.inv_cell, self.values.len());
+        let (i, du) = self.locate(x)?;
         if self.values[i] == 0.0 {
             return None;
         }
-        Some(invert_cell(&self.cdf, i, du))
+        Some(self.invert_cell(i, du))
+    }
+
+    /// The `u` mapped to position `du ∈ [0, 1]` of cell `i`.
+    #[inline]
+    pub(crate) fn invert_cell(&self, i: usize, du: f64) -> f64 {
+        invert_cell(&self.cdf, i, du)
     }
 
     /// Heap and inline bytes used by the table.
     pub fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + (self.values.capacity() + self.cdf.capacity()) * std::mem::size_of::<f64>()
+            + self.guide.capacity() * std::mem::size_of::<u32>()
     }
 }
 
@@ -175,17 +203,10 @@ struct Table1DData {
     values: Vec<f64>,
 }
 
-const FORMAT_VERSION: u32 = 1;
-
 impl TryFrom<Table1DData> for PiecewiseConstant1D {
     type Error = PiecewiseConstantError;
     fn try_from(d: Table1DData) -> Result<Self, PiecewiseConstantError> {
-        if d.version != FORMAT_VERSION {
-            return Err(PiecewiseConstantError::FormatVersion {
-                found: d.version,
-                expected: FORMAT_VERSION,
-            });
-        }
+        check_version(d.version)?;
         Self::new(d.values, d.min, d.max)
     }
 }

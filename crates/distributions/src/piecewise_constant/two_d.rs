@@ -3,11 +3,12 @@
 use crate::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource};
 use serde::{Deserialize, Serialize};
 
-use super::PiecewiseConstantError;
 use super::cdf::{
-    cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, invert_cell,
+    cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms,
     invert_in, place, scan_from, validate_values,
 };
+use super::error::{FORMAT_VERSION, check_version};
+use super::{PiecewiseConstant1D, PiecewiseConstantError};
 
 /// A density on a rectangle proportional to a `width × height` grid of non-negative values,
 /// constant on each cell, sampled by inverting the marginal CDF of the rows and then the
@@ -42,11 +43,9 @@ pub struct PiecewiseConstant2D {
     /// entry's value is 0) so that the value of the sampled cell shares a cache line with the
     /// CDF entries the binary search just read.
     conditional: Vec<[f64; 2]>,
-    /// Marginal CDF over rows, `height + 1` entries.
-    marginal: Vec<f64>,
-    /// Guide table of the marginal CDF (`height` entries, see `cdf::fill_guide_by`): the row
-    /// search starts there instead of a binary search.
-    marginal_guide: Vec<u32>,
+    /// The marginal over rows: the 1D table of the row sums on `[y0, y1]` (its guide table
+    /// starts the row search; its warp places the `y` coordinate).
+    marginal: PiecewiseConstant1D,
     /// Guide tables of the conditional CDFs, `width` entries per row, concatenated: one
     /// cache line read and a short scan instead of ~log₂(width) dependent probes of a long row.
     /// The warp is unchanged (same cell, same position, bit for bit).
@@ -93,7 +92,7 @@ impl PiecewiseConstant2D {
         {
             return Err(PiecewiseConstantError::InvalidDomain { x0, y0, x1, y1 });
         }
-        validate_values(&values, width)?;
+        validate_values(&values).map_err(|e| in_2d_terms(e, width))?;
 
         let mut conditional = Vec::with_capacity(height * (width + 1));
         let mut row_sums = Vec::with_capacity(height);
@@ -113,16 +112,13 @@ impl PiecewiseConstant2D {
         {
             fill_guide_by(entries, |e| e[0], guide);
         }
-        let mut marginal = vec![0.0; height + 1];
-        let total = fill_cdf(&row_sums, &mut marginal);
-        let mut marginal_guide = vec![0u32; height];
-        fill_guide_by(&marginal, |&c| c, &mut marginal_guide);
-        if !total.is_finite() || row_sums.iter().any(|s| !s.is_finite()) {
-            return Err(PiecewiseConstantError::TotalNotFinite);
-        }
-        if !(total > 0.0) {
-            return Err(PiecewiseConstantError::AllZero);
-        }
+        // The row sums are finite and non-negative unless one overflowed: the 1D table's
+        // `NonFiniteValue` of a row sum is the 2D table's overflowing total.
+        let marginal = PiecewiseConstant1D::new(row_sums, y0, y1).map_err(|e| match e {
+            PiecewiseConstantError::NonFiniteValue { .. } => PiecewiseConstantError::TotalNotFinite,
+            other => other,
+        })?;
+        let total = marginal.sum();
         let cell = [(x1 - x0) / width as f64, (y1 - y0) / height as f64];
         let integral = total * cell[0] * cell[1];
         if !(integral.is_finite() && integral > 0.0) {
@@ -134,7 +130,6 @@ impl PiecewiseConstant2D {
             domain,
             conditional,
             marginal,
-            marginal_guide,
             conditional_guide,
             inv_integral: 1.0 / integral,
             cell,
@@ -211,7 +206,7 @@ impl PiecewiseConstant2D {
         Sample2 {
             point: [
                 place(d.x0, d.x1, self.cell[0], self.inv_cell[0], col, du),
-                place(d.y0, d.y1, self.cell[1], self.inv_cell[1], row, dv),
+                self.marginal.place(row, dv),
             ],
             pdf: value * self.inv_integral,
         }
@@ -242,22 +237,29 @@ impl Sampler2D for PiecewiseConstant2D {
         let w = self.width;
         let mut cols = [0.0f64; BLOCK];
         let mut rows = [(0usize, 0.0f64); BLOCK];
+        let mut guide_at = [0usize; BLOCK];
         let mut starts = [0u32; BLOCK];
         let mut firsts = [0.0f64; BLOCK];
         for chunk in out.chunks_mut(BLOCK) {
             for j in 0..chunk.len() {
                 let u0 = clamp_unit(u.next_uniform());
                 let u1 = clamp_unit(u.next_uniform());
-                let (row, dv) =
-                    find_cell_guided_by(&self.marginal, |&c| c, &self.marginal_guide, u1);
-                let g = guide_bucket(u0, w);
+                let (row, dv) = self.marginal.find(u1);
                 cols[j] = u0;
                 rows[j] = (row, dv);
-                starts[j] = self.conditional_guide[row * w + g];
+                guide_at[j] = row * w + guide_bucket(u0, w);
             }
-            // Second stage: the conditional entry each scan starts from, loaded for the whole
-            // block in a branch-free loop, so that these misses overlap too (in the scan loop
-            // below they would wait behind its data-dependent branches).
+            // The guide entries (4 bytes per cell, mostly out of cache on a large map), loaded
+            // for the whole block in a loop of a few instructions per sample, so that many of
+            // their misses are in flight at once (inside the loop above, whose generator and
+            // row search take tens of instructions per sample, few would be). Coarser guides
+            // (one entry per 4 or 16 cells, more of them cached, longer scans) measured
+            // slower: docs/benchmarks.md §20.5.
+            for j in 0..chunk.len() {
+                starts[j] = self.conditional_guide[guide_at[j]];
+            }
+            // Then the conditional entry each scan starts from, the same way (in the scan
+            // loop below these misses would wait behind its data-dependent branches).
             for j in 0..chunk.len() {
                 firsts[j] = self.conditional[rows[j].0 * (w + 1) + starts[j] as usize][0];
             }
@@ -283,9 +285,8 @@ impl Sampler2D for PiecewiseConstant2D {
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.conditional.capacity() * std::mem::size_of::<[f64; 2]>()
-            + self.marginal.capacity() * std::mem::size_of::<f64>()
-            + (self.marginal_guide.capacity() + self.conditional_guide.capacity())
-                * std::mem::size_of::<u32>()
+            + (self.marginal.bytes_used() - std::mem::size_of::<PiecewiseConstant1D>())
+            + self.conditional_guide.capacity() * std::mem::size_of::<u32>()
     }
 }
 
@@ -293,12 +294,7 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
     /// Inputs outside `[0,1)` (and NaN) are clamped into it.
     #[inline]
     fn sample_square(&self, u: Point2) -> Sample2 {
-        let (row, dv) = find_cell_guided_by(
-            &self.marginal,
-            |&c| c,
-            &self.marginal_guide,
-            clamp_unit(u[1]),
-        );
+        let (row, dv) = self.marginal.find(u[1]);
         let start = row * (self.width + 1);
         let entries = &self.conditional[start..start + self.width + 1];
         let guide = &self.conditional_guide[row * self.width..(row + 1) * self.width];
@@ -314,7 +310,7 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
             return None;
         }
         let u0 = invert_in(lo, self.entry(c + 1, r)[0], du);
-        let u1 = invert_cell(&self.marginal, r, dv);
+        let u1 = self.marginal.invert_cell(r, dv);
         Some([u0, u1])
     }
 }
@@ -329,17 +325,10 @@ struct Table2DData {
     values: Vec<f64>,
 }
 
-const FORMAT_VERSION: u32 = 1;
-
 impl TryFrom<Table2DData> for PiecewiseConstant2D {
     type Error = PiecewiseConstantError;
     fn try_from(d: Table2DData) -> Result<Self, PiecewiseConstantError> {
-        if d.version != FORMAT_VERSION {
-            return Err(PiecewiseConstantError::FormatVersion {
-                found: d.version,
-                expected: FORMAT_VERSION,
-            });
-        }
+        check_version(d.version)?;
         let [x0, y0, x1, y1] = d.domain;
         Self::new(d.width, d.height, d.values, Rect { x0, y0, x1, y1 })
     }
@@ -355,5 +344,107 @@ impl From<PiecewiseConstant2D> for Table2DData {
             domain: [x0, y0, x1, y1],
             values: t.values(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::cdf::{find_cell, place};
+    use super::*;
+
+    /// Tables with empty cells and rows, a spike, and a non-unit, non-square domain.
+    fn tables() -> Vec<PiecewiseConstant2D> {
+        let d = Rect {
+            x0: -1.5,
+            y0: 0.25,
+            x1: 2.0,
+            y1: 0.75,
+        };
+        let spike: Vec<f64> = (0..24 * 9)
+            .map(|k| if k == 100 { 1e6 } else { (k % 5) as f64 })
+            .collect();
+        let holes: Vec<f64> = (0..7 * 5)
+            .map(|k| {
+                if k / 7 == 2 || k % 3 == 0 {
+                    0.0
+                } else {
+                    1.0 + k as f64
+                }
+            })
+            .collect();
+        vec![
+            PiecewiseConstant2D::new(24, 9, spike, d).unwrap(),
+            PiecewiseConstant2D::new(7, 5, holes, Rect::UNIT).unwrap(),
+            PiecewiseConstant2D::new(1, 1, vec![2.0], d).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn the_marginal_is_the_1d_table_of_the_row_sums() {
+        for t in tables() {
+            let (w, h) = (t.width(), t.height());
+            let values = t.values();
+            let sums: Vec<f64> = values.chunks_exact(w).map(|r| r.iter().sum()).collect();
+            let d = t.domain();
+            let m = PiecewiseConstant1D::new(sums.clone(), d.y0, d.y1).unwrap();
+            // The row search and the y coordinate are the 1D warp's, bit for bit; the x
+            // coordinate is the conditional's binary search placed on the row.
+            let mut row_cdf = vec![0.0; h + 1];
+            fill_cdf(&sums, &mut row_cdf);
+            for k in 0..4000 {
+                let u = [(k as f64 * 0.618_034) % 1.0, (k as f64 + 0.5) / 4000.0];
+                let s = t.sample_square(u);
+                let y = m.sample(u[1]);
+                assert_eq!(s.point[1].to_bits(), y.x.to_bits(), "u {u:?}");
+                let (row, _) = find_cell(&row_cdf, u[1]);
+                assert_eq!(row, y.index);
+                let mut cdf = vec![0.0; w + 1];
+                fill_cdf(&values[row * w..(row + 1) * w], &mut cdf);
+                let (col, du) = find_cell(&cdf, u[0]);
+                let dx = (d.x1 - d.x0) / w as f64;
+                let x_ref = place(d.x0, d.x1, dx, w as f64 / (d.x1 - d.x0), col, du);
+                assert_eq!(s.point[0].to_bits(), x_ref.to_bits(), "u {u:?}");
+                let pdf = values[row * w + col] / t.integral();
+                assert!((s.pdf - pdf).abs() <= 1e-14 * pdf, "u {u:?}");
+                let inv = t.invert(s.point).unwrap();
+                assert!((inv[1] - u[1]).abs() < 1e-9 && (inv[0] - u[0]).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn errors_name_the_cell_in_2d_and_the_overflow_as_the_total() {
+        let e = PiecewiseConstant2D::new(3, 2, vec![1.0, 1.0, 1.0, 1.0, -2.0, 1.0], Rect::UNIT);
+        assert_eq!(
+            e.unwrap_err(),
+            PiecewiseConstantError::Negative {
+                column: 1,
+                row: 1,
+                value: -2.0
+            }
+        );
+        let e = PiecewiseConstant2D::new(2, 2, vec![1.0, 1.0, f64::NAN, 1.0], Rect::UNIT);
+        assert!(matches!(
+            e.unwrap_err(),
+            PiecewiseConstantError::NonFinite {
+                column: 0,
+                row: 1,
+                ..
+            }
+        ));
+        // Each value finite, a row sum overflows: the total is not finite.
+        let e = PiecewiseConstant2D::new(2, 2, vec![f64::MAX, f64::MAX, 1.0, 1.0], Rect::UNIT);
+        assert_eq!(e.unwrap_err(), PiecewiseConstantError::TotalNotFinite);
+        let e = PiecewiseConstant2D::new(2, 2, vec![0.0; 4], Rect::UNIT);
+        assert_eq!(e.unwrap_err(), PiecewiseConstantError::AllZero);
+        // The 1D table names the same cell by its index.
+        let e = PiecewiseConstant1D::new(vec![1.0, 1.0, 1.0, 1.0, -2.0], 0.0, 1.0);
+        assert_eq!(
+            e.unwrap_err(),
+            PiecewiseConstantError::NegativeValue {
+                index: 4,
+                value: -2.0
+            }
+        );
     }
 }
