@@ -49,7 +49,6 @@ pub mod hemisphere;
 pub mod lobe;
 pub mod options;
 pub mod rgl_native;
-pub mod sphere;
 pub mod srbf;
 
 pub use cdf::{CascadeCdf, CdfReport, TabulatedCdf};
@@ -61,5 +60,4 @@ pub use options::{
     LobeOptions, NmfCost, Reparam, SrbfOptions,
 };
 pub use rgl_native::{NotRglError, RglNative};
-pub use sphere::UniformSphere;
 pub use srbf::{SrbfError, SrbfSampler};

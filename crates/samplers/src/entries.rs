@@ -142,19 +142,6 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         applies_to: None,
         study: Some(1),
     },
-    SamplerEntry {
-        name: "uniform-sphere",
-        summary: "uniform directions on the sphere, p = 1/(4π); below-horizon samples contribute zero",
-        capabilities: BLIND,
-        constructor: Constructor::Direction {
-            support: Support::Sphere,
-            build: |_| Ok(BuiltDirection::plain(Arc::new(baselines::UniformSphere))),
-        },
-        options: &[],
-        check: None,
-        applies_to: None,
-        study: Some(15),
-    },
     // -- lobe baselines (lobe-sphere, lobe-hemisphere, analytic) --
     SamplerEntry {
         name: "lobe-sphere",
