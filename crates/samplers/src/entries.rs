@@ -428,45 +428,73 @@ fn has_analytic_lobes(brdf: &dyn Brdf) -> Result<(), String> {
 /// The largest `usize` as a `u64` (options whose range the sampler's own check states).
 const ANY: u64 = usize::MAX as u64;
 
+/// An integer option in `min ..= max`.
+const fn int(
+    name: &'static str,
+    value_name: &'static str,
+    help: &'static str,
+    (min, max): (u64, u64),
+    set: fn(&mut BaselineOptions, u64),
+) -> OptionSpec {
+    OptionSpec {
+        name,
+        value_name,
+        help,
+        kind: OptionKind::Int { min, max, set },
+    }
+}
+
+/// A real option in the interval `(lo, hi)`.
+const fn real(
+    name: &'static str,
+    value_name: &'static str,
+    help: &'static str,
+    (lo, hi): (End, End),
+    set: fn(&mut BaselineOptions, f64),
+) -> OptionSpec {
+    OptionSpec {
+        name,
+        value_name,
+        help,
+        kind: OptionKind::Real { lo, hi, set },
+    }
+}
+
+/// `(min, max)` of a `usize` range as `u64`s.
+const fn range((min, max): (usize, usize)) -> (u64, u64) {
+    (min as u64, max as u64)
+}
+
 /// Options of the cosine-lobe baselines (`lobe-sphere`, `lobe-hemisphere`).
 static LOBE_OPTIONS: &[OptionSpec] = &[
-    OptionSpec {
-        name: "lobe-exponent",
-        value_name: "N",
-        help: "Fixed exponent of the lobe-sphere / lobe-hemisphere samplers, in [0, 1e6] (default: fitted per outgoing slice by minimising the estimator's second moment)",
-        kind: OptionKind::Real {
-            lo: End::Closed(0.0),
-            hi: End::Closed(LobeOptions::MAX_EXPONENT),
-            set: |o, n| {
-                o.lobe.exponent = Some(n);
-                o.lobe.max_exponent = o.lobe.max_exponent.max(n);
-            },
+    real(
+        "lobe-exponent",
+        "N",
+        "Fixed exponent of the lobe-sphere / lobe-hemisphere samplers, in [0, 1e6] (default: fitted per outgoing slice by minimising the estimator's second moment)",
+        (End::Closed(0.0), End::Closed(LobeOptions::MAX_EXPONENT)),
+        |o, n| {
+            o.lobe.exponent = Some(n);
+            o.lobe.max_exponent = o.lobe.max_exponent.max(n);
         },
-    },
-    OptionSpec {
-        name: "lobe-slices",
-        value_name: "K",
-        help: "Number of outgoing θo slices of the lobe fit, in [1, 1024] (default 16)",
-        kind: OptionKind::Int {
-            min: 1,
-            max: LobeOptions::MAX_SLICES as u64,
-            set: |o, k| o.lobe.slices = k as usize,
-        },
-    },
+    ),
+    int(
+        "lobe-slices",
+        "K",
+        "Number of outgoing θo slices of the lobe fit, in [1, 1024] (default 16)",
+        range((1, LobeOptions::MAX_SLICES)),
+        |o, k| o.lobe.slices = k as usize,
+    ),
 ];
 
 /// Options of the per-slice CDFs: `tabulated-cdf` takes the first four, `cascade-cdf` all.
 static CDF_OPTIONS: &[OptionSpec] = &[
-    OptionSpec {
-        name: "cdf-slices",
-        value_name: "N",
-        help: "CDF baselines: outgoing θ slices of an isotropic BRDF (1 ..= 1024; default 32)",
-        kind: OptionKind::Int {
-            min: 1,
-            max: CdfOptions::MAX_SLICES as u64,
-            set: |o, n| o.cdf.slices = n as usize,
-        },
-    },
+    int(
+        "cdf-slices",
+        "N",
+        "CDF baselines: outgoing θ slices of an isotropic BRDF (1 ..= 1024; default 32)",
+        range((1, CdfOptions::MAX_SLICES)),
+        |o, n| o.cdf.slices = n as usize,
+    ),
     OptionSpec {
         name: "cdf-anisotropic-slices",
         value_name: "THETAxPHI",
@@ -491,26 +519,20 @@ static CDF_OPTIONS: &[OptionSpec] = &[
             set: |o, v| (o.cdf.n_z, o.cdf.n_phi) = (v[0] as usize, v[1] as usize),
         },
     },
-    OptionSpec {
-        name: "cdf-supersampling",
-        value_name: "N",
-        help: "CDF baselines: BRDF evaluations per cell and axis (1 ..= 16; default 3)",
-        kind: OptionKind::Int {
-            min: 1,
-            max: CdfOptions::MAX_SUPERSAMPLING as u64,
-            set: |o, n| o.cdf.supersampling = n as usize,
-        },
-    },
-    OptionSpec {
-        name: "epsilon",
-        value_name: "EPS",
-        help: "cascade-cdf: Douglas–Peucker tolerance ε in CDF units, in (0, 1) (default 0.001)",
-        kind: OptionKind::Real {
-            lo: End::Open(0.0),
-            hi: End::Open(1.0),
-            set: |o, e| o.cdf.epsilon = e,
-        },
-    },
+    int(
+        "cdf-supersampling",
+        "N",
+        "CDF baselines: BRDF evaluations per cell and axis (1 ..= 16; default 3)",
+        range((1, CdfOptions::MAX_SUPERSAMPLING)),
+        |o, n| o.cdf.supersampling = n as usize,
+    ),
+    real(
+        "epsilon",
+        "EPS",
+        "cascade-cdf: Douglas–Peucker tolerance ε in CDF units, in (0, 1) (default 0.001)",
+        (End::Open(0.0), End::Open(1.0)),
+        |o, e| o.cdf.epsilon = e,
+    ),
 ];
 
 /// Options of `tabulated-cdf`: the CDF options but the cascade's tolerance.
@@ -518,26 +540,20 @@ static TABULATED_CDF_OPTIONS: &[OptionSpec] = CDF_OPTIONS.split_at(4).0;
 
 /// Options of the factored baseline (Lawrence 2004).
 static FACTORED_OPTIONS: &[OptionSpec] = &[
-    OptionSpec {
-        name: "factored-j",
-        value_name: "J",
-        help: "Factored: outer terms J, in 1..=16 (default 3)",
-        kind: OptionKind::Int {
-            min: FactoredOptions::TERMS_RANGE.0 as u64,
-            max: FactoredOptions::TERMS_RANGE.1 as u64,
-            set: |o, j| o.factored.outer_terms = j as usize,
-        },
-    },
-    OptionSpec {
-        name: "factored-k",
-        value_name: "K",
-        help: "Factored: inner terms K per outer term, in 1..=16 (default 2)",
-        kind: OptionKind::Int {
-            min: FactoredOptions::TERMS_RANGE.0 as u64,
-            max: FactoredOptions::TERMS_RANGE.1 as u64,
-            set: |o, k| o.factored.inner_terms = k as usize,
-        },
-    },
+    int(
+        "factored-j",
+        "J",
+        "Factored: outer terms J, in 1..=16 (default 3)",
+        range(FactoredOptions::TERMS_RANGE),
+        |o, j| o.factored.outer_terms = j as usize,
+    ),
+    int(
+        "factored-k",
+        "K",
+        "Factored: inner terms K per outer term, in 1..=16 (default 2)",
+        range(FactoredOptions::TERMS_RANGE),
+        |o, k| o.factored.inner_terms = k as usize,
+    ),
     OptionSpec {
         name: "factored-cost",
         value_name: "COST",
@@ -574,46 +590,34 @@ static FACTORED_OPTIONS: &[OptionSpec] = &[
             },
         },
     },
-    OptionSpec {
-        name: "factored-iterations",
-        value_name: "N",
-        help: "Factored: iteration cap of each factorisation, in 1..=1000000 (default 2000)",
-        kind: OptionKind::Int {
-            min: FactoredOptions::MAX_ITERATIONS_RANGE.0 as u64,
-            max: FactoredOptions::MAX_ITERATIONS_RANGE.1 as u64,
-            set: |o, n| o.factored.max_iterations = n as usize,
-        },
-    },
-    OptionSpec {
-        name: "factored-tolerance",
-        value_name: "TOL",
-        help: "Factored: stop at this relative cost change, in (0, 1) (default 1e-6)",
-        kind: OptionKind::Real {
-            lo: End::Open(0.0),
-            hi: End::Open(1.0),
-            set: |o, t| o.factored.tolerance = t,
-        },
-    },
-    OptionSpec {
-        name: "factored-seed",
-        value_name: "S",
-        help: "Factored: seed of the initial factors (default 2004)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: u64::MAX,
-            set: |o, s| o.factored.seed = s,
-        },
-    },
-    OptionSpec {
-        name: "factored-alpha",
-        value_name: "ALPHA",
-        help: "Factored: weight α of the defensive cosine component, in [0, 1] (default 0.05; 0 is the paper-pure sampler, which may leave support holes)",
-        kind: OptionKind::Real {
-            lo: End::Closed(0.0),
-            hi: End::Closed(1.0),
-            set: |o, a| o.factored.defensive_alpha = a,
-        },
-    },
+    int(
+        "factored-iterations",
+        "N",
+        "Factored: iteration cap of each factorisation, in 1..=1000000 (default 2000)",
+        range(FactoredOptions::MAX_ITERATIONS_RANGE),
+        |o, n| o.factored.max_iterations = n as usize,
+    ),
+    real(
+        "factored-tolerance",
+        "TOL",
+        "Factored: stop at this relative cost change, in (0, 1) (default 1e-6)",
+        (End::Open(0.0), End::Open(1.0)),
+        |o, t| o.factored.tolerance = t,
+    ),
+    int(
+        "factored-seed",
+        "S",
+        "Factored: seed of the initial factors (default 2004)",
+        (0, u64::MAX),
+        |o, s| o.factored.seed = s,
+    ),
+    real(
+        "factored-alpha",
+        "ALPHA",
+        "Factored: weight α of the defensive cosine component, in [0, 1] (default 0.05; 0 is the paper-pure sampler, which may leave support holes)",
+        (End::Closed(0.0), End::Closed(1.0)),
+        |o, a| o.factored.defensive_alpha = a,
+    ),
     OptionSpec {
         name: "factored-full-rows",
         value_name: "",
@@ -627,36 +631,27 @@ static FACTORED_OPTIONS: &[OptionSpec] = &[
 /// Options of the `srbf` sampler's fits (Tsai 2008); their ranges are the fit's own check
 /// ([`baselines::SrbfOptions::validate`], via [`srbf_check`]).
 static SRBF_OPTIONS: &[OptionSpec] = &[
-    OptionSpec {
-        name: "srbf-slices",
-        value_name: "N",
-        help: "srbf: outgoing-angle slices θo (slice j fitted at (j+½)·90°/slices; default 32)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: ANY,
-            set: |o, n| o.srbf.slices = n as usize,
-        },
-    },
-    OptionSpec {
-        name: "srbf-phi-slices",
-        value_name: "N",
-        help: "srbf: azimuthal slices φo of anisotropic BRDFs (default 8)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: ANY,
-            set: |o, n| o.srbf.phi_slices = n as usize,
-        },
-    },
-    OptionSpec {
-        name: "srbf-lobes",
-        value_name: "N",
-        help: "srbf: lobes per BRDF slice (default 8)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: ANY,
-            set: |o, n| o.srbf.brdf_lobes = n as usize,
-        },
-    },
+    int(
+        "srbf-slices",
+        "N",
+        "srbf: outgoing-angle slices θo (slice j fitted at (j+½)·90°/slices; default 32)",
+        (0, ANY),
+        |o, n| o.srbf.slices = n as usize,
+    ),
+    int(
+        "srbf-phi-slices",
+        "N",
+        "srbf: azimuthal slices φo of anisotropic BRDFs (default 8)",
+        (0, ANY),
+        |o, n| o.srbf.phi_slices = n as usize,
+    ),
+    int(
+        "srbf-lobes",
+        "N",
+        "srbf: lobes per BRDF slice (default 8)",
+        (0, ANY),
+        |o, n| o.srbf.brdf_lobes = n as usize,
+    ),
     OptionSpec {
         name: "srbf-lambda",
         value_name: "MIN,MAX",
@@ -665,36 +660,27 @@ static SRBF_OPTIONS: &[OptionSpec] = &[
             set: |o, l| o.srbf.brdf_lambda = l,
         },
     },
-    OptionSpec {
-        name: "srbf-fit-rows",
-        value_name: "N",
-        help: "srbf: polar rows of each slice's hemisphere fit grid (4× as many azimuths; default 32)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: ANY,
-            set: |o, n| o.srbf.fit_rows = n as usize,
-        },
-    },
-    OptionSpec {
-        name: "srbf-brdf-defensive",
-        value_name: "SHARE",
-        help: "srbf: share of cosine-hemisphere sampling mixed into each slice's lobes, in [0, 1) (0 = the SRBF mixture alone; default 0.1)",
-        kind: OptionKind::Real {
-            lo: End::None,
-            hi: End::None,
-            set: |o, d| o.srbf.brdf_defensive = d,
-        },
-    },
-    OptionSpec {
-        name: "srbf-max-iter",
-        value_name: "N",
-        help: "srbf: iteration cap per fit (Levenberg–Marquardt steps per BRDF slice, L-BFGS iterations of the map; a fit that reaches it unconverged is warned about; default 2000)",
-        kind: OptionKind::Int {
-            min: 0,
-            max: ANY,
-            set: |o, n| o.srbf.max_iter = n as usize,
-        },
-    },
+    int(
+        "srbf-fit-rows",
+        "N",
+        "srbf: polar rows of each slice's hemisphere fit grid (4× as many azimuths; default 32)",
+        (0, ANY),
+        |o, n| o.srbf.fit_rows = n as usize,
+    ),
+    real(
+        "srbf-brdf-defensive",
+        "SHARE",
+        "srbf: share of cosine-hemisphere sampling mixed into each slice's lobes, in [0, 1) (0 = the SRBF mixture alone; default 0.1)",
+        (End::None, End::None),
+        |o, d| o.srbf.brdf_defensive = d,
+    ),
+    int(
+        "srbf-max-iter",
+        "N",
+        "srbf: iteration cap per fit (Levenberg–Marquardt steps per BRDF slice, L-BFGS iterations of the map; a fit that reaches it unconverged is warned about; default 2000)",
+        (0, ANY),
+        |o, n| o.srbf.max_iter = n as usize,
+    ),
 ];
 
 fn lobe_check(o: &BaselineOptions) -> Result<(), (&'static str, String)> {

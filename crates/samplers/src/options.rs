@@ -340,6 +340,16 @@ mod tests {
         }
     }
 
+    /// The error of `--name text`, which must name the option, the value and `sampler`.
+    fn located(name: &str, text: &str, sampler: &str) -> OptionError {
+        let e = option_error(name, text);
+        assert_eq!(
+            (e.sampler, e.option, e.value.as_str()),
+            (sampler, name, text)
+        );
+        e
+    }
+
     #[test]
     fn no_option_given_is_the_defaults() {
         assert_eq!(
@@ -397,11 +407,7 @@ mod tests {
 
     #[test]
     fn values_out_of_range_are_typed_errors_naming_sampler_option_and_range() {
-        let e = option_error("factored-j", "0");
-        assert_eq!(
-            (e.sampler, e.option, e.value.as_str()),
-            ("factored", "factored-j", "0")
-        );
+        let e = located("factored-j", "0", "factored");
         assert_eq!(e.reason, "must be an integer in 1 ..= 16");
         assert_eq!(
             e.to_string(),
@@ -424,11 +430,7 @@ mod tests {
 
     #[test]
     fn the_entries_checks_name_the_option_when_they_can() {
-        let e = option_error("srbf-max-iter", "0");
-        assert_eq!(
-            (e.sampler, e.option, e.value.as_str()),
-            ("srbf", "srbf-max-iter", "0")
-        );
+        located("srbf-max-iter", "0", "srbf");
         let e = option_error("srbf-lambda", "5,1");
         assert_eq!((e.sampler, e.option), ("srbf", ""));
         assert!(e.reason.contains("bandwidth bounds"), "{e}");
