@@ -9,7 +9,7 @@ use brdf_sampling::{DirectionSampler, DiscMapPolicy, QuadTreeSet, SetOptions};
 use clap::Args;
 use partition_sampler::TreeParams;
 
-use crate::baseline_args::{APPLIES_TO, BaselineArgs, ProductBaselineArgs};
+use crate::baseline_args::{BaselineArgs, ProductBaselineArgs, applies_to};
 use crate::error::{CliError, CliResult};
 use crate::progress;
 use crate::values::{self, End, display_path};
@@ -64,7 +64,7 @@ pub(crate) struct AdaptiveArgs {
 }
 
 /// The sampler options of `sample`, `eval` and `build`: the adaptive sets' and the baseline
-/// samplers'. Each applies to some samplers only ([`APPLIES_TO`]).
+/// samplers'. Each applies to some samplers only ([`applies_to`]).
 #[derive(Debug, Args, Clone)]
 pub(crate) struct SamplerArgs {
     #[command(flatten)]
@@ -382,11 +382,11 @@ impl Given {
     }
 }
 
-/// Refuses sampler options given for a sampler they do not configure ([`APPLIES_TO`]): exit
+/// Refuses sampler options given for a sampler they do not configure ([`applies_to`]): exit
 /// 2 with `--epsilon applies to sampler cascade-cdf, not adaptive`. `sampler` is the sampler
 /// in use; `None` when the command builds none (`eval` without `--sampler`).
 pub(crate) fn check_options_apply(given: &Given, sampler: Option<&str>) -> CliResult<()> {
-    for (ids, names) in APPLIES_TO {
+    for (ids, names) in applies_to() {
         if sampler.is_some_and(|s| names.contains(&s.trim())) {
             continue;
         }

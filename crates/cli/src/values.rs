@@ -70,63 +70,13 @@ pub(crate) fn seed(s: &str) -> Result<u64, String> {
         .map_err(|_| format!("must be an integer in 0 ..= {}", u64::MAX))
 }
 
-/// One end of a real interval.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum End {
-    /// The end belongs to the interval.
-    Closed(f64),
-    /// The end does not belong to the interval.
-    Open(f64),
-    /// No bound on this side (finite values only).
-    None,
-}
+pub(crate) use samplers::End;
 
 /// A parser of finite reals in an interval; NaN and ±∞ are refused with the same message,
-/// e.g. `must be a finite number in [0, 90)`.
+/// e.g. `must be a finite number in [0, 90)` (the registry's, so sampler options and the
+/// other options say ranges alike).
 pub(crate) fn real(lo: End, hi: End) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
-    move |s: &str| {
-        let range = match (lo, hi) {
-            (End::None, End::None) => "must be a finite number".to_string(),
-            (End::Closed(a), End::None) => format!("must be a finite number ≥ {a}"),
-            (End::Open(a), End::None) => format!("must be a finite number > {a}"),
-            (End::None, End::Closed(b)) => format!("must be a finite number ≤ {b}"),
-            (End::None, End::Open(b)) => format!("must be a finite number < {b}"),
-            (a, b) => {
-                let left = match a {
-                    End::Closed(a) => format!("[{a}"),
-                    End::Open(_) | End::None => format!("({}", bound(a)),
-                };
-                let right = match b {
-                    End::Closed(b) => format!("{b}]"),
-                    End::Open(_) | End::None => format!("{})", bound(b)),
-                };
-                format!("must be a finite number in {left}, {right}")
-            }
-        };
-        let v: f64 = s.trim().parse().map_err(|_| range.clone())?;
-        let above = match lo {
-            End::Closed(a) => v >= a,
-            End::Open(a) => v > a,
-            End::None => true,
-        };
-        let below = match hi {
-            End::Closed(b) => v <= b,
-            End::Open(b) => v < b,
-            End::None => true,
-        };
-        if v.is_finite() && above && below {
-            Ok(v)
-        } else {
-            Err(range)
-        }
-    }
-}
-
-fn bound(e: End) -> String {
-    match e {
-        End::Closed(x) | End::Open(x) => x.to_string(),
-        End::None => "±∞".to_string(),
-    }
+    move |s: &str| samplers::options::parse_real(s, lo, hi)
 }
 
 /// Outgoing polar angles θo: degrees in `[0, 90)`.

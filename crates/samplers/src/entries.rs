@@ -7,9 +7,12 @@ use brdf_sampling::{DiscBrdf, Variant};
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler, Scheme};
 use partition_sampler::{Domain, QuadTreeBuilder, Rect, SampledGridDensity};
 
+use baselines::{BaselineOptions, CdfOptions, FactoredOptions, LobeOptions, NmfCost, Reparam};
+
+use crate::options::{End, OptionKind, OptionSpec};
 use crate::{
     BuiltDirection, Capabilities, Constructor, DirectionRequest, DiscSampler, GridSampler,
-    RegistryError, SamplerEntry, Support,
+    RegistryError, SamplerEntry, Support, UserError,
 };
 
 /// Capabilities of the adaptive quadtree sets: exact pdf (envelope scheme, or the papers'
@@ -41,6 +44,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             variant: Variant::Adaptive,
             mixture: false,
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(10),
     },
     SamplerEntry {
         name: "adaptive-paper",
@@ -53,6 +60,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             variant: Variant::Paper,
             mixture: false,
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(13),
     },
     SamplerEntry {
         name: "adaptive-mixture",
@@ -62,6 +73,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             variant: Variant::Adaptive,
             mixture: true,
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(11),
     },
     SamplerEntry {
         name: "adaptive-paper-mixture",
@@ -71,6 +86,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             variant: Variant::Paper,
             mixture: true,
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(14),
     },
     SamplerEntry {
         name: "adaptive-exact",
@@ -83,10 +102,15 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                     Arc::clone(&r.brdf),
                     &brdf_sampling::ExactOptions::with_set(*r.options),
                     r.progress,
-                )?;
+                )
+                .map_err(RegistryError::from)?;
                 Ok(BuiltDirection::from_exact(set))
             },
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(12),
     },
     SamplerEntry {
         name: "uniform",
@@ -100,6 +124,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                 )))
             },
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(0),
     },
     SamplerEntry {
         name: "cosine",
@@ -109,6 +137,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             support: Support::Hemisphere,
             build: |_| Ok(BuiltDirection::plain(Arc::new(baselines::CosineHemisphere))),
         },
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: Some(1),
     },
     // -- lobe baselines (lobe-sphere, lobe-hemisphere, analytic) --
     SamplerEntry {
@@ -119,6 +151,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             support: Support::Sphere,
             build: |r| lobe(r, baselines::LobeSupport::Sphere),
         },
+        options: LOBE_OPTIONS,
+        check: Some(lobe_check),
+        applies_to: None,
+        study: Some(2),
     },
     SamplerEntry {
         name: "lobe-hemisphere",
@@ -128,6 +164,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             support: Support::Hemisphere,
             build: |r| lobe(r, baselines::LobeSupport::Hemisphere),
         },
+        options: LOBE_OPTIONS,
+        check: Some(lobe_check),
+        applies_to: None,
+        study: Some(3),
     },
     SamplerEntry {
         name: "analytic",
@@ -145,6 +185,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                 )))
             },
         },
+        options: &[],
+        check: None,
+        applies_to: Some(has_analytic_lobes),
+        study: Some(4),
     },
     // -- CDF baselines (tabulated-cdf, cascade-cdf) --
     SamplerEntry {
@@ -155,6 +199,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             support: Support::Hemisphere,
             build: cdf_baseline::<baselines::cdf::TabulatedSlice>,
         },
+        options: TABULATED_CDF_OPTIONS,
+        check: Some(cdf_check),
+        applies_to: None,
+        study: Some(5),
     },
     SamplerEntry {
         name: "cascade-cdf",
@@ -164,6 +212,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             support: Support::Hemisphere,
             build: cdf_baseline::<baselines::cdf::CascadeSlice>,
         },
+        options: CDF_OPTIONS,
+        check: Some(cdf_check),
+        applies_to: None,
+        study: Some(6),
     },
     // -- factored baseline (Lawrence 2004) --
     SamplerEntry {
@@ -186,6 +238,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                 Ok(BuiltDirection::plain(Arc::new(sampler)))
             },
         },
+        options: FACTORED_OPTIONS,
+        check: Some(factored_check),
+        applies_to: None,
+        study: Some(7),
     },
     SamplerEntry {
         name: "quadtree-disc",
@@ -195,6 +251,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
             ..ADAPTIVE
         },
         constructor: Constructor::Disc(quadtree_disc),
+        options: &[],
+        check: None,
+        applies_to: Some(bounded_on_disc),
+        study: None,
     },
     SamplerEntry {
         name: "envmap-adaptive",
@@ -206,6 +266,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         constructor: Constructor::EnvMap(|map, options| {
             envmap_adaptive(map, options, Scheme::Envelope)
         }),
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: None,
     },
     SamplerEntry {
         name: "envmap-adaptive-paper",
@@ -217,18 +281,30 @@ pub static SAMPLERS: &[SamplerEntry] = &[
         constructor: Constructor::EnvMap(|map, options| {
             envmap_adaptive(map, options, Scheme::Paper)
         }),
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: None,
     },
     SamplerEntry {
         name: "envmap-cdf",
         summary: "environment map: classic marginal/conditional piecewise-constant CDF over Y·sin(πv_centre)",
         capabilities: BLIND_TABLE,
         constructor: Constructor::EnvMap(|map, _| Ok(EnvMapSampler::piecewise_constant(map)?)),
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: None,
     },
     SamplerEntry {
         name: "grid-cdf",
         summary: "planar marginal/conditional piecewise-constant CDF of a grid of values",
         capabilities: BLIND_TABLE,
         constructor: Constructor::Grid(grid_cdf),
+        options: &[],
+        check: None,
+        applies_to: None,
+        study: None,
     },
     SamplerEntry {
         name: "rgl-native",
@@ -248,6 +324,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                 )))
             },
         },
+        options: &[],
+        check: None,
+        applies_to: Some(rgl_material),
+        study: Some(9),
     },
     SamplerEntry {
         name: "srbf",
@@ -267,6 +347,10 @@ pub static SAMPLERS: &[SamplerEntry] = &[
                 Ok(BuiltDirection::plain(Arc::new(sampler)))
             },
         },
+        options: SRBF_OPTIONS,
+        check: Some(srbf_check),
+        applies_to: None,
+        study: Some(8),
     },
 ];
 
@@ -293,7 +377,7 @@ const LOBE: Capabilities = Capabilities {
 /// Builds a per-slice CDF baseline (`tabulated-cdf`, `cascade-cdf`) for the request.
 fn cdf_baseline<S: baselines::cdf::SliceCdf + 'static>(
     request: &DirectionRequest<'_>,
-) -> Result<BuiltDirection, RegistryError> {
+) -> Result<BuiltDirection, UserError> {
     let cdf = baselines::cdf::CdfSampler::<S>::build_with_progress(
         request.brdf.as_ref(),
         &request.baselines.cdf,
@@ -305,23 +389,11 @@ fn cdf_baseline<S: baselines::cdf::SliceCdf + 'static>(
 fn lobe(
     request: &DirectionRequest<'_>,
     support: baselines::LobeSupport,
-) -> Result<BuiltDirection, RegistryError> {
+) -> Result<BuiltDirection, UserError> {
     Ok(BuiltDirection::plain(Arc::new(
         baselines::LobeSampler::new(&request.brdf, support, &request.baselines.lobe)?,
     )))
 }
-
-/// Whether a sampler applies to a BRDF: `Err(reason)` when it does not.
-pub(crate) type AppliesTo = fn(&dyn Brdf) -> Result<(), String>;
-
-/// Samplers that apply only to some BRDFs, with the test of the BRDFs they accept; every other
-/// entry applies to every BRDF of its kind. The one source of "does not apply" for the
-/// command line, the validation suite and the studies ([`crate::SamplerEntry::applicability`]).
-pub(crate) static APPLIES_TO: &[(&str, AppliesTo)] = &[
-    ("rgl-native", rgl_material),
-    ("analytic", has_analytic_lobes),
-    ("quadtree-disc", bounded_on_disc),
-];
 
 /// `quadtree-disc` needs a BRDF bounded at the horizon ([`disc_refusal`]).
 fn bounded_on_disc(brdf: &dyn Brdf) -> Result<(), String> {
@@ -349,6 +421,288 @@ fn has_analytic_lobes(brdf: &dyn Brdf) -> Result<(), String> {
         }
         .to_string()),
     }
+}
+
+// -- options of the baselines (the CLI's flags, the registry's option errors) --
+
+/// The largest `usize` as a `u64` (options whose range the sampler's own check states).
+const ANY: u64 = usize::MAX as u64;
+
+/// An integer option in `min ..= max`.
+const fn int(
+    name: &'static str,
+    value_name: &'static str,
+    help: &'static str,
+    (min, max): (u64, u64),
+    set: fn(&mut BaselineOptions, u64),
+) -> OptionSpec {
+    OptionSpec {
+        name,
+        value_name,
+        help,
+        kind: OptionKind::Int { min, max, set },
+    }
+}
+
+/// A real option in the interval `(lo, hi)`.
+const fn real(
+    name: &'static str,
+    value_name: &'static str,
+    help: &'static str,
+    (lo, hi): (End, End),
+    set: fn(&mut BaselineOptions, f64),
+) -> OptionSpec {
+    OptionSpec {
+        name,
+        value_name,
+        help,
+        kind: OptionKind::Real { lo, hi, set },
+    }
+}
+
+/// `(min, max)` of a `usize` range as `u64`s.
+const fn range((min, max): (usize, usize)) -> (u64, u64) {
+    (min as u64, max as u64)
+}
+
+/// Options of the cosine-lobe baselines (`lobe-sphere`, `lobe-hemisphere`).
+static LOBE_OPTIONS: &[OptionSpec] = &[
+    real(
+        "lobe-exponent",
+        "N",
+        "Fixed exponent of the lobe-sphere / lobe-hemisphere samplers, in [0, 1e6] (default: fitted per outgoing slice by minimising the estimator's second moment)",
+        (End::Closed(0.0), End::Closed(LobeOptions::MAX_EXPONENT)),
+        |o, n| {
+            o.lobe.exponent = Some(n);
+            o.lobe.max_exponent = o.lobe.max_exponent.max(n);
+        },
+    ),
+    int(
+        "lobe-slices",
+        "K",
+        "Number of outgoing θo slices of the lobe fit, in [1, 1024] (default 16)",
+        range((1, LobeOptions::MAX_SLICES)),
+        |o, k| o.lobe.slices = k as usize,
+    ),
+];
+
+/// Options of the per-slice CDFs: `tabulated-cdf` takes the first four, `cascade-cdf` all.
+static CDF_OPTIONS: &[OptionSpec] = &[
+    int(
+        "cdf-slices",
+        "N",
+        "CDF baselines: outgoing θ slices of an isotropic BRDF (1 ..= 1024; default 32)",
+        range((1, CdfOptions::MAX_SLICES)),
+        |o, n| o.cdf.slices = n as usize,
+    ),
+    OptionSpec {
+        name: "cdf-anisotropic-slices",
+        value_name: "THETAxPHI",
+        help: "CDF baselines: outgoing slices THETAxPHI of an anisotropic BRDF (each 1 ..= 1024; default 16x8)",
+        kind: OptionKind::Ints {
+            count: 2,
+            sep: 'x',
+            min: 1,
+            max: CdfOptions::MAX_SLICES as u64,
+            set: |o, v| o.cdf.anisotropic_slices = [v[0] as usize, v[1] as usize],
+        },
+    },
+    OptionSpec {
+        name: "cdf-grid",
+        value_name: "NZxNPHI",
+        help: "CDF baselines: fine cells NZxNPHI of each slice over (cosθ, φ) (each 1 ..= 16384; default 256x512)",
+        kind: OptionKind::Ints {
+            count: 2,
+            sep: 'x',
+            min: 1,
+            max: CdfOptions::MAX_CELLS_PER_AXIS as u64,
+            set: |o, v| (o.cdf.n_z, o.cdf.n_phi) = (v[0] as usize, v[1] as usize),
+        },
+    },
+    int(
+        "cdf-supersampling",
+        "N",
+        "CDF baselines: BRDF evaluations per cell and axis (1 ..= 16; default 3)",
+        range((1, CdfOptions::MAX_SUPERSAMPLING)),
+        |o, n| o.cdf.supersampling = n as usize,
+    ),
+    real(
+        "epsilon",
+        "EPS",
+        "cascade-cdf: Douglas–Peucker tolerance ε in CDF units, in (0, 1) (default 0.001)",
+        (End::Open(0.0), End::Open(1.0)),
+        |o, e| o.cdf.epsilon = e,
+    ),
+];
+
+/// Options of `tabulated-cdf`: the CDF options but the cascade's tolerance.
+static TABULATED_CDF_OPTIONS: &[OptionSpec] = CDF_OPTIONS.split_at(4).0;
+
+/// Options of the factored baseline (Lawrence 2004).
+static FACTORED_OPTIONS: &[OptionSpec] = &[
+    int(
+        "factored-j",
+        "J",
+        "Factored: outer terms J, in 1..=16 (default 3)",
+        range(FactoredOptions::TERMS_RANGE),
+        |o, j| o.factored.outer_terms = j as usize,
+    ),
+    int(
+        "factored-k",
+        "K",
+        "Factored: inner terms K per outer term, in 1..=16 (default 2)",
+        range(FactoredOptions::TERMS_RANGE),
+        |o, k| o.factored.inner_terms = k as usize,
+    ),
+    OptionSpec {
+        name: "factored-cost",
+        value_name: "COST",
+        help: "Factored: NMF cost, euclidean (weighted squared Frobenius distance) or kl (generalised Kullback–Leibler divergence) (default euclidean)",
+        kind: OptionKind::Choice {
+            names: &["euclidean", "kl"],
+            set: |o, i| {
+                o.factored.cost = [NmfCost::Euclidean, NmfCost::KullbackLeibler][i.min(1)];
+            },
+        },
+    },
+    OptionSpec {
+        name: "factored-param",
+        value_name: "PARAM",
+        help: "Factored: parametrisation of ωi, halfangle (half vector, with the 1/(4 ωi·ωh) Jacobian) or spherical (ωi itself) (default halfangle)",
+        kind: OptionKind::Choice {
+            names: &["halfangle", "spherical"],
+            set: |o, i| o.factored.reparam = [Reparam::HalfAngle, Reparam::Spherical][i.min(1)],
+        },
+    },
+    OptionSpec {
+        name: "factored-grid",
+        value_name: "THO,PHO,THP,PHP",
+        help: "Factored: table cells θo,φo,θp,φp, each in 1..=1024 (default 16,32,32,16)",
+        kind: OptionKind::Ints {
+            count: 4,
+            sep: ',',
+            min: FactoredOptions::GRID_RANGE.0 as u64,
+            max: FactoredOptions::GRID_RANGE.1 as u64,
+            set: |o, v| {
+                let f = &mut o.factored;
+                (f.theta_o_cells, f.phi_o_cells) = (v[0] as usize, v[1] as usize);
+                (f.theta_p_cells, f.phi_p_cells) = (v[2] as usize, v[3] as usize);
+            },
+        },
+    },
+    int(
+        "factored-iterations",
+        "N",
+        "Factored: iteration cap of each factorisation, in 1..=1000000 (default 2000)",
+        range(FactoredOptions::MAX_ITERATIONS_RANGE),
+        |o, n| o.factored.max_iterations = n as usize,
+    ),
+    real(
+        "factored-tolerance",
+        "TOL",
+        "Factored: stop at this relative cost change, in (0, 1) (default 1e-6)",
+        (End::Open(0.0), End::Open(1.0)),
+        |o, t| o.factored.tolerance = t,
+    ),
+    int(
+        "factored-seed",
+        "S",
+        "Factored: seed of the initial factors (default 2004)",
+        (0, u64::MAX),
+        |o, s| o.factored.seed = s,
+    ),
+    real(
+        "factored-alpha",
+        "ALPHA",
+        "Factored: weight α of the defensive cosine component, in [0, 1] (default 0.05; 0 is the paper-pure sampler, which may leave support holes)",
+        (End::Closed(0.0), End::Closed(1.0)),
+        |o, a| o.factored.defensive_alpha = a,
+    ),
+    OptionSpec {
+        name: "factored-full-rows",
+        value_name: "",
+        help: "Factored: tabulate θo × φo rows even for isotropic BRDFs (default: θo only, turned by φo)",
+        kind: OptionKind::Switch {
+            set: |o| o.factored.isotropic_rows = false,
+        },
+    },
+];
+
+/// Options of the `srbf` sampler's fits (Tsai 2008); their ranges are the fit's own check
+/// ([`baselines::SrbfOptions::validate`], via [`srbf_check`]).
+static SRBF_OPTIONS: &[OptionSpec] = &[
+    int(
+        "srbf-slices",
+        "N",
+        "srbf: outgoing-angle slices θo (slice j fitted at (j+½)·90°/slices; default 32)",
+        (0, ANY),
+        |o, n| o.srbf.slices = n as usize,
+    ),
+    int(
+        "srbf-phi-slices",
+        "N",
+        "srbf: azimuthal slices φo of anisotropic BRDFs (default 8)",
+        (0, ANY),
+        |o, n| o.srbf.phi_slices = n as usize,
+    ),
+    int(
+        "srbf-lobes",
+        "N",
+        "srbf: lobes per BRDF slice (default 8)",
+        (0, ANY),
+        |o, n| o.srbf.brdf_lobes = n as usize,
+    ),
+    OptionSpec {
+        name: "srbf-lambda",
+        value_name: "MIN,MAX",
+        help: "srbf: bandwidth bounds of the BRDF lobes, MIN,MAX (0 < MIN < MAX, finite; default 0.5,20000)",
+        kind: OptionKind::RealPair {
+            set: |o, l| o.srbf.brdf_lambda = l,
+        },
+    },
+    int(
+        "srbf-fit-rows",
+        "N",
+        "srbf: polar rows of each slice's hemisphere fit grid (4× as many azimuths; default 32)",
+        (0, ANY),
+        |o, n| o.srbf.fit_rows = n as usize,
+    ),
+    real(
+        "srbf-brdf-defensive",
+        "SHARE",
+        "srbf: share of cosine-hemisphere sampling mixed into each slice's lobes, in [0, 1) (0 = the SRBF mixture alone; default 0.1)",
+        (End::None, End::None),
+        |o, d| o.srbf.brdf_defensive = d,
+    ),
+    int(
+        "srbf-max-iter",
+        "N",
+        "srbf: iteration cap per fit (Levenberg–Marquardt steps per BRDF slice, L-BFGS iterations of the map; a fit that reaches it unconverged is warned about; default 2000)",
+        (0, ANY),
+        |o, n| o.srbf.max_iter = n as usize,
+    ),
+];
+
+fn lobe_check(o: &BaselineOptions) -> Result<(), (&'static str, String)> {
+    o.lobe.validate().map_err(|e| ("", e.to_string()))
+}
+
+fn cdf_check(o: &BaselineOptions) -> Result<(), (&'static str, String)> {
+    o.cdf.validate().map_err(|e| ("", e.to_string()))
+}
+
+fn factored_check(o: &BaselineOptions) -> Result<(), (&'static str, String)> {
+    o.factored.validate().map_err(|e| ("", e.to_string()))
+}
+
+fn srbf_check(o: &BaselineOptions) -> Result<(), (&'static str, String)> {
+    if o.srbf.max_iter == 0 {
+        return Err((
+            "srbf-max-iter",
+            "the fit iteration cap must be at least 1".to_string(),
+        ));
+    }
+    o.srbf.validate().map_err(|e| ("", e.to_string()))
 }
 
 /// Capabilities of the tabulated CDFs of maps and grids.

@@ -43,8 +43,9 @@ pub enum RegistryError {
         /// The names of the expected kind.
         candidates: String,
     },
-    /// A sampler added at run time ([`crate::SamplerEntry::direction`]) could not be built: its
-    /// own error.
+    /// A sampler could not be built: its own error (a built-in baseline's, e.g. no analytic
+    /// sampler for the model, or that of a closure added at run time with
+    /// [`crate::SamplerEntry::direction`]).
     #[error("sampler `{name}`: {source}")]
     User {
         /// The sampler's registered name.
@@ -92,19 +93,6 @@ pub enum RegistryError {
     /// A grid sampler could not be built.
     #[error(transparent)]
     Grid(#[from] partition_sampler::PiecewiseConstantError),
-    // -- lobe baselines' error --
-    /// A lobe or analytic baseline could not be built (bad option, or no analytic sampler for
-    /// the model).
-    #[error(transparent)]
-    Lobe(#[from] baselines::LobeError),
-    // -- CDF baselines' error --
-    /// A tabulated or cascade CDF could not be built (an option out of range).
-    #[error("cdf baseline: {0}")]
-    Cdf(#[from] baselines::CdfOptionsError),
-    // -- factored baseline's error --
-    /// The factored baseline could not be built.
-    #[error(transparent)]
-    Factored(#[from] baselines::FactoredError),
     /// The projected-disc sampler (`quadtree-disc`) was asked to sample a BRDF that grows
     /// without bound at the horizon ([`brdf::Brdf::bounded_at_horizon`] `= false`): its disc
     /// density `f_r(ωo, h⁻¹(x))` is unbounded near the rim, so no finite leaf bound holds there.
@@ -115,10 +103,8 @@ pub enum RegistryError {
         /// The BRDF's name.
         brdf: String,
     },
-    /// A format-specific sampler was asked to sample a BRDF of another kind.
+    /// A sampler option is out of its range or fails its sampler's check
+    /// ([`crate::options_from`]).
     #[error(transparent)]
-    NotRgl(#[from] baselines::NotRglError),
-    /// The SRBF fits (Tsai 2008) could not be set up.
-    #[error(transparent)]
-    Srbf(#[from] baselines::SrbfError),
+    Option(#[from] crate::OptionError),
 }

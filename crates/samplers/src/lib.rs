@@ -37,11 +37,13 @@
 
 mod entries;
 mod error;
+pub mod options;
 mod registry;
 mod request;
 
 pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, quadtree_disc_density};
 pub use error::{NotApplicable, RegistryError};
+pub use options::{End, OptionError, OptionKind, OptionSpec, options_from};
 pub use registry::Registry;
 pub use request::{BuiltDirection, DirectionRequest};
 
@@ -93,8 +95,10 @@ impl Capabilities {
     }
 }
 
-/// Builds a direction sampler (other than an adaptive set) for a request.
-pub type DirectionBuild = fn(&DirectionRequest<'_>) -> Result<BuiltDirection, RegistryError>;
+/// Builds a direction sampler (other than an adaptive set) for a request. Any error will do:
+/// [`SamplerEntry::build_direction`] passes a [`RegistryError`] on as it is and wraps any other
+/// as [`RegistryError::User`] with the entry's name.
+pub type DirectionBuild = fn(&DirectionRequest<'_>) -> Result<BuiltDirection, UserError>;
 
 /// Builds a direction sampler from a closure (an entry made at run time, e.g. by a crate outside
 /// the workspace or by the Python bindings: see [`SamplerEntry::direction`]).
@@ -189,7 +193,27 @@ pub struct SamplerEntry {
     pub capabilities: Capabilities,
     /// How it is built.
     pub constructor: Constructor,
+    /// Its options (`--NAME VALUE` on the command line; each sets a field of
+    /// [`baselines::BaselineOptions`]); empty for none.
+    pub options: &'static [OptionSpec],
+    /// Checks its options together once set (`Err((option name or "", reason))`), e.g. a
+    /// bound below another; `None`: the ranges of [`Self::options`] say it all.
+    pub check: Option<OptionCheck>,
+    /// The BRDFs it applies to (`Err(reason)` for the others: a format- or model-specific
+    /// sampler); `None`: every BRDF of its kind. See [`Self::applicability`].
+    pub applies_to: Option<AppliesTo>,
+    /// Its place in the studies' presets and their palette (`study::PREFERRED_SAMPLERS`, the
+    /// plots' colour and marker): a stable index, unique over the registry; `None` keeps the
+    /// sampler out of the presets.
+    pub study: Option<u8>,
 }
+
+/// Checks a sampler's options together ([`SamplerEntry::check`]): `Err((option, reason))`,
+/// `option` the option's name or `""` when the reason concerns several.
+pub type OptionCheck = fn(&baselines::BaselineOptions) -> Result<(), (&'static str, String)>;
+
+/// Whether a sampler applies to a BRDF ([`SamplerEntry::applies_to`]): `Err(reason)` when not.
+pub type AppliesTo = fn(&dyn Brdf) -> Result<(), String>;
 
 impl std::fmt::Debug for SamplerEntry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -241,6 +265,10 @@ impl SamplerEntry {
             name,
             summary,
             capabilities,
+            options: &[],
+            check: None,
+            applies_to: None,
+            study: None,
             constructor: Constructor::SharedDirection {
                 support,
                 build: Arc::new(move |request: &DirectionRequest<'_>| {
@@ -284,7 +312,15 @@ impl SamplerEntry {
                 .with_spec(request.spec_or_name());
                 Ok(BuiltDirection::from_set(set))
             }
-            Constructor::Direction { build, .. } => build(request),
+            Constructor::Direction { build, .. } => {
+                build(request).map_err(|source| match source.downcast::<RegistryError>() {
+                    Ok(e) => *e,
+                    Err(source) => RegistryError::User {
+                        name: self.name,
+                        source,
+                    },
+                })
+            }
             Constructor::SharedDirection { build, .. } => build(request),
             other => Err(self.wrong_kind("direction", other.kind())),
         }
@@ -296,11 +332,8 @@ impl SamplerEntry {
     /// check it first ([`RegistryError::NotApplicable`]); the validation suite and the studies
     /// call it to skip such pairs and report the reason instead of a failed build.
     pub fn applicability(&self, brdf: &dyn Brdf) -> Result<(), NotApplicable> {
-        match entries::APPLIES_TO
-            .iter()
-            .find(|(name, _)| *name == self.name)
-        {
-            Some((_, applies)) => applies(brdf).map_err(|reason| NotApplicable {
+        match self.applies_to {
+            Some(applies) => applies(brdf).map_err(|reason| NotApplicable {
                 sampler: self.name,
                 reason,
             }),
@@ -354,6 +387,16 @@ impl SamplerEntry {
             candidates: names_of_kind(expected),
         }
     }
+}
+
+/// The samplers of the studies' presets, in their order ([`SamplerEntry::study`]).
+pub fn study_samplers() -> Vec<&'static str> {
+    let mut ranked: Vec<(u8, &'static str)> = SAMPLERS
+        .iter()
+        .filter_map(|e| e.study.map(|i| (i, e.name)))
+        .collect();
+    ranked.sort_unstable();
+    ranked.into_iter().map(|(_, name)| name).collect()
 }
 
 /// Every registered sampler, in listing order.

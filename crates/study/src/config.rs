@@ -10,27 +10,12 @@ use crate::StudyError;
 /// The papers' sample counts: N ∈ {1, 5², 10², 15², 20², 30², 40², 50²}.
 pub const PAPER_N_GRID: [usize; 8] = [1, 25, 100, 225, 400, 900, 1600, 2500];
 
-/// Preferred samplers of `--quick` and `--paper`, in report order. A preset runs **every
-/// registered direction sampler of this list that exists** in the registry, so baselines
-/// registered later join the presets without a code change, and names not (yet) registered
-/// are skipped.
-pub const PREFERRED_SAMPLERS: [&str; 15] = [
-    "uniform",
-    "cosine",
-    "lobe-sphere",
-    "lobe-hemisphere",
-    "analytic",
-    "tabulated-cdf",
-    "cascade-cdf",
-    "factored",
-    "srbf",
-    "rgl-native",
-    "adaptive",
-    "adaptive-mixture",
-    "adaptive-exact",
-    "adaptive-paper",
-    "adaptive-paper-mixture",
-];
+/// Preferred samplers of `--quick` and `--paper`, in report order: the registry's entries
+/// that carry a study index (`samplers::SamplerEntry::study`), ordered by it, so a sampler
+/// joins the presets (and gets its plot style) with its entry. A preset runs every
+/// registered direction sampler of this list.
+pub static PREFERRED_SAMPLERS: std::sync::LazyLock<Vec<&'static str>> =
+    std::sync::LazyLock::new(samplers::study_samplers);
 
 /// BRDFs of `--quick`: a glossy Phong, an anisotropic Ward, a rough GGX microfacet, a
 /// Cook–Torrance; a measured one is added when a MERL file is found ([`MEASURED_CANDIDATES`]).

@@ -52,30 +52,28 @@ pub struct SamplerStyle {
     pub marker: Marker,
 }
 
-/// The fixed sampler → style map: every sampler of [`crate::PREFERRED_SAMPLERS`] has its own
-/// colour (Okabe–Ito's colour-blind-friendly eight, then darker or lighter variants) and, so
-/// that no two samplers look alike even in grey, a marker; families share a hue family
-/// (greens for the lobes, blues for the CDFs, reds/oranges for the adaptive ones).
-const STYLES: [(&str, RGBColor, Marker); 15] = [
-    ("uniform", RGBColor(120, 120, 120), Marker::Circle),
-    ("cosine", RGBColor(0, 0, 0), Marker::Square),
-    ("lobe-sphere", RGBColor(0, 158, 115), Marker::Triangle),
-    ("lobe-hemisphere", RGBColor(0, 90, 60), Marker::Diamond),
-    ("analytic", RGBColor(86, 180, 233), Marker::Cross),
-    ("tabulated-cdf", RGBColor(0, 114, 178), Marker::Square),
-    ("cascade-cdf", RGBColor(0, 50, 110), Marker::Triangle),
-    ("factored", RGBColor(204, 121, 167), Marker::Diamond),
-    ("srbf", RGBColor(120, 40, 140), Marker::Circle),
-    ("rgl-native", RGBColor(160, 140, 0), Marker::Cross),
-    ("adaptive", RGBColor(213, 94, 0), Marker::Circle),
-    ("adaptive-mixture", RGBColor(230, 159, 0), Marker::Square),
-    ("adaptive-exact", RGBColor(150, 30, 30), Marker::Triangle),
-    ("adaptive-paper", RGBColor(240, 80, 140), Marker::Diamond),
-    (
-        "adaptive-paper-mixture",
-        RGBColor(130, 80, 30),
-        Marker::Cross,
-    ),
+/// The fixed sampler styles, indexed by the registry entry's study index
+/// (`samplers::SamplerEntry::study`, the order of [`crate::PREFERRED_SAMPLERS`]): every
+/// preferred sampler has its own colour (Okabe–Ito's colour-blind-friendly eight, then darker
+/// or lighter variants) and, so that no two samplers look alike even in grey, a marker;
+/// families share a hue family (greens for the lobes, blues for the CDFs, reds/oranges for the
+/// adaptive ones). The comments name today's holders.
+const STYLES: [(RGBColor, Marker); 15] = [
+    (RGBColor(120, 120, 120), Marker::Circle),  // uniform
+    (RGBColor(0, 0, 0), Marker::Square),        // cosine
+    (RGBColor(0, 158, 115), Marker::Triangle),  // lobe-sphere
+    (RGBColor(0, 90, 60), Marker::Diamond),     // lobe-hemisphere
+    (RGBColor(86, 180, 233), Marker::Cross),    // analytic
+    (RGBColor(0, 114, 178), Marker::Square),    // tabulated-cdf
+    (RGBColor(0, 50, 110), Marker::Triangle),   // cascade-cdf
+    (RGBColor(204, 121, 167), Marker::Diamond), // factored
+    (RGBColor(120, 40, 140), Marker::Circle),   // srbf
+    (RGBColor(160, 140, 0), Marker::Cross),     // rgl-native
+    (RGBColor(213, 94, 0), Marker::Circle),     // adaptive
+    (RGBColor(230, 159, 0), Marker::Square),    // adaptive-mixture
+    (RGBColor(150, 30, 30), Marker::Triangle),  // adaptive-exact
+    (RGBColor(240, 80, 140), Marker::Diamond),  // adaptive-paper
+    (RGBColor(130, 80, 30), Marker::Cross),     // adaptive-paper-mixture
 ];
 
 /// Colours and markers of samplers outside [`STYLES`] (picked by a hash of the name, so
@@ -91,7 +89,8 @@ const SPARE: [RGBColor; 4] = [
 /// `adaptive-paper`, with a dashed line): the same in every plot of every study.
 pub fn sampler_style(label: &str) -> SamplerStyle {
     let name = label.strip_suffix(" (batch)").unwrap_or(label);
-    if let Some((_, colour, marker)) = STYLES.iter().find(|s| s.0 == name) {
+    let slot = samplers::find(name).ok().and_then(|e| e.study);
+    if let Some((colour, marker)) = slot.and_then(|i| STYLES.get(usize::from(i))) {
         return SamplerStyle {
             colour: *colour,
             marker: *marker,

@@ -95,10 +95,15 @@ impl SrbfOptions {
 
     /// Fit settings of one BRDF slice.
     pub fn brdf_settings(&self) -> FitSettings {
+        self.fit(self.brdf_lobes, self.brdf_lambda)
+    }
+
+    /// Fit settings of `lobes` lobes with bandwidths in `[λ_min, λ_max]`, at this iteration cap.
+    fn fit(&self, lobes: usize, (lambda_min, lambda_max): (f64, f64)) -> FitSettings {
         FitSettings {
-            lobes: self.brdf_lobes,
-            lambda_min: self.brdf_lambda.0,
-            lambda_max: self.brdf_lambda.1,
+            lobes,
+            lambda_min,
+            lambda_max,
             max_iter: self.max_iter,
         }
     }
@@ -115,11 +120,6 @@ impl SrbfOptions {
 
     /// Fit settings of the environment map.
     pub fn map_settings(&self) -> FitSettings {
-        FitSettings {
-            lobes: self.map_lobes,
-            lambda_min: self.map_lambda.0,
-            lambda_max: self.map_lambda.1,
-            max_iter: self.max_iter,
-        }
+        self.fit(self.map_lobes, self.map_lambda)
     }
 }
