@@ -8,12 +8,11 @@
 //!
 //! The Cornell interpolant (k nearest scattered samples with cut Gaussian weights) has kinks on
 //! surfaces no coordinate follows, everywhere in `ωi`: the leaf quadrature of an interval's
-//! tree was up to 7·10⁻⁴ off at 16 000 evaluations, and each interval integrated its own 9
-//! nodes. Its nodes are now the reference rule at `ωo` itself
-//! ([`crate::reference_albedo_with_budget`], the leaves refined around the mirror direction,
-//! [`CORNELL_NODE_BUDGET`] evaluations), 5 per interval, and the set keeps every node it
-//! integrated ([`NodeCache`]): an interval's ends are its neighbours' ends, so each is
-//! integrated once per build.
+//! tree was up to 7·10⁻⁴ off at 16 000 evaluations. Its nodes are now the reference rule at
+//! `ωo` itself ([`crate::reference_albedo_with_budget`], the leaves refined around the mirror
+//! direction, [`CORNELL_NODE_BUDGET`] evaluations), integrated for one table of `A(θo)` per
+//! set (`set_table.rs`) from which the intervals take their nodes. The MERL nodes are kept
+//! once per build ([`NodeCache`]: an interval's ends are its neighbours' ends).
 //!
 //! The other nodes keep the leaf quadrature of the interval's tree ([`node_quadrature`]), with
 //! a larger budget for the RGL tables ([`RGL_NODE_BUDGET`]): their bilinear interpolants have
@@ -71,8 +70,7 @@ pub(crate) const MERL_REL_TOL: f64 = 1e-4;
 
 /// Chebyshev nodes per interval of a set whose nodes are integrated in the table's cells
 /// (at most the options' count): with exact node values the MERL layout's interpolation tails
-/// stay below 1e-5 on the default layout, and each node costs ~10⁵ lookups. The Cornell nodes
-/// (~1.5·10⁵ evaluations each) use as many.
+/// stay below 1e-5 on the default layout, and each node costs ~10⁵ lookups.
 pub(crate) const TABLE_NODES: usize = 5;
 
 /// Most table lookups of one MERL normaliser node (about 10⁵ reach [`MERL_REL_TOL`] up to
