@@ -3,7 +3,12 @@
 //! item 4).
 //!
 //! `cargo run --release -p brdf-sampling --example norm_gap -- --spec SPEC [--angles 180]
-//!   [--n 1024] [--check-n 2048] [--ref-every 16] [--adaptive] [--at θ,θ,…] [--write-merl PATH]`
+//!   [--n 1024] [--check-n 2048] [--ref-every 16] [--adaptive] [--at θ,θ,…] [--write-merl PATH]
+//!   [--count]`
+//!
+//! `--count`: the build's evaluations are all counted (the BRDF wrapped in a `CountingBrdf`,
+//! summed over the rayon threads), also those of split intervals and of a set-level table of
+//! `A(θo)` (Cornell data), which the set's report leaves out.
 //!
 //! `--ref-every K`: the adaptive reference quadrature (`reference_albedo`, 4·10⁶ evaluations,
 //! its own error estimate printed) at every K-th angle (0: never), a second reference where
