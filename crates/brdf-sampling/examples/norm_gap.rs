@@ -3,7 +3,12 @@
 //! item 4).
 //!
 //! `cargo run --release -p brdf-sampling --example norm_gap -- --spec SPEC [--angles 180]
-//!   [--n 1024] [--check-n 2048] [--ref-every 16] [--adaptive] [--at θ,θ,…] [--write-merl PATH]`
+//!   [--n 1024] [--check-n 2048] [--ref-every 16] [--adaptive] [--at θ,θ,…] [--write-merl PATH]
+//!   [--count]`
+//!
+//! `--count`: the build's evaluations are all counted (the BRDF wrapped in a `CountingBrdf`,
+//! summed over the rayon threads), also those of split intervals and of a set-level table of
+//! `A(θo)` (Cornell data), which the set's report leaves out.
 //!
 //! `--ref-every K`: the adaptive reference quadrature (`reference_albedo`, 4·10⁶ evaluations,
 //! its own error estimate printed) at every K-th angle (0: never), a second reference where
@@ -96,6 +101,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let check_n: usize = arg(&args, "--check-n").unwrap_or(2048);
     let with_adaptive = args.iter().any(|a| a == "--adaptive");
     let ref_every: usize = arg(&args, "--ref-every").unwrap_or(16);
+    // `--count`: every evaluation of the build counted (a `CountingBrdf` summed over the
+    // rayon threads), also those of split intervals and of a set-level normaliser table,
+    // which the report's count leaves out.
+    let count_all = args.iter().any(|a| a == "--count");
     let brdf: Arc<dyn Brdf> =
         if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {
             Arc::new(MerlBrdf::tabulate(&*parse_spec(inner)?))
@@ -124,9 +133,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Ok(());
     }
     let opts = ExactOptions::with_set(SetOptions::default());
-    let (c0, t0) = (cpu_seconds(), Instant::now());
-    let exact = ExactSet::build(Arc::clone(&brdf), &opts, None)?;
+    let all_threads = || {
+        rayon::broadcast(|_| brdf::thread_evaluations())
+            .iter()
+            .sum::<u64>()
+            + if rayon::current_thread_index().is_none() {
+                brdf::thread_evaluations()
+            } else {
+                0
+            }
+    };
+    let built_on: Arc<dyn Brdf> = if count_all {
+        Arc::new(brdf::CountingBrdf(Arc::clone(&brdf)))
+    } else {
+        Arc::clone(&brdf)
+    };
+    let (c0, t0, e0) = (cpu_seconds(), Instant::now(), all_threads());
+    let exact = ExactSet::build(built_on, &opts, None)?;
     let (wall, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
+    if count_all {
+        println!("evaluations of the whole build: {}", all_threads() - e0);
+    }
     let rep = exact.report();
     let edges: Vec<String> = rep.layout[0]
         .theta_edges_deg

@@ -18,6 +18,7 @@ use super::jobs::{Inheritance, Job};
 use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
 use super::set::ExactSet;
+use super::set_table::SetTable;
 use super::tabulated;
 
 /// BRDFs slower than this per evaluation (nanoseconds) keep their bound nodes' values for the
@@ -64,7 +65,15 @@ impl ExactSet {
     ) -> Result<Self, ExactError> {
         options.validate()?;
         let start = Instant::now();
-        let plan = Plan::new(brdf.as_ref(), options, cache, follow_kinks);
+        let mut plan = Plan::new(brdf.as_ref(), options, cache, follow_kinks);
+        if plan.table_nodes && tabulated::tabulates_over_theta(brdf.as_ref()) {
+            let breaks: Vec<f64> = (1..plan.n0)
+                .map(|i| plan.grid.edge(i << EDGE_BITS))
+                .collect();
+            plan.set_table =
+                SetTable::build(brdf.as_ref(), 0.0, THETA_TOP_DEG.to_radians(), &breaks)
+                    .map(Arc::new);
+        }
         let done = run_jobs(&brdf, options, &plan, progress)?;
         let cells = assemble_cells(done, &plan);
         Ok(Self {
@@ -97,8 +106,17 @@ pub(super) struct Plan {
     pub(super) cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     pub(super) min_width: f64,
-    /// Integrate the normaliser nodes in the BRDF's own table cells (`tabulated.rs`).
+    /// Integrate the normaliser nodes by a rule of their own, not on the interval's tree
+    /// (the MERL layout's cells, the Cornell reference rule: `tabulated.rs`).
     pub(super) table_nodes: bool,
+    /// Those nodes, integrated once per build.
+    pub(super) node_cache: Arc<tabulated::NodeCache>,
+    /// The set's table of `A(θo)` the intervals take their nodes from (Cornell data,
+    /// `set_table.rs`; filled by the build, not by a load).
+    pub(super) set_table: Option<Arc<SetTable>>,
+    /// The largest interpolation tail an interval keeps whatever its nodes' error estimate
+    /// ([`tabulated::tail_cap`]).
+    pub(super) tail_cap: f64,
 }
 
 impl Plan {
@@ -115,10 +133,11 @@ impl Plan {
         } else {
             Vec::new()
         };
-        let var = table_var(isotropic, !kinks.is_empty());
-        // `follow_kinks: false` also keeps the leaf quadrature for the MERL layout (before
-        // issue 27).
+        // `follow_kinks: false` also keeps the leaf quadrature and the `cos θo` table for the
+        // MERL layout and Cornell data (before issue 27).
         let table_nodes = follow_kinks && isotropic && tabulated::table_normaliser_exists(brdf);
+        let over_theta = follow_kinks && tabulated::tabulates_over_theta(brdf);
+        let var = table_var(isotropic, !kinks.is_empty() || over_theta);
         // Azimuth cells: the sets' rule (half-turn symmetry halves an even count over [0, π)).
         let layout = layout_for(
             brdf,
@@ -162,6 +181,13 @@ impl Plan {
             cache,
             min_width: options.min_width_deg.to_radians(),
             table_nodes,
+            node_cache: Arc::default(),
+            set_table: None,
+            tail_cap: if table_nodes {
+                tabulated::tail_cap(brdf)
+            } else {
+                f64::INFINITY
+            },
         }
     }
 
@@ -176,6 +202,8 @@ impl Plan {
             cache: self.cache,
             min_width: self.min_width,
             table_nodes: self.table_nodes,
+            node_cache: Arc::clone(&self.node_cache),
+            set_table: self.set_table.clone(),
         }
     }
 
@@ -258,7 +286,7 @@ fn run_jobs(
 /// The axis to halve (`Some(true)`: δ), if any: too many trials (either axis, `trials_axis`
 /// from the build; `iv` is `None` only for an interval that can be split), or an
 /// interpolation tail above the tolerance (or the quadrature's own error, if larger: below it
-/// the tail is quadrature noise) along θ or δ.
+/// the tail is quadrature noise; at most the plan's `tail_cap`) along θ or δ.
 fn next_axis(
     options: &ExactOptions,
     plan: &Plan,
@@ -267,7 +295,7 @@ fn next_axis(
     trials_axis: Option<bool>,
 ) -> Option<bool> {
     let (grid, min_width) = (&plan.grid, plan.min_width);
-    let floor = |iv: &Interval| options.normaliser_tol.max(iv.quad_err);
+    let floor = |iv: &Interval| options.normaliser_tol.max(iv.quad_err.min(plan.tail_cap));
     match iv {
         None => trials_axis,
         Some(iv) if iv.worst_trials > options.max_trials && trials_axis.is_some() => trials_axis,

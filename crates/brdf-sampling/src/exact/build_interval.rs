@@ -70,9 +70,13 @@ pub(super) struct IntervalContext {
     pub(super) cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     pub(super) min_width: f64,
-    /// Integrate the normaliser nodes in the BRDF's own table cells (the MERL layout,
-    /// `tabulated.rs`) instead of on the tree's leaves.
+    /// Integrate the normaliser nodes by a rule of their own (the MERL layout's cells, the
+    /// Cornell reference rule: `tabulated.rs`) instead of on the tree's leaves.
     pub(super) table_nodes: bool,
+    /// The build's nodes of that rule, shared by its intervals.
+    pub(super) node_cache: Arc<tabulated::NodeCache>,
+    /// The set's table of `A(θo)` (Cornell data): the nodes are its values.
+    pub(super) set_table: Option<Arc<super::set_table::SetTable>>,
 }
 
 /// One interval's build: the interval (`None`: to be split) and what its children can reuse.
@@ -285,12 +289,21 @@ fn normaliser_table(
     let (va, vb) = (var.of(span.ta), var.of(span.tb));
     // Nodes integrated in the table's cells are exact to ~1e-6 but cost ~10⁵ lookups each;
     // `A(θo)` of the MERL layout interpolates to < 1e-5 on 5 of them (`tabulated.rs`).
-    let n_theta = if ctx.table_nodes {
+    let n_theta = if ctx.table_nodes && ctx.set_table.is_none() {
         options.normaliser_nodes.min(tabulated::TABLE_NODES)
     } else {
         options.normaliser_nodes
     };
-    let theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), n_theta);
+    let mut theta_nodes = lobatto_nodes(va.min(vb), va.max(vb), n_theta);
+    // Nodes of their own rule are kept per build (`NodeCache`): over θo the middle node is
+    // the children's shared end with the same bits (Lobatto's is within an ulp of it).
+    let halves = (job.num[1] - job.num[0]).is_multiple_of(2)
+        && span.tb == span.theta_b
+        && var == TableVar::Theta;
+    if ctx.table_nodes && n_theta % 2 == 1 && halves {
+        let mid = ctx.grid.edge(job.num[0] + (job.num[1] - job.num[0]) / 2);
+        theta_nodes[n_theta / 2] = var.of(mid);
+    }
     let volume = tree.volume();
     let nt = theta_nodes.len();
     let mut nd = options.phi_normaliser_nodes;
@@ -356,8 +369,9 @@ fn normaliser_table(
     }
 }
 
-/// `A` at the outgoing direction `(t, φ_k + d)`: over the BRDF's own bins for the MERL layout
-/// (`tabulated.rs`), by the leaf quadrature of `tree` otherwise.
+/// `A` at the outgoing direction `(t, φ_k + d)`: over the BRDF's own bins for the MERL layout,
+/// by the reference rule for Cornell data (`tabulated.rs`), by the leaf quadrature of `tree`
+/// otherwise.
 fn integrate_node(
     brdf: &dyn Brdf,
     ctx: &IntervalContext,
@@ -366,8 +380,12 @@ fn integrate_node(
     t: f64,
     d: f64,
 ) -> Normaliser {
+    if let Some(table) = &ctx.set_table {
+        let (total, rel_err) = table.at(t);
+        return Normaliser { total, rel_err };
+    }
     if ctx.table_nodes {
-        let (total, rel_err) = tabulated::table_normaliser(brdf, t).unwrap_or((f64::NAN, 0.0));
+        let (total, rel_err) = ctx.node_cache.get(brdf, t).unwrap_or((f64::NAN, 0.0));
         return Normaliser { total, rel_err };
     }
     let q = QueryDensity::new(brdf, direction_from_radians(t, ctx.phi_k + d), d, span.map);

@@ -7,7 +7,8 @@ use brdf::Brdf;
 ///
 /// Isotropic BRDFs use `v = cos θo`: `A` is then an even function of `θo` (`ωo` at `−θo` is
 /// `ωo` at `θo` turned by π), hence a smooth function of `cos θo` up to normal incidence, and
-/// a query needs no `acos` — unless the BRDF is a table linear in θo (see [`table_var`]). Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
+/// a query needs no `acos` — unless the BRDF is a table linear in θo or depends on `sin θo`
+/// (Cornell data) (see [`table_var`]). Anisotropic cells keep `v = θo` (without half-turn symmetry `A`
 /// is not even in `θo` at a fixed azimuth, and `cos θo` would put a square-root singularity at
 /// normal incidence).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -28,7 +28,8 @@
 //! `A = ∫_Ω f_r(ωo, ·) cos θi dσ` (the disc integral of `g`), tabulated per interval at
 //! Chebyshev–Lobatto nodes ([`ExactOptions::normaliser_nodes`] × [`ExactOptions::phi_normaliser_nodes`]),
 //! each node integrated with the leaf quadrature of the interval's tree (`normalisation.rs`;
-//! a MERL table over its own bins instead, 5 nodes per interval, `tabulated.rs`, issue 27);
+//! a MERL table over its own bins instead, 5 nodes per interval, `tabulated.rs`; Cornell data
+//! from one table of `A(θo)` per set, `set_table.rs`; issue 27);
 //! the δ nodes are doubled (Lobatto-nested, up to 17) while the δ tail exceeds the same floor;
 //! `A · cos θo` is interpolated ([`chebyshev`]): it stays smooth up to grazing angles for models
 //! whose `f_r` has a `1/cos θo` factor (Beard–Maxwell, Ward), where `A` itself diverges. The
@@ -81,6 +82,7 @@ mod probe;
 mod report;
 mod sampler;
 mod set;
+mod set_table;
 mod tabulated;
 mod walk;
 

@@ -6,11 +6,22 @@
 //! integrates the table over its bins instead (exact rings of constant half-vector angle, an
 //! adaptive rule across them), to [`MERL_REL_TOL`] within [`MERL_BUDGET`] lookups.
 //!
+//! The Cornell interpolant (k nearest scattered samples with cut Gaussian weights) has kinks on
+//! surfaces no coordinate follows, everywhere in `ωi`: the leaf quadrature of an interval's
+//! tree was up to 7·10⁻⁴ off at 16 000 evaluations. Its nodes are now the reference rule at
+//! `ωo` itself ([`crate::reference_albedo_with_budget`], the leaves refined around the mirror
+//! direction, [`CORNELL_NODE_BUDGET`] evaluations), integrated for one table of `A(θo)` per
+//! set (`set_table.rs`) from which the intervals take their nodes. The MERL nodes are kept
+//! once per build ([`NodeCache`]: an interval's ends are its neighbours' ends).
+//!
 //! The other nodes keep the leaf quadrature of the interval's tree ([`node_quadrature`]), with
 //! a larger budget for the RGL tables ([`RGL_NODE_BUDGET`]): their bilinear interpolants have
 //! kinks along the cells of the warped square and of the `ndf` grid, which no leaf follows.
 
-use brdf::{Brdf, MerlBrdf, RglBrdf};
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use brdf::{Brdf, CornellBrdf, MerlBrdf, RglBrdf, direction_from_radians};
 use partition_sampler::{Density, LeafInfo};
 
 use crate::disc::count_evaluations;
@@ -66,23 +77,85 @@ pub(crate) const TABLE_NODES: usize = 5;
 /// 85°; 89.5° needs 5 · 10⁶, and stops at this budget with its estimate declared).
 pub(crate) const MERL_BUDGET: u64 = 1_000_000;
 
-/// `(A, relative error estimate)` at the outgoing polar angle `theta` (radians) integrated in
-/// the table's own cells, for BRDFs that have such an integral (the MERL layout); `None` for
-/// every other BRDF (the caller integrates on the tree's leaves). The lookups are counted as
-/// evaluations of the build.
+/// Evaluations of one Cornell normaliser node (the reference rule's budget; its default is
+/// 4·10⁶). Measured on the three shared files at 11 angles from 2.8° to 89.9° against the
+/// same rule at 10⁶ evaluations: docs/benchmarks.md §13.11.
+pub(crate) const CORNELL_NODE_BUDGET: u64 = 150_000;
+
+/// Largest interpolation tail a Cornell interval keeps (relative). The tail test of the
+/// build stops at the nodes' own error estimate (below it the tail is quadrature noise), but
+/// the reference rule's estimate (`Σ |I₈ − I₅|`) is 3–10 × its actual error here, so the
+/// tail is held to this instead when it is smaller.
+pub(crate) const CORNELL_TAIL_CAP: f64 = 2e-5;
+
+/// `(A, relative error estimate)` at the outgoing polar angle `theta` (radians) by a rule
+/// that does not depend on the interval (the MERL layout's integral in its own cells; the
+/// reference rule for Cornell data); `None` for every other BRDF (the caller integrates on
+/// the tree's leaves). The evaluations are counted as evaluations of the build.
 pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)> {
-    let merl = brdf.as_any()?.downcast_ref::<MerlBrdf>()?;
-    let a = merl.albedo_in_bins(theta, MERL_REL_TOL, MERL_BUDGET);
-    count_evaluations(a.evaluations);
-    let rel = if a.value > 0.0 {
-        a.abs_err / a.value
+    let any = brdf.as_any()?;
+    let (value, abs_err, evaluations) = if let Some(merl) = any.downcast_ref::<MerlBrdf>() {
+        let a = merl.albedo_in_bins(theta, MERL_REL_TOL, MERL_BUDGET);
+        (a.value, a.abs_err, a.evaluations)
+    } else if any.is::<CornellBrdf>() {
+        let wo = direction_from_radians(theta, 0.0);
+        match crate::reference::reference_albedo_with_budget(brdf, &wo, CORNELL_NODE_BUDGET) {
+            Ok(a) => (a.value, a.abs_err, a.evaluations),
+            Err(_) => (f64::NAN, f64::INFINITY, 0),
+        }
+    } else {
+        return None;
+    };
+    count_evaluations(evaluations);
+    let rel = if value > 0.0 {
+        abs_err / value
     } else {
         f64::INFINITY
     };
-    Some((a.value, rel))
+    Some((value, rel))
 }
 
 /// Whether [`table_normaliser`] serves `brdf`.
 pub(crate) fn table_normaliser_exists(brdf: &dyn Brdf) -> bool {
-    brdf.as_any().is_some_and(|a| a.is::<MerlBrdf>())
+    brdf.as_any()
+        .is_some_and(|a| a.is::<MerlBrdf>() || a.is::<CornellBrdf>())
+}
+
+/// Whether `brdf`'s set tabulates `A` over `θo` rather than `cos θo`: the Cornell interpolant
+/// depends on `sin θo` (its first remapped coordinate), so `A` is linear in `θo` at normal
+/// incidence, a square root of `1 − cos θo`.
+pub(crate) fn tabulates_over_theta(brdf: &dyn Brdf) -> bool {
+    brdf.as_any().is_some_and(|a| a.is::<CornellBrdf>())
+}
+
+/// The largest interpolation tail a set of `brdf` keeps, whatever its nodes' error estimate
+/// (`f64::INFINITY`: the estimate decides, see [`CORNELL_TAIL_CAP`]).
+pub(crate) fn tail_cap(brdf: &dyn Brdf) -> f64 {
+    if tabulates_over_theta(brdf) {
+        CORNELL_TAIL_CAP
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The [`table_normaliser`] values a build has integrated, by the bits of `θo`: shared by
+/// its intervals (adjacent intervals share their ends, a split interval's middle is its
+/// children's end). The values depend on `θo` alone, so the set does not depend on which
+/// interval integrated a node first.
+#[derive(Default)]
+pub(crate) struct NodeCache(Mutex<HashMap<u64, (f64, f64)>>);
+
+impl NodeCache {
+    /// [`table_normaliser`] at `theta`, integrated once per build.
+    pub(crate) fn get(&self, brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)> {
+        let key = theta.to_bits();
+        if let Some(v) = self.0.lock().ok().and_then(|m| m.get(&key).copied()) {
+            return Some(v);
+        }
+        let v = table_normaliser(brdf, theta)?;
+        if let Ok(mut m) = self.0.lock() {
+            m.insert(key, v);
+        }
+        Some(v)
+    }
 }

@@ -503,3 +503,51 @@ fn merl_layout_normaliser_in_the_table_cells_is_within_1e4() {
         "leaf quadrature: max |A/Â − 1| = {worst_old:e}"
     );
 }
+
+/// A Cornell-format file of `f = 0.05 + 3 exp(−(Δθ² + (π − Δφ)²)/0.08)` (a lobe at the mirror
+/// direction) at every `θi, θo ∈ {5°, 15°, …, 85°}` and `Δφ ∈ {0°, 30°, …, 180°}` (567
+/// samples, one grey spectrum): the k-nearest-neighbour interpolant has kinks everywhere in
+/// `ωi`, as on the measured files.
+fn synthetic_cornell() -> brdf::CornellBrdf {
+    let mut text = String::from("3\n450 550 650\n");
+    for ti in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+        for to in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+            for dp in (0..7).map(|k| (30.0 * k as f64).to_radians()) {
+                let lobe = ((ti - to).powi(2) + (std::f64::consts::PI - dp).powi(2)) / 0.08;
+                let f = 0.05 + 3.0 * (-lobe).exp();
+                text.push_str(&format!("{ti} 0 {to} {dp} {f} {f} {f}\n"));
+            }
+        }
+    }
+    brdf::CornellBrdf::parse(&text).unwrap()
+}
+
+/// Issue 27 item 4: Cornell data (k nearest scattered samples, cut Gaussian weights: kinks
+/// everywhere in `ωi`). A set's normaliser is one table of `A(θo)` on pieces of θo whose nodes
+/// are the reference rule at `CORNELL_NODE_BUDGET` evaluations (`set_table.rs`); here one
+/// piece, 40°–41.5°, of the synthetic file's table (the whole set takes minutes). Between its
+/// nodes it is within 1e-4 of the reference rule at 10⁶ evaluations (itself within its
+/// estimate, asserted ≤ 2e-5) and within its declared error. With the node budget of the old
+/// per-interval leaf quadrature (16 000) the table misses 1e-4 (checked: the test fails).
+#[test]
+fn cornell_set_table_is_within_1e4_between_its_nodes() {
+    let brdf: Arc<dyn Brdf> = Arc::new(synthetic_cornell());
+    let (lo, hi) = (40f64.to_radians(), 41.5f64.to_radians());
+    let table = super::set_table::SetTable::build(brdf.as_ref(), lo, hi, &[]).unwrap();
+    assert_eq!(table.edges().len(), 2, "one piece: {:?}", table.edges());
+    let mut worst = 0.0f64;
+    for t in [40.23f64, 41.07] {
+        let wo = brdf::direction_from_angles(t, 0.0);
+        let r = crate::reference_albedo_with_budget(brdf.as_ref(), &wo, 1_000_000).unwrap();
+        assert!(r.abs_err <= 2e-5 * r.value, "θo {t}: reference {r:?}");
+        let (a_hat, declared) = table.at(t.to_radians());
+        let g = (r.value / a_hat - 1.0).abs();
+        eprintln!("θo {t}: |A/Â − 1| = {g:.2e}, declared {declared:.1e}");
+        assert!(
+            g <= declared,
+            "θo {t}: gap {g:e} above the declared {declared:e}"
+        );
+        worst = worst.max(g);
+    }
+    assert!(worst <= 1e-4, "set table: max |A/Â − 1| = {worst:e}");
+}
