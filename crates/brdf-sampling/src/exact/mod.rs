@@ -81,6 +81,7 @@ mod probe;
 mod report;
 mod sampler;
 mod set;
+mod table;
 mod tabulated;
 mod walk;
 
