@@ -2,7 +2,7 @@
 //! (issue 29): builds the exact sampler of one BRDF spec at each cap given, then draws N
 //! samples through `sample_eval` at random outgoing directions (uniform in solid angle,
 //! θo ≤ 89°, as `brdf-lab bench --queries random`) on one thread, and prints per cap: the
-//! intervals, the build's CPU seconds (the process's, all threads), the memory, the trials and
+//! intervals, the build's BRDF evaluations (kept intervals), the memory, the trials and
 //! evaluations per sample and the mean weight `f cos / pdf` (the albedo averaged over ωo: the
 //! same figure at every cap, to its standard error).
 //!
@@ -18,15 +18,6 @@ use brdf::parse_spec;
 use brdf_sampling::{DirectionSampler, ExactOptions, ExactSet, thread_evaluations};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
-
-/// CPU seconds (user + system) of the process, from `/proc/self/stat` (clock ticks of 1/100 s).
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -48,8 +39,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let brdf: Arc<dyn brdf::Brdf> = Arc::from(parse_spec(spec)?);
     println!(
-        "{:>6} {:>6} {:>9} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
-        "cap", "n_max", "intervals", "build s", "KiB", "trials", "evals", "mean w", "violations"
+        "{:>6} {:>6} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "cap",
+        "n_max",
+        "intervals",
+        "build evals",
+        "KiB",
+        "trials",
+        "evals",
+        "mean w",
+        "violations"
     );
     for (cap, n_max) in caps {
         let mut opts = ExactOptions {
@@ -59,11 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(m) = n_max {
             opts.set.tree.n_max = m;
         }
-        let c0 = process_cpu_seconds();
         let set = ExactSet::build(Arc::clone(&brdf), &opts, None)?;
-        let build = process_cpu_seconds()
-            .zip(c0)
-            .map_or(f64::NAN, |(a, b)| a - b);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
         let e0 = thread_evaluations();
         let mut sum = 0.0;
@@ -77,9 +72,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let evals = (thread_evaluations() - e0) as f64 / n as f64;
         let report = set.report();
         println!(
-            "{cap:>6} {:>6} {:>9} {build:>8.2} {:>10.1} {:>10.3} {evals:>10.3} {:>10.5} {:>10}",
+            "{cap:>6} {:>6} {:>9} {:>11} {:>10.1} {:>10.3} {evals:>10.3} {:>10.5} {:>10}",
             opts.set.tree.n_max,
             set.len(),
+            report.build_evaluations,
             set.bytes_used() as f64 / 1024.0,
             report.trials as f64 / report.samples.max(1) as f64,
             sum / n as f64,
