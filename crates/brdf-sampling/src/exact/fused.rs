@@ -98,6 +98,8 @@ mod tests {
     fn sample_eval_returns_the_accepted_trials_f_with_the_same_samples() {
         for spec in ["phong:n=50", "ward:alpha_x=0.2,alpha_y=0.4"] {
             let (brdf, set) = set_of(spec);
+            // The compact tables draw what the trees' own walks draw (`table.rs`).
+            assert!(super::super::table::assert_table_walks_match_trees(&set) >= 2 * set.len());
             let other: Arc<dyn Brdf> = Arc::new(Counted(Arc::from(parse_spec(spec).unwrap())));
             let (mut r1, mut r2, mut r3) = (
                 Xoshiro256PlusPlus::seed_from_u64(5),

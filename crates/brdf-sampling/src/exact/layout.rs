@@ -4,6 +4,7 @@ use crate::layout::Turn;
 
 use super::grid::{Grid, TableVar};
 use super::interval::Interval;
+use super::table::LeafTable;
 
 /// One azimuth cell: its centre and its intervals. The cell is cut into θ **strips** at every
 /// interval's θ edges; a strip holds the intervals that cover it, ordered by δ (one, unless
@@ -30,6 +31,9 @@ pub(super) struct Cell {
     pub(super) members: Vec<u32>,
     /// The intervals, ordered by θ, then δ.
     pub(super) intervals: Vec<Interval>,
+    /// Per interval, the compact table its samples are drawn from ([`LeafTable`]; `None`: the
+    /// tree's own walk).
+    pub(super) tables: Vec<Option<LeafTable>>,
 }
 
 /// An interval with its θ and δ numerators ([`Grid`]).
@@ -71,7 +75,8 @@ impl Cell {
             lower = e;
         }
         let plain = entries.len() == edges.len();
-        let intervals = members.into_iter().map(|(_, _, iv)| iv).collect();
+        let intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
+        let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
         Self {
             phi,
             phi_turn: Turn::from_angle(phi),
@@ -83,6 +88,7 @@ impl Cell {
             delta_upper: if plain { Vec::new() } else { delta_upper },
             members: if plain { Vec::new() } else { entries },
             intervals,
+            tables,
         }
     }
 

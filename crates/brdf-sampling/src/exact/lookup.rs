@@ -124,7 +124,10 @@ impl ExactSet {
         let q = *q;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
-        let drawn = iv.tree.sample_envelope_of(&|p| g.at(p), u, audit);
+        let drawn = match &self.cells[q.cell].tables[q.interval] {
+            Some(table) => table.draw(&|p| g.at(p), u, audit),
+            None => iv.tree.sample_envelope_of(&|p| g.at(p), u, audit),
+        };
         match drawn {
             Some((x, gx)) => {
                 let a = iv.normaliser(self.var, &q);

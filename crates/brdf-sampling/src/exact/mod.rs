@@ -83,6 +83,7 @@ mod report;
 mod sampler;
 mod set;
 mod set_table;
+mod table;
 mod tabulated;
 mod walk;
 

@@ -88,6 +88,11 @@ impl DirectionSampler for ExactSet {
                 .map(|c| {
                     std::mem::size_of::<Cell>()
                         + c.upper.capacity() * 8
+                        + c.tables
+                            .iter()
+                            .flatten()
+                            .map(|t| t.bytes_used())
+                            .sum::<usize>()
                         + c.intervals
                             .iter()
                             .map(|iv| {

@@ -1,0 +1,182 @@
+//! The compact sampling table of one interval (issue 29 item 2): what the rejection walk
+//! reads per trial — alias entry, rejection rectangle and bound — in one 32-byte record per
+//! leaf, apart from the tree's build state (leaf integrals, nodes, the density provider).
+//!
+//! The records are derived from the interval's tree when its cell is assembled (built or
+//! loaded; nothing new is saved): rectangle and bound are the tree's own stored `f32` values,
+//! and the alias table is built from `V_i = (dx · dy) · M_i` of those values, the tree's own
+//! selection weights. A draw therefore consumes the same uniforms and returns the same point
+//! bits as [`QuadTreeSampler::sample_envelope_of`] (tested); it is that walk without the
+//! tree's generality (frame map, descent tables, per-trial flags) and with its counters kept
+//! in registers.
+
+use distributions::alias::build_alias;
+use distributions::index::{floor_index, index_to_f64};
+use partition_sampler::{
+    Audit, MAX_TRIALS_PER_SAMPLE, Point2, QuadTreeSampler, RegionStats, UniformSource,
+};
+
+/// One leaf as a trial reads it: `[x0, x0 + dx] × [y0, y0 + dy]` on the disc's square, its
+/// bound `M_i` and its alias entry. 32 bytes, aligned to 32: never across a cache line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+struct Entry {
+    x0: f32,
+    y0: f32,
+    dx: f32,
+    dy: f32,
+    /// `M_i`.
+    m: f32,
+    /// Alias target.
+    alias: u32,
+    /// Alias threshold (`f64`: the pick probabilities are the weights' to rounding).
+    prob: f64,
+}
+
+/// The compact table of one interval's tree (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct LeafTable {
+    entries: Box<[Entry]>,
+    /// `entries.len()` as `f64`.
+    n: f64,
+}
+
+impl LeafTable {
+    /// The table of a disc tree with the identity frame (stored coordinates are the disc's),
+    /// or `None` when a leaf's rectangle or bound is not exactly the `f32` values the walk
+    /// reads, or there is no leaf of positive weight: the tree's own walk serves such an
+    /// interval.
+    pub(super) fn of<D: RegionStats>(tree: &QuadTreeSampler<D>) -> Option<Self> {
+        let mut entries = Vec::with_capacity(tree.tree().leaves().len());
+        let mut weights = Vec::with_capacity(entries.capacity());
+        for l in tree.tree().leaves() {
+            let r = l.rect;
+            let (x0, y0) = (r.x0 as f32, r.y0 as f32);
+            let (dx, dy) = ((r.x1 - r.x0) as f32, (r.y1 - r.y0) as f32);
+            let m = l.max_bound as f32;
+            let exact = f64::from(x0) == r.x0
+                && f64::from(y0) == r.y0
+                && f64::from(x0) + f64::from(dx) == r.x1
+                && f64::from(y0) + f64::from(dy) == r.y1
+                && f64::from(m) == l.max_bound
+                && m.is_finite();
+            if !exact {
+                return None;
+            }
+            weights.push((f64::from(dx) * f64::from(dy)) * f64::from(m));
+            entries.push(Entry {
+                x0,
+                y0,
+                dx,
+                dy,
+                m,
+                alias: 0,
+                prob: 1.0,
+            });
+        }
+        let total: f64 = weights.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        for (e, (prob, alias)) in entries.iter_mut().zip(build_alias(&weights)) {
+            e.prob = prob;
+            e.alias = alias;
+        }
+        Some(Self {
+            n: index_to_f64(entries.len()),
+            entries: entries.into_boxed_slice(),
+        })
+    }
+
+    /// Bytes of the records.
+    pub(super) fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>() + std::mem::size_of_val(&*self.entries)
+    }
+
+    /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds
+    /// (`g ≤ M_i` on leaf `i`; a trial above its bound is counted in `audit.violations`), and
+    /// `g` there; `None` after [`MAX_TRIALS_PER_SAMPLE`] trials (counted as exhausted). Four
+    /// uniforms per trial, in one [`UniformSource::next_uniform4`] call: the leaf pick, the
+    /// point's two coordinates and the acceptance test. `g` is called inside the unit circle
+    /// only.
+    #[inline]
+    pub(super) fn draw<G, U>(&self, g: &G, u: &mut U, audit: &mut Audit) -> Option<(Point2, f64)>
+    where
+        G: Fn(Point2) -> f64,
+        U: UniformSource + ?Sized,
+    {
+        let last = self.entries.len() - 1;
+        let (mut trials, mut violations) = (0u64, 0u64);
+        let found = loop {
+            if trials >= MAX_TRIALS_PER_SAMPLE {
+                audit.exhausted += 1;
+                break None;
+            }
+            let us = u.next_uniform4();
+            let s = us[0] * self.n;
+            let i = floor_index(s, last);
+            let first = &self.entries[i];
+            let e = if s - index_to_f64(i) < first.prob {
+                first
+            } else {
+                self.entries.get(first.alias as usize).unwrap_or(first)
+            };
+            let x = f64::from(e.x0) + us[1] * f64::from(e.dx);
+            let y = f64::from(e.y0) + us[2] * f64::from(e.dy);
+            let m = f64::from(e.m);
+            trials += 1;
+            if x * x + y * y >= 1.0 {
+                continue;
+            }
+            let f = g([x, y]);
+            violations += u64::from(f > m);
+            if us[3] * m < f {
+                break Some(([x, y], f));
+            }
+        };
+        audit.trials += trials;
+        audit.violations += violations;
+        audit.samples += 1;
+        found
+    }
+}
+
+/// Test support: every interval of `set` has a table, and its walk draws the very points of
+/// the interval tree's own walk (same uniforms, same bits, same trial, violation and sample
+/// counts) for two test densities, one below most leaves' bounds and one above many (the
+/// violations counted alike). Returns the number of walks compared.
+#[cfg(test)]
+pub(super) fn assert_table_walks_match_trees(set: &super::ExactSet) -> usize {
+    use rand::SeedableRng;
+    use rand::rngs::Xoshiro256PlusPlus;
+
+    let mut checked = 0;
+    for cell in &set.cells {
+        assert_eq!(cell.tables.len(), cell.intervals.len());
+        for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
+            let table = table.as_ref().expect("a table for every interval");
+            let m0 = table
+                .entries
+                .iter()
+                .map(|e| f64::from(e.m))
+                .fold(0.0, f64::max);
+            for scale in [0.06, 0.6] {
+                let g = |p: [f64; 2]| scale * m0 * (1.0 - 0.5 * p[0] * p[0]);
+                let (mut r1, mut r2) = (
+                    Xoshiro256PlusPlus::seed_from_u64(3),
+                    Xoshiro256PlusPlus::seed_from_u64(3),
+                );
+                let (mut a1, mut a2) = (Audit::default(), Audit::default());
+                for _ in 0..100 {
+                    let want = iv.tree.sample_envelope_of(&g, &mut r1, &mut a1);
+                    let got = table.draw(&g, &mut r2, &mut a2);
+                    assert_eq!(got, want);
+                }
+                assert_eq!(a1, a2);
+                assert_eq!(r1.next_uniform(), r2.next_uniform());
+                checked += 1;
+            }
+        }
+    }
+    checked
+}
