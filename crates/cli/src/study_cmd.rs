@@ -189,17 +189,16 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     };
     bar.finish_and_clear();
     let cpu_before_outputs = study::process_cpu_seconds();
-    if let (Some(run), Some(a), Some(b)) = (
+    if let (Some(run), Some(a), Some(b), true) = (
         results.runs.first_mut(),
         cpu_before_images,
         cpu_before_outputs,
+        images || tables.is_some(),
     ) {
-        if images || tables.is_some() {
-            run.phases.push(study::PhaseCpu {
-                phase: "images".into(),
-                cpu_seconds: b - a,
-            });
-        }
+        run.phases.push(study::PhaseCpu {
+            phase: "images".into(),
+            cpu_seconds: b - a,
+        });
     }
     write_outputs(staging.path(), &results, render.as_ref(), tables.as_deref())?;
     staging.commit()?;

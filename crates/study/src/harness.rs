@@ -1248,8 +1248,10 @@ impl Accumulator {
 /// of one group are correlated with each other, never with another cell of their own
 /// ranking (a ranking compares cells of one estimator, so one heuristic).
 fn mis_groups(cells: &[&PlanCell]) -> Vec<Vec<usize>> {
+    /// (BRDF sampler, map sampler, BRDF, θo, light).
+    type Pair = (usize, usize, usize, usize, usize);
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut lead: Vec<((usize, usize, usize, usize, usize), usize)> = Vec::new();
+    let mut lead: Vec<(Pair, usize)> = Vec::new();
     for (i, c) in cells.iter().enumerate() {
         let Kind::Mis { ls, .. } = c.kind else {
             groups.push(vec![i]);
