@@ -1,5 +1,5 @@
 //! Progress of long runs on stderr: a bar on a terminal; otherwise (logs, CI, pipes) one line
-//! every [`DEFAULT_INTERVAL_SECS`] seconds, e.g. `validating: 120/1100 (11 %), 42 s elapsed`,
+//! every [`DEFAULT_INTERVAL_SECS`] seconds, e.g. `validating: 120/1100 (11 %), ETA 343 s, 42 s elapsed`,
 //! so a long run is never silent. `BRDF_LAB_PROGRESS_SECS` sets that interval.
 
 use std::io::IsTerminal;
@@ -30,8 +30,14 @@ impl Shared {
         let (pos, len) = (self.pos.load(Relaxed), self.len.load(Relaxed));
         let secs = self.started.elapsed().as_secs_f64();
         if len > 0 {
+            // The remaining steps at the mean pace so far.
+            let eta = if pos > 0 && pos < len {
+                format!("ETA {:.0} s, ", secs * (len - pos) as f64 / pos as f64)
+            } else {
+                String::new()
+            };
             format!(
-                "{}: {pos}/{len} ({:.0} %), {secs:.0} s elapsed",
+                "{}: {pos}/{len} ({:.0} %), {eta}{secs:.0} s elapsed",
                 self.label,
                 100.0 * pos as f64 / len as f64
             )

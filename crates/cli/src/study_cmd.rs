@@ -116,6 +116,7 @@ const MAX_SPHERE_PX: usize = 512;
 
 /// Runs `brdf-lab study`.
 pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
+    let started = std::time::Instant::now();
     if let Some(StudySub::Merge(m)) = &args.merge {
         return merge(m);
     }
@@ -163,7 +164,8 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     };
     let table_steps = if args.paper && shard.is_none() { 4 } else { 0 };
     let bar = progress::bar(plan.steps(shard) + render_steps + table_steps, "study");
-    let results = plan.run(shard, &|n| bar.inc(n));
+    let mut results = plan.run(shard, &|n| bar.inc(n));
+    let cpu_before_images = study::process_cpu_seconds();
     let render = images
         .then(|| {
             let default_px = if args.quick {
@@ -186,10 +188,43 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         None
     };
     bar.finish_and_clear();
+    let cpu_before_outputs = study::process_cpu_seconds();
+    if let (Some(run), Some(a), Some(b), true) = (
+        results.runs.first_mut(),
+        cpu_before_images,
+        cpu_before_outputs,
+        images || tables.is_some(),
+    ) {
+        run.phases.push(study::PhaseCpu {
+            phase: "images".into(),
+            cpu_seconds: b - a,
+        });
+    }
     write_outputs(staging.path(), &results, render.as_ref(), tables.as_deref())?;
     staging.commit()?;
     summary(&args.out, &results);
+    if let (Some(run), Some(a), Some(b)) = (
+        results.runs.first(),
+        cpu_before_outputs,
+        study::process_cpu_seconds(),
+    ) {
+        phase_summary(run, Some(b - a), started.elapsed().as_secs_f64());
+    }
     Ok(())
+}
+
+/// The one-line phase summary on stderr: CPU seconds per phase of the run (all threads),
+/// then the plots and report (`outputs`), and the total.
+fn phase_summary(run: &study::RunInfo, outputs: Option<f64>, wall: f64) {
+    let Some(phases) = run.phase_summary() else {
+        return;
+    };
+    let total: f64 = run.phases.iter().map(|p| p.cpu_seconds).sum::<f64>() + outputs.unwrap_or(0.0);
+    eprintln!(
+        "study: CPU time by phase: {phases}{}; total {total:.0} CPU s, {:.0} s wall",
+        outputs.map_or(String::new(), |o| format!(", outputs {o:.0} s")),
+        wall
+    );
 }
 
 /// `brdf-lab study merge DIR… --out DIR`.
@@ -254,15 +289,10 @@ fn render_sheet(
         let note = missing_samplers(plan, &r);
         return Ok((r, note));
     }
-    let sub = StudyPlan::new(
-        StudyConfig {
-            brdfs: chosen.clone(),
-            ..plan.config().clone()
-        },
-        Vec::new(),
-    )
-    .map_err(CliError::input)?;
-    let r = sub.render(cfg, progress).map_err(CliError::input)?;
+    // The plan's own samplers for the chosen BRDFs (built once for the statistics).
+    let r = plan
+        .render_subset(cfg, &chosen, progress)
+        .map_err(CliError::input)?;
     let note = format!(
         "The sphere images show {} of the study's {} materials (the first of each material family, then in order; `study::SHEET_MAX_BRDFS`), left to right: {}.\n\n",
         chosen.len(),

@@ -112,7 +112,10 @@ pub fn shared_measured(root: Option<&std::path::Path>) -> (Vec<String>, Vec<Stri
             let spec = format!("{reader}:{}", f.display());
             match brdf::parse_spec(&spec) {
                 Ok(_) => specs.push(spec),
-                Err(e) => notes.push(format!("{} is not studied: {e}", crate::short_brdf(&spec))),
+                Err(e) => notes.push(format!(
+                    "{} is not studied: {e}",
+                    crate::names::short_brdf(&spec)
+                )),
             }
         }
     }

@@ -41,6 +41,14 @@ pub enum StudyError {
     /// A study with no sampler, BRDF, angle or light.
     #[error("the study has no {0}")]
     EmptyGrid(&'static str),
+    /// A name that is not one of the study's (e.g. a sphere-sheet BRDF).
+    #[error("{name} is not one of the study's {what}")]
+    NotInStudy {
+        /// `BRDFs`, …
+        what: &'static str,
+        /// The name given.
+        name: String,
+    },
     /// An estimator the study does not know, or a MIS sampler outside the study's samplers.
     #[error("unknown estimator setting: {0} (estimators: light, mis-balance, mis-power)")]
     UnknownEstimator(String),

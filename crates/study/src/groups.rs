@@ -1,6 +1,7 @@
 //! Cells grouped by what they estimate: one group per (light, BRDF, θo), samplers compared
 //! inside it.
 
+pub use crate::names::{short_brdf, short_light};
 use crate::{CellResult, StudyResults};
 
 /// The cells of one (light, BRDF, θo).
@@ -41,37 +42,6 @@ impl Group<'_> {
             .collect();
         v.sort_by(|a, b| b.1.total_cmp(&a.1));
         v
-    }
-}
-
-/// A light spec without a long path (`envmap:…/grace_probe_latlong.hdr` → `envmap:grace_probe_latlong.hdr`).
-pub fn short_light(spec: &str) -> String {
-    match spec.split_once(':') {
-        Some(("envmap", path)) => format!(
-            "envmap:{}",
-            std::path::Path::new(path)
-                .file_name()
-                .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned())
-        ),
-        _ => spec.to_string(),
-    }
-}
-
-/// A BRDF spec without a long path or key: `rgl:/…/paper_white_rgb.bsdf` →
-/// `rgl:paper_white_rgb`, `sgd:material=red-fabric` → `sgd:red-fabric`; analytic specs as
-/// they are.
-pub fn short_brdf(spec: &str) -> String {
-    match spec.split_once(':') {
-        Some((reader @ ("rgl" | "cornell" | "merl"), path)) => format!(
-            "{reader}:{}",
-            std::path::Path::new(path)
-                .file_stem()
-                .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned())
-        ),
-        Some((fit @ ("sgd" | "abc"), rest)) => {
-            format!("{fit}:{}", rest.strip_prefix("material=").unwrap_or(rest))
-        }
-        _ => spec.to_string(),
     }
 }
 
@@ -175,7 +145,7 @@ pub fn groups(results: &StudyResults) -> Vec<Group<'_>> {
                     .cells
                     .iter()
                     .filter(|c| &c.light == light && &c.brdf == brdf && c.theta_o_deg == theta)
-                    .filter(|c| c.estimator == crate::ranking::ESTIMATOR_BRDF)
+                    .filter(|c| c.estimator == crate::verdict::ESTIMATOR_BRDF)
                     .collect();
                 if cells.is_empty() {
                     continue;

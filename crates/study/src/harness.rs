@@ -14,20 +14,30 @@
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
 //! * relative errors and MSE in batch mode rest on `max(repetitions, batch_repetitions)`
 //!   estimates per N;
-//! * timings: after the statistics, on the calling thread with nothing else of the study
-//!   running, `timing_repeats` runs of `timing_samples` samples per cell, interleaved across
-//!   cells (run 1 of every cell, then run 2, …), on the thread's CPU clock where the platform
-//!   has one (and the wall clock beside); the median and the spread are kept.
+//! * timings: after the statistics, nothing else of the study running, on every rayon thread
+//!   at once, each thread with an equal share of the cells (every T-th):
+//!   `timing_repeats` runs of `timing_samples` samples per cell, interleaved across its
+//!   cells (run 1 of each, then run 2, …), on the thread's own CPU clock where the platform
+//!   has one (and the wall clock beside); the median and the spread are kept. Every cell is
+//!   timed under the same condition (the other threads timing too);
+//! * the MIS cells of one (BRDF sampler, map sampler, BRDF, θo, light) under the balance and
+//!   the power heuristic share their draws (the stream of the first): each cell's values are
+//!   exactly those it would get alone from that stream, the heuristic's weights only differ;
+//! * the CPU time of each phase (builds, map samplers, references, statistics, timings,
+//!   rankings) is in the run's [`crate::RunInfo::phases`].
 //!
 //! Builds: each `(sampler, BRDF)` is built once, and samplers that build the same structure
 //! (the adaptive sets of one variant, nearest slice or two-slice mixture) share one build;
 //! the builds run on every core at once, each alone in a one-thread pool, and a build's time
 //! is the CPU time of the thread that ran it (wall time where the platform has no thread
 //! clock), so it is neither inflated by the builds beside it nor hidden by parallelism. A
-//! shared build's time is reported for every sampler that uses it.
+//! shared build's time is reported for every sampler that uses it. Longest first: samplers
+//! that need a build before the others, the BRDFs dearest to evaluate first (so that no long
+//! build starts last and runs alone while the other cores idle).
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
-//! `distributions::chunk_seed(seed, i)` and sums in a fixed order, so its numbers do not
+//! `distributions::chunk_seed(seed, i)` (a power-heuristic MIS cell from its balance
+//! partner's) and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it. A shard `K/N` runs every cell of the
 //! BRDFs `b` with `b mod N = K − 1` (not every N-th cell), so its builds are its own.
 
@@ -37,7 +47,7 @@ use std::time::Instant;
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirSample, DirectionSampler, QuadTreeSet, SetOptions, Variant};
 use envmap::{AdaptiveOptions, EnvMapSampler};
-use estimators::{LocalFrame, MisHeuristic, MisPair};
+use estimators::{LightTechnique, LocalFrame, MisHeuristic, MisPair};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -45,7 +55,7 @@ use samplers::{BuiltDirection, Constructor, DirectionRequest, Registry, SamplerE
 
 use crate::counting::{CountingBrdf, thread_evaluations};
 use crate::dispersion::{self, BudgetMse, Z95};
-use crate::machine::{RunClock, thread_cpu_seconds};
+use crate::machine::{PhaseClock, RunClock, thread_cpu_seconds};
 use crate::results::{
     CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi,
 };
@@ -86,7 +96,7 @@ fn build_warnings<'a>(
             notes.push(format!(
                 "sampler {} on {}: {w}",
                 sampler_name(*s),
-                crate::short_brdf(brdf_spec(*b))
+                crate::names::short_brdf(brdf_spec(*b))
             ));
         }
     }
@@ -176,6 +186,22 @@ impl DirectionSampler for SharedSet {
     fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
         self.set.singular_directions(wo)
     }
+}
+
+/// CPU seconds (wall where the platform has no thread clock) of 2 048 evaluations of `brdf`
+/// at fixed directions: the build order's estimate of what a build on it costs.
+fn evaluation_cost(brdf: &dyn Brdf) -> f64 {
+    let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
+    let mut sink = 0.0;
+    for i in 0..2048_u32 {
+        let t = f64::from(i % 64) * (89.0 / 64.0);
+        let p = f64::from(i / 64) * (360.0 / 32.0);
+        let wo = brdf::direction_from_angles(t, 0.0);
+        let wi = brdf::direction_from_angles(89.0 - t, p);
+        sink += brdf.eval_rgb(&wo, &wi)[1];
+    }
+    std::hint::black_box(sink);
+    cpu_or_wall(cpu, thread_cpu_seconds(), wall.elapsed().as_secs_f64())
 }
 
 /// A rayon pool of one thread (`None` if the platform cannot start one): a build run inside
@@ -325,7 +351,7 @@ impl StudyPlan {
                                     brdf: b.clone(),
                                     theta_o_deg: theta,
                                     light: light.clone(),
-                                    estimator: crate::ranking::ESTIMATOR_BRDF.to_string(),
+                                    estimator: crate::verdict::ESTIMATOR_BRDF.to_string(),
                                     light_sampler: None,
                                 },
                                 sampler: si,
@@ -552,6 +578,25 @@ impl StudyPlan {
                 own.push((s, b));
             }
         }
+        // Longest first (a long build started last would run alone at the end while the other
+        // cores idle): samplers that need a build before those that do not, and among them the
+        // BRDFs dearest to evaluate first (a build's cost is mostly BRDF evaluations). The
+        // order changes no build, only when each starts.
+        let cost: Vec<f64> = {
+            let mut bs: Vec<usize> = own.iter().map(|&(_, b)| b).collect();
+            bs.sort_unstable();
+            bs.dedup();
+            let mut c = vec![0.0; self.brdfs.len()];
+            for b in bs {
+                c[b] = evaluation_cost(self.brdfs[b].raw.as_ref());
+            }
+            c
+        };
+        own.sort_by(|&(s1, b1), &(s2, b2)| {
+            let n1 = self.entries[s1].capabilities.needs_build;
+            let n2 = self.entries[s2].capabilities.needs_build;
+            n2.cmp(&n1).then(cost[b2].total_cmp(&cost[b1]))
+        });
         let next = std::sync::atomic::AtomicUsize::new(0);
         let workers = rayon::current_num_threads().clamp(1, own.len().max(1));
         std::thread::scope(|scope| {
@@ -576,6 +621,12 @@ impl StudyPlan {
             let _ = self.build(s, b);
             progress(1);
         }
+    }
+
+    /// How many `(sampler, BRDF)` builds the plan holds (tests: a render reuses them).
+    #[cfg(test)]
+    pub(crate) fn built_len(&self) -> usize {
+        self.built.lock().map_or(0, |v| v.len())
     }
 
     /// The study's config.
@@ -677,6 +728,7 @@ impl StudyPlan {
     /// Runs the cells of `shard` (all when `None`); see the module docs.
     pub fn run(&self, shard: Option<Shard>, progress: ProgressFn<'_>) -> StudyResults {
         let clock = RunClock::start();
+        let mut phases = PhaseClock::start();
         let cells = self.selected(shard);
         // Builds: each structure once, on every core, each timed on its own thread's CPU
         // clock (`build_all`).
@@ -686,18 +738,21 @@ impl StudyPlan {
             .into_iter()
             .map(|(s, b)| ((s, b), self.build(s, b)))
             .collect();
+        phases.lap("builds");
         let light_built: Vec<((usize, usize), LightBuild)> = self
             .light_builds(&cells)
-            .into_iter()
+            .into_par_iter()
             .map(|(l, ls)| {
                 let r = self.build_light(l, ls);
                 progress(1);
                 ((l, ls), r)
             })
             .collect();
+        phases.lap("map samplers");
+        // References: independent quadratures, on every core.
         let references: Vec<((usize, usize, usize), Reference)> = self
             .references(&cells)
-            .into_iter()
+            .into_par_iter()
             .map(|(b, t, l)| {
                 let wo = brdf::direction_from_angles(self.config.theta_o_deg[t], 0.0);
                 let r = reference(self.brdfs[b].raw.as_ref(), &wo, &self.lights[l]);
@@ -705,6 +760,7 @@ impl StudyPlan {
                 ((b, t, l), r)
             })
             .collect();
+        phases.lap("references");
         let find_build = |c: &PlanCell| {
             built
                 .iter()
@@ -757,20 +813,42 @@ impl StudyPlan {
                     method: String::new(),
                 })
         };
-        let mut results: Vec<CellResult> = cells
+        // Statistics: the MIS cells of one (BRDF sampler, map sampler, BRDF, θo, light) under
+        // different heuristics share their draws (`mis_groups`); every other cell runs alone.
+        let groups = mis_groups(&cells);
+        let mut slots: Vec<Option<CellResult>> = vec![None; cells.len()];
+        let done: Vec<Vec<(usize, CellResult)>> = groups
             .par_iter()
-            .map(|c| {
-                let r = match technique(c) {
-                    Ok((t, _)) => self.run_cell(c, t, find_ref(c)),
-                    Err(e) => failed(c, find_ref(c), e),
+            .map(|g| {
+                let members: Vec<&PlanCell> = g.iter().map(|&i| cells[i]).collect();
+                let out = match technique(members[0]) {
+                    Ok((t, _)) => {
+                        let refs: Vec<Reference> = members.iter().map(|c| find_ref(c)).collect();
+                        self.run_cells(&members, t, refs)
+                    }
+                    Err(e) => members
+                        .iter()
+                        .map(|c| failed(c, find_ref(c), e.clone()))
+                        .collect(),
                 };
-                progress(1);
-                r
+                progress(g.len() as u64);
+                g.iter().copied().zip(out).collect()
             })
             .collect();
-        // Timings on this thread, interleaved: repeat 1 of every cell, then repeat 2, … so that a
-        // change of the machine's load during the timing phase shows in every cell's spread.
-        let mut timers: Vec<(usize, CellTimer<'_>)> = cells
+        for (i, r) in done.into_iter().flatten() {
+            slots[i] = Some(r);
+        }
+        let mut results: Vec<CellResult> = slots
+            .into_iter()
+            .map(|r| r.expect("every cell of a group ran"))
+            .collect();
+        phases.lap("statistics");
+        // Timings: every timing thread gets an equal share of the cells (every T-th), and
+        // runs its share interleaved — repeat 1 of each of its cells, then repeat 2, … — so
+        // that a change of the machine's load during the timing phase shows in every cell's
+        // spread. Each time is on its own thread's CPU clock; all threads run at once, so every
+        // cell is timed under the same condition (the other cores timing too).
+        let timers: Vec<(usize, CellTimer<'_>)> = cells
             .iter()
             .enumerate()
             .filter_map(|(i, c)| match (technique(c), results[i].ok()) {
@@ -778,19 +856,38 @@ impl StudyPlan {
                 _ => None,
             })
             .collect();
-        for _ in 0..self.config.timing_repeats {
-            for (_, t) in timers.iter_mut() {
-                t.repeat(self.config.timing_samples);
-            }
+        let untimed = (cells.len() - timers.len()) as u64;
+        let threads = timing_threads().clamp(1, timers.len().max(1));
+        let mut shares: Vec<Vec<(usize, CellTimer<'_>)>> =
+            (0..threads).map(|_| Vec::new()).collect();
+        for (k, t) in timers.into_iter().enumerate() {
+            shares[k % threads].push(t);
         }
-        for (i, t) in timers {
+        let (repeats, samples) = (self.config.timing_repeats, self.config.timing_samples);
+        std::thread::scope(|scope| {
+            for share in &mut shares {
+                scope.spawn(move || {
+                    let mut reported = 0;
+                    for r in 0..repeats {
+                        for (_, t) in share.iter_mut() {
+                            t.repeat(samples);
+                        }
+                        let due = share.len() * (r + 1) / repeats;
+                        progress((due - reported) as u64);
+                        reported = due;
+                    }
+                });
+            }
+        });
+        for (i, t) in shares.into_iter().flatten() {
             let r = &mut results[i];
             // Efficiency divides by the MSE at the budget (module `dispersion`); an exact
             // sampler's rounding-level value counts as 0 (no efficiency).
             let mse = if r.zero_variance { 0.0 } else { r.mse.value };
             r.timing = Some(t.finish(mse));
         }
-        progress(cells.len() as u64);
+        progress(untimed);
+        phases.lap("timings");
         let mut warnings = build_warnings(
             &built,
             |s| self.entries[s].name,
@@ -816,74 +913,116 @@ impl StudyPlan {
                 })
                 .collect(),
             cells: results,
-            runs: vec![clock.finish()],
+            runs: Vec::new(),
             rankings: Vec::new(),
         };
         if shard.is_none() {
             out.rankings = crate::ranking::rankings(&out);
+            phases.lap("rankings");
         }
+        out.runs = vec![clock.finish(phases.finish())];
         out
     }
 
-    /// The statistics of one cell (deterministic).
-    fn run_cell(&self, c: &PlanCell, technique: Technique<'_>, reference: Reference) -> CellResult {
+    /// The statistics of `members`, cells of one technique that differ at most in their MIS
+    /// heuristic, from one stream of draws (deterministic): the stream of the first member
+    /// (`chunk_seed(seed, index)`), each draw's value computed under each member's heuristic.
+    /// A lone cell is its own group, so its numbers are those of its own stream.
+    fn run_cells(
+        &self,
+        members: &[&PlanCell],
+        technique: Technique<'_>,
+        references: Vec<Reference>,
+    ) -> Vec<CellResult> {
         let cfg = &self.config;
-        let wo = brdf::direction_from_angles(c.spec.theta_o_deg, 0.0);
-        let est = Estimator {
-            brdf: self.brdfs[c.brdf].raw.as_ref(),
-            light: &self.lights[c.light],
-            technique,
-            mode: c.spec.mode,
-            wo,
-        };
+        let c = members[0];
+        let est = self.estimator(c, technique);
+        let heuristics: Vec<MisHeuristic> = members
+            .iter()
+            .filter_map(|m| match m.kind {
+                Kind::Mis { heuristic, .. } => Some(heuristic),
+                _ => None,
+            })
+            .collect();
+        let k = members.len();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(distributions::chunk_seed(
             cfg.seed,
             c.spec.index as u64,
         ));
         let mut counter = EvalCounter::default();
-        let ref_value = reference.value;
-        let mut errors = Vec::with_capacity(cfg.n_grid.len());
         let reps = match c.spec.mode {
             Mode::OneSample => cfg.repetitions,
             Mode::Batch => cfg.repetitions.max(cfg.batch_repetitions),
         };
-        let mut values = Vec::with_capacity(reps);
-        // Every one-sample value of the cell (independent draws): the variance and the MSE
-        // at the budget are measured on all of them.
-        let mut all_values: Vec<f64> = Vec::new();
-        for &n in &cfg.n_grid {
-            values.clear();
-            for _ in 0..reps {
-                let ys = est.values(n, &mut rng, &mut counter).into_iter();
-                let sum: f64 = if c.spec.mode == Mode::OneSample {
-                    let start = all_values.len();
-                    all_values.extend(ys);
-                    all_values[start..].iter().sum()
-                } else {
-                    ys.sum()
-                };
-                values.push(sum / n as f64);
+        let mut acc: Vec<Accumulator> = references
+            .into_iter()
+            .map(|reference| Accumulator {
+                reference,
+                errors: Vec::with_capacity(cfg.n_grid.len()),
+                values: Vec::with_capacity(reps),
+                all_values: Vec::new(),
+            })
+            .collect();
+        let draw = |n: usize, rng: &mut Xoshiro256PlusPlus, counter: &mut EvalCounter| {
+            if k == 1 {
+                vec![est.values(n, rng, counter)]
+            } else {
+                est.mis_values(&heuristics, n, rng, counter)
             }
-            let rel: Vec<f64> = values
-                .iter()
-                .map(|v| (v - ref_value).abs() / ref_value)
-                .collect();
-            let (mean_rel, var_rel) = mean_var(&rel);
-            let (_, var_est) = mean_var(&values);
-            errors.push(ErrorAtN {
-                n,
-                mean_rel_err: finite(mean_rel),
-                ci95: finite(Z95 * (var_rel / rel.len() as f64).sqrt()),
-                rms_rel_err: finite(
-                    (rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt(),
-                ),
-                variance_per_sample: finite(n as f64 * var_est),
-            });
+        };
+        for &n in &cfg.n_grid {
+            for a in acc.iter_mut() {
+                a.values.clear();
+            }
+            for _ in 0..reps {
+                let ys = draw(n, &mut rng, &mut counter);
+                for (a, ys) in acc.iter_mut().zip(ys) {
+                    let sum: f64 = if c.spec.mode == Mode::OneSample {
+                        let start = a.all_values.len();
+                        a.all_values.extend(ys);
+                        a.all_values[start..].iter().sum()
+                    } else {
+                        ys.into_iter().sum()
+                    };
+                    a.values.push(sum / n as f64);
+                }
+            }
+            for a in acc.iter_mut() {
+                a.error_at(n);
+            }
         }
-        let budget = cfg.n_grid.last().copied().unwrap_or(1);
+        if c.spec.mode == Mode::OneSample {
+            let ys = draw(cfg.variance_samples, &mut rng, &mut counter);
+            for (a, ys) in acc.iter_mut().zip(ys) {
+                a.all_values.extend(ys);
+            }
+        }
+        members
+            .iter()
+            .zip(acc)
+            .map(|(m, a)| self.cell_result(m, technique, &counter, reps, a))
+            .collect()
+    }
+
+    /// A cell's result from its accumulated values.
+    fn cell_result(
+        &self,
+        c: &PlanCell,
+        technique: Technique<'_>,
+        counter: &EvalCounter,
+        reps: usize,
+        a: Accumulator,
+    ) -> CellResult {
+        let budget = self.config.n_grid.last().copied().unwrap_or(1);
+        let Accumulator {
+            reference,
+            errors,
+            values,
+            all_values,
+        } = a;
+        let ref_value = reference.value;
         let (variance, mse, tail_share, warnings) = match c.spec.mode {
             Mode::OneSample => {
-                all_values.extend(est.values(cfg.variance_samples, &mut rng, &mut counter));
                 let st = dispersion::one_sample_stats(&all_values);
                 let mse = dispersion::one_sample_mse(&st, ref_value, reference.abs_err, budget);
                 let warnings = dispersion::warnings(
@@ -955,6 +1094,17 @@ impl StudyPlan {
         }
     }
 
+    /// The estimator of cell `c` with `technique`.
+    fn estimator<'a>(&'a self, c: &PlanCell, technique: Technique<'a>) -> Estimator<'a> {
+        Estimator {
+            brdf: self.brdfs[c.brdf].raw.as_ref(),
+            light: &self.lights[c.light],
+            technique,
+            mode: c.spec.mode,
+            wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
+        }
+    }
+
     /// The timer of one cell (its own stream, seeded apart from the statistics').
     fn cell_timer<'a>(
         &'a self,
@@ -964,13 +1114,7 @@ impl StudyPlan {
     ) -> CellTimer<'a> {
         let cfg = &self.config;
         CellTimer {
-            est: Estimator {
-                brdf: self.brdfs[c.brdf].raw.as_ref(),
-                light: &self.lights[c.light],
-                technique,
-                mode: c.spec.mode,
-                wo: brdf::direction_from_angles(c.spec.theta_o_deg, 0.0),
-            },
+            est: self.estimator(c, technique),
             rng: Xoshiro256PlusPlus::seed_from_u64(distributions::chunk_seed(
                 cfg.seed ^ 0x7469_6d65,
                 c.spec.index as u64,
@@ -1061,6 +1205,73 @@ fn cpu_or_wall(start: Option<f64>, end: Option<f64>, wall: f64) -> f64 {
         (Some(a), Some(b)) => b - a,
         _ => wall,
     }
+}
+
+/// One cell's values while its statistics run.
+struct Accumulator {
+    reference: Reference,
+    errors: Vec<ErrorAtN>,
+    /// The estimates at the current N.
+    values: Vec<f64>,
+    /// Every one-sample value drawn (one-sample mode): the variance and the MSE at the budget
+    /// are measured on all of them.
+    all_values: Vec<f64>,
+}
+
+impl Accumulator {
+    /// Records the relative errors of the estimates at `n`.
+    fn error_at(&mut self, n: usize) {
+        let ref_value = self.reference.value;
+        let rel: Vec<f64> = self
+            .values
+            .iter()
+            .map(|v| (v - ref_value).abs() / ref_value)
+            .collect();
+        let (mean_rel, var_rel) = mean_var(&rel);
+        let (_, var_est) = mean_var(&self.values);
+        self.errors.push(ErrorAtN {
+            n,
+            mean_rel_err: finite(mean_rel),
+            ci95: finite(Z95 * (var_rel / rel.len() as f64).sqrt()),
+            rms_rel_err: finite((rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt()),
+            variance_per_sample: finite(n as f64 * var_est),
+        });
+    }
+}
+
+/// The groups of cells (positions in `cells`) whose statistics run together: the MIS cells of
+/// one (BRDF sampler, map sampler, BRDF, θo, light) under each heuristic — the same pair of
+/// draws serves every heuristic, only the weights differ, so each cell's values keep their
+/// law (one BRDF draw and one map draw per sample) and the study draws once instead of once
+/// per heuristic. Each group is led by its first cell (the balance heuristic's in the
+/// config's order), whose stream it uses; every other cell is a group of its own. The cells
+/// of one group are correlated with each other, never with another cell of their own
+/// ranking (a ranking compares cells of one estimator, so one heuristic).
+fn mis_groups(cells: &[&PlanCell]) -> Vec<Vec<usize>> {
+    /// (BRDF sampler, map sampler, BRDF, θo, light).
+    type Pair = (usize, usize, usize, usize, usize);
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut lead: Vec<(Pair, usize)> = Vec::new();
+    for (i, c) in cells.iter().enumerate() {
+        let Kind::Mis { ls, .. } = c.kind else {
+            groups.push(vec![i]);
+            continue;
+        };
+        let key = (c.sampler, ls, c.brdf, c.theta, c.light);
+        match lead.iter().find(|(k, _)| *k == key) {
+            Some(&(_, g)) => groups[g].push(i),
+            None => {
+                lead.push((key, groups.len()));
+                groups.push(vec![i]);
+            }
+        }
+    }
+    groups
+}
+
+/// Threads of the timing phase: rayon's (every core, or `RAYON_NUM_THREADS`).
+fn timing_threads() -> usize {
+    rayon::current_num_threads()
 }
 
 /// Sample standard deviation of `ln t` over the positive `t` (0 with fewer than two).
@@ -1186,6 +1397,49 @@ impl Estimator<'_> {
                 v
             }
         }
+    }
+
+    /// `n` one-sample values of an MIS cell under each of `heuristics`, from one pair of
+    /// draws per sample (a BRDF draw, then a map draw: [`MisPair::value`]'s order, so the
+    /// values under each heuristic are those `MisPair::value` gives from the same stream).
+    /// The other technique's pdf is evaluated once per draw and serves every heuristic.
+    fn mis_values(
+        &self,
+        heuristics: &[MisHeuristic],
+        n: usize,
+        rng: &mut Xoshiro256PlusPlus,
+        counter: &mut EvalCounter,
+    ) -> Vec<Vec<f64>> {
+        let Technique::Mis(pair) = self.technique else {
+            return vec![self.values(n, rng, counter)];
+        };
+        let before = thread_evaluations();
+        let mut out: Vec<Vec<f64>> = heuristics.iter().map(|_| Vec::with_capacity(n)).collect();
+        for _ in 0..n {
+            let s = pair.brdf_sampler.sample(&self.wo, rng);
+            let g = self.integrand(&s.wi);
+            let other = (g > 0.0 && s.pdf > 0.0)
+                .then(|| pair.light_sampler.pdf_world(&pair.frame.to_world(&s.wi)));
+            let light = pair.light_sampler.sample_world(rng).map(|(d, pl)| {
+                let wi = pair.frame.to_local(&d);
+                let g = self.integrand(&wi);
+                let other = (g > 0.0 && pl > 0.0).then(|| pair.brdf_sampler.pdf(&self.wo, &wi));
+                (g, pl, other)
+            });
+            for (h, o) in heuristics.iter().zip(out.iter_mut()) {
+                let a = estimators::mis_term(*h, g, s.pdf, 1.0, 1.0, || other.unwrap_or(0.0));
+                let v = match light {
+                    Some((g, pl, other)) => {
+                        a + estimators::mis_term(*h, g, pl, 1.0, 1.0, || other.unwrap_or(0.0))
+                    }
+                    None => a,
+                };
+                o.push(v);
+            }
+        }
+        counter.evaluations += thread_evaluations() - before;
+        counter.samples += n as u64;
+        out
     }
 
     /// The sampling alone of `n` values (timing); returns a number to keep.
@@ -1558,5 +1812,152 @@ mod shared_build_tests {
             let bytes = |s: &str| shared.cells.iter().find(|c| c.sampler == s).unwrap().bytes;
             assert_eq!(bytes(a), bytes(b));
         }
+    }
+}
+
+#[cfg(test)]
+mod shared_draw_tests {
+    use super::*;
+
+    /// MIS of `cosine` and `phong:n=20` under the sky with the given estimators; the map
+    /// samplers are the study's two.
+    fn run(estimators: &[&str]) -> StudyResults {
+        let mut c = StudyConfig::new(
+            vec!["cosine".into(), "lobe-sphere".into()],
+            vec!["phong:n=20".into()],
+            vec![40.0],
+            vec!["sky".into()],
+        );
+        c.n_grid = vec![2, 8];
+        c.repetitions = 4;
+        c.variance_samples = 300;
+        c.timing_samples = 4;
+        c.timing_repeats = 1;
+        c.estimators = estimators.iter().map(|s| s.to_string()).collect();
+        StudyPlan::new(c, Vec::new()).unwrap().run(None, &|_| {})
+    }
+
+    /// A cell's statistics, without what names it (index, estimator) or times it.
+    fn numbers(c: &CellResult) -> CellResult {
+        CellResult {
+            index: 0,
+            estimator: String::new(),
+            timing: None,
+            ..c.clone()
+        }
+    }
+
+    fn of<'a>(r: &'a StudyResults, estimator: &str) -> Vec<&'a CellResult> {
+        r.cells
+            .iter()
+            .filter(|c| c.estimator == estimator)
+            .collect()
+    }
+
+    /// The balance and power cells of one pair share their draws: each gets exactly the
+    /// values it would get alone from the same stream. With both heuristics, the balance
+    /// cells equal a balance-only study's and the power cells a power-only study's (whose
+    /// power cells sit at the balance cells' indices, so use their streams), every number.
+    #[test]
+    fn heuristics_sharing_draws_give_each_cell_its_lone_values() {
+        let both = run(&["mis-balance", "mis-power"]);
+        let balance = run(&["mis-balance"]);
+        let power = run(&["mis-power"]);
+        for (h, alone) in [("mis-balance", &balance), ("mis-power", &power)] {
+            let (a, b) = (of(&both, h), of(alone, h));
+            assert_eq!(a.len(), 4, "{h}");
+            assert_eq!(a.len(), b.len(), "{h}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!(x.ok() && x.variance.value > 0.0, "{h}: {x:?}");
+                assert_eq!(numbers(x), numbers(y), "{h}");
+            }
+        }
+        // The two heuristics give different numbers from the same draws.
+        assert_ne!(
+            numbers(of(&both, "mis-balance")[0]).variance,
+            numbers(of(&both, "mis-power")[0]).variance
+        );
+    }
+
+    /// The sphere sheet of a subset of a study's BRDFs reuses the samplers the study built:
+    /// rendering after the run builds nothing more.
+    #[test]
+    fn the_sphere_sheet_of_a_subset_reuses_the_study_builds() {
+        let mut c = StudyConfig::new(
+            vec!["cosine".into(), "adaptive".into()],
+            vec!["lambert".into(), "phong:n=20".into()],
+            vec![40.0],
+            vec!["area:theta=30,phi=180,radius=10".into()],
+        );
+        c.n_grid = vec![2];
+        c.repetitions = 2;
+        c.variance_samples = 10;
+        c.timing_samples = 2;
+        c.timing_repeats = 1;
+        c.slices = 8;
+        c.estimators = Vec::new();
+        let plan = StudyPlan::new(c, Vec::new()).unwrap();
+        let _ = plan.run(None, &|_| {});
+        assert_eq!(plan.built_len(), 4);
+        let cfg = crate::RenderConfig {
+            sphere_px: 8,
+            spp: 2,
+            reference_spp: 4,
+            light: 0,
+            seed: 1,
+        };
+        let r = plan
+            .render_subset(&cfg, &["phong:n=20".to_string()], &|_| {})
+            .unwrap();
+        assert_eq!(r.brdfs, ["phong:n=20"]);
+        assert_eq!(plan.built_len(), 4);
+    }
+
+    /// `Estimator::mis_values` gives, under each heuristic, `MisPair::value`'s values from
+    /// the same stream, and consumes the stream as one `MisPair::value` per sample does.
+    #[test]
+    fn mis_values_are_mis_pair_values_under_each_heuristic() {
+        let light = Light::parse("sky").unwrap();
+        let Light::Map { map, .. } = &light else {
+            unreachable!()
+        };
+        let cdf = EnvMapSampler::piecewise_constant(map).unwrap();
+        let brdf = brdf::parse_spec("phong:n=20").unwrap();
+        let sampler = samplers::build_direction(
+            "lobe-sphere",
+            &DirectionRequest::new(
+                Arc::from(brdf::parse_spec("phong:n=20").unwrap()),
+                &SetOptions::default(),
+            ),
+        )
+        .unwrap()
+        .sampler;
+        let est = |heuristic| Estimator {
+            brdf: brdf.as_ref(),
+            light: &light,
+            technique: Technique::Mis(MisPair {
+                brdf_sampler: sampler.as_ref(),
+                light_sampler: &cdf,
+                frame: LocalFrame::identity(),
+                heuristic,
+            }),
+            mode: Mode::OneSample,
+            wo: brdf::direction_from_angles(40.0, 0.0),
+        };
+        let n = 2000;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let shared = est(MisHeuristic::Balance).mis_values(
+            &MisHeuristic::ALL,
+            n,
+            &mut rng,
+            &mut EvalCounter::default(),
+        );
+        for (h, values) in MisHeuristic::ALL.into_iter().zip(&shared) {
+            let mut alone = Xoshiro256PlusPlus::seed_from_u64(11);
+            let v = est(h).values(n, &mut alone, &mut EvalCounter::default());
+            assert_eq!(values, &v, "{h:?}");
+            assert_eq!(alone, rng, "{h:?}: the stream is consumed differently");
+        }
+        assert!(shared[0].iter().any(|v| *v > 0.0));
     }
 }

@@ -47,6 +47,8 @@ mod groups;
 mod harness;
 mod light;
 mod machine;
+mod merge;
+mod names;
 mod paper;
 mod plot;
 pub mod ranking;
@@ -55,6 +57,7 @@ mod render;
 mod report;
 mod results;
 mod sheet;
+mod verdict;
 
 pub use config::{
     BATCH_REPETITIONS, CellSpec, DEFAULT_MERL_FITS, EXTRA_ESTIMATORS, FULL_THETA_O_DEG,
@@ -70,7 +73,7 @@ pub use groups::{
 };
 pub use harness::{ProgressFn, StudyPlan};
 pub use light::{AREA_PHI_DEG, AREA_RADIANCE, AREA_RADIUS_DEG, AREA_THETA_DEG, Light, SKY_WIDTH};
-pub use machine::{COMMIT, RunInfo};
+pub use machine::{COMMIT, PhaseCpu, RunInfo, process_cpu_seconds};
 pub use paper::{
     Claim, ClaimVerdict, MERL_SAMPLES, PAPER_SPHERE_PX, PaperRow, PaperTable, SEED_003_MODELS,
     TIME_MARGIN, paper_markdown, paper_tables,

@@ -29,6 +29,67 @@ pub struct RunInfo {
     /// /proc/self/stat (`None` elsewhere): with [`Self::wall_seconds`] it tells how much of
     /// the machine the run had.
     pub cpu_seconds: Option<f64>,
+    /// CPU time (user + system, s) of the process in each phase of the run, in order (builds,
+    /// map samplers, references, statistics, timings; the command line adds its images and
+    /// outputs): where a run's CPU goes. Empty where the platform gives no process CPU time,
+    /// and in results written before the phases were recorded.
+    #[serde(default)]
+    pub phases: Vec<PhaseCpu>,
+}
+
+/// The CPU time of one phase of a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseCpu {
+    /// `builds`, `map samplers`, `references`, `statistics`, `timings`, …
+    pub phase: String,
+    /// User + system CPU seconds of the process during the phase (every thread).
+    pub cpu_seconds: f64,
+}
+
+/// Records the process CPU time of consecutive phases: [`PhaseClock::lap`] closes the current
+/// phase under a name and starts the next.
+#[derive(Debug)]
+pub(crate) struct PhaseClock {
+    last: Option<f64>,
+    phases: Vec<PhaseCpu>,
+}
+
+impl PhaseClock {
+    pub(crate) fn start() -> Self {
+        Self {
+            last: process_cpu_seconds(),
+            phases: Vec::new(),
+        }
+    }
+
+    /// Ends the phase `phase` (nothing is recorded where there is no process CPU clock).
+    pub(crate) fn lap(&mut self, phase: &str) {
+        let now = process_cpu_seconds();
+        if let (Some(a), Some(b)) = (self.last, now) {
+            self.phases.push(PhaseCpu {
+                phase: phase.to_string(),
+                cpu_seconds: (b - a).max(0.0),
+            });
+        }
+        self.last = now;
+    }
+
+    pub(crate) fn finish(self) -> Vec<PhaseCpu> {
+        self.phases
+    }
+}
+
+impl RunInfo {
+    /// `builds 11 s, references 2 s, …` (CPU seconds per phase), or `None` without phases.
+    pub fn phase_summary(&self) -> Option<String> {
+        (!self.phases.is_empty()).then(|| {
+            self.phases
+                .iter()
+                .map(|p| format!("{} {:.0} s", p.phase, p.cpu_seconds))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+    }
 }
 
 /// The three load averages of /proc/loadavg (empty when unreadable).
@@ -59,7 +120,7 @@ pub(crate) fn cpu_model() -> String {
 
 /// User + system CPU time of this process (s), from fields 14 and 15 of /proc/self/stat in
 /// clock ticks of 1/100 s (Linux's `USER_HZ` on every mainstream architecture).
-pub(crate) fn process_cpu_seconds() -> Option<f64> {
+pub fn process_cpu_seconds() -> Option<f64> {
     let s = std::fs::read_to_string("/proc/self/stat").ok()?;
     // The command name (field 2) is in parentheses and may hold spaces: split after it.
     let rest = &s[s.rfind(')')? + 1..];
@@ -100,7 +161,7 @@ impl RunClock {
         }
     }
 
-    pub(crate) fn finish(self) -> RunInfo {
+    pub(crate) fn finish(self, phases: Vec<PhaseCpu>) -> RunInfo {
         RunInfo {
             commit: COMMIT.to_string(),
             cpu_model: cpu_model(),
@@ -110,6 +171,7 @@ impl RunClock {
             load_end: load_average(),
             wall_seconds: self.start.elapsed().as_secs_f64(),
             cpu_seconds: process_cpu_seconds(),
+            phases,
         }
     }
 }
@@ -120,13 +182,23 @@ mod tests {
 
     #[test]
     fn the_run_info_is_read_where_linux_gives_it() {
-        let info = RunClock::start().finish();
+        let mut phases = PhaseClock::start();
+        let x: f64 = (0..2_000_000).map(|i| (i as f64).sqrt()).sum();
+        std::hint::black_box(x);
+        phases.lap("work");
+        let info = RunClock::start().finish(phases.finish());
         assert!(!info.commit.is_empty());
         assert!(info.threads >= 1 && info.logical_cpus >= 1);
         if std::path::Path::new("/proc/loadavg").exists() {
             assert_eq!(info.load_start.len(), 3);
             assert!(info.cpu_seconds.is_some_and(|s| s >= 0.0));
             assert_ne!(info.cpu_model, "");
+            assert_eq!(info.phases.len(), 1);
+            assert!(info.phases[0].cpu_seconds >= 0.0);
+            assert_eq!(
+                info.phase_summary().unwrap(),
+                format!("work {:.0} s", info.phases[0].cpu_seconds)
+            );
         }
     }
 }

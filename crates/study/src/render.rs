@@ -299,24 +299,64 @@ impl StudyPlan {
         cfg: &RenderConfig,
         progress: crate::ProgressFn<'_>,
     ) -> Result<Render, StudyError> {
+        let all: Vec<usize> = (0..self.brdfs.len()).collect();
+        self.render_brdfs(cfg, &all, progress)
+    }
+
+    /// [`StudyPlan::render`] of some of the study's BRDFs (`specs`, each one of the config's,
+    /// left to right in this order), with the samplers the plan built for them (a study's
+    /// sphere sheet reuses its statistics' builds instead of building them again).
+    ///
+    /// Errors: a spec that is not one of the study's BRDFs, and [`StudyPlan::render`]'s.
+    pub fn render_subset(
+        &self,
+        cfg: &RenderConfig,
+        specs: &[String],
+        progress: crate::ProgressFn<'_>,
+    ) -> Result<Render, StudyError> {
+        let chosen = specs
+            .iter()
+            .map(|spec| {
+                self.brdfs
+                    .iter()
+                    .position(|b| &b.spec == spec)
+                    .ok_or_else(|| StudyError::NotInStudy {
+                        what: "BRDFs",
+                        name: crate::names::short_brdf(spec),
+                    })
+            })
+            .collect::<Result<Vec<usize>, _>>()?;
+        if chosen.is_empty() {
+            return Err(StudyError::EmptyGrid("sphere BRDFs"));
+        }
+        self.render_brdfs(cfg, &chosen, progress)
+    }
+
+    fn render_brdfs(
+        &self,
+        cfg: &RenderConfig,
+        chosen: &[usize],
+        progress: crate::ProgressFn<'_>,
+    ) -> Result<Render, StudyError> {
         let light = self
             .lights
             .get(cfg.light)
             .ok_or(StudyError::EmptyGrid("light to render under"))?;
         let px = cfg.sphere_px.max(4);
-        let (width, height) = (self.brdfs.len() * px, px);
-        let hits = hits(self.brdfs.len(), px);
-        let brdfs: Vec<&dyn Brdf> = self.brdfs.iter().map(|b| b.raw.as_ref()).collect();
-        // Samplers per (sampler, BRDF), built on every core first (cached); the reference
-        // sampler is `adaptive`.
+        let (width, height) = (chosen.len() * px, px);
+        let hits = hits(chosen.len(), px);
+        let brdfs: Vec<&dyn Brdf> = chosen.iter().map(|&b| self.brdfs[b].raw.as_ref()).collect();
+        // Samplers per (sampler, BRDF), built on every core first (cached: those the study's
+        // statistics built are reused); the reference sampler is `adaptive`.
         let pairs: Vec<(usize, usize)> = (0..self.entries.len())
-            .flat_map(|s| (0..self.brdfs.len()).map(move |b| (s, b)))
+            .flat_map(|s| chosen.iter().map(move |&b| (s, b)))
             .collect();
         self.build_all(&pairs, &|_| {});
         let built: Vec<Vec<Option<std::sync::Arc<dyn DirectionSampler>>>> = (0..self.entries.len())
             .map(|s| {
-                (0..self.brdfs.len())
-                    .map(|b| self.build(s, b).ok().map(|(d, _)| d.sampler))
+                chosen
+                    .iter()
+                    .map(|&b| self.build(s, b).ok().map(|(d, _)| d.sampler))
                     .collect()
             })
             .collect();
@@ -334,8 +374,9 @@ impl StudyPlan {
                     slices: self.config.slices,
                     ..Default::default()
                 };
-                self.brdfs
+                chosen
                     .iter()
+                    .map(|&b| &self.brdfs[b])
                     .map(|b| {
                         reference_entry
                             .build_direction(&samplers::DirectionRequest::new(
@@ -440,7 +481,7 @@ impl StudyPlan {
         Ok(Render {
             config: cfg.clone(),
             light: self.config.lights[cfg.light].clone(),
-            brdfs: self.brdfs.iter().map(|b| b.spec.clone()).collect(),
+            brdfs: chosen.iter().map(|&b| self.brdfs[b].spec.clone()).collect(),
             reference_method: format!(
                 "MIS (balance heuristic) of the adaptive BRDF sampler and {}, {} samples of each per pixel",
                 match light_sampler {
@@ -732,10 +773,10 @@ impl Render {
             "Spheres, left to right: {}; under `{}`; {}×{} pixels per sphere, orthographic camera, direct lighting, no shadows. Reference: {} ({:.1} s †). Relative error = mean over pixels with non-null reference luminance of |Y − Y_ref| / Y_ref. Equal time: samples per pixel scaled by the measured time per sample (†) to the `adaptive` sampler's budget of {} spp.\n",
             self.brdfs
                 .iter()
-                .map(|b| format!("`{}`", crate::short_brdf(b)))
+                .map(|b| format!("`{}`", crate::names::short_brdf(b)))
                 .collect::<Vec<_>>()
                 .join(", "),
-            crate::short_light(&self.light),
+            crate::names::short_light(&self.light),
             self.config.sphere_px,
             self.config.sphere_px,
             self.reference_method,

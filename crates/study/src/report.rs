@@ -31,7 +31,7 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
         cfg.samplers.join(", "),
         cfg.brdfs
             .iter()
-            .map(|b| format!("`{}`", crate::short_brdf(b)))
+            .map(|b| format!("`{}`", crate::names::short_brdf(b)))
             .collect::<Vec<_>>()
             .join(", "),
         cfg.theta_o_deg
@@ -140,7 +140,7 @@ fn run_section(s: &mut String, results: &StudyResults) {
     for r in &results.runs {
         let _ = writeln!(
             s,
-            "* commit `{}`, CPU {} ({} logical CPUs), {} threads for the statistics (one for the timings); load average (1 / 5 / 15 min) {} at the start, {} at the end; {:.0} s wall, {} CPU.",
+            "* commit `{}`, CPU {} ({} logical CPUs), {} threads for the statistics and the timings (each timing on its own thread's CPU clock); load average (1 / 5 / 15 min) {} at the start, {} at the end; {:.0} s wall, {} CPU.",
             r.commit,
             r.cpu_model,
             r.logical_cpus,
@@ -151,6 +151,9 @@ fn run_section(s: &mut String, results: &StudyResults) {
             r.cpu_seconds
                 .map_or("unknown".to_string(), |c| format!("{c:.0} s")),
         );
+        if let Some(p) = r.phase_summary() {
+            let _ = writeln!(s, "  CPU time by phase: {p}.");
+        }
     }
     let spread = |f: &dyn Fn(&crate::Timing) -> f64| {
         let mut v: Vec<f64> = results
@@ -313,7 +316,7 @@ pub(crate) fn verdicts(s: &mut String, rankings: &[Ranking]) {
     for (r, o) in rankings.iter().zip(&outcomes) {
         let title = format!(
             "{} at θo = {}° under {}",
-            crate::short_brdf(&r.brdf),
+            crate::names::short_brdf(&r.brdf),
             r.theta_o,
             short_light(&r.light)
         );
@@ -557,11 +560,7 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                                 r.theta_o,
                                 r.best,
                                 list(r),
-                                r.rows()
-                                    .iter()
-                                    .map(usize::to_string)
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
+                                r.rows_text()
                             )
                         })
                         .collect();
@@ -572,8 +571,8 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
                         s,
                         "* Inside MIS ({}) under {} with `{ls}`, the best BRDF sampler for `{}` is {}.",
                         estimator.trim_start_matches("mis-"),
-                        crate::short_light(light),
-                        crate::short_brdf(brdf),
+                        crate::names::short_light(light),
+                        crate::names::short_brdf(brdf),
                         parts.join("; ")
                     );
                 }
@@ -587,16 +586,12 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
         let _ = writeln!(
             s,
             "* Light sampling alone under {} for `{}` at θo = {}°: the best map sampler is **{}** ({}; rows {}).",
-            crate::short_light(&r.light),
-            crate::short_brdf(&r.brdf),
+            crate::names::short_light(&r.light),
+            crate::names::short_brdf(&r.brdf),
             r.theta_o,
             r.best,
             list(r),
-            r.rows()
-                .iter()
-                .map(usize::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
+            r.rows_text()
         );
     }
     s.push('\n');

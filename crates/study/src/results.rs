@@ -70,13 +70,11 @@
 //!   a heavy-tailed sampler whose sample variance misses its rare large values, or a biased
 //!   one, no longer ranks first. Version 1 files are refused by `study merge`.
 
-use std::collections::BTreeSet;
-
 use serde::{Deserialize, Serialize};
 
 use crate::dispersion::BudgetMse;
 use crate::machine::RunInfo;
-use crate::ranking::Ranking;
+use crate::verdict::Ranking;
 use crate::{Mode, Reference, Shard, StudyConfig, StudyError};
 
 /// Version tag of [`StudyResults`]' JSON form.
@@ -231,7 +229,7 @@ impl CellResult {
 }
 
 fn brdf_estimator() -> String {
-    crate::ranking::ESTIMATOR_BRDF.to_string()
+    crate::verdict::ESTIMATOR_BRDF.to_string()
 }
 
 /// A light of the study and its description.
@@ -306,8 +304,8 @@ impl StudyResults {
 
     /// The CSV form: one row per cell and N; timing columns are marked `[timing]` in the
     /// header. Fields are quoted where needed (BRDF specs contain commas). Measured files and
-    /// map lights are named by their short names ([`crate::short_brdf`],
-    /// [`crate::short_light`]); the full paths are in `results.json` only.
+    /// map lights are named by their short names ([`crate::names::short_brdf`],
+    /// [`crate::names::short_light`]); the full paths are in `results.json` only.
     pub fn to_csv(&self) -> String {
         let mut out = String::from(
             "index,sampler,mode,brdf,theta_o_deg,light,status,reference,reference_abs_err,n,mean_rel_err,rel_err_ci95,rms_rel_err,variance_per_sample_at_n,variance_per_sample,variance_ci95,zero_variance,mse_per_sample,mse_ci95,mse_reference_err,tail_share,warnings,evaluations_per_sample,bytes,build_seconds[timing],sample_ns[timing],estimator_ns[timing],estimator_ns_min[timing],estimator_ns_max[timing],estimator_log_sd[timing],estimator_wall_ns[timing],efficiency[timing],estimator,light_sampler\n",
@@ -335,9 +333,9 @@ impl StudyResults {
                     c.index.to_string(),
                     quote(&c.sampler),
                     c.mode.as_str().to_string(),
-                    quote(&crate::short_brdf(&c.brdf)),
+                    quote(&crate::names::short_brdf(&c.brdf)),
                     num(c.theta_o_deg),
-                    quote(&crate::short_light(&c.light)),
+                    quote(&crate::names::short_light(&c.light)),
                     quote(c.status.as_deref().unwrap_or("")),
                     num(c.reference.value),
                     num(c.reference.abs_err),
@@ -370,95 +368,6 @@ impl StudyResults {
             }
         }
         out
-    }
-
-    /// Combines the results of shards into the results of the whole study: the shards must
-    /// share the config, notes and shard count, be distinct, and together cover every cell.
-    ///
-    /// Errors: [`StudyError::Merge`] saying what does not fit.
-    pub fn merge(parts: Vec<StudyResults>) -> Result<Self, StudyError> {
-        let fail = |m: String| Err(StudyError::Merge(m));
-        let Some(first) = parts.first() else {
-            return fail("no results given".into());
-        };
-        let mut seen_shards = BTreeSet::new();
-        for p in &parts {
-            if p.config != first.config {
-                return fail("the results come from different study configurations".into());
-            }
-            if p.total_cells != first.total_cells
-                || p.notes != first.notes
-                || p.lights != first.lights
-            {
-                return fail(
-                    "the results come from different runs (cells, notes or lights differ)".into(),
-                );
-            }
-            match (p.shard, first.shard) {
-                (Some(s), Some(f)) if s.count == f.count => {
-                    if !seen_shards.insert(s.index) {
-                        return fail(format!("shard {}/{} given twice", s.index, s.count));
-                    }
-                }
-                (None, _) if parts.len() == 1 => {}
-                _ => return fail("every input must be a shard K/N of the same N".into()),
-            }
-        }
-        // Every shard is required, even one without cells (more shards than BRDFs): a merge
-        // of an incomplete set is refused whatever the shards hold.
-        if let Some(f) = first.shard
-            && seen_shards.len() != f.count
-        {
-            let missing: Vec<String> = (1..=f.count)
-                .filter(|k| !seen_shards.contains(k))
-                .map(|k| format!("{k}/{}", f.count))
-                .collect();
-            return fail(format!(
-                "the shards do not cover every cell once (missing shards: {})",
-                missing.join(", ")
-            ));
-        }
-        let mut cells: Vec<CellResult> =
-            parts.iter().flat_map(|p| p.cells.iter().cloned()).collect();
-        cells.sort_by_key(|c| c.index);
-        let indices: Vec<usize> = cells.iter().map(|c| c.index).collect();
-        if indices != (0..first.total_cells).collect::<Vec<_>>() {
-            let missing = first
-                .shard
-                .map(|s| {
-                    (1..=s.count)
-                        .filter(|k| !seen_shards.contains(k))
-                        .map(|k| format!("{k}/{}", s.count))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                })
-                .unwrap_or_default();
-            return fail(format!(
-                "the shards do not cover every cell once (missing shards: {missing})"
-            ));
-        }
-        let mut merged = Self {
-            schema: SCHEMA.to_string(),
-            config: first.config.clone(),
-            shard: None,
-            total_cells: first.total_cells,
-            notes: first.notes.clone(),
-            build_warnings: {
-                let mut w: Vec<String> = parts
-                    .iter()
-                    .flat_map(|p| p.build_warnings.iter().cloned())
-                    .collect();
-                w.sort();
-                w.dedup();
-                w
-            },
-            lights: first.lights.clone(),
-            cells,
-            runs: parts.iter().flat_map(|p| p.runs.iter().cloned()).collect(),
-            rankings: Vec::new(),
-        };
-        merged.rankings = crate::ranking::rankings(&merged);
-        Ok(merged)
     }
 }
 

@@ -90,3 +90,37 @@ fn images_do_not_depend_on_the_thread_count() {
             .all(|i| i.rel_error.is_some_and(f64::is_finite))
     );
 }
+
+/// The sphere sheet of some of a study's BRDFs (`render_subset`, what `brdf-lab study` draws
+/// with the samplers its statistics built) equals the render of a study of those BRDFs alone;
+/// a BRDF outside the study is refused.
+#[test]
+fn a_subset_of_the_study_renders_as_a_study_of_the_subset() {
+    let light = "area:theta=30,phi=180,radius=10";
+    let both = plan(light);
+    let sub = both
+        .render_subset(&cfg(), &["phong:n=20".to_string()], &|_| {})
+        .unwrap();
+    let mut c = both.config().clone();
+    c.brdfs = vec!["phong:n=20".into()];
+    let alone = StudyPlan::new(c, Vec::new())
+        .unwrap()
+        .render(&cfg(), &|_| {})
+        .unwrap();
+    assert_eq!(sub.brdfs, alone.brdfs);
+    assert_eq!(sub.reference.width, 12);
+    assert_eq!(sub.reference.rgb, alone.reference.rgb);
+    let equal_samples = |r: &study::Render| -> Vec<(String, Vec<[f64; 3]>)> {
+        r.images
+            .iter()
+            .filter(|i| i.kind == "equal samples")
+            .map(|i| (i.sampler.clone(), i.rgb.clone()))
+            .collect()
+    };
+    assert_eq!(equal_samples(&sub).len(), 3);
+    assert_eq!(equal_samples(&sub), equal_samples(&alone));
+    assert!(
+        both.render_subset(&cfg(), &["ward".to_string()], &|_| {})
+            .is_err()
+    );
+}
