@@ -167,3 +167,33 @@ pub(crate) fn rows<const K: usize>(py: Python<'_>, v: Vec<[f64; K]>) -> Bound<'_
         .expect("n rows of K values")
         .into_pyarray(py)
 }
+
+/// A direction as a `(3,)` float64 array.
+pub(crate) fn dir_array<'py>(py: Python<'py>, v: &Vec3) -> Bound<'py, PyArray1<f64>> {
+    vec1(py, vec![v.x, v.y, v.z])
+}
+
+/// Directions as an `(N, 3)` float64 array.
+pub(crate) fn dir_rows<'py>(py: Python<'py>, v: &[Vec3]) -> Bound<'py, PyArray2<f64>> {
+    flat_rows(py, v.iter().flat_map(|w| [w.x, w.y, w.z]).collect(), 3)
+}
+
+/// The values of an array-like returned by Python code, which must have `shape` (float64, C
+/// order): the message names `name` otherwise.
+pub(crate) fn floats(
+    a: &Bound<'_, PyAny>,
+    name: &str,
+    shape: &[usize],
+) -> Result<Vec<f64>, String> {
+    let arr: ArrayIn<'_> = a
+        .extract()
+        .map_err(|e| format!("{name} must be a float array: {e}"))?;
+    let view = arr.as_array();
+    if view.shape() != shape {
+        return Err(format!(
+            "{name} must have shape {shape:?}, got {:?}",
+            view.shape()
+        ));
+    }
+    Ok(view.iter().copied().collect())
+}

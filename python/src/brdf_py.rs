@@ -5,11 +5,11 @@ use std::sync::Arc;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use rayon::prelude::*;
 
-use crate::arrays::{ArrayIn, dirs, pair_len, rows, vec1};
+use crate::arrays::{ArrayIn, Dirs, dirs, pair_len, rows, vec1};
+use crate::callable::{Claims, PyBrdf};
 use crate::errors::value_error;
-use crate::threads::install;
+use crate::threads::par_map;
 
 /// A BRDF from a spec string, exactly as the CLI's `--brdf` accepts it.
 ///
@@ -19,7 +19,8 @@ use crate::threads::install;
 /// the outgoing (view) direction, `wi` the incident (light) one. Values are 0 when either
 /// direction is at or below the horizon.
 ///
-/// Raises ``ValueError`` with the parser's message for a bad spec.
+/// Raises ``ValueError`` with the parser's message for a bad spec. A BRDF written in Python:
+/// :meth:`Brdf.from_callable`.
 #[pyclass(module = "brdf_lab._native", name = "Brdf", frozen)]
 pub(crate) struct Brdf {
     pub(crate) inner: Arc<dyn brdf::Brdf>,
@@ -34,6 +35,21 @@ impl Brdf {
             inner: Arc::from(inner),
             spec: spec.to_string(),
         })
+    }
+
+    /// The callable BRDF's values at the pairs, in one call of the callable with the GIL
+    /// held (its error as `ValueError`).
+    fn eval_callable(py: Python<'_>, c: &PyBrdf, wo: &Dirs, wi: &Dirs) -> PyResult<Vec<f64>> {
+        let n = pair_len(wo, "wo", wi, "wi")?;
+        let wis: Vec<brdf::Vec3> = (0..n).map(|k| *wi.get(k)).collect();
+        let wos: Vec<brdf::Vec3> = if wo.single && n > 0 {
+            vec![*wo.get(0)]
+        } else {
+            (0..n).map(|k| *wo.get(k)).collect()
+        };
+        let out = c.eval_batch(py, &wos, &wis);
+        c.take_error(py)?;
+        Ok(out)
     }
 
     /// `f(brdf, wo_k, wi_k)` over the query pairs, in parallel with the GIL released (0 where
@@ -51,24 +67,30 @@ impl Brdf {
     {
         let wo = dirs(wo, "wo")?;
         let wi = dirs(wi, "wi")?;
+        if let Some(c) = PyBrdf::of(self.inner.as_ref()) {
+            // Grey: `f(brdf, ·)` of a callable BRDF is built from its scalar value.
+            let v = Self::eval_callable(py, c, &wo, &wi)?;
+            return Ok(v
+                .into_iter()
+                .map(|y| {
+                    f(
+                        &Constant(y),
+                        &brdf::Vec3::new(0.0, 0.0, 1.0),
+                        &brdf::Vec3::new(0.0, 0.0, 1.0),
+                    )
+                })
+                .collect());
+        }
         let n = pair_len(&wo, "wo", &wi, "wi")?;
-        let b = Arc::clone(&self.inner);
-        Ok(py.detach(|| {
-            install(|| {
-                let b = b.as_ref();
-                (0..n)
-                    .into_par_iter()
-                    .with_min_len(1024)
-                    .map(|k| {
-                        let (o, i) = (wo.get(k), wi.get(k));
-                        if o.z > 0.0 && i.z > 0.0 {
-                            f(b, o, i)
-                        } else {
-                            T::default()
-                        }
-                    })
-                    .collect()
-            })
+        let b = self.inner.as_ref();
+        let ks: Vec<usize> = (0..n).collect();
+        Ok(par_map(py, &ks, |&k| {
+            let (o, i) = (wo.get(k), wi.get(k));
+            if o.z > 0.0 && i.z > 0.0 {
+                f(b, o, i)
+            } else {
+                T::default()
+            }
         }))
     }
 }
@@ -78,6 +100,56 @@ impl Brdf {
     #[new]
     fn new(spec: &str) -> PyResult<Self> {
         Self::parse(spec)
+    }
+
+    /// A BRDF written in Python: ``f(wo, wi)`` takes NumPy float64 arrays, ``wo`` of shape
+    /// (3,) (shared by every pair) or (N, 3) and ``wi`` of shape (N, 3), unit vectors in the
+    /// local frame (z = normal, both above the horizon), and returns the N values of f_r in
+    /// 1/sr (finite, ≥ 0). The samplers' builds call it one pair at a time (taking the GIL for
+    /// each call, from their worker threads); ``eval`` and the ``f`` of
+    /// ``DirectionSampler.sample`` call it once per batch. An exception it raises, a result of
+    /// another shape, or a NaN, infinite or negative value makes the calling method raise
+    /// ``ValueError`` (the exception as its ``__cause__``).
+    ///
+    /// The claims (``isotropic``, ``mirror_symmetric`` — isotropic and even under y ↦ −y —,
+    /// ``reciprocal``, ``bounded_at_horizon``) let samplers save work, as for the built-in
+    /// models: a false claim gives a wrong sampler. The spec is ``"python:NAME"``.
+    #[staticmethod]
+    #[pyo3(signature = (f, *, name = "python", isotropic = false, mirror_symmetric = false, reciprocal = false, bounded_at_horizon = true))]
+    fn from_callable(
+        py: Python<'_>,
+        f: Py<PyAny>,
+        name: &str,
+        isotropic: bool,
+        mirror_symmetric: bool,
+        reciprocal: bool,
+        bounded_at_horizon: bool,
+    ) -> PyResult<Self> {
+        let claims = Claims {
+            isotropic,
+            mirror_symmetric,
+            reciprocal,
+            bounded_at_horizon,
+        };
+        let b = PyBrdf::new(py, f, name, claims)?;
+        let spec = format!("python:{}", brdf::Brdf::name(&b));
+        Ok(Self {
+            inner: Arc::new(b),
+            spec,
+        })
+    }
+
+    /// Whether this BRDF is a Python callable (:meth:`from_callable`).
+    #[getter]
+    fn is_callable(&self) -> bool {
+        PyBrdf::of(self.inner.as_ref()).is_some()
+    }
+
+    /// ``(calls, pairs)``: how many times a callable BRDF's function was called and on how
+    /// many (wo, wi) pairs in all (None for the built-in models).
+    #[getter]
+    fn callable_counts(&self) -> Option<(u64, u64)> {
+        PyBrdf::of(self.inner.as_ref()).map(PyBrdf::counts)
     }
 
     /// The spec this BRDF was built from.
@@ -122,6 +194,15 @@ impl Brdf {
 
     fn __repr__(&self) -> String {
         format!("Brdf({:?})", self.spec)
+    }
+}
+
+/// A BRDF of one value (the grey RGB of a callable BRDF's value).
+struct Constant(f64);
+
+impl brdf::Brdf for Constant {
+    fn eval(&self, _wo: &brdf::Vec3, _wi: &brdf::Vec3) -> f64 {
+        self.0
     }
 }
 

@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
 use ::samplers::{BuiltDirection, DirectionRequest};
@@ -17,9 +17,10 @@ use rayon::prelude::*;
 
 use crate::arrays::{ArrayIn, dirs, flat_rows, pair_len, uniforms, vec1};
 use crate::brdf_py::Brdf;
+use crate::callable::PyBrdf;
 use crate::errors::{invalid, value_error};
 use crate::options::{BASELINE_KEYS, direction_options, set_keys};
-use crate::threads::{call_seed, install};
+use crate::threads::{install, next_seed, par_map};
 
 /// A uniform source that hands out a query's two given uniforms first, then continues from the
 /// chunk's generator (rejection samplers and lobe choices may need more than two).
@@ -179,7 +180,7 @@ impl DirectionSampler {
     }
 
     fn next_seed(&self, seed: Option<u64>) -> u64 {
-        seed.unwrap_or_else(|| call_seed(self.seed, self.calls.fetch_add(1, Ordering::Relaxed)))
+        next_seed(self.seed, &self.calls, seed)
     }
 }
 
@@ -225,6 +226,47 @@ fn batch_chunk(
     }
 }
 
+/// The recorded error of `brdf` if it is a callable BRDF (raised as `ValueError`).
+fn callable_error(py: Python<'_>, brdf: &Arc<dyn brdf::Brdf>) -> PyResult<()> {
+    PyBrdf::of(brdf.as_ref()).map_or(Ok(()), |c| c.take_error(py))
+}
+
+/// The `f` of drawn samples (`wi` flat, `pdf`) for a callable BRDF: one call on the valid
+/// draws (`pdf > 0`, `wi` above the horizon, `wo` above it), 0 elsewhere; RGB grey with `rgb`.
+fn callable_f(
+    py: Python<'_>,
+    c: &PyBrdf,
+    wo: &crate::arrays::Dirs,
+    wi: &[f64],
+    pdf: &[f64],
+    rgb: bool,
+) -> PyResult<Vec<f64>> {
+    let valid: Vec<usize> = (0..pdf.len())
+        .filter(|&k| pdf[k] > 0.0 && wi[3 * k + 2] > 0.0 && above(wo.get(k)))
+        .collect();
+    let wis: Vec<Vec3> = valid
+        .iter()
+        .map(|&k| Vec3::new(wi[3 * k], wi[3 * k + 1], wi[3 * k + 2]))
+        .collect();
+    let wos: Vec<Vec3> = if wo.single {
+        vec![*wo.get(0)]
+    } else {
+        valid.iter().map(|&k| *wo.get(k)).collect()
+    };
+    let values = if wis.is_empty() {
+        Vec::new()
+    } else {
+        c.eval_batch(py, &wos, &wis)
+    };
+    c.take_error(py)?;
+    let fw = if rgb { 3 } else { 1 };
+    let mut f = vec![0.0; fw * pdf.len()];
+    for (&k, v) in valid.iter().zip(values) {
+        f[fw * k..fw * (k + 1)].fill(v);
+    }
+    Ok(f)
+}
+
 /// Whether `wo` lies strictly above the horizon.
 #[inline]
 fn above(wo: &Vec3) -> bool {
@@ -263,7 +305,12 @@ impl DirectionSampler {
                     entry.build_direction(&request)
                 })
             })
-            .map_err(|e| value_error(&e))?;
+            .map_err(|e| {
+                callable_error(py, &brdf)
+                    .err()
+                    .unwrap_or_else(|| value_error(&e))
+            })?;
+        callable_error(py, &brdf)?;
         Ok(Self {
             name: entry.name.to_string(),
             brdf,
@@ -315,7 +362,13 @@ impl DirectionSampler {
         }
         let seed = self.next_seed(seed);
         let sampler = Arc::clone(&self.built.sampler);
-        let brdf = Arc::clone(&self.brdf);
+        // A callable BRDF's `f` is evaluated after the draws, in one call of the callable.
+        let callable = PyBrdf::of(self.brdf.as_ref()).is_some();
+        let (brdf, rgb_out, rgb): (Arc<dyn brdf::Brdf>, bool, bool) = if callable {
+            (Arc::new(NoEval), rgb, false)
+        } else {
+            (Arc::clone(&self.brdf), rgb, rgb)
+        };
         let fw = if rgb { 3 } else { 1 };
         let mut wi = vec![0.0; 3 * n];
         let mut pdf = vec![0.0; n];
@@ -368,7 +421,11 @@ impl DirectionSampler {
                     });
             })
         });
-        let f = if rgb {
+        let f = match PyBrdf::of(self.brdf.as_ref()) {
+            Some(c) => callable_f(py, c, &wo, &wi, &pdf, rgb_out)?,
+            None => f,
+        };
+        let f = if rgb_out {
             flat_rows(py, f, 3).into_any()
         } else {
             vec1(py, f).into_any()
@@ -387,22 +444,15 @@ impl DirectionSampler {
         let wo = dirs(&wo, "wo")?;
         let wi = dirs(&wi, "wi")?;
         let n = pair_len(&wo, "wo", &wi, "wi")?;
-        let sampler = Arc::clone(&self.built.sampler);
-        let out: Vec<f64> = py.detach(|| {
-            install(|| {
-                (0..n)
-                    .into_par_iter()
-                    .with_min_len(1024)
-                    .map(|k| {
-                        let o = wo.get(k);
-                        if above(o) {
-                            sampler.pdf(o, wi.get(k))
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect()
-            })
+        let sampler = self.built.sampler.as_ref();
+        let ks: Vec<usize> = (0..n).collect();
+        let out = par_map(py, &ks, |&k| {
+            let o = wo.get(k);
+            if above(o) {
+                sampler.pdf(o, wi.get(k))
+            } else {
+                0.0
+            }
         });
         Ok(vec1(py, out))
     }
@@ -497,7 +547,15 @@ impl DirectionSampler {
                     given.as_ref().map(|(b, s)| (Arc::clone(b), s.as_str())),
                 )
             })
-            .map_err(|e| value_error(&e))?;
+            .map_err(|e| {
+                given
+                    .as_ref()
+                    .and_then(|(b, _)| callable_error(py, b).err())
+                    .unwrap_or_else(|| value_error(&e))
+            })?;
+        if let Some((b, _)) = &given {
+            callable_error(py, b)?;
+        }
         let (brdf, spec) = match given {
             Some(g) => g,
             None => {

@@ -13,6 +13,7 @@
 
 mod arrays;
 mod brdf_py;
+mod callable;
 mod direction;
 mod errors;
 mod options;

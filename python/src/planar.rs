@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
 use envmap::{AdaptiveOptions, EnvMap, EnvSample, LeafChoice};
@@ -19,7 +19,19 @@ use rayon::prelude::*;
 use crate::arrays::{ArrayIn, dirs, points, rows, vec1};
 use crate::direction::{UArg, UIn, chunked, view_of};
 use crate::errors::{invalid, value_error};
-use crate::threads::{call_seed, install};
+use crate::threads::{install, next_seed, par_map};
+
+/// The uniforms that `t` maps to each point (N, 2); NaN rows where the density is zero.
+fn invert_points<'py>(
+    py: Python<'py>,
+    t: &PiecewiseConstant2D,
+    p: &[[f64; 2]],
+) -> Bound<'py, PyArray2<f64>> {
+    rows(
+        py,
+        par_map(py, p, |q| t.invert(*q).unwrap_or([f64::NAN; 2])),
+    )
+}
 
 /// Tree options shared by both planar samplers.
 fn tree_params(
@@ -204,8 +216,7 @@ impl EnvMapSampler {
         let u_in = UIn::read(u)?;
         let u_view = view_of(&u_in);
         let u = UArg::of(&u_in, &u_view)?;
-        let seed = seed
-            .unwrap_or_else(|| call_seed(self.seed, self.calls.fetch_add(1, Ordering::Relaxed)));
+        let seed = next_seed(self.seed, &self.calls, seed);
         let inner = Arc::clone(&self.inner);
         let out: Vec<EnvSample> = py.detach(|| {
             let planar = match inner.as_piecewise_constant() {
@@ -232,15 +243,7 @@ impl EnvMapSampler {
         dirs_: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let d = dirs(&dirs_, "dirs")?;
-        let inner = Arc::clone(&self.inner);
-        let out: Vec<f64> = py.detach(|| {
-            install(|| {
-                d.v.par_iter()
-                    .with_min_len(1024)
-                    .map(|v| inner.pdf_sa([v.x, v.y, v.z]))
-                    .collect()
-            })
-        });
+        let out = par_map(py, &d.v, |v| self.inner.pdf_sa([v.x, v.y, v.z]));
         Ok(vec1(py, out))
     }
 
@@ -251,10 +254,7 @@ impl EnvMapSampler {
         uv: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let p = points(&uv, "uv")?;
-        let inner = Arc::clone(&self.inner);
-        let out: Vec<f64> =
-            py.detach(|| install(|| p.par_iter().map(|q| inner.pdf_uv(q[0], q[1])).collect()));
-        Ok(vec1(py, out))
+        Ok(vec1(py, par_map(py, &p, |q| self.inner.pdf_uv(q[0], q[1]))))
     }
 
     /// The uniforms that `sample` maps to `uv` (N, 2): only ``envmap-cdf`` is invertible
@@ -264,23 +264,13 @@ impl EnvMapSampler {
         py: Python<'py>,
         uv: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let Some(_) = self.inner.as_piecewise_constant() else {
+        let Some(t) = self.inner.as_piecewise_constant() else {
             return Err(invalid(format!(
                 "`{}` is not invertible (rejection sampling); envmap-cdf is",
                 self.name
             )));
         };
-        let p = points(&uv, "uv")?;
-        let inner = Arc::clone(&self.inner);
-        let out: Vec<[f64; 2]> = py.detach(|| {
-            let t = inner.as_piecewise_constant().expect("checked above");
-            install(|| {
-                p.par_iter()
-                    .map(|q| t.invert(*q).unwrap_or([f64::NAN; 2]))
-                    .collect()
-            })
-        });
-        Ok(rows(py, out))
+        Ok(invert_points(py, t, &points(&uv, "uv")?))
     }
 
     /// The registry name.
@@ -425,8 +415,7 @@ impl PartitionSampler {
         let u_in = UIn::read(u)?;
         let u_view = view_of(&u_in);
         let u = UArg::of(&u_in, &u_view)?;
-        let seed = seed
-            .unwrap_or_else(|| call_seed(self.seed, self.calls.fetch_add(1, Ordering::Relaxed)));
+        let seed = next_seed(self.seed, &self.calls, seed);
         let inner = Arc::clone(&self.inner);
         let out = py.detach(|| match inner.as_ref() {
             Planar::Adaptive(s) => sample_planar(s.as_ref(), None, &u, seed),
@@ -448,9 +437,7 @@ impl PartitionSampler {
         points_: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let p = points(&points_, "points")?;
-        let inner = Arc::clone(&self.inner);
-        let out: Vec<f64> = py.detach(|| install(|| p.par_iter().map(|q| inner.pdf(*q)).collect()));
-        Ok(vec1(py, out))
+        Ok(vec1(py, par_map(py, &p, |q| self.inner.pdf(*q))))
     }
 
     /// The uniforms that `sample` maps to `points` (N, 2); only ``"cdf"`` is invertible.
@@ -459,24 +446,12 @@ impl PartitionSampler {
         py: Python<'py>,
         points_: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let Planar::Cdf(_) = self.inner.as_ref() else {
+        let Planar::Cdf(t) = self.inner.as_ref() else {
             return Err(invalid(
                 "the adaptive partition sampler is not invertible (rejection sampling); method=\"cdf\" is",
             ));
         };
-        let p = points(&points_, "points")?;
-        let inner = Arc::clone(&self.inner);
-        let out: Vec<[f64; 2]> = py.detach(|| {
-            let Planar::Cdf(t) = inner.as_ref() else {
-                unreachable!("checked above")
-            };
-            install(|| {
-                p.par_iter()
-                    .map(|q| t.invert(*q).unwrap_or([f64::NAN; 2]))
-                    .collect()
-            })
-        });
-        Ok(rows(py, out))
+        Ok(invert_points(py, t, &points(&points_, "points")?))
     }
 
     /// ``"adaptive"`` or ``"cdf"``.

@@ -2,12 +2,15 @@
 //! Python objects by `brdf_lab`) and writing the same files as the CLI.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use study::{Shard, StudyConfig, StudyPlan};
 use validation::ValidateConfig;
 
+use crate::brdf_py::Brdf;
+use crate::callable::PyBrdf;
 use crate::errors::{invalid, value_error};
 use crate::threads::install;
 use crate::user::{check_errors, registry_with};
@@ -25,7 +28,7 @@ fn write(path: &Path, bytes: &[u8]) -> PyResult<()> {
 /// design.md §5); `json` / `report` write the CLI's `--json` / `--report` files. Empty lists
 /// take the tier's defaults (`quick`: the CI tier).
 #[pyfunction]
-#[pyo3(signature = (samplers, brdfs, theta_o, samples = None, seed = 1, quick = true, mutants = false, alpha = 0.01, json = None, report = None, sets = Vec::new(), user = Vec::new()))]
+#[pyo3(signature = (samplers, brdfs, theta_o, samples = None, seed = 1, quick = true, mutants = false, alpha = 0.01, json = None, report = None, sets = Vec::new(), user = Vec::new(), objects = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn validate_json(
     py: Python<'_>,
@@ -41,7 +44,16 @@ pub(crate) fn validate_json(
     report: Option<PathBuf>,
     sets: Vec<PathBuf>,
     user: Vec<(String, Py<PyAny>)>,
+    objects: Vec<Py<Brdf>>,
 ) -> PyResult<String> {
+    // BRDFs that no spec names (Python callables): validated as objects, labelled by spec.
+    let given: Vec<(String, Arc<dyn brdf::Brdf>)> = objects
+        .iter()
+        .map(|b| {
+            let b = b.get();
+            (b.spec.clone(), Arc::clone(&b.inner))
+        })
+        .collect();
     let (registry, wrapped) = registry_with(py, user)?;
     let base = if quick {
         ValidateConfig::quick()
@@ -73,9 +85,18 @@ pub(crate) fn validate_json(
         ..base
     };
     let rep = py
-        .detach(|| install(|| validation::run_with(&registry, &config, &|_| {}).map_err(Box::new)))
+        .detach(|| {
+            install(|| {
+                validation::run_with_brdfs(&registry, &config, &given, &|_| {}).map_err(Box::new)
+            })
+        })
         .map_err(|e| value_error(e.as_ref()))?;
     check_errors(&wrapped)?;
+    for (_, b) in &given {
+        if let Some(c) = PyBrdf::of(b.as_ref()) {
+            c.take_error(py)?;
+        }
+    }
     let text = rep.to_json();
     if let Some(p) = &json {
         write(p, text.as_bytes())?;

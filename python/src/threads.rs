@@ -1,9 +1,11 @@
 //! The thread pool the bindings run on, and the fixed chunking that makes results independent
 //! of it.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, RwLock};
 
 use pyo3::prelude::*;
+use rayon::prelude::*;
 
 use crate::errors::invalid;
 
@@ -49,4 +51,19 @@ pub(crate) fn num_threads() -> usize {
 /// their own draw fresh, reproducible streams).
 pub(crate) fn call_seed(seed: u64, call: u64) -> u64 {
     partition_sampler::chunk_seed(seed ^ 0xB5AD_4ECE_DA1C_E2A9, call)
+}
+
+/// `given`, or else the seed of the next call of an object seeded with `seed` (its calls
+/// counted in `calls`).
+pub(crate) fn next_seed(seed: u64, calls: &AtomicU64, given: Option<u64>) -> u64 {
+    given.unwrap_or_else(|| call_seed(seed, calls.fetch_add(1, Ordering::Relaxed)))
+}
+
+/// `f` of every item, in parallel on the configured pool with the GIL released.
+pub(crate) fn par_map<T: Sync, R: Send>(
+    py: Python<'_>,
+    items: &[T],
+    f: impl Fn(&T) -> R + Sync + Send,
+) -> Vec<R> {
+    py.detach(|| install(|| items.par_iter().with_min_len(1024).map(f).collect()))
 }

@@ -13,13 +13,11 @@ use std::sync::{Arc, Mutex};
 
 use brdf::Vec3;
 use brdf_sampling::{DirSample, DirectionSampler};
-use numpy::IntoPyArray;
-use numpy::ndarray::{Array1, Array2};
 use partition_sampler::UniformSource;
 use pyo3::prelude::*;
 use samplers::{Capabilities, Registry, SamplerEntry, Support};
 
-use crate::arrays::ArrayIn;
+use crate::arrays::{dir_array, dir_rows, flat_rows, floats};
 use crate::errors::invalid;
 
 /// A Python sampler object as a [`DirectionSampler`] (pdf w.r.t. solid angle, on the sphere:
@@ -75,10 +73,7 @@ impl PySampler {
     fn call_sample(&self, wo: &Vec3, u: Vec<f64>) -> Result<Vec<DirSample>, String> {
         let n = u.len() / 2;
         Python::attach(|py| {
-            let wo = Array1::from_vec(vec![wo.x, wo.y, wo.z]).into_pyarray(py);
-            let u = Array2::from_shape_vec((n, 2), u)
-                .map_err(|e| e.to_string())?
-                .into_pyarray(py);
+            let (wo, u) = (dir_array(py, wo), flat_rows(py, u, 2));
             let out = self
                 .obj
                 .bind(py)
@@ -108,11 +103,7 @@ impl PySampler {
     fn call_pdf(&self, wo: &Vec3, wi: &[Vec3]) -> Result<Vec<f64>, String> {
         let n = wi.len();
         Python::attach(|py| {
-            let wo = Array1::from_vec(vec![wo.x, wo.y, wo.z]).into_pyarray(py);
-            let flat: Vec<f64> = wi.iter().flat_map(|w| [w.x, w.y, w.z]).collect();
-            let wi = Array2::from_shape_vec((n, 3), flat)
-                .map_err(|e| e.to_string())?
-                .into_pyarray(py);
+            let (wo, wi) = (dir_array(py, wo), dir_rows(py, wi));
             let out = self
                 .obj
                 .bind(py)
@@ -121,21 +112,6 @@ impl PySampler {
             floats(&out, "pdf", &[n])
         })
     }
-}
-
-/// The values of an array-like of `shape` (float64, C order).
-fn floats(a: &Bound<'_, PyAny>, name: &str, shape: &[usize]) -> Result<Vec<f64>, String> {
-    let arr: ArrayIn<'_> = a
-        .extract()
-        .map_err(|e| format!("{name} must be a float array: {e}"))?;
-    let view = arr.as_array();
-    if view.shape() != shape {
-        return Err(format!(
-            "{name} must have shape {shape:?}, got {:?}",
-            view.shape()
-        ));
-    }
-    Ok(view.iter().copied().collect())
 }
 
 /// A failed draw: a NaN direction with pdf NaN (the suite reports it; the run raises the

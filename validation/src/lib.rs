@@ -77,4 +77,4 @@ pub use report::{BuildWarning, MutantRecord, ShardInfo, TestRecord, ValidationRe
 pub use subject::{
     AnySubject, Dir3, Estimand, Point2, Reference, SamplerUnderTest, ScalarFn, Subject,
 };
-pub use suite::{ProgressEvent, run, run_shard, run_shard_with, run_with};
+pub use suite::{ProgressEvent, run, run_shard, run_shard_with, run_with, run_with_brdfs};

@@ -109,6 +109,7 @@ fn merl_specs(dir: &Path) -> Vec<String> {
 fn resolve<'r>(
     registry: &'r Registry,
     config: &ValidateConfig,
+    given: &[(String, Arc<dyn Brdf>)],
 ) -> Result<Resolved<'r>, ValidationError> {
     if !(config.alpha > 0.0 && config.alpha < 1.0) {
         return Err(ValidationError::BadAlpha(config.alpha));
@@ -148,7 +149,9 @@ fn resolve<'r>(
         }
     }
     let mut few_angles: Vec<String> = Vec::new();
-    let specs: Vec<String> = if config.brdfs.is_empty() {
+    let specs: Vec<String> = if config.brdfs.is_empty() && !given.is_empty() {
+        Vec::new()
+    } else if config.brdfs.is_empty() {
         match tier {
             Tier::Quick => QUICK_BRDFS.iter().map(|s| (*s).to_owned()).collect(),
             Tier::Full => {
@@ -183,6 +186,7 @@ fn resolve<'r>(
             Err(source) => return Err(ValidationError::Brdf { spec, source }),
         }
     }
+    brdfs.extend(given.iter().map(|(l, b)| (l.clone(), Arc::clone(b))));
     if entries.is_empty() && sets.is_empty() {
         return Err(ValidationError::Empty("no sampler selected".into()));
     }
@@ -544,7 +548,32 @@ pub fn run_shard_with(
     shard: Option<Shard>,
     progress: &(dyn Fn(ProgressEvent) + Sync),
 ) -> Result<ValidationReport, ValidationError> {
-    let r = resolve(registry, config)?;
+    run_brdfs_shard(registry, config, &[], shard, progress)
+}
+
+/// [`run_with`] on BRDF objects too: `brdfs` (label, BRDF) are validated after the specs of
+/// `config.brdfs` (alone when that is empty), each labelled in the report by its label. For
+/// BRDFs that no spec names (e.g. a Python callable).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with_brdfs(
+    registry: &Registry,
+    config: &ValidateConfig,
+    brdfs: &[(String, Arc<dyn Brdf>)],
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
+    run_brdfs_shard(registry, config, brdfs, None, progress)
+}
+
+fn run_brdfs_shard(
+    registry: &Registry,
+    config: &ValidateConfig,
+    given: &[(String, Arc<dyn Brdf>)],
+    shard: Option<Shard>,
+    progress: &(dyn Fn(ProgressEvent) + Sync),
+) -> Result<ValidationReport, ValidationError> {
+    let r = resolve(registry, config, given)?;
     let seed = config.seed;
 
     // Standalone samplers' cases are built up front (cheap), so the total is known.

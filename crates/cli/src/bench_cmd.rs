@@ -59,11 +59,16 @@ pub(crate) enum Queries {
 #[derive(Debug, Args)]
 pub(crate) struct BenchArgs {
     /// BRDF: `name` or `name:key=value,...` (e.g. `ggx:alpha=0.2`), `merl:PATH`, `rgl:PATH`, ….
-    #[arg(long = "brdf")]
-    spec: String,
+    /// Optional with --set (then the sets' stored spec; when given it must match theirs).
+    #[arg(long = "brdf", required_unless_present = "set_files")]
+    spec: Option<String>,
     /// Samplers to compare (registry names, see `brdf-lab list`); several in one run.
-    #[arg(long = "sampler", num_args = 1.., required = true)]
+    #[arg(long = "sampler", num_args = 1.., required_unless_present = "set_files")]
     samplers: Vec<String>,
+    /// Also compare a set written by `build --out` (repeatable): loaded, not built (its own
+    /// options apply; its build time is reported as 0). Every set must be for the same BRDF.
+    #[arg(long = "set", value_name = "FILE")]
+    set_files: Vec<PathBuf>,
     /// Outgoing directions: `fixed` (one ωo) or `random` (a fresh ωo per query).
     #[arg(long, value_enum, default_value_t = Queries::Random)]
     queries: Queries,
@@ -199,8 +204,8 @@ struct Subject {
     build_seconds: f64,
 }
 
-fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject> {
-    let (built, elapsed) = brdf_args::build(name, &args.spec, brdf, &args.set)?;
+fn build(name: &str, spec: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject> {
+    let (built, elapsed) = brdf_args::build(name, spec, brdf, &args.set)?;
     let build_seconds = elapsed.as_secs_f64();
     let sampler: Arc<dyn DirectionSampler> = built.shared();
     Ok(Subject {
@@ -210,12 +215,47 @@ fn build(name: &str, args: &BenchArgs, brdf: Arc<dyn Brdf>) -> CliResult<Subject
     })
 }
 
+/// `--brdf` (`spec`), or else the stored spec of the first of the `--set` files; every set is
+/// checked to be for it (`brdf_args::load_set`'s errors). `product` shares it.
+pub(crate) fn spec_with_sets(spec: Option<&str>, sets: &[PathBuf]) -> CliResult<String> {
+    let mut spec = spec.map(str::to_owned);
+    for path in sets {
+        let (stored, ..) = brdf_args::load_set(path, spec.as_deref(), None)?;
+        spec.get_or_insert(stored);
+    }
+    spec.ok_or_else(|| CliError::input("--brdf SPEC is required without --set"))
+}
+
+/// The set saved in `path` (written by `build --out`, for `spec`: see [`spec_with_sets`])
+/// attached to `brdf`, named `SAMPLER@FILE` (its registry name and file name).
+pub(crate) fn load_attached(
+    path: &std::path::Path,
+    spec: &str,
+    brdf: Arc<dyn Brdf>,
+) -> CliResult<(String, Arc<dyn DirectionSampler>)> {
+    let fail = |why: String| CliError::input(format!("--set {}: {why}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    let (entry, built) =
+        samplers::load_set(&bytes, Some((brdf, spec))).map_err(|e| fail(e.to_string()))?;
+    let file = path
+        .file_name()
+        .unwrap_or(path.as_os_str())
+        .to_string_lossy();
+    Ok((format!("{}@{file}", entry.name), built.sampler))
+}
+
 /// Runs `brdf-lab bench`.
 pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
     crate::output::check_all([("--json", args.json.as_deref())])?;
     args.set.check()?;
-    // Each sampler option given must configure at least one of the samplers compared.
-    for option in &given.0 {
+    // Each sampler option given must configure at least one of the samplers compared (the
+    // built ones: a saved set keeps its own options).
+    let options = if args.samplers.is_empty() {
+        &[][..]
+    } else {
+        &given.0[..]
+    };
+    for option in options {
         let one = Given(vec![option.clone()]);
         let checks: Vec<CliResult<()>> = args
             .samplers
@@ -234,13 +274,23 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
         .map_err(CliError::input)?;
     let threads = pool.current_num_threads();
     let fixed = brdf::direction_from_angles(args.theta_o, args.phi_o);
-    let plain = brdf_args::parse_brdf(&args.spec)?;
+    let spec = spec_with_sets(args.spec.as_deref(), &args.set_files)?;
+    let plain = brdf_args::parse_brdf(&spec)?;
     let counted: Arc<dyn Brdf> = Arc::new(CountingBrdf(plain.clone()));
 
     // Built over the counting wrapper: one build serves both passes (a build can take seconds).
-    let mut subjects = Vec::with_capacity(args.samplers.len());
+    let mut subjects = Vec::with_capacity(args.samplers.len() + args.set_files.len());
     for name in &args.samplers {
-        subjects.push(build(name, args, counted.clone())?);
+        subjects.push(build(name, &spec, args, counted.clone())?);
+    }
+    // Saved sets, attached to the counting wrapper; loaded, not built.
+    for path in &args.set_files {
+        let (name, sampler) = load_attached(path, &spec, counted.clone())?;
+        subjects.push(Subject {
+            name,
+            sampler,
+            build_seconds: 0.0,
+        });
     }
 
     // Evaluations per sample: an untimed pass on the worker threads.
@@ -308,7 +358,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
             mean_weight: means[k],
         })
         .collect();
-    print_table(args, &records, threads);
+    print_table(args, &spec, &records, threads);
     if let Some(path) = &args.json {
         write_atomically(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &records).map_err(std::io::Error::other)?;
@@ -319,14 +369,14 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
     Ok(())
 }
 
-fn print_table(args: &BenchArgs, records: &[BenchRecord], threads: usize) {
+fn print_table(args: &BenchArgs, spec: &str, records: &[BenchRecord], threads: usize) {
     let queries = match args.queries {
         Queries::Fixed => format!("fixed ωo (θo = {}°, φo = {}°)", args.theta_o, args.phi_o),
         Queries::Random => {
             format!("a random ωo per query (uniform in solid angle, θo ≤ {RANDOM_THETA_MAX_DEG}°)")
         }
     };
-    println!("brdf       {}", args.spec);
+    println!("brdf       {spec}");
     println!("queries    {queries}");
     if args.batch {
         println!("batches    {CHUNK} queries per sample_eval_batch call");

@@ -11,6 +11,7 @@ use clap::Args;
 use estimators::{LocalFrame, ProductExperiment, load_map};
 use serde::Serialize;
 
+use crate::bench_cmd::{load_attached, spec_with_sets};
 use crate::brdf_args::{SetArgs, parse_brdf};
 use crate::error::{CliError, CliResult};
 use crate::output::{check_all, num, write_atomically};
@@ -19,9 +20,10 @@ use crate::values;
 /// Arguments of `brdf-lab product`.
 #[derive(Debug, Args)]
 pub(crate) struct ProductArgs {
-    /// BRDF: `name` or `name:key=value,...` or `merl:PATH`.
-    #[arg(long = "brdf")]
-    spec: String,
+    /// BRDF: `name` or `name:key=value,...` or `merl:PATH`. Optional with --set (then the
+    /// sets' stored spec; when given it must match theirs).
+    #[arg(long = "brdf", required_unless_present = "set_files")]
+    spec: Option<String>,
     /// Lat-long map (.hdr, .exr or .pfm) in world space; without it the built-in procedural sky.
     #[arg(long)]
     map: Option<PathBuf>,
@@ -46,6 +48,11 @@ pub(crate) struct ProductArgs {
     /// BRDF direction samplers for the `brdf` and `mis` estimators (repeatable; registry names).
     #[arg(long = "brdf-sampler", default_values_t = ["srbf".to_string(), "cosine".to_string()])]
     brdf_samplers: Vec<String>,
+    /// A set written by `build --out` (repeatable), loaded instead of built: one more BRDF
+    /// sampler of the `brdf` and `mis` estimators, named `SAMPLER@FILE`, after the
+    /// --brdf-sampler ones. Every set must be for the same BRDF.
+    #[arg(long = "set", value_name = "FILE")]
+    set_files: Vec<PathBuf>,
     /// Environment-map samplers for the `light` and `mis` estimators (repeatable).
     #[arg(long = "light-sampler", default_values_t = ["envmap-adaptive".to_string(), "envmap-cdf".to_string()])]
     light_samplers: Vec<String>,
@@ -167,12 +174,18 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
     let frame = LocalFrame::new(args.normal, args.rotation.to_radians())
         .map_err(|e| CliError::input(format!("--normal: {e}")))?;
     let baselines = args.set.baselines.options()?;
-    let brdf = parse_brdf(&args.spec)?;
+    let spec = spec_with_sets(args.spec.as_deref(), &args.set_files)?;
+    let brdf = parse_brdf(&spec)?;
+    let saved = args
+        .set_files
+        .iter()
+        .map(|path| load_attached(path, &spec, brdf.clone()))
+        .collect::<CliResult<Vec<_>>>()?;
     let (map, map_name) =
         load_map(args.map.as_deref()).map_err(|e| CliError::input(format!("--map {e}")))?;
     let outcome = ProductExperiment {
         brdf,
-        spec: &args.spec,
+        spec: &spec,
         map: &map,
         frame,
         wo: brdf::direction_from_angles(args.theta_o, args.phi_o),
@@ -180,6 +193,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         reference_samples: args.reference_samples as usize,
         seed: args.seed,
         brdf_samplers: &args.brdf_samplers,
+        saved_brdf_samplers: &saved,
         light_samplers: &args.light_samplers,
         set_options: args.set.options(),
         baselines,
@@ -224,7 +238,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
         })
         .collect();
 
-    println!("brdf       {}", args.spec);
+    println!("brdf       {spec}");
     println!(
         "map        {map_name} ({} x {} pixels)",
         map.width(),
@@ -324,7 +338,7 @@ pub(crate) fn run(args: &ProductArgs) -> CliResult<()> {
     }
     if let Some(path) = &args.json {
         let report = Report {
-            brdf: args.spec.clone(),
+            brdf: spec.clone(),
             map: map_name,
             normal: args.normal,
             rotation_deg: args.rotation,

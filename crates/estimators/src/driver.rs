@@ -42,6 +42,9 @@ pub struct ProductExperiment<'a> {
     pub seed: u64,
     /// BRDF direction samplers (registry names), at least one.
     pub brdf_samplers: &'a [String],
+    /// BRDF direction samplers already built (e.g. loaded from saved sets), with their names:
+    /// compared after `brdf_samplers` (which may then be empty).
+    pub saved_brdf_samplers: &'a [(String, Arc<dyn DirectionSampler>)],
     /// Map samplers (registry names), at least one.
     pub light_samplers: &'a [String],
     /// Options of the adaptive sets.
@@ -89,7 +92,7 @@ impl ProductExperiment<'_> {
     /// Errors: an unknown or unbuildable sampler, no sampler of a kind, a bad frame, too few
     /// samples, a refused SRBF setting.
     pub fn run(&self) -> Result<ProductOutcome, EstimatorError> {
-        if self.brdf_samplers.is_empty() {
+        if self.brdf_samplers.is_empty() && self.saved_brdf_samplers.is_empty() {
             return Err(EstimatorError::NoSampler("BRDF"));
         }
         if self.light_samplers.is_empty() {
@@ -106,6 +109,9 @@ impl ProductExperiment<'_> {
                     .with_spec(self.spec);
             let built = samplers::build_direction(name, &request).map_err(sampler_error)?;
             brdf_samplers.push((name, built.sampler));
+        }
+        for (name, s) in self.saved_brdf_samplers {
+            brdf_samplers.push((name, Arc::clone(s)));
         }
         let mut light_samplers: Vec<(&str, EnvMapSampler)> = Vec::new();
         for name in self.light_samplers {

@@ -95,15 +95,22 @@ class StudyResult:
     raw: dict
 
 
-def _names(x: Any, what: str) -> list:
+def _items(x: Any) -> list:
     if x is None:
         return []
-    if isinstance(x, (str, Brdf)):
-        x = [x]
-    if not isinstance(x, (list, tuple)):
-        x = [x]
+    if isinstance(x, (list, tuple)):
+        return list(x)
+    return [x]
+
+
+def _names(x: Any, what: str) -> list:
     out = []
-    for item in x:
+    for item in _items(x):
+        if isinstance(item, Brdf) and item.is_callable:
+            raise TypeError(
+                f"{what}: a callable BRDF ({item.spec}) has no spec; validate() takes it, "
+                "study() does not"
+            )
         if isinstance(item, Brdf):
             out.append(item.spec)
         elif isinstance(item, str):
@@ -114,6 +121,13 @@ def _names(x: Any, what: str) -> list:
                 f"got {type(item).__name__}"
             )
     return out
+
+
+def _brdfs(x: Any) -> tuple:
+    """The specs and the callable BRDFs (:meth:`Brdf.from_callable`) of a selection."""
+    items = _items(x)
+    objects = [b for b in items if isinstance(b, Brdf) and b.is_callable]
+    return _names([b for b in items if not any(b is o for o in objects)], "brdf"), objects
 
 
 def _is_user_sampler(x: Any) -> bool:
@@ -182,15 +196,20 @@ def validate(
     suite as the built-in ones, with draws batched into few calls; an exception they raise is
     raised here as ``ValueError``.
 
+    ``brdf``: specs, :class:`Brdf` objects, or BRDFs written in Python
+    (:meth:`Brdf.from_callable`, validated as objects and labelled ``python:NAME``; with
+    only such BRDFs, only they run). An error of the callable is raised as ``ValueError``.
+
     ``None`` / empty selections take the tier's defaults (``quick=True``: the CI tier).
     ``json`` / ``report`` write the CLI's ``--json`` / ``--report`` files. Returns a
     :class:`ValidationResult`; raises ``ValueError`` for bad input (unknown sampler, bad
     spec, bad angle, too few samples). Failing samplers are reported, not raised.
     """
     names, user = _samplers(sampler)
+    specs, objects = _brdfs(brdf)
     text = _native.validate_json(
         names,
-        _names(brdf, "brdf"),
+        specs,
         [float(t) for t in (theta_o or [])],
         samples,
         seed,
@@ -201,6 +220,7 @@ def validate(
         None if report is None else os.fspath(report),
         [os.fspath(s) for s in sets],
         user,
+        objects,
     )
     raw = _json.loads(text)
     return ValidationResult(

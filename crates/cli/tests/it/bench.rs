@@ -156,3 +156,61 @@ fn bench_bad_input_is_exit_2_with_the_reason() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// `build --out` of `spec` with `extra` options into `dir/NAME`; the path.
+pub(crate) fn saved_set(
+    dir: &std::path::Path,
+    name: &str,
+    spec: &str,
+    extra: &[&str],
+) -> std::path::PathBuf {
+    let path = dir.join(name);
+    let mut args = vec!["build", "--brdf", spec, "--out", path.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = brdf_lab(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    path
+}
+
+#[test]
+fn bench_set_compares_a_saved_set_with_the_same_sampler_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = saved_set(dir.path(), "p.set", "phong:n=40", &["--slices", "4"]);
+    let set = set.to_str().unwrap();
+    // The saved set beside the same sampler built with the same options: same seed, same
+    // queries, so the same samples and the same mean weight f·cos/pdf, bit for bit.
+    let v = bench_json_of(
+        &["adaptive"],
+        "1",
+        "random",
+        &["--slices", "4", "--set", set],
+    );
+    assert_eq!(v.len(), 2, "{v:?}");
+    assert_eq!(v[1]["sampler"], "adaptive@p.set");
+    assert_eq!(v[1]["build_seconds"], 0.0);
+    assert_eq!(v[0]["mean_weight"], v[1]["mean_weight"], "{v:?}");
+    assert_eq!(v[0]["evals_per_sample"], v[1]["evals_per_sample"]);
+    // --brdf and --sampler may be left out: the set's spec is used.
+    let json = dir.path().join("b.json");
+    let o = brdf_lab(&[
+        "bench",
+        "--set",
+        set,
+        "-n",
+        "2000",
+        "--repeat",
+        "1",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("phong:n=40"));
+    let only: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(only.as_array().map(Vec::len), Some(1));
+    // A set built for another BRDF than --brdf is refused before any work.
+    let o = brdf_lab(&["bench", "--brdf", "ggx", "--set", set]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("built for --brdf phong:n=40"), "{err}");
+}

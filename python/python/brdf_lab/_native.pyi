@@ -1,8 +1,8 @@
-"""Type stubs of brdf_lab (the NumPy API of brdf-lab)."""
+"""Type stubs of brdf_lab._native, the extension module (re-exported by brdf_lab, whose own
+Python code — validate, study, their result classes — carries its annotations itself)."""
 
 import os
-from dataclasses import dataclass
-from typing import Any, Dict, Iterable, Optional, Protocol, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -11,13 +11,27 @@ ArrayLike = npt.ArrayLike
 F64 = npt.NDArray[np.float64]
 PathLike = Union[str, os.PathLike[str]]
 
-__version__: str
 PAR_CHUNK: int
 
 class Brdf:
     """A BRDF from a spec string (``"ggx:alpha=0.2"``, ``"rgl:PATH"``, ``"merl:PATH"``, …)."""
 
     def __init__(self, spec: str) -> None: ...
+    @staticmethod
+    def from_callable(
+        f: Callable[[F64, F64], ArrayLike],
+        *,
+        name: str = "python",
+        isotropic: bool = False,
+        mirror_symmetric: bool = False,
+        reciprocal: bool = False,
+        bounded_at_horizon: bool = True,
+    ) -> "Brdf":
+        """A BRDF written in Python: f(wo (3,) or (N, 3), wi (N, 3)) -> (N,) values in 1/sr."""
+    @property
+    def is_callable(self) -> bool: ...
+    @property
+    def callable_counts(self) -> Optional[Tuple[int, int]]: ...
     @property
     def spec(self) -> str: ...
     @property
@@ -105,64 +119,10 @@ class PartitionSampler:
     @property
     def build_report(self) -> dict: ...
 
-@dataclass
-class ValidationResult:
-    passed: bool
-    alpha: float
-    per_test_level: float
-    tests: list
-    mutants: list
-    raw: dict
-    @property
-    def failures(self) -> list: ...
-    def __bool__(self) -> bool: ...
-
-@dataclass
-class StudyResult:
-    cells: list
-    config: dict
-    notes: list
-    raw: dict
-
 def models() -> list: ...
 def samplers() -> list: ...
 def option_names() -> dict: ...
 def set_num_threads(n: Optional[int] = None) -> None: ...
 def num_threads() -> int: ...
-class UserSampler(Protocol):
-    """A sampler written in Python (see :func:`validate`)."""
-
-    def sample(self, wo: np.ndarray, u: np.ndarray) -> tuple: ...
-    def pdf(self, wo: np.ndarray, wi: np.ndarray) -> np.ndarray: ...
-
-def validate(
-    sampler: Union[str, UserSampler, Sequence[Union[str, UserSampler]], Dict[str, UserSampler], None] = None,
-    brdf: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
-    theta_o: Optional[Iterable[float]] = None,
-    samples: Optional[int] = None,
-    seed: int = 1,
-    *,
-    quick: bool = True,
-    mutants: bool = False,
-    alpha: float = 0.01,
-    json: Optional[PathLike] = None,
-    report: Optional[PathLike] = None,
-    sets: Sequence[PathLike] = (),
-) -> ValidationResult: ...
-def study(
-    samplers: Union[str, UserSampler, Sequence[Union[str, UserSampler]], Dict[str, UserSampler], None] = None,
-    brdfs: Union[str, Brdf, Sequence[Union[str, Brdf]], None] = None,
-    theta_o: Optional[Iterable[float]] = None,
-    lights: Union[str, Sequence[str], None] = None,
-    *,
-    preset: str = "quick",
-    n_grid: Optional[Sequence[int]] = None,
-    repetitions: Optional[int] = None,
-    seed: int = 1,
-    shard: Optional[str] = None,
-    out: Optional[PathLike] = None,
-    root: Optional[PathLike] = None,
-    extra_samplers: Optional[Dict[str, UserSampler]] = None,
-    variance_samples: Optional[int] = None,
-    timing_samples: Optional[int] = None,
-) -> StudyResult: ...
+def validate_json(*args: Any) -> str: ...
+def study_json(*args: Any) -> str: ...
