@@ -14,7 +14,8 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use baselines::{CascadeCdf, CdfOptions, TabulatedCdf, UniformHemisphere};
+use baselines::cdf::{CascadeSlice, CdfSampler, SliceCdf, TabulatedSlice};
+use baselines::{CascadeCdf, CdfOptions, CdfReport, TabulatedCdf, UniformHemisphere};
 use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles};
 use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
 use rand::SeedableRng;
@@ -156,40 +157,36 @@ fn row(
     );
 }
 
+/// Builds the CDF sampler of slice kind `S` under `o` and prints its [`row`], its points column
+/// written by `points` from the build report.
+fn cdf_row<S: SliceCdf>(
+    name: &str,
+    brdf: &Arc<dyn Brdf>,
+    o: &CdfOptions,
+    n: usize,
+    points: impl Fn(&CdfReport) -> String,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (s, build) = timed(|| CdfSampler::<S>::build(brdf.as_ref(), o));
+    let s = s?;
+    let r = s.report();
+    row(name, &build, r.bytes, &points(r), brdf.as_ref(), &s, n);
+    Ok(())
+}
+
 fn compare(brdf: &Arc<dyn Brdf>, n: usize) -> Result<(), Box<dyn std::error::Error>> {
     row("uniform", "—", 0, "—", brdf.as_ref(), &UniformHemisphere, n);
     let o = CdfOptions::default();
-    let (t, build) = timed(|| TabulatedCdf::build(brdf.as_ref(), &o));
-    let t = t?;
-    let r = t.report();
-    row(
-        "tabulated-cdf",
-        &build,
-        r.bytes,
-        &format!("{} / {}", r.stored_points, r.fine_points),
-        brdf.as_ref(),
-        &t,
-        n,
-    );
-    drop(t);
-    let (c, build) = timed(|| CascadeCdf::build(brdf.as_ref(), &o));
-    let c = c?;
-    let r = c.report();
-    row(
-        "cascade-cdf (ε = 1e-3)",
-        &build,
-        r.bytes,
-        &format!(
+    cdf_row::<TabulatedSlice>("tabulated-cdf", brdf, &o, n, |r| {
+        format!("{} / {}", r.stored_points, r.fine_points)
+    })?;
+    cdf_row::<CascadeSlice>("cascade-cdf (ε = 1e-3)", brdf, &o, n, |r| {
+        format!(
             "{} / {} ({:.4})",
             r.stored_points,
             r.fine_points,
             r.compression_ratio()
-        ),
-        brdf.as_ref(),
-        &c,
-        n,
-    );
-    drop(c);
+        )
+    })?;
     for (name, variant) in [
         ("adaptive", Variant::Adaptive),
         ("adaptive-paper", Variant::Paper),

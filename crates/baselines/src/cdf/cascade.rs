@@ -3,7 +3,7 @@
 
 use super::douglas_peucker::douglas_peucker;
 use super::grid::GridShape;
-use super::linear::{density, draw, segment_of, settle};
+use super::linear::{density, draw_settled};
 use super::tabulated::{TabulatedSlice, density_scale};
 use super::{SliceCdf, SlicePoint};
 use crate::CdfOptions;
@@ -83,31 +83,13 @@ impl SliceCdf for CascadeSlice {
     #[inline]
     fn sample(&self, shape: GridShape, u: [f64; 2]) -> SlicePoint {
         let (mxs, mcs) = self.marginal();
-        let dz = draw(mxs, mcs, u[0]);
-        let m = dz.segment;
-        let mid = 0.5 * (f64::from(mxs[m]) + f64::from(mxs[m + 1]));
-        let z = settle(
-            dz.t,
-            m,
-            mid,
-            |t| shape.z_of(t),
-            |z| segment_of(mxs, shape.t_of_z(z)),
-        );
+        let (z, dz) = draw_settled(mxs, mcs, u[0], |t| shape.z_of(t), |z| shape.t_of_z(z));
         let (xs, cs) = self.conditional(shape.row_of(z));
-        let dp = draw(xs, cs, u[1]);
-        let k = dp.segment;
-        let mid = 0.5 * (f64::from(xs[k]) + f64::from(xs[k + 1]));
-        let phi = settle(
-            dp.t,
-            k,
-            mid,
-            |s| shape.phi_of(s),
-            |phi| segment_of(xs, shape.s_of_phi(phi)),
-        );
+        let (phi, dp) = draw_settled(xs, cs, u[1], |s| shape.phi_of(s), |p| shape.s_of_phi(p));
         SlicePoint {
             z,
             phi,
-            pdf: dz.slope * dp.slope * density_scale(shape),
+            pdf: dz * dp * density_scale(shape),
         }
     }
 

@@ -97,6 +97,24 @@ pub(crate) fn settle(
     }
 }
 
+/// [`draw`] from the kept points `(xs, cs)`, [`settle`]d into the caller's variable: `to` maps
+/// a grid coordinate to it and `from` back (the lookup `pdf` uses). Returns the value and the
+/// drawn segment's density w.r.t. the grid coordinate.
+#[inline]
+pub(crate) fn draw_settled(
+    xs: &[u32],
+    cs: &[f64],
+    u: f64,
+    to: impl Fn(f64) -> f64,
+    from: impl Fn(f64) -> f64,
+) -> (f64, f64) {
+    let d = draw(xs, cs, u);
+    let m = d.segment;
+    let mid = 0.5 * (f64::from(xs[m]) + f64::from(xs[m + 1]));
+    let v = settle(d.t, m, mid, to, |v| segment_of(xs, from(v)));
+    (v, d.slope)
+}
+
 /// Slope of segment `m`.
 #[inline]
 pub(crate) fn slope(xs: &[u32], cs: &[f64], m: usize) -> f64 {

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{
-    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SliceLayout,
-    SliceLocator,
+    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SetOptions,
+    SliceLayout, SliceLocator, layout_for,
 };
 use distributions::UniformSource;
 use rayon::prelude::*;
@@ -118,21 +118,15 @@ impl CdfReport {
 /// rotation serves every azimuth), else the `[θ, φ]` grid of `anisotropic_slices`, over
 /// `[0, π)` for a half-turn-symmetric BRDF with an even φ count (see [`SliceLayout`]).
 pub fn cdf_layout(brdf: &dyn Brdf, options: &CdfOptions) -> SliceLayout {
-    if brdf.is_isotropic() {
-        SliceLayout {
-            theta: options.slices,
-            phi: 1,
-            half_turn: false,
-        }
-    } else {
-        let [theta, phi] = options.anisotropic_slices;
-        let half_turn = brdf.is_half_turn_symmetric() && phi.is_multiple_of(2);
-        SliceLayout {
-            theta,
-            phi: if half_turn { phi / 2 } else { phi },
-            half_turn,
-        }
-    }
+    // The quadtree set's own rule with every declared symmetry in use: the CDF tables slice
+    // the outgoing directions exactly as the sets do.
+    let set = SetOptions {
+        slices: options.slices,
+        anisotropic_slices: options.anisotropic_slices,
+        symmetries: true,
+        ..SetOptions::default()
+    };
+    layout_for(brdf, &set)
 }
 
 /// A tabulated CDF per outgoing slice of one BRDF, as a [`DirectionSampler`]

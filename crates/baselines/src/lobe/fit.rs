@@ -192,30 +192,31 @@ mod tests {
     use super::*;
     use brdf::direction_from_angles;
 
+    /// The second moment of BRDF `spec` at `θo = theta_deg` (`φo = 0`; exponents up to 10⁴,
+    /// `truncated` as in [`SecondMoment::new`]) and its [`fit_slice`] with no warm start.
+    fn fit_at(spec: &str, theta_deg: f64, truncated: bool) -> (SecondMoment, (f64, f64, f64)) {
+        let brdf = brdf::parse_spec(spec).unwrap();
+        let wo = direction_from_angles(theta_deg, 0.0);
+        let m = SecondMoment::new(brdf.as_ref(), &wo, 1e4, truncated);
+        let fit = fit_slice(&m, None, 0.0, 1e4, 0.02);
+        (m, fit)
+    }
+
     #[test]
     fn lambert_prefers_the_cosine_component_and_phong_a_lobe_near_its_exponent() {
-        let lambert = brdf::parse_spec("lambert").unwrap();
-        let wo = direction_from_angles(30.0, 0.0);
-        let m = SecondMoment::new(lambert.as_ref(), &wo, 1e4, false);
-        let (_, w, _) = fit_slice(&m, None, 0.0, 1e4, 0.02);
+        let (_, (_, w, _)) = fit_at("lambert", 30.0, false);
         assert!(w > 0.99, "lambert defensive weight {w}");
 
         // Pure Phong lobe (kd = 0) at normal incidence: g = ks(n+2)/(2π) c^n cosθ, so the best
         // lobe exponent lies near n (cosθ adds about one), and nowhere near the bounds.
-        let phong = brdf::parse_spec("phong:n=50,kd=0,ks=1").unwrap();
-        let wo = direction_from_angles(0.0, 0.0);
-        let m = SecondMoment::new(phong.as_ref(), &wo, 1e4, true);
-        let (n, w, _) = fit_slice(&m, None, 0.0, 1e4, 0.02);
+        let (_, (n, w, _)) = fit_at("phong:n=50,kd=0,ks=1", 0.0, true);
         assert!((40.0..70.0).contains(&n), "phong exponent {n}");
         assert!(w < 0.1, "phong defensive weight {w}");
     }
 
     #[test]
     fn second_moment_at_the_optimum_is_not_above_other_choices() {
-        let b = brdf::parse_spec("ggx:alpha=0.3").unwrap();
-        let wo = direction_from_angles(60.0, 0.0);
-        let m = SecondMoment::new(b.as_ref(), &wo, 1e4, false);
-        let (n, w, best) = fit_slice(&m, None, 0.0, 1e4, 0.02);
+        let (m, (n, w, best)) = fit_at("ggx:alpha=0.3", 60.0, false);
         assert!((best - m.eval(n, w)).abs() <= 1e-12 * best);
         for (n2, w2) in [
             (0.0, 1.0),

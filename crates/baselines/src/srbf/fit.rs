@@ -588,6 +588,23 @@ pub(super) mod tests {
         FitTarget::new(d, a, v).unwrap()
     }
 
+    /// The two-lobe truth the fit tests recover: a sharp lobe (sharpness `lambda[0]`, amplitude
+    /// 2) tilted towards +y and a broad one (`lambda[1]`, amplitude 0.5) towards −x.
+    pub(in crate::srbf) fn two_lobes(lambda: [f64; 2]) -> [SgLobe; 2] {
+        [
+            SgLobe {
+                axis: Vec3::new(0.0, 0.6, 0.8),
+                lambda: lambda[0],
+                amplitude: 2.0,
+            },
+            SgLobe {
+                axis: Vec3::new(-0.8, 0.0, 0.6),
+                lambda: lambda[1],
+                amplitude: 0.5,
+            },
+        ]
+    }
+
     #[test]
     fn gradient_matches_finite_differences() {
         let target = sphere_target(
@@ -627,18 +644,7 @@ pub(super) mod tests {
 
     #[test]
     fn recovers_a_two_lobe_mixture() {
-        let truth = [
-            SgLobe {
-                axis: Vec3::new(0.0, 0.6, 0.8),
-                lambda: 20.0,
-                amplitude: 2.0,
-            },
-            SgLobe {
-                axis: Vec3::new(-0.8, 0.0, 0.6),
-                lambda: 5.0,
-                amplitude: 0.5,
-            },
-        ];
+        let truth = two_lobes([20.0, 5.0]);
         let target = sphere_target(|d| truth.iter().map(|l| l.eval(d)).sum(), 128, 64);
         let settings = FitSettings {
             lobes: 2,

@@ -284,22 +284,11 @@ pub(crate) fn refine(
 mod tests {
     use super::*;
 
-    use crate::srbf::fit::tests::sphere_target;
+    use crate::srbf::fit::tests::{sphere_target, two_lobes};
 
     #[test]
     fn recovers_a_mixture_from_a_perturbed_start_and_holds_bounds() {
-        let truth = [
-            SgLobe {
-                axis: Vec3::new(0.0, 0.6, 0.8),
-                lambda: 40.0,
-                amplitude: 2.0,
-            },
-            SgLobe {
-                axis: Vec3::new(-0.8, 0.0, 0.6),
-                lambda: 4.0,
-                amplitude: 0.5,
-            },
-        ];
+        let truth = two_lobes([40.0, 4.0]);
         let target = sphere_target(|d| truth.iter().map(|l| l.eval(d)).sum(), 96, 48);
         let start: Vec<SgLobe> = truth
             .iter()
