@@ -19,7 +19,8 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetFileError;
 use crate::layout::SliceLayout;
 use crate::options::SetOptions;
-use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for};
+use crate::options::Variant;
+use crate::set::{QuadTreeSet, SliceNorm, layout_for};
 
 /// Version of the stored set format; bumped on any incompatible change.
 pub const SET_FORMAT_VERSION: u32 = 5;

@@ -15,7 +15,8 @@ use brdf_sampling::{DirectionSampler, EvalSample};
 use envmap::EnvMapSampler;
 use partition_sampler::UniformSource;
 
-use crate::{LocalFrame, MisHeuristic};
+use crate::LocalFrame;
+use crate::heuristic::MisHeuristic;
 
 /// A value an estimator averages: a scalar (luminance) or a linear RGB triple. Values are
 /// non-negative integrands divided by densities.
