@@ -12,7 +12,7 @@ use std::collections::HashSet;
 use std::sync::{Arc, Mutex};
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
 use partition_sampler::UniformSource;
@@ -188,6 +188,8 @@ impl DirectionSampler for PySampler {
         0
     }
 }
+
+impl SamplerDiagnostics for PySampler {}
 
 /// Registered names of Python samplers (leaked once per distinct name: entries are named by
 /// `&'static str`).

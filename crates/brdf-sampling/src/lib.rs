@@ -101,7 +101,7 @@ mod reference;
 mod report;
 mod set;
 
-pub use direction_sampler::{DirSample, DirectionSampler, EvalSample};
+pub use direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
 pub use disc::{
     DiscBrdf, DiscMap, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
     solid_angle_pdf_to_area, thread_evaluations,

@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
     AllocationMode, Audit, AuditCounters, Density, GridOptions, QuadTreeBuilder, QuadTreeSampler,
     Sample2, Sampler2D, TreeParams, UniformSource,
@@ -15,7 +16,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::direction_sampler::{DirSample, DirectionSampler, SamplerDiagnostics};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
@@ -749,6 +750,16 @@ impl DirectionSampler for QuadTreeSet {
         }
     }
 
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
+            + (self.trees.capacity() - self.trees.len())
+                * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
+            + self.spec.capacity()
+    }
+}
+
+impl SamplerDiagnostics for QuadTreeSet {
     fn bound_violations(&self) -> Option<u64> {
         Some(self.report().bound_violations)
     }
@@ -766,13 +777,5 @@ impl DirectionSampler for QuadTreeSet {
                 }
             })
             .reduce(f64::max)
-    }
-
-    fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
-            + (self.trees.capacity() - self.trees.len())
-                * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
-            + self.spec.capacity()
     }
 }

@@ -334,7 +334,6 @@ mod tests {
     use super::*;
     use crate::quadrature_reference;
     use baselines::CosineHemisphere;
-    use envmap::EnvMap;
     use proptest::prelude::*;
 
     proptest! {
@@ -357,21 +356,7 @@ mod tests {
     /// the BRDF technique's density) is caught.
     #[test]
     fn mis_agrees_with_the_quadrature_and_a_broken_weight_is_caught() {
-        let (w, h) = (32, 16);
-        let rgb: Vec<[f32; 3]> = (0..w * h)
-            .map(|i| {
-                let (x, y) = (i % w, i / w);
-                if (3..6).contains(&y) && (20..24).contains(&x) {
-                    [40.0; 3]
-                } else {
-                    [0.5; 3]
-                }
-            })
-            .collect();
-        let map = EnvMap::new(w, h, rgb).unwrap();
-        let brdf = brdf::parse_spec("phong:n=20,ks=0.6,kd=0.3").unwrap();
-        let frame = LocalFrame::new([0.3, -0.2, 0.9], 0.4).unwrap();
-        let wo = brdf::direction_from_angles(35.0, 20.0);
+        let (map, brdf, frame, wo) = crate::batch::tests::scene_parts();
         let scene = ProductScene::new(brdf.as_ref(), &map, frame, wo).unwrap();
         let (q, q_err) = quadrature_reference(&scene, 4);
         assert!(q > 0.0 && q_err < 1e-3 * q, "{q} ± {q_err}");

@@ -3,7 +3,7 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{Audit, Sampler2D, UniformSource};
 
-use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample};
+use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
 
 use super::interval::Interval;
 use super::layout::Cell;
@@ -59,6 +59,28 @@ impl DirectionSampler for ExactSet {
         self.brdf.eval(&q.wo, wi) * wi.z / a
     }
 
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self
+                .cells
+                .iter()
+                .map(|c| {
+                    std::mem::size_of::<Cell>()
+                        + c.upper.capacity() * 8
+                        + c.intervals
+                            .iter()
+                            .map(|iv| {
+                                std::mem::size_of::<Interval>()
+                                    + iv.tree.bytes_used()
+                                    + iv.table.bytes_used()
+                            })
+                            .sum::<usize>()
+                })
+                .sum::<usize>()
+    }
+}
+
+impl SamplerDiagnostics for ExactSet {
     fn bound_violations(&self) -> Option<u64> {
         let trees: u64 = self
             .cells
@@ -78,25 +100,5 @@ impl DirectionSampler for ExactSet {
     /// audit, build cost and memory.
     fn build_report(&self) -> Option<String> {
         Some(self.report().to_string())
-    }
-
-    fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self
-                .cells
-                .iter()
-                .map(|c| {
-                    std::mem::size_of::<Cell>()
-                        + c.upper.capacity() * 8
-                        + c.intervals
-                            .iter()
-                            .map(|iv| {
-                                std::mem::size_of::<Interval>()
-                                    + iv.tree.bytes_used()
-                                    + iv.table.bytes_used()
-                            })
-                            .sum::<usize>()
-                })
-                .sum::<usize>()
     }
 }

@@ -22,6 +22,20 @@ fn assert_input_error(args: &[&str], needle: &str) {
 
 const BASE: [&str; 6] = ["product", "--brdf", "lambert", "--theta-o", "30", "-n=1000"];
 
+/// Small SRBF fits (2 slices of 8 rows, 2 lobes; a 4-lobe map fit 16 wide): fast runs.
+const SMALL_SRBF: [&str; 10] = [
+    "--srbf-slices",
+    "2",
+    "--srbf-fit-rows",
+    "8",
+    "--srbf-lobes",
+    "2",
+    "--srbf-map-lobes",
+    "4",
+    "--srbf-map-fit-width",
+    "16",
+];
+
 fn with(extra: &[&str]) -> Vec<String> {
     BASE.iter().chain(extra).map(|s| s.to_string()).collect()
 }
@@ -53,30 +67,25 @@ fn small_run_writes_json_and_csv() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("p.json");
     let csv = dir.path().join("p.csv");
-    let args = with(&[
-        "--normal",
-        "0.2,-0.1,1",
-        "--srbf-slices",
-        "2",
-        "--srbf-fit-rows",
-        "8",
-        "--srbf-lobes",
-        "2",
-        "--srbf-map-lobes",
-        "4",
-        "--srbf-map-fit-width",
-        "16",
-        "--reference-samples",
-        "20000",
-        "--brdf-sampler",
-        "cosine",
-        "--light-sampler",
-        "envmap-cdf",
-        "--json",
-        json.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
+    let args = with(
+        &[
+            &["--normal", "0.2,-0.1,1"][..],
+            &SMALL_SRBF,
+            &[
+                "--reference-samples",
+                "20000",
+                "--brdf-sampler",
+                "cosine",
+                "--light-sampler",
+                "envmap-cdf",
+                "--json",
+                json.to_str().unwrap(),
+                "--csv",
+                csv.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
     let o = brdf_lab(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(
         o.status.code(),
@@ -153,16 +162,8 @@ fn heavy_tailed_estimators_get_a_warning_instead_of_a_bare_z() {
         "4000",
         "--map",
         map.to_str().unwrap(),
-        "--srbf-slices",
-        "2",
-        "--srbf-fit-rows",
-        "8",
-        "--srbf-lobes",
-        "2",
-        "--srbf-map-lobes",
-        "4",
-        "--srbf-map-fit-width",
-        "16",
+    ];
+    let rest = [
         "--reference-samples",
         "200000",
         "--brdf-sampler",
@@ -172,7 +173,7 @@ fn heavy_tailed_estimators_get_a_warning_instead_of_a_bare_z() {
         "--json",
         json.to_str().unwrap(),
     ];
-    let o = brdf_lab(&args);
+    let o = brdf_lab(&[&args[..], &SMALL_SRBF, &rest].concat());
     let out = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
