@@ -22,8 +22,9 @@ fn assert_input_error(args: &[&str], needle: &str) {
 
 const BASE: [&str; 6] = ["product", "--brdf", "lambert", "--theta-o", "30", "-n=1000"];
 
-/// Small SRBF fits (2 slices of 8 rows, 2 lobes; a 4-lobe map fit 16 wide): fast runs.
-const SMALL_SRBF: [&str; 10] = [
+/// Small SRBF fits (2 slices of 8 rows, 2 lobes; a 4-lobe map fit 16 wide) for fast runs,
+/// with the cosine BRDF sampler and the map's CDF light sampler.
+const SMALL_SRBF: [&str; 14] = [
     "--srbf-slices",
     "2",
     "--srbf-fit-rows",
@@ -34,6 +35,10 @@ const SMALL_SRBF: [&str; 10] = [
     "4",
     "--srbf-map-fit-width",
     "16",
+    "--brdf-sampler",
+    "cosine",
+    "--light-sampler",
+    "envmap-cdf",
 ];
 
 fn with(extra: &[&str]) -> Vec<String> {
@@ -74,10 +79,6 @@ fn small_run_writes_json_and_csv() {
             &[
                 "--reference-samples",
                 "20000",
-                "--brdf-sampler",
-                "cosine",
-                "--light-sampler",
-                "envmap-cdf",
                 "--json",
                 json.to_str().unwrap(),
                 "--csv",
@@ -166,10 +167,6 @@ fn heavy_tailed_estimators_get_a_warning_instead_of_a_bare_z() {
     let rest = [
         "--reference-samples",
         "200000",
-        "--brdf-sampler",
-        "cosine",
-        "--light-sampler",
-        "envmap-cdf",
         "--json",
         json.to_str().unwrap(),
     ];
