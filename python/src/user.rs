@@ -12,7 +12,7 @@ use std::collections::HashSet;
 use std::sync::{Arc, Mutex};
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use pyo3::prelude::*;
 use samplers::{Capabilities, Registry, SamplerEntry, Support};
@@ -164,6 +164,8 @@ impl DirectionSampler for PySampler {
         0
     }
 }
+
+impl SamplerDiagnostics for PySampler {}
 
 /// Registered names of Python samplers (leaked once per distinct name: entries are named by
 /// `&'static str`).

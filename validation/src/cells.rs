@@ -419,7 +419,7 @@ mod tests {
     use crate::plan::Tier;
     use baselines::{CdfOptions, FactoredOptions, FactoredSampler, TabulatedCdf};
     use brdf::direction_from_angles;
-    use brdf_sampling::{DirectionSampler, PdfCellRow};
+    use brdf_sampling::{DirectionSampler, PdfCellRow, SamplerDiagnostics};
     use stats::QuadratureOptions;
     use std::sync::Arc;
 
@@ -557,6 +557,12 @@ mod tests {
         fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
             CosineHemisphere.pdf(wo, wi)
         }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+    }
+
+    impl SamplerDiagnostics for FalseCells {
         fn pdf_cells(&self, _wo: &Vec3) -> Option<PdfCells> {
             let edges: Vec<f64> = (0..=4).map(|k| k as f64 * TAU / 4.0).collect();
             Some(PdfCells {
@@ -568,9 +574,6 @@ mod tests {
                     .collect(),
                 cosine_weight: 0.0,
             })
-        }
-        fn bytes_used(&self) -> usize {
-            0
         }
     }
 

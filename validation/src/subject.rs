@@ -71,14 +71,14 @@ pub trait SamplerUnderTest<P>: Send + Sync {
     }
 
     /// Where the pdf is piecewise constant, for direction samplers that declare it
-    /// ([`brdf_sampling::DirectionSampler::pdf_cells`]): the suite then integrates it exactly
+    /// ([`brdf_sampling::SamplerDiagnostics::pdf_cells`]): the suite then integrates it exactly
     /// (see [`crate::cells`]). `None` by default.
     fn pdf_cells(&self) -> Option<brdf_sampling::PdfCells> {
         None
     }
 
     /// Points where the pdf is singular or sharply peaked, for samplers that declare them
-    /// ([`brdf_sampling::DirectionSampler::singular_directions`]): the KS projection CDFs grade
+    /// ([`brdf_sampling::SamplerDiagnostics::singular_directions`]): the KS projection CDFs grade
     /// their quadrature towards them. Empty by default.
     fn singular_points(&self) -> Vec<P> {
         Vec::new()

@@ -10,7 +10,7 @@
 use std::f64::consts::{FRAC_1_PI, PI, TAU};
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 /// Uniform directions on the upper hemisphere Ω: `p(ωi) = 1/(2π)` for `ωi.z > 0`.
@@ -124,6 +124,8 @@ impl DirectionSampler for UniformHemisphere {
     }
 }
 
+impl SamplerDiagnostics for UniformHemisphere {}
+
 impl DirectionSampler for CosineHemisphere {
     fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let u0 = u.next_uniform();
@@ -137,6 +139,8 @@ impl DirectionSampler for CosineHemisphere {
         0
     }
 }
+
+impl SamplerDiagnostics for CosineHemisphere {}
 
 #[cfg(test)]
 mod tests {

@@ -17,7 +17,7 @@ use std::f64::consts::PI;
 
 use brdf::measured::rgl::{RglBrdf, u_to_phi, u_to_theta};
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 /// The RGL file's own sampler (see the [module docs](self)).
@@ -108,3 +108,5 @@ impl DirectionSampler for RglNative {
         0
     }
 }
+
+impl SamplerDiagnostics for RglNative {}

@@ -25,49 +25,12 @@ use brdf_sampling::{
 use partition_sampler::UniformSource;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-use rayon::prelude::*;
+
+mod support;
+use support::{arg, cpu_seconds, integrate};
 
 const N_COS: usize = 128;
 const N_PHI: usize = 256;
-
-fn integrate(g: &(dyn Fn(&Vec3) -> f64 + Sync)) -> f64 {
-    let cell = (1.0 / N_COS as f64) * (std::f64::consts::TAU / N_PHI as f64);
-    let rows: Vec<f64> = (0..N_COS)
-        .into_par_iter()
-        .map(|i| {
-            let z = (i as f64 + 0.5) / N_COS as f64;
-            let r = (1.0 - z * z).sqrt();
-            (0..N_PHI)
-                .map(|j| {
-                    let phi = (j as f64 + 0.5) / N_PHI as f64 * std::f64::consts::TAU;
-                    g(&Vec3::new(r * phi.cos(), r * phi.sin(), z))
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    rows.iter().sum::<f64>() * cell
-}
-
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let after = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<&str> = after.split_whitespace().collect();
-    let t = |i: usize| {
-        f.get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    (t(11) + t(12)) / 100.0
-}
-
-fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
-    args.iter()
-        .position(|a| a == key)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-}
 
 /// Per-sampler figures over the random angles.
 #[derive(Default, Clone, Copy)]
@@ -95,11 +58,15 @@ fn figures(
     let mut secs = 0.0;
     for (k, (wo, a)) in angles.iter().enumerate() {
         if k % l1_every == 0 {
-            let l1 = integrate(&|wi| (s.pdf(wo, wi) - brdf.eval(wo, wi) * wi.z / a).abs());
+            let l1 = integrate(
+                &|wi| (s.pdf(wo, wi) - brdf.eval(wo, wi) * wi.z / a).abs(),
+                N_COS,
+                N_PHI,
+            );
             // Relative to the same grid's integral of the ideal pdf: the grid's own error on
             // ∫ f cos cancels.
-            let norm = (integrate(&|wi| s.pdf(wo, wi))
-                / integrate(&|wi| brdf.eval(wo, wi) * wi.z / a)
+            let norm = (integrate(&|wi| s.pdf(wo, wi), N_COS, N_PHI)
+                / integrate(&|wi| brdf.eval(wo, wi) * wi.z / a, N_COS, N_PHI)
                 - 1.0)
                 .abs();
             f.l1_mean += l1;

@@ -9,35 +9,22 @@ use std::sync::Arc;
 
 use brdf::{Brdf, Vec3, models, parse_spec};
 use brdf_sampling::{DirectionSampler, SetOptions};
-use rayon::prelude::*;
+
+mod support;
+use support::integrate;
 
 const ANGLES: [f64; 5] = [0.0, 30.0, 60.0, 85.0, 89.0];
 const N_COS: usize = 256;
 const N_PHI: usize = 512;
 
-/// `∫ g dω` over the upper hemisphere by the midpoint rule in (cosθ, φ).
-fn integrate(g: &(dyn Fn(&Vec3) -> f64 + Sync)) -> f64 {
-    let cell = (1.0 / N_COS as f64) * (std::f64::consts::TAU / N_PHI as f64);
-    let rows: Vec<f64> = (0..N_COS)
-        .into_par_iter()
-        .map(|i| {
-            let z = (i as f64 + 0.5) / N_COS as f64;
-            let r = (1.0 - z * z).sqrt();
-            (0..N_PHI)
-                .map(|j| {
-                    let phi = (j as f64 + 0.5) / N_PHI as f64 * std::f64::consts::TAU;
-                    g(&Vec3::new(r * phi.cos(), r * phi.sin(), z))
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    rows.iter().sum::<f64>() * cell
-}
-
 /// `∫ |p − f·cos/A| dω` with `A = ∫ f·cos dω`.
 fn l1(set: &dyn DirectionSampler, brdf: &dyn Brdf, wo: &Vec3) -> f64 {
-    let albedo = integrate(&|wi| brdf.eval(wo, wi) * wi.z);
-    integrate(&|wi| (set.pdf(wo, wi) - brdf.eval(wo, wi) * wi.z / albedo).abs())
+    let albedo = integrate(&|wi| brdf.eval(wo, wi) * wi.z, N_COS, N_PHI);
+    integrate(
+        &|wi| (set.pdf(wo, wi) - brdf.eval(wo, wi) * wi.z / albedo).abs(),
+        N_COS,
+        N_PHI,
+    )
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -22,6 +22,9 @@ use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
+mod support;
+use support::{arg, cpu_seconds};
+
 struct Row {
     name: String,
     trees: usize,
@@ -34,29 +37,6 @@ struct Row {
     evals: f64,
     violations: u64,
     msps: f64,
-}
-
-/// User + system CPU seconds of this process (Linux `/proc/self/stat`, 100 ticks/s); NaN elsewhere.
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let after = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<&str> = after.split_whitespace().collect();
-    let ticks = |i: usize| {
-        f.get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    // Fields 14 and 15 of stat (utime, stime) are at 11 and 12 after the command name.
-    (ticks(11) + ticks(12)) / 100.0
-}
-
-fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
-    args.iter()
-        .position(|a| a == key)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
 }
 
 fn measure(

@@ -33,7 +33,8 @@ use std::time::Instant;
 
 use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles, parse_spec};
 use brdf_sampling::{
-    DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SetOptions, Variant, reference_albedo,
+    DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SamplerDiagnostics, SetOptions, Variant,
+    reference_albedo,
 };
 use rayon::prelude::*;
 

@@ -53,7 +53,13 @@ impl EvalSample {
 /// The pdf is always with respect to solid angle on the sphere of directions. Samplers consume
 /// caller-given uniforms (so QMC streams work) and are immutable and `Sync` once built. The trait
 /// is object-safe: the CLI and the validation suite hold samplers as `Box<dyn DirectionSampler>`.
-pub trait DirectionSampler: Send + Sync {
+///
+/// The methods here are the sampling ones: draw ([`Self::sample`], [`Self::sample_eval`] and
+/// their batched forms [`Self::sample_eval_batch`], [`Self::sample_batch`],
+/// [`Self::sample_many`]), evaluate ([`Self::pdf`], [`Self::pdf_many`]) and the cost of the
+/// structure ([`Self::bytes_used`], [`Self::prefers_batches`]). Validation and report hooks
+/// are the supertrait [`SamplerDiagnostics`].
+pub trait DirectionSampler: SamplerDiagnostics + Send + Sync {
     /// Draws `ωi` for the outgoing direction `wo` (unit, `wo.z > 0`).
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample;
 
@@ -134,6 +140,19 @@ pub trait DirectionSampler: Send + Sync {
         false
     }
 
+    /// Bytes of the precomputed structures this sampler needs.
+    fn bytes_used(&self) -> usize;
+}
+
+/// Validation and report hooks of a [`DirectionSampler`], apart from its sampling methods.
+///
+/// A supertrait of [`DirectionSampler`], so a `Box<dyn DirectionSampler>` still offers every
+/// hook; each has a default ("nothing to declare"), so a sampler with no diagnostics writes
+/// `impl SamplerDiagnostics for MySampler {}`. The hooks never change what a sampler draws or
+/// the pdf it reports: the validation suite reads them to grade its quadratures and audits
+/// ([`Self::pdf_cells`], [`Self::singular_directions`], [`Self::normaliser_rel_err`]), and the
+/// CLI and studies print them ([`Self::bound_violations`], [`Self::build_report`]).
+pub trait SamplerDiagnostics {
     /// Cumulative count of trials that found the density above its bound (samplers with an
     /// audited bound, e.g. the adaptive sets); `None` for samplers that have no bound to audit.
     fn bound_violations(&self) -> Option<u64> {
@@ -158,9 +177,6 @@ pub trait DirectionSampler: Send + Sync {
     fn build_report(&self) -> Option<String> {
         None
     }
-
-    /// Bytes of the precomputed structures this sampler needs.
-    fn bytes_used(&self) -> usize;
 
     /// Directions (unit vectors, local frame) at or near which the pdf at `wo` is singular or
     /// sharply peaked — e.g. `−ωo` for the half-vector samplers, whose solid-angle pdf

@@ -101,7 +101,7 @@ mod reference;
 mod report;
 mod set;
 
-pub use direction_sampler::{DirSample, DirectionSampler, EvalSample};
+pub use direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
 pub use disc::{
     DiscBrdf, DiscMap, SliceDensity, area_pdf_to_solid_angle, direction_to_disc, disc_to_direction,
     solid_angle_pdf_to_area, thread_evaluations,
@@ -109,7 +109,7 @@ pub use disc::{
 pub use error::{SetError, SetFileError};
 pub use exact::{CellLayout, ExactError, ExactOptions, ExactReport, ExactSet};
 pub use layout::{SliceChoice, SliceLayout, SliceLocator, Turn};
-pub use options::{DiscMapPolicy, OptionsError, SetOptions};
+pub use options::{DiscMapPolicy, OptionsError, SetOptions, Variant};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};
 pub use persist::{MAX_LOADED_MEAN_TRIALS, SET_FORMAT_VERSION};
 pub use reference::{
@@ -117,4 +117,4 @@ pub use reference::{
     reference_albedo_with_budget,
 };
 pub use report::{CostMeasurement, SetReport};
-pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, Variant, layout_for};
+pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

@@ -19,7 +19,8 @@ use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
 use crate::error::SetFileError;
 use crate::layout::SliceLayout;
 use crate::options::SetOptions;
-use crate::set::{QuadTreeSet, SliceNorm, Variant, layout_for};
+use crate::options::Variant;
+use crate::set::{QuadTreeSet, SliceNorm, layout_for};
 
 /// Version of the stored set format; bumped on any incompatible change.
 pub const SET_FORMAT_VERSION: u32 = 5;
@@ -118,6 +119,28 @@ pub(crate) fn encode<T: Serialize>(magic: &[u8; 4], version: u32, stored: &T) ->
     out
 }
 
+/// The checks every stored set's `from_bytes` starts with, in this order: the given `spec`
+/// (trimmed) is the stored one ([`SetFileError::SpecMismatch`]), `brdf` reproduces the stored
+/// probe values ([`check_probes`]) and the stored options validate (`options`, the result of
+/// their `validate()`; [`SetFileError::Corrupt`]). Shared by [`QuadTreeSet::from_bytes`] and
+/// [`crate::ExactSet::from_bytes`].
+pub(crate) fn check_stored<E: std::fmt::Display>(
+    stored_spec: &str,
+    spec: &str,
+    stored_probes: &[f64],
+    brdf: &dyn Brdf,
+    options: Result<(), E>,
+) -> Result<(), SetFileError> {
+    if stored_spec != spec.trim() {
+        return Err(SetFileError::SpecMismatch {
+            stored: stored_spec.to_string(),
+            given: spec.trim().to_string(),
+        });
+    }
+    check_probes(stored_probes, brdf)?;
+    options.map_err(|e| SetFileError::Corrupt(format!("options: {e}")))
+}
+
 /// Checks that `brdf` reproduces the `stored` probe values ([`probes`], relative
 /// [`PROBE_TOLERANCE`]).
 pub(crate) fn check_probes(stored: &[f64], brdf: &dyn Brdf) -> Result<(), SetFileError> {
@@ -198,16 +221,8 @@ impl QuadTreeSet {
     /// [`SetFileError::Tree`] / [`SetFileError::Attach`] for a bad tree.
     pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
         let s = decode(bytes)?;
-        if s.spec != spec.trim() {
-            return Err(SetFileError::SpecMismatch {
-                stored: s.spec,
-                given: spec.trim().to_string(),
-            });
-        }
-        check_probes(&s.probes, brdf.as_ref())?;
-        s.options
-            .validate()
-            .map_err(|e| SetFileError::Corrupt(format!("options: {e}")))?;
+        let options = s.options.validate();
+        check_stored(&s.spec, spec, &s.probes, brdf.as_ref(), options)?;
         if layout_for(brdf.as_ref(), &s.options) != s.layout
             || s.layout.len() != s.trees.len()
             || s.maps.len() != s.trees.len()

@@ -6,55 +6,24 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
-    AllocationMode, Audit, AuditCounters, Density, GridOptions, LeafChoice, QuadTreeBuilder,
-    QuadTreeSampler, Sample2, Sampler2D, Scheme, TreeParams, UniformSource,
+    AllocationMode, Audit, AuditCounters, Density, GridOptions, QuadTreeBuilder, QuadTreeSampler,
+    Sample2, Sampler2D, TreeParams, UniformSource,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::direction_sampler::{DirSample, DirectionSampler};
+use crate::direction_sampler::{DirSample, DirectionSampler, SamplerDiagnostics};
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity, thread_evaluations};
 use crate::error::SetError;
 use crate::image_map::{Counted, EvalCounter, SliceImageMap};
 use crate::layout::{SliceChoice, SliceLayout, SliceLocator};
 use crate::normalisation::{Grading, per_leaf_quadrature};
-use crate::options::SetOptions;
+use crate::options::{SetOptions, Variant};
 use crate::report::{CostMeasurement, SetReport};
-
-/// Which of the two partition-sampler schemes the trees of a set use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum Variant {
-    /// `adaptive` (default): [`Scheme::Envelope`] with [`LeafChoice::Alias`]. Exact: accepted
-    /// points have density `f / ∫ f` whenever the leaf bounds hold, whatever the error of the
-    /// grid integrals; mean trials `Σ V_i / Σ I_i ≤ n_max`.
-    #[default]
-    Adaptive,
-    /// `adaptive-paper`: the papers' variant — leaf chosen ∝ `I_i` by the per-node CDF descent
-    /// (seed 003 Algorithm 1), rejection repeated inside the leaf. Its true density is
-    /// `(I_i / Î) f / ∫_leaf f`, equal to the reported `f / Î` only when the grid integrals
-    /// `I_i` are exact. `sample_batch` uses the papers' batch split (seed 000 §3.6) with the
-    /// randomized remainder.
-    Paper,
-}
-
-impl Variant {
-    fn scheme(&self) -> Scheme {
-        match self {
-            Variant::Adaptive => Scheme::Envelope,
-            Variant::Paper => Scheme::Paper,
-        }
-    }
-
-    fn leaf_choice(&self) -> LeafChoice {
-        match self {
-            Variant::Adaptive => LeafChoice::Alias,
-            Variant::Paper => LeafChoice::Descent,
-        }
-    }
-}
 
 /// Progress callback: `(slices done, total)`, called from the building threads after each
 /// slice is built. `total` starts at the number of slices and grows by the number of slices
@@ -781,6 +750,16 @@ impl DirectionSampler for QuadTreeSet {
         }
     }
 
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
+            + (self.trees.capacity() - self.trees.len())
+                * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
+            + self.spec.capacity()
+    }
+}
+
+impl SamplerDiagnostics for QuadTreeSet {
     fn bound_violations(&self) -> Option<u64> {
         Some(self.report().bound_violations)
     }
@@ -798,13 +777,5 @@ impl DirectionSampler for QuadTreeSet {
                 }
             })
             .reduce(f64::max)
-    }
-
-    fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.trees.iter().map(Sampler2D::bytes_used).sum::<usize>()
-            + (self.trees.capacity() - self.trees.len())
-                * std::mem::size_of::<QuadTreeSampler<SliceDensity>>()
-            + self.spec.capacity()
     }
 }

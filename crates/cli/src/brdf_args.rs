@@ -329,7 +329,7 @@ pub(crate) fn build(
 }
 
 /// The warnings of a built sampler: the lines `warning: …` of its
-/// [`DirectionSampler::build_report`] (e.g. `srbf` fits that hit the L-BFGS iteration cap),
+/// [`brdf_sampling::SamplerDiagnostics::build_report`] (e.g. `srbf` fits that hit the L-BFGS iteration cap),
 /// without that prefix.
 pub(crate) fn build_warnings(sampler: &dyn DirectionSampler) -> Vec<String> {
     sampler

@@ -15,7 +15,8 @@ use brdf_sampling::{DirectionSampler, EvalSample};
 use envmap::EnvMapSampler;
 use partition_sampler::UniformSource;
 
-use crate::{LocalFrame, MisHeuristic};
+use crate::LocalFrame;
+use crate::heuristic::MisHeuristic;
 
 /// A value an estimator averages: a scalar (luminance) or a linear RGB triple. Values are
 /// non-negative integrands divided by densities.
@@ -278,7 +279,7 @@ impl Batch<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::{ProductScene, estimate_brdf, quadrature_reference};
     use baselines::CosineHemisphere;
@@ -286,8 +287,9 @@ mod tests {
     use rand::SeedableRng;
     use rand::rngs::Xoshiro256PlusPlus;
 
-    /// A dim map with a bright patch, a glossy Phong, a tilted frame (as `mis.rs`'s test).
-    fn scene_parts() -> (EnvMap, Box<dyn Brdf>, LocalFrame, Vec3) {
+    /// A dim map with a bright patch, a glossy Phong, a tilted frame (shared with `mis.rs`'s
+    /// test).
+    pub(crate) fn scene_parts() -> (EnvMap, Box<dyn Brdf>, LocalFrame, Vec3) {
         let (w, h) = (32, 16);
         let rgb: Vec<[f32; 3]> = (0..w * h)
             .map(|i| {

@@ -50,6 +50,7 @@ mod batch;
 mod driver;
 mod error;
 mod estimate;
+mod heuristic;
 mod map;
 mod mis;
 mod product;
@@ -60,9 +61,10 @@ pub use batch::{Batch, LightTechnique, Query, Radiance, brdf_value, mis_term};
 pub use driver::{ProductExperiment, ProductOutcome};
 pub use error::EstimatorError;
 pub use estimate::{Estimate, HEAVY_TAIL_SHARE, UNCERTAIN_VARIANCE, tail_threshold};
+pub use heuristic::MisHeuristic;
 pub use map::{SKY_NAME, SKY_SIZE, load_map};
 pub use mis::{
-    MisHeuristic, MisPair, estimate_brdf, estimate_light, estimate_mis, light_value, mis_brdf_term,
+    MisPair, estimate_brdf, estimate_light, estimate_mis, light_value, mis_brdf_term,
     mis_light_term,
 };
 pub use product::{ProductStats, estimate_srbf_product};

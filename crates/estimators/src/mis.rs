@@ -19,6 +19,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 
 use crate::batch::{LightTechnique, Radiance, brdf_value, mis_term, mis_term_with};
 use crate::estimate::{Estimate, Moments};
+use crate::heuristic::MisHeuristic;
 use crate::{EstimatorError, LocalFrame, ProductScene};
 
 pub(crate) fn check_samples(
@@ -130,55 +131,6 @@ fn one_sample_estimate(
         start.elapsed().as_secs_f64(),
         &[(&m, 1.0 / n as f64)],
     )
-}
-
-/// The multiple-importance-sampling weight of a technique.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum MisHeuristic {
-    /// `w_a = n_a p_a / Σ_k n_k p_k`.
-    Balance,
-    /// `w_a = (n_a p_a)² / Σ_k (n_k p_k)²`.
-    Power,
-}
-
-impl MisHeuristic {
-    /// Both heuristics, in report order.
-    pub const ALL: [MisHeuristic; 2] = [MisHeuristic::Balance, MisHeuristic::Power];
-
-    /// The weight of a technique of two: `own = n_a p_a`, `other = n_b p_b` at the same
-    /// direction. `weight(a, b) + weight(b, a) = 1` whenever `a + b > 0` (the condition that
-    /// makes MIS unbiased).
-    pub fn weight(self, own: f64, other: f64) -> f64 {
-        match self {
-            MisHeuristic::Balance => own / (own + other),
-            MisHeuristic::Power => own * own / (own * own + other * other),
-        }
-    }
-
-    /// `balance` or `power`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            MisHeuristic::Balance => "balance",
-            MisHeuristic::Power => "power",
-        }
-    }
-
-    /// The estimator's name: `mis-balance` or `mis-power`.
-    pub fn estimator_name(self) -> &'static str {
-        match self {
-            MisHeuristic::Balance => "mis-balance",
-            MisHeuristic::Power => "mis-power",
-        }
-    }
-
-    /// The heuristic of `balance` / `power` (or `mis-balance` / `mis-power`).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s.strip_prefix("mis-").unwrap_or(s) {
-            "balance" => Some(MisHeuristic::Balance),
-            "power" => Some(MisHeuristic::Power),
-            _ => None,
-        }
-    }
 }
 
 /// The MIS contribution of a BRDF-sampled direction: `w_brdf · g / p_brdf`, with
@@ -382,7 +334,6 @@ mod tests {
     use super::*;
     use crate::quadrature_reference;
     use baselines::CosineHemisphere;
-    use envmap::EnvMap;
     use proptest::prelude::*;
 
     proptest! {
@@ -405,21 +356,7 @@ mod tests {
     /// the BRDF technique's density) is caught.
     #[test]
     fn mis_agrees_with_the_quadrature_and_a_broken_weight_is_caught() {
-        let (w, h) = (32, 16);
-        let rgb: Vec<[f32; 3]> = (0..w * h)
-            .map(|i| {
-                let (x, y) = (i % w, i / w);
-                if (3..6).contains(&y) && (20..24).contains(&x) {
-                    [40.0; 3]
-                } else {
-                    [0.5; 3]
-                }
-            })
-            .collect();
-        let map = EnvMap::new(w, h, rgb).unwrap();
-        let brdf = brdf::parse_spec("phong:n=20,ks=0.6,kd=0.3").unwrap();
-        let frame = LocalFrame::new([0.3, -0.2, 0.9], 0.4).unwrap();
-        let wo = brdf::direction_from_angles(35.0, 20.0);
+        let (map, brdf, frame, wo) = crate::batch::tests::scene_parts();
         let scene = ProductScene::new(brdf.as_ref(), &map, frame, wo).unwrap();
         let (q, q_err) = quadrature_reference(&scene, 4);
         assert!(q > 0.0 && q_err < 1e-3 * q, "{q} ± {q_err}");

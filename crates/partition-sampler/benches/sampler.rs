@@ -6,6 +6,7 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
     Domain, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, SampledGridDensity,
     Sampler2D, Scheme, SharedDensity, SinPiRows, TabulatedDensity,

@@ -3,6 +3,7 @@
 //!
 //! Run: `cargo run --release -p partition-sampler --example perf_probe`
 
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
     Audit, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, SinPiRows, TabulatedDensity,
 };

@@ -1,7 +1,7 @@
 //! Trial and bound-violation accounting without shared writes on the hot path.
 //!
 //! Callers that want exact local numbers use an [`Audit`] (plain integers, merged with
-//! [`crate::QuadTreeSampler::record_audit`]). Batch and parallel calls count locally and flush
+//! [`crate::diagnostics::AuditedDraws::record_audit`]). Batch and parallel calls count locally and flush
 //! once per call or chunk (relaxed atomics). The plain one-sample `sample()` adds its trial
 //! count to a thread-local buffer that is flushed every [`FLUSH_EVERY`] samples, when the
 //! thread switches to another sampler, when [`crate::QuadTreeSampler::stats`] is called from

@@ -17,10 +17,21 @@
 //! [`Scheme::Envelope`] is exact whenever the bounds hold; [`Scheme::Paper`] is the papers'
 //! scheme. See [`QuadTreeSampler`] for what `pdf` returns.
 //!
-//! Beyond one-sample draws: the papers' batch mode ([`QuadTreeSampler::sample_batch`] on top
-//! of the reusable [`allocate()`]), reproducible parallel batches of any [`Sampler2D`]
-//! ([`sample_par()`], identical for any thread count), a bound audit
-//! ([`SamplerStats::bound_violations`], [`QuadTreeSampler::sample_audited`]), versioned
+//! # Sampling verbs
+//! A [`QuadTreeSampler`] draws through four verbs, each for one use:
+//!
+//! | verb | draws | for |
+//! |---|---|---|
+//! | [`Sampler2D::sample`] | one sample from the caller's uniforms | a renderer's inner loop, QMC streams |
+//! | [`Sampler2D::sample_into`] | a slice of samples, the same as repeated `sample` (bit for bit) | filling a buffer with the one-sample law, faster |
+//! | [`QuadTreeSampler::sample_batch`] | `n` samples stratified over the leaves (the papers' batch mode, seed 000 §3.6, on [`allocate()`]) | lower-variance estimates from one batch |
+//! | [`QuadTreeSampler::sample_par`] | `n` one-sample draws in parallel, reproducible from a seed whatever the thread count ([`sample_par()`]) | large sample sets, tests |
+//!
+//! The draws with caller-held trial counts and rejection against another density under the
+//! tree's bounds are diagnostics, behind [`diagnostics::AuditedDraws`] (import it to use
+//! them); every verb also feeds the bound audit of [`SamplerStats::bound_violations`].
+//!
+//! Beyond sampling: versioned
 //! persistence of the tree ([`QuadTree::to_bytes`], [`QuadTreeSampler::from_parts`]) and
 //! memory reports ([`QuadTreeSampler::memory`]). Wrap a provider in [`SharedDensity`] to
 //! build several trees over one copy of it.
@@ -51,6 +62,7 @@
 
 pub mod allocate;
 mod audit;
+pub mod diagnostics;
 // The general planar machinery lives in the `distributions` crate: the sampler contract,
 // alias tables, index helpers, rectangles and domains, parallel sampling and the
 // piecewise-constant tables. Re-exported here so that `partition_sampler::X` keeps working.

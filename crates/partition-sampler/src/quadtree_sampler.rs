@@ -218,18 +218,9 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         self.counters.reset();
     }
 
-    /// Draws one sample, counting trials and violations into `audit` only (no shared state is
-    /// touched; merge later with [`QuadTreeSampler::record_audit`] if wanted).
-    pub fn sample_audited<U: UniformSource + ?Sized>(
-        &self,
-        u: &mut U,
-        audit: &mut Audit,
-    ) -> Sample2 {
-        self.draw(u, audit)
-    }
-
-    /// Adds locally gathered counts to the sampler's statistics.
-    pub fn record_audit(&self, audit: &Audit) {
+    /// Adds locally gathered counts to the sampler's statistics
+    /// ([`crate::diagnostics::AuditedDraws::record_audit`]).
+    pub(crate) fn add_audit(&self, audit: &Audit) {
         self.counters.add(audit);
     }
 
@@ -525,7 +516,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
 
     /// One sample of the configured scheme (counts the sample in `a`).
     #[inline]
-    fn draw<U: UniformSource + ?Sized>(&self, u: &mut U, a: &mut Audit) -> Sample2 {
+    pub(crate) fn draw<U: UniformSource + ?Sized>(&self, u: &mut U, a: &mut Audit) -> Sample2 {
         if self.identity {
             self.draw_with::<false, U>(u, a)
         } else {

@@ -45,7 +45,9 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirSample, DirectionSampler, QuadTreeSet, SetOptions, Variant};
+use brdf_sampling::{
+    DirSample, DirectionSampler, QuadTreeSet, SamplerDiagnostics, SetOptions, Variant,
+};
 use envmap::{AdaptiveOptions, EnvMapSampler};
 use estimators::{LightTechnique, LocalFrame, MisHeuristic, MisPair};
 use rand::SeedableRng;
@@ -168,21 +170,28 @@ impl DirectionSampler for SharedSet {
     fn prefers_batches(&self) -> bool {
         self.set.prefers_batches()
     }
-    fn bound_violations(&self) -> Option<u64> {
-        self.set.bound_violations()
-    }
-    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
-        self.set.normaliser_rel_err(wo)
-    }
-    fn pdf_cells(&self, wo: &Vec3) -> Option<brdf_sampling::PdfCells> {
-        self.set.pdf_cells(wo)
-    }
-    fn build_report(&self) -> Option<String> {
-        self.set.build_report()
-    }
     fn bytes_used(&self) -> usize {
         self.bytes
     }
+}
+
+impl SamplerDiagnostics for SharedSet {
+    fn bound_violations(&self) -> Option<u64> {
+        self.set.bound_violations()
+    }
+
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        self.set.normaliser_rel_err(wo)
+    }
+
+    fn pdf_cells(&self, wo: &Vec3) -> Option<brdf_sampling::PdfCells> {
+        self.set.pdf_cells(wo)
+    }
+
+    fn build_report(&self) -> Option<String> {
+        self.set.build_report()
+    }
+
     fn singular_directions(&self, wo: &Vec3) -> Vec<Vec3> {
         self.set.singular_directions(wo)
     }
@@ -1547,6 +1556,8 @@ mod tests {
         }
     }
 
+    impl SamplerDiagnostics for BrokenCosine {}
+
     fn baselines_cosine() -> std::sync::Arc<dyn DirectionSampler> {
         samplers::build_direction(
             "cosine",
@@ -1689,7 +1700,7 @@ mod tests {
 mod build_warning_tests {
     use super::*;
     use brdf::Vec3;
-    use brdf_sampling::{DirSample, DirectionSampler};
+    use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
     use distributions::UniformSource;
 
     /// A sampler whose report carries one warning line among others.
@@ -1708,6 +1719,9 @@ mod build_warning_tests {
         fn bytes_used(&self) -> usize {
             0
         }
+    }
+
+    impl SamplerDiagnostics for Warns {
         fn build_report(&self) -> Option<String> {
             Some("fit  ok\nwarning: 2 of 2 fits hit the L-BFGS cap\nmemory 0".into())
         }

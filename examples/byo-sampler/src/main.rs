@@ -1,7 +1,7 @@
 //! Bring your own sampler: a cos² lobe about the normal, validated and studied beside the
 //! built-in samplers. `--broken`: its pdf is 2 % high where x > 0.5; the suite must reject it.
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use samplers::{Capabilities, Registry, SamplerEntry, Support};
 use std::f64::consts::PI;
@@ -25,6 +25,8 @@ impl DirectionSampler for CosSquared {
         0
     }
 }
+
+impl SamplerDiagnostics for CosSquared {}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let broken = std::env::args().any(|a| a == "--broken");

@@ -3,7 +3,7 @@
 use std::f64::consts::{FRAC_1_PI, TAU};
 
 use brdf::{Vec3, direction_from_angles};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 /// Cosine-weighted hemisphere sampling: `p(ωi) = cos θi / π` w.r.t. solid angle on `z > 0`.
@@ -40,6 +40,8 @@ impl DirectionSampler for CosineHemisphere {
         0
     }
 }
+
+impl SamplerDiagnostics for CosineHemisphere {}
 
 /// A mixture of cosine-weighted hemisphere sampling and a Phong lobe
 /// `p_lobe(ωi) = (n+1)/(2π) max(0, a·ωi)^n` around an axis `a` (support on the sphere: lobe
@@ -144,3 +146,5 @@ impl DirectionSampler for LobeMixture {
         std::mem::size_of::<Self>()
     }
 }
+
+impl SamplerDiagnostics for LobeMixture {}

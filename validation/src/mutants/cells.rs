@@ -6,7 +6,7 @@ use std::f64::consts::FRAC_1_PI;
 use std::sync::Arc;
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler, PdfCells};
+use brdf_sampling::{DirSample, DirectionSampler, PdfCells, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 use crate::adapters::DirectionAtWo;
@@ -90,11 +90,13 @@ impl DirectionSampler for RowScaledPdf {
         self.broken_pdf(wi, self.base.pdf(wo, wi))
     }
 
-    fn pdf_cells(&self, wo: &Vec3) -> Option<PdfCells> {
-        self.base.pdf_cells(wo)
-    }
-
     fn bytes_used(&self) -> usize {
         0
+    }
+}
+
+impl SamplerDiagnostics for RowScaledPdf {
+    fn pdf_cells(&self, wo: &Vec3) -> Option<PdfCells> {
+        self.base.pdf_cells(wo)
     }
 }

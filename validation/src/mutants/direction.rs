@@ -3,7 +3,7 @@
 use std::f64::consts::{FRAC_1_PI, TAU};
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 use super::bases::{LobeMixture, cosine_direction};
@@ -31,6 +31,8 @@ impl DirectionSampler for CosineReportedUniform {
         0
     }
 }
+
+impl SamplerDiagnostics for CosineReportedUniform {}
 
 /// Cosine-weighted sampling restricted to `θ ≤ θ_max`, renormalised there
 /// (`p = cos θ / (π sin²θ_max)`), 0 beyond: a hole in the support near the horizon. The pdf is
@@ -68,6 +70,8 @@ impl DirectionSampler for TruncatedCosine {
         0
     }
 }
+
+impl SamplerDiagnostics for TruncatedCosine {}
 
 /// A correct sampler whose reported pdf is `factor` times too high where `ωi.y > 0` and
 /// `2 − factor` times elsewhere. For `ωo` in the `xz`-plane the base is symmetric in `y`, so the
@@ -109,6 +113,8 @@ impl DirectionSampler for RegionScaledPdf {
     }
 }
 
+impl SamplerDiagnostics for RegionScaledPdf {}
+
 /// Any direction sampler whose reported pdf (from `sample` and `pdf` alike) is multiplied by
 /// `factor`: a normaliser off by `1/factor − 1` (e.g. `adaptive-exact` with `A(θo)` 1 % too
 /// large). Self-consistent; its pdf integrates to `factor`.
@@ -132,11 +138,13 @@ impl DirectionSampler for ScaledPdf {
         self.inner.pdf(wo, wi) * self.factor
     }
 
-    fn bound_violations(&self) -> Option<u64> {
-        self.inner.bound_violations()
-    }
-
     fn bytes_used(&self) -> usize {
         self.inner.bytes_used()
+    }
+}
+
+impl SamplerDiagnostics for ScaledPdf {
+    fn bound_violations(&self) -> Option<u64> {
+        self.inner.bound_violations()
     }
 }

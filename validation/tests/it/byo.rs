@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use samplers::{Capabilities, Registry, SamplerEntry, Support};
 use validation::{ValidateConfig, run_with};
@@ -68,6 +68,8 @@ impl DirectionSampler for CosinePower {
         0
     }
 }
+
+impl SamplerDiagnostics for CosinePower {}
 
 fn entry(name: &'static str, scale: f64) -> SamplerEntry {
     entry_with(name, scale, false, Arc::default())

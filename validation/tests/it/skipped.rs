@@ -2,46 +2,57 @@
 //! for a model without an analytic sampler, `rgl-native` for a non-RGL BRDF) is skipped and
 //! reported, not failed; a real build failure still fails.
 
-use validation::{ValidateConfig, names, run};
+use validation::{TestRecord, ValidateConfig, ValidationReport, names, run};
 
-#[test]
-fn analytic_on_a_model_without_one_is_skipped_and_reported() {
+/// The quick tier of `sampler` on `brdfs` at `theta_o` with `samples` samples.
+fn run_quick(brdfs: &[&str], sampler: &str, theta_o: &[f64], samples: usize) -> ValidationReport {
     let config = ValidateConfig {
-        brdfs: vec!["oren-nayar".into(), "lambert".into()],
-        samplers: vec!["analytic".into()],
-        theta_o: vec![30.0, 60.0],
-        samples: Some(validation::MIN_SAMPLES),
+        brdfs: brdfs.iter().map(|b| b.to_string()).collect(),
+        samplers: vec![sampler.into()],
+        theta_o: theta_o.to_vec(),
+        samples: Some(samples),
         ..ValidateConfig::quick()
     };
-    let report = run(&config, &|_| {}).expect("valid configuration");
-    let skipped: Vec<_> = report
+    run(&config, &|_| {}).expect("valid configuration")
+}
+
+/// The report's skipped cases.
+fn skipped(report: &ValidationReport) -> Vec<&TestRecord> {
+    report
         .tests
         .iter()
         .filter(|t| t.test == names::SKIPPED)
-        .collect();
+        .collect()
+}
+
+/// Whether `brdf` was really tested (it has a χ² result).
+fn really_tested(report: &ValidationReport, brdf: &str) -> bool {
+    report
+        .tests
+        .iter()
+        .any(|t| t.brdf == brdf && t.test == names::CHI_SQUARE)
+}
+
+#[test]
+fn analytic_on_a_model_without_one_is_skipped_and_reported() {
+    let report = run_quick(
+        &["oren-nayar", "lambert"],
+        "analytic",
+        &[30.0, 60.0],
+        validation::MIN_SAMPLES,
+    );
+    let skipped = skipped(&report);
     assert_eq!(skipped.len(), 2, "one per angle of oren-nayar");
     assert!(skipped.iter().all(|t| t.brdf == "oren-nayar" && t.passed));
     assert!(skipped[0].detail.contains("has no analytic sampler"));
     // lambert has one: it is really tested.
-    assert!(
-        report
-            .tests
-            .iter()
-            .any(|t| t.brdf == "lambert" && t.test == names::CHI_SQUARE)
-    );
+    assert!(really_tested(&report, "lambert"));
     assert!(report.passed());
 }
 
 #[test]
 fn rgl_native_on_an_analytic_model_is_skipped_and_reported() {
-    let config = ValidateConfig {
-        brdfs: vec!["lambert".into()],
-        samplers: vec!["rgl-native".into()],
-        theta_o: vec![30.0],
-        samples: Some(validation::MIN_SAMPLES),
-        ..ValidateConfig::quick()
-    };
-    let report = run(&config, &|_| {}).expect("valid configuration");
+    let report = run_quick(&["lambert"], "rgl-native", &[30.0], validation::MIN_SAMPLES);
     let tests: Vec<_> = report
         .tests
         .iter()
@@ -78,19 +89,13 @@ fn a_bad_option_is_a_failed_build_not_a_skip() {
 
 #[test]
 fn quadtree_disc_skips_brdfs_unbounded_at_the_horizon() {
-    let config = ValidateConfig {
-        brdfs: vec!["ward-original".into(), "lambert".into()],
-        samplers: vec!["quadtree-disc".into()],
-        theta_o: vec![45.0],
-        samples: Some(20_000),
-        ..ValidateConfig::quick()
-    };
-    let report = run(&config, &|_| {}).expect("valid configuration");
-    let skipped: Vec<_> = report
-        .tests
-        .iter()
-        .filter(|t| t.test == names::SKIPPED)
-        .collect();
+    let report = run_quick(
+        &["ward-original", "lambert"],
+        "quadtree-disc",
+        &[45.0],
+        20_000,
+    );
+    let skipped = skipped(&report);
     assert_eq!(skipped.len(), 1, "ward-original at 45°");
     assert!(skipped[0].brdf == "ward-original" && skipped[0].passed);
     assert!(
@@ -99,12 +104,7 @@ fn quadtree_disc_skips_brdfs_unbounded_at_the_horizon() {
         skipped[0].detail
     );
     // lambert is bounded: it is really tested.
-    assert!(
-        report
-            .tests
-            .iter()
-            .any(|t| t.brdf == "lambert" && t.test == names::CHI_SQUARE)
-    );
+    assert!(really_tested(&report, "lambert"));
     for t in report.failures() {
         eprintln!(
             "FAILED {} {} {:?} {} {}",

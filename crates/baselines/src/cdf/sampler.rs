@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{
-    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SetOptions,
+    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SamplerDiagnostics,
     SliceLayout, SliceLocator, layout_for,
 };
 use distributions::UniformSource;
@@ -276,6 +276,12 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
         self.slices[f.index].pdf(self.shape, wi.z.min(1.0), phi)
     }
 
+    fn bytes_used(&self) -> usize {
+        self.report.bytes
+    }
+}
+
+impl<S: SliceCdf> SamplerDiagnostics for CdfSampler<S> {
     /// The pdf at `wo` is constant on the cells of the serving slice's fine rows
     /// (`z ∈ [a/n_z, (a+1)/n_z)`), cut at [`SliceCdf::phi_edges`] and turned by the slice's
     /// rotation `Δ`; zero below the horizon (the rows tile the upper hemisphere).
@@ -302,10 +308,6 @@ impl<S: SliceCdf> DirectionSampler for CdfSampler<S> {
             rows,
             cosine_weight: 0.0,
         })
-    }
-
-    fn bytes_used(&self) -> usize {
-        self.report.bytes
     }
 
     /// [`CdfReport::summary`]: layout, grid, build time, memory and compression.

@@ -4,7 +4,9 @@
 use std::f64::consts::FRAC_1_PI;
 
 use brdf::Vec3;
-use brdf_sampling::{CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells};
+use brdf_sampling::{
+    CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, SamplerDiagnostics,
+};
 use partition_sampler::UniformSource;
 
 use crate::CosineHemisphere;
@@ -183,6 +185,20 @@ impl DirectionSampler for FactoredSampler {
         factored + defensive
     }
 
+    fn bytes_used(&self) -> usize {
+        let floats = self.weights.len()
+            + self.weight_cdf.len()
+            + self.u_bar.len()
+            + self.u_cdf.len()
+            + self.v_bar.len()
+            + self.v_cdf.len()
+            + self.theta_p.cos_edges.len()
+            + self.theta_p.measure.len();
+        std::mem::size_of::<Self>() + floats * std::mem::size_of::<f64>()
+    }
+}
+
+impl SamplerDiagnostics for FactoredSampler {
     /// The factored part is constant on each `(θp band, φp bin)` cell of the reparametrised
     /// direction `ωp` (the half vector, or `ωi` in spherical mode), turned by the row's frame;
     /// the defensive part is the cosine component of weight `α`.
@@ -207,18 +223,6 @@ impl DirectionSampler for FactoredSampler {
             rows,
             cosine_weight: self.alpha,
         })
-    }
-
-    fn bytes_used(&self) -> usize {
-        let floats = self.weights.len()
-            + self.weight_cdf.len()
-            + self.u_bar.len()
-            + self.u_cdf.len()
-            + self.v_bar.len()
-            + self.v_cdf.len()
-            + self.theta_p.cos_edges.len()
-            + self.theta_p.measure.len();
-        std::mem::size_of::<Self>() + floats * std::mem::size_of::<f64>()
     }
 
     /// [`FactoredReport`]'s lines (fit, convergence, time, memory), and a line `warning: …`

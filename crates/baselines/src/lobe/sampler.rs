@@ -6,7 +6,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::Arc;
 
 use brdf::{Brdf, Vec3, direction_from_radians, mirror};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use rayon::prelude::*;
 
@@ -58,7 +58,7 @@ pub const MAX_LOBE_TRIALS: usize = 64;
 ///   `L_n = (n+1)/(2π) max(0, ω_r·ω)^n`; samples below the horizon contribute zero.
 /// * [`LobeSupport::Hemisphere`]: `p(ω) = w·cosθ/π + (1−w)·L_n(ω)/A(θo, n)` on Ω, `A` the
 ///   lobe's mass above the horizon (quadrature, declared by
-///   [`DirectionSampler::normaliser_rel_err`]); the truncated lobe is drawn by rejection of
+///   [`brdf_sampling::SamplerDiagnostics::normaliser_rel_err`]); the truncated lobe is drawn by rejection of
 ///   below-horizon lobe draws (at most [`MAX_LOBE_TRIALS`]).
 ///
 /// The cosine component is what keeps the sampler unbiased: for `θo > 0` the lobe is zero on
@@ -252,6 +252,12 @@ impl DirectionSampler for LobeSampler {
         }
     }
 
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>() + self.fits.len() * std::mem::size_of::<LobeFit>()
+    }
+}
+
+impl SamplerDiagnostics for LobeSampler {
     fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
         if self.support == LobeSupport::Sphere || !(wo.z > 0.0) {
             return None;
@@ -261,10 +267,6 @@ impl DirectionSampler for LobeSampler {
         let fine = self.mass(wo, n, 2 * MASS_NODES);
         // A 2⁻⁵² floor: the mass is a sum of rounded terms even when both rules agree.
         Some(((a - fine).abs() / fine).max(f64::EPSILON))
-    }
-
-    fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>() + self.fits.len() * std::mem::size_of::<LobeFit>()
     }
 
     /// The fitted exponents and cosine weights over the slices (the fit), and the memory.

@@ -20,7 +20,7 @@
 use brdf::Vec3;
 use nalgebra::{DMatrix, DVector};
 
-use super::fit::FitTarget;
+use super::target::FitTarget;
 use super::vmf::SgLobe;
 
 /// Convergence threshold on `gᵀH⁻¹g / ‖r‖²` (see the module docs): the linear model promises

@@ -36,6 +36,7 @@ mod lbfgs;
 mod lm;
 pub mod product;
 pub mod sampler;
+mod target;
 pub mod vmf;
 
 pub use envfit::{EnvSrbf, fit_envmap};

@@ -22,7 +22,7 @@ use std::f64::consts::{FRAC_1_PI, FRAC_PI_2, TAU};
 use std::time::Instant;
 
 use brdf::{Brdf, Vec3, rotate_y, rotate_z};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use rayon::prelude::*;
 
@@ -385,7 +385,9 @@ impl DirectionSampler for SrbfSampler {
                 .sum::<usize>()
             + self.fits.capacity() * std::mem::size_of::<FitReport>()
     }
+}
 
+impl SamplerDiagnostics for SrbfSampler {
     /// The fits' quality and cost, and a line `warning: …` ([`SrbfReport::lbfgs_cap_warning`])
     /// when some slice fits hit the iteration cap (the command line prints such lines
     /// as warnings).

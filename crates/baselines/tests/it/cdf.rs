@@ -7,7 +7,7 @@ use std::f64::consts::TAU;
 use baselines::cdf::{GridShape, SliceCdf, TabulatedSlice};
 use baselines::{CascadeCdf, CdfOptions, CdfOptionsError, TabulatedCdf};
 use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles, parse_spec};
-use brdf_sampling::DirectionSampler;
+use brdf_sampling::{DirectionSampler, SamplerDiagnostics};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -304,6 +304,8 @@ impl DirectionSampler for UncompressedPdf {
         0
     }
 }
+
+impl SamplerDiagnostics for UncompressedPdf {}
 
 #[test]
 fn chi_square_accepts_the_cascade_and_rejects_the_uncompressed_pdf() {

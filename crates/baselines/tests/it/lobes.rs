@@ -9,7 +9,7 @@ use std::sync::Arc;
 use baselines::lobe::{above_horizon_mass, lobe_density, sample_lobe};
 use baselines::{AnalyticSampler, LobeError, LobeOptions, LobeSampler, LobeSupport};
 use brdf::{Brdf, Vec3, direction_from_angles, directional_albedo, mirror};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use proptest::prelude::*;
 use rand::SeedableRng;
@@ -257,6 +257,8 @@ impl DirectionSampler for RenormalisedSphereLobe {
         0
     }
 }
+
+impl SamplerDiagnostics for RenormalisedSphereLobe {}
 
 #[test]
 fn a_z_test_rejects_the_sphere_lobe_renormalised_over_the_hemisphere() {

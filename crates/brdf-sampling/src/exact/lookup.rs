@@ -1,6 +1,7 @@
 //! Locating a query (cell, interval, rotation) and drawing one direction.
 
 use brdf::{Vec3, direction_from_radians};
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, UniformSource};
 
 use crate::direction_sampler::DirSample;

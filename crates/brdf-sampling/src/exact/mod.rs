@@ -14,7 +14,7 @@
 //! the interval).
 //! The leaf bounds `M_i` thus hold for every outgoing direction of the interval (between the
 //! nodes, the safety factor covers the envelope's dips; every trial above its bound is counted
-//! by the audit, [`crate::DirectionSampler::bound_violations`]).
+//! by the audit, [`crate::SamplerDiagnostics::bound_violations`]).
 //!
 //! For a query `ωo = (θo, φo)`: the cell `k` with the nearest `φ_k`, the rotation
 //! `r = φo − φ_k` (`δ = r` reduced to `[−h, h]`; one cell and `r = φo` for isotropic BRDFs),

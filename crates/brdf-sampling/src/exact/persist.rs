@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use crate::disc::SliceDensity;
 use crate::error::SetFileError;
 use crate::persist::{
-    MAX_LOADED_MEAN_TRIALS, check_probes, decode_payload, encode, estimated_mean_trials, payload,
+    MAX_LOADED_MEAN_TRIALS, check_stored, decode_payload, encode, estimated_mean_trials, payload,
     probes,
 };
 
@@ -132,16 +132,8 @@ impl ExactSet {
     /// slice number counts the intervals over all cells).
     pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
         let s = decode(bytes)?;
-        if s.spec != spec.trim() {
-            return Err(SetFileError::SpecMismatch {
-                stored: s.spec,
-                given: spec.trim().to_string(),
-            });
-        }
-        check_probes(&s.probes, brdf.as_ref())?;
-        s.options
-            .validate()
-            .map_err(|e| corrupt(format!("options: {e}")))?;
+        let options = s.options.validate();
+        check_stored(&s.spec, spec, &s.probes, brdf.as_ref(), options)?;
         // The build's own plan (no timing: the node cache does not matter here).
         let plan = Plan::new(brdf.as_ref(), &s.options, Some(false), true);
         if s.cells.len() != plan.phis.len() {

@@ -3,7 +3,7 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{Audit, Sampler2D, UniformSource};
 
-use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample};
+use crate::direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
 
 use super::interval::Interval;
 use super::layout::Cell;
@@ -59,27 +59,6 @@ impl DirectionSampler for ExactSet {
         self.brdf.eval(&q.wo, wi) * wi.z / a
     }
 
-    fn bound_violations(&self) -> Option<u64> {
-        let trees: u64 = self
-            .cells
-            .iter()
-            .flat_map(|c| c.intervals.iter())
-            .map(|iv| iv.tree.stats().bound_violations)
-            .sum();
-        Some(trees + self.counters.snapshot().violations)
-    }
-
-    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
-        let q = self.locate(wo)?;
-        Some(self.interval(&q).norm_err)
-    }
-
-    /// The [`ExactReport`]: the interval layout per azimuth cell, trials, normaliser error,
-    /// audit, build cost and memory.
-    fn build_report(&self) -> Option<String> {
-        Some(self.report().to_string())
-    }
-
     fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + self
@@ -103,5 +82,28 @@ impl DirectionSampler for ExactSet {
                             .sum::<usize>()
                 })
                 .sum::<usize>()
+    }
+}
+
+impl SamplerDiagnostics for ExactSet {
+    fn bound_violations(&self) -> Option<u64> {
+        let trees: u64 = self
+            .cells
+            .iter()
+            .flat_map(|c| c.intervals.iter())
+            .map(|iv| iv.tree.stats().bound_violations)
+            .sum();
+        Some(trees + self.counters.snapshot().violations)
+    }
+
+    fn normaliser_rel_err(&self, wo: &Vec3) -> Option<f64> {
+        let q = self.locate(wo)?;
+        Some(self.interval(&q).norm_err)
+    }
+
+    /// The [`ExactReport`]: the interval layout per azimuth cell, trials, normaliser error,
+    /// audit, build cost and memory.
+    fn build_report(&self) -> Option<String> {
+        Some(self.report().to_string())
     }
 }

@@ -4,7 +4,7 @@
 use super::grid::theta_kinks;
 use super::layout::{GUIDE_LEN, guided_interval, interval_guide};
 use super::*;
-use crate::direction_sampler::DirectionSampler;
+use crate::direction_sampler::{DirectionSampler, SamplerDiagnostics};
 use crate::reference_albedo;
 use brdf::parse_spec;
 use brdf::{Brdf, Vec3};

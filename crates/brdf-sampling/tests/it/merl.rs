@@ -7,7 +7,7 @@ use crate::common;
 use std::sync::Arc;
 
 use brdf::{Brdf, MerlBrdf};
-use brdf_sampling::{DirectionSampler, QuadTreeSet, Variant};
+use brdf_sampling::{DirectionSampler, QuadTreeSet, SamplerDiagnostics, Variant};
 use common::*;
 
 fn synthetic_merl(dir: &std::path::Path) -> (Arc<dyn Brdf>, String) {

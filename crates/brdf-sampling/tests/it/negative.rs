@@ -6,7 +6,9 @@
 use crate::common;
 
 use brdf::Vec3;
-use brdf_sampling::{DirSample, DirectionSampler, QuadTreeSet, SetOptions, SliceChoice, Variant};
+use brdf_sampling::{
+    DirSample, DirectionSampler, QuadTreeSet, SamplerDiagnostics, SetOptions, SliceChoice, Variant,
+};
 use common::*;
 use partition_sampler::UniformSource;
 
@@ -59,6 +61,8 @@ impl DirectionSampler for Broken<'_> {
         0
     }
 }
+
+impl SamplerDiagnostics for Broken<'_> {}
 
 #[test]
 fn broken_pdfs_are_rejected_and_the_honest_one_passes() {

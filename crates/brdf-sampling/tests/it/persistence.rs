@@ -79,18 +79,25 @@ fn typed_errors() {
     assert!(err.to_string().contains("phong"));
 }
 
+/// `bytes` with one bit flipped past the 8-byte header, at a place drawn from the LCG `state`
+/// (advanced once).
+fn flip_one_bit(bytes: &[u8], state: &mut u64) -> Vec<u8> {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut v = bytes.to_vec();
+    let at = 8 + (*state >> 33) as usize % (v.len() - 8);
+    v[at] ^= 1 << ((*state >> 20) % 8);
+    v
+}
+
 #[test]
 fn corrupted_bytes_never_panic() {
     let bytes = small_set(Variant::Paper).to_bytes();
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
     let mut errors = 0;
     for _ in 0..300 {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let mut v = bytes.clone();
-        let at = 8 + (state >> 33) as usize % (v.len() - 8);
-        v[at] ^= 1 << ((state >> 20) % 8);
+        let v = flip_one_bit(&bytes, &mut state);
         if let Ok(s) = QuadTreeSet::from_bytes(&v, brdf("phong:n=50"), "phong:n=50") {
             // A flip that decodes (e.g. in a float) still yields a usable sampler.
             let wo = wo_at(30.0);
@@ -305,12 +312,7 @@ fn exact_files_give_typed_errors() {
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
     let (mut errors, mut loaded) = (0, 0);
     for _ in 0..200 {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let mut v = bytes.clone();
-        let at = 8 + (state >> 33) as usize % (v.len() - 8);
-        v[at] ^= 1 << ((state >> 20) % 8);
+        let v = flip_one_bit(&bytes, &mut state);
         match load(&v) {
             // A flip that decodes (e.g. in a float) still yields a usable sampler.
             Ok(s) => {

@@ -7,6 +7,7 @@
 
 mod bench;
 mod cli;
+mod import_cycles;
 mod product;
 mod readme;
 mod study;

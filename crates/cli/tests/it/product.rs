@@ -22,6 +22,25 @@ fn assert_input_error(args: &[&str], needle: &str) {
 
 const BASE: [&str; 6] = ["product", "--brdf", "lambert", "--theta-o", "30", "-n=1000"];
 
+/// Small SRBF fits (2 slices of 8 rows, 2 lobes; a 4-lobe map fit 16 wide) for fast runs,
+/// with the cosine BRDF sampler and the map's CDF light sampler.
+const SMALL_SRBF: [&str; 14] = [
+    "--srbf-slices",
+    "2",
+    "--srbf-fit-rows",
+    "8",
+    "--srbf-lobes",
+    "2",
+    "--srbf-map-lobes",
+    "4",
+    "--srbf-map-fit-width",
+    "16",
+    "--brdf-sampler",
+    "cosine",
+    "--light-sampler",
+    "envmap-cdf",
+];
+
 fn with(extra: &[&str]) -> Vec<String> {
     BASE.iter().chain(extra).map(|s| s.to_string()).collect()
 }
@@ -48,25 +67,10 @@ fn bad_input_is_exit_2_with_the_reason() {
     run_input_error(&["--map", black.to_str().unwrap()], "black");
 }
 
-/// Small fits and reference, one BRDF and one map sampler: a run of seconds.
-const SMALL_FITS: [&str; 16] = [
-    "--srbf-slices",
-    "2",
-    "--srbf-fit-rows",
-    "8",
-    "--srbf-lobes",
-    "2",
-    "--srbf-map-lobes",
-    "4",
-    "--srbf-map-fit-width",
-    "16",
-    "--reference-samples",
-    "20000",
-    "--brdf-sampler",
-    "cosine",
-    "--light-sampler",
-    "envmap-cdf",
-];
+/// [`SMALL_SRBF`] with a small reference: a run of seconds.
+fn small_fits() -> Vec<&'static str> {
+    [&SMALL_SRBF[..], &["--reference-samples", "20000"]].concat()
+}
 
 #[test]
 fn small_run_writes_json_and_csv() {
@@ -74,7 +78,7 @@ fn small_run_writes_json_and_csv() {
     let json = dir.path().join("p.json");
     let csv = dir.path().join("p.csv");
     let mut extra = vec!["--normal", "0.2,-0.1,1"];
-    extra.extend(SMALL_FITS);
+    extra.extend(small_fits());
     extra.extend([
         "--json",
         json.to_str().unwrap(),
@@ -158,26 +162,14 @@ fn heavy_tailed_estimators_get_a_warning_instead_of_a_bare_z() {
         "4000",
         "--map",
         map.to_str().unwrap(),
-        "--srbf-slices",
-        "2",
-        "--srbf-fit-rows",
-        "8",
-        "--srbf-lobes",
-        "2",
-        "--srbf-map-lobes",
-        "4",
-        "--srbf-map-fit-width",
-        "16",
+    ];
+    let rest = [
         "--reference-samples",
         "200000",
-        "--brdf-sampler",
-        "cosine",
-        "--light-sampler",
-        "envmap-cdf",
         "--json",
         json.to_str().unwrap(),
     ];
-    let o = brdf_lab(&args);
+    let o = brdf_lab(&[&args[..], &SMALL_SRBF, &rest].concat());
     let out = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
@@ -226,7 +218,7 @@ fn product_set_adds_a_saved_set_as_a_brdf_sampler() {
         "--set",
         set.to_str().unwrap(),
     ];
-    args.extend(SMALL_FITS);
+    args.extend(small_fits());
     args.extend(["--json", json.to_str().unwrap()]);
     let o = brdf_lab(&args);
     assert_eq!(

@@ -29,7 +29,7 @@
 use baselines::srbf::{EnvSrbf, fit_envmap};
 use baselines::{CosineHemisphere, SrbfOptions, SrbfSampler};
 use brdf::{Brdf, Vec3};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use envmap::latlong::uv_to_direction;
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
 use estimators::{
@@ -292,6 +292,8 @@ impl DirectionSampler for HalfCosine {
         0
     }
 }
+
+impl SamplerDiagnostics for HalfCosine {}
 
 #[test]
 fn the_check_rejects_samplers_that_miss_part_of_the_support() {

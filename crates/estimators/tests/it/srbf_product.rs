@@ -28,6 +28,21 @@ fn z(a: &Estimate, b: &Estimate) -> f64 {
 /// estimators (the sun or the lobe is hit a handful of times in 10⁵ samples, or not at all), so
 /// their sample standard error is no yardstick (measured: z down to −117 on the railway map's sun,
 /// −41 on the studio map's sharp lobe). SRBF product sampling and MIS are always tested.
+/// The reference: balance-heuristic MIS of the cosine sampler and the map's CDF sampler
+/// (independent of the SRBF fits), `n` samples from `seed`.
+fn reference(scene: &ProductScene, cdf: &EnvMapSampler, n: usize, seed: u64) -> Estimate {
+    estimate_mis(
+        scene,
+        &CosineHemisphere,
+        cdf,
+        MisHeuristic::Balance,
+        "reference",
+        n,
+        seed,
+    )
+    .unwrap()
+}
+
 fn check(
     map: &EnvMap,
     brdf: &dyn Brdf,
@@ -48,16 +63,7 @@ fn check(
         let scene = ProductScene::new(brdf, map, frame, wo).unwrap();
         let seed = 100 * i as u64;
         // The reference uses samplers independent of the SRBF fits.
-        let reference = estimate_mis(
-            &scene,
-            &CosineHemisphere,
-            &cdf,
-            MisHeuristic::Balance,
-            "reference",
-            n_ref,
-            seed + 1,
-        )
-        .unwrap();
+        let reference = reference(&scene, &cdf, n_ref, seed + 1);
         let mut estimates = vec![
             estimate_srbf_product(
                 &scene,
@@ -173,16 +179,7 @@ fn reduced_detects_a_biased_estimator() {
         brdf::direction_from_angles(35.0, 20.0),
     )
     .unwrap();
-    let reference = estimate_mis(
-        &scene,
-        &CosineHemisphere,
-        &cdf,
-        MisHeuristic::Balance,
-        "reference",
-        200_000,
-        1,
-    )
-    .unwrap();
+    let reference = reference(&scene, &cdf, 200_000, 1);
     let mut biased = estimate_light(&scene, &cdf, "light", 20_000, 2).unwrap();
     assert!(z(&biased, &reference).abs() < 4.0);
     biased.estimate *= 1.05;

@@ -15,11 +15,11 @@ use crate::contract::{Point2, UniformSource};
 use crate::density::RegionStats;
 
 impl<D: RegionStats> QuadTreeSampler<D> {
-    /// Adds one [`QuadTreeSampler::sample_envelope_of`] call's counts to the sampler's
-    /// statistics the way a plain `sample()` does: trials and samples buffered per thread,
-    /// violations and exhaustion at once.
+    /// Adds one [`Self::draw_envelope_of`] call's counts to the sampler's statistics the way
+    /// a plain `sample()` does: trials and samples buffered per thread, violations and
+    /// exhaustion at once ([`crate::diagnostics::AuditedDraws::record_one_sample`]).
     #[inline]
-    pub fn record_one_sample(&self, audit: &Audit) {
+    pub(crate) fn add_one_sample(&self, audit: &Audit) {
         record_one(&self.counters, audit);
     }
 
@@ -31,7 +31,8 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// (`g(x) > M_i`) and the sample are counted in `audit` only.
     ///
     /// `g` is called only at points inside the domain (inside the unit circle for disc trees).
-    pub fn sample_envelope_of<G, U>(
+    /// Public as [`crate::diagnostics::AuditedDraws::sample_envelope_of`].
+    pub(crate) fn draw_envelope_of<G, U>(
         &self,
         g: &G,
         u: &mut U,
@@ -89,6 +90,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
 
 #[cfg(test)]
 mod tests {
+    use crate::diagnostics::AuditedDraws;
     use crate::{Audit, QuadTreeBuilder, Sampler2D, TabulatedDensity};
     use rand::SeedableRng;
     use rand::rngs::Xoshiro256PlusPlus;

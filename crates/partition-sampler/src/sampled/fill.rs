@@ -3,8 +3,8 @@
 
 use rayon::prelude::*;
 
-use super::Refinement;
 use super::lattice::{GridPoint, Lattice};
+use super::refinement::Refinement;
 use crate::contract::Point2;
 use crate::density::Density;
 use crate::error::DensityError;

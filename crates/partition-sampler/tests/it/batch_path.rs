@@ -6,6 +6,7 @@
 use crate::common;
 
 use common::*;
+use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
     Audit, Domain, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, Sample2,
     SampledGridDensity, Sampler2D, Scheme, SinPiRows, TabulatedDensity,

@@ -40,14 +40,13 @@ fn product_density_masses_are_accurate_at_huge_sample_counts() {
 }
 
 /// A density that no fixed rule integrates exactly: a narrow lobe on the sphere.
-#[test]
-fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
-    // Exponent 2000: the lobe (width ~0.02 rad) is much narrower than a bin, so refinement is needed.
+/// The narrow-lobe case of the two tests below: a lobe of exponent 2000 about `(0.5, 1.0)`, a
+/// 10 × 20 sphere binning and the tight quadrature options of its reference masses.
+fn narrow_lobe_case() -> (Lobe, SphereBinning, QuadratureOptions) {
     let lobe = Lobe {
         axis: dir(0.5, 1.0),
         exponent: 2000.0,
     };
-    let pdf = |d: [f64; 3]| lobe.pdf(d);
     let bins = SphereBinning::sphere(10, 20).unwrap();
     let tight = QuadratureOptions {
         accuracy: 1e-7,
@@ -55,6 +54,14 @@ fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
         min_depth: 3,
         ..Default::default()
     };
+    (lobe, bins, tight)
+}
+
+#[test]
+fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
+    // Exponent 2000: the lobe (width ~0.02 rad) is much narrower than a bin, so refinement is needed.
+    let (lobe, bins, tight) = narrow_lobe_case();
+    let pdf = |d: [f64; 3]| lobe.pdf(d);
     let reference = expected_masses_with(&pdf, &bins, 1e12 as u64, &tight).unwrap();
     assert_eq!(reference.unconverged_bins, 0);
     assert!(
@@ -82,18 +89,8 @@ fn lobe_masses_error_stays_below_the_noise_as_n_grows() {
 fn a_fixed_coarse_rule_would_not_be_accurate_enough() {
     // Sanity check of the premise: the same lobe on a 4 x 4 midpoint rule per bin is off by
     // more than √E at N = 1e9, so the test above is not trivially satisfied.
-    let lobe = Lobe {
-        axis: dir(0.5, 1.0),
-        exponent: 2000.0,
-    };
-    let bins = SphereBinning::sphere(10, 20).unwrap();
+    let (lobe, bins, tight) = narrow_lobe_case();
     let pdf = |d: [f64; 3]| lobe.pdf(d);
-    let tight = QuadratureOptions {
-        accuracy: 1e-7,
-        max_depth: 16,
-        min_depth: 3,
-        ..Default::default()
-    };
     let reference = expected_masses_with(&pdf, &bins, 1e12 as u64, &tight).unwrap();
     let coarse: Vec<f64> = (0..bins.n_bins())
         .map(|b| {

@@ -17,7 +17,7 @@ mod vndf;
 use std::f64::consts::{FRAC_1_PI, TAU};
 
 use brdf::{AnalyticLobes, Brdf, SpecularLobe, Vec3, mirror};
-use brdf_sampling::{DirSample, DirectionSampler};
+use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 
 use super::LobeError;
@@ -212,7 +212,9 @@ impl DirectionSampler for AnalyticSampler {
         // Nothing is precomputed: a few model parameters.
         0
     }
+}
 
+impl SamplerDiagnostics for AnalyticSampler {
     /// The mirror direction (the specular lobe's peak) and, for the samplers that reflect a
     /// half vector (Blinn, Lewis, Ward, microfacet), `−ωo`: the fold of the reflection map,
     /// where the half vector `(ωo+ωi)/|ωo+ωi|` has no limit, so the pdf's value depends on the

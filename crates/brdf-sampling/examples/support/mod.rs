@@ -1,0 +1,50 @@
+//! Helpers shared by this crate's examples (`mod support;`), each of which uses a subset.
+#![allow(dead_code)]
+
+use brdf::Vec3;
+use rayon::prelude::*;
+
+/// `∫ g dω` over the upper hemisphere by the midpoint rule on `n_cos × n_phi` cells in
+/// (cosθ, φ), rows in parallel.
+pub(crate) fn integrate(g: &(dyn Fn(&Vec3) -> f64 + Sync), n_cos: usize, n_phi: usize) -> f64 {
+    let cell = (1.0 / n_cos as f64) * (std::f64::consts::TAU / n_phi as f64);
+    let rows: Vec<f64> = (0..n_cos)
+        .into_par_iter()
+        .map(|i| {
+            let z = (i as f64 + 0.5) / n_cos as f64;
+            let r = (1.0 - z * z).sqrt();
+            (0..n_phi)
+                .map(|j| {
+                    let phi = (j as f64 + 0.5) / n_phi as f64 * std::f64::consts::TAU;
+                    g(&Vec3::new(r * phi.cos(), r * phi.sin(), z))
+                })
+                .sum::<f64>()
+        })
+        .collect();
+    rows.iter().sum::<f64>() * cell
+}
+
+/// CPU seconds (user + system) of this process so far, from `/proc/self/stat`; NaN where it
+/// cannot be read.
+pub(crate) fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    let after = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| {
+        f.get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    // Fields 14 and 15 of stat (utime, stime) are at 11 and 12 after the command name.
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// The value after `key` in `args`, parsed; `None` when absent or unparsable.
+pub(crate) fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
+    args.iter()
+        .position(|a| a == key)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+}
