@@ -15,7 +15,9 @@
 use std::sync::Arc;
 
 use brdf::parse_spec;
-use brdf_sampling::{DirectionSampler, ExactOptions, ExactSet, thread_evaluations};
+use brdf_sampling::{
+    DirectionSampler, ExactOptions, ExactSet, SamplerDiagnostics, thread_evaluations,
+};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 

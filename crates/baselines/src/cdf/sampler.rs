@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{
     CellCoords, DirSample, DirectionSampler, PdfCellRow, PdfCells, Progress, SamplerDiagnostics,
-    SliceLayout, SliceLocator, layout_for,
+    SetOptions, SliceLayout, SliceLocator, layout_for,
 };
 use distributions::UniformSource;
 use rayon::prelude::*;

@@ -147,6 +147,7 @@ impl LeafTable {
 /// violations counted alike). Returns the number of walks compared.
 #[cfg(test)]
 pub(super) fn assert_table_walks_match_trees(set: &super::ExactSet) -> usize {
+    use partition_sampler::diagnostics::AuditedDraws;
     use rand::SeedableRng;
     use rand::rngs::Xoshiro256PlusPlus;
 
