@@ -311,6 +311,7 @@ impl EnvMapSampler {
     }
 }
 
+#[allow(clippy::large_enum_variant)] // one per Python object; boxing the table adds a load per draw
 enum Planar {
     Adaptive(Box<QuadTreeSampler<TabulatedDensity>>),
     Cdf(PiecewiseConstant2D),

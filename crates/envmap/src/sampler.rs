@@ -94,6 +94,9 @@ impl EnvSample {
     }
 }
 
+/// One per built sampler, never in an array: the size of the table variant (its marginal's
+/// guide inline) costs nothing, and boxing it would add a load to every draw.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 enum Inner {
     Adaptive(Box<QuadTreeSampler<TabulatedDensity<SinPiRows>>>),

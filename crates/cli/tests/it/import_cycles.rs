@@ -430,7 +430,7 @@ impl Crate {
         // src/bin/* are crate roots of their own, and so is main.rs beside a lib.rs: the scan
         // reads the library's module tree (or main.rs's when there is no library).
         let has_lib = files.iter().any(|f| f.rel == "lib.rs");
-        files.retain(|f| !f.rel.starts_with("bin/") && !(has_lib && f.rel == "main.rs"));
+        files.retain(|f| !(f.rel.starts_with("bin/") || (has_lib && f.rel == "main.rs")));
         let mut file_of = BTreeMap::new();
         let mut children: BTreeMap<Vec<String>, BTreeSet<String>> = BTreeMap::new();
         for (i, f) in files.iter().enumerate() {
@@ -535,10 +535,10 @@ impl Crate {
                 let Some(target) = absolute(&n.from, &n.path, &self.children) else {
                     continue;
                 };
-                if let Some(j) = self.defining_file(&target) {
-                    if j != i {
-                        edges.entry((i, j)).or_insert(n.line);
-                    }
+                if let Some(j) = self.defining_file(&target)
+                    && j != i
+                {
+                    edges.entry((i, j)).or_insert(n.line);
                 }
             }
         }
