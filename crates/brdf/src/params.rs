@@ -309,41 +309,6 @@ macro_rules! model_common {
 }
 pub(crate) use model_common;
 
-/// The one declaration of a model built from its parameters alone: its parameters
-/// ([`model_params!`]), the scaffolding ([`model_common!`]) and its registry entry
-/// ([`registry_entry!`](crate::registry)) from one list:
-///
-/// ```text
-/// model! {
-///     /// Parameters of [`Phong`].
-///     pub struct PhongParams in PARAMS for Phong {
-///         n = [50.0] in Range::closed(0.0, 1e5), "specular exponent";
-///     }
-///     registry INFO: NAME = "phong", ["modified-phong"], Always, "summary for `list`";
-/// }
-/// ```
-///
-/// The model itself writes its struct, `new` (with `params.validate(NAME)?`), `properties` and
-/// its `Brdf` impl (with `brdf_properties!(NAME)`).
-macro_rules! model {
-    (
-        $(#[$meta:meta])*
-        pub struct $Params:ident in $TABLE:ident for $Model:ident { $($fields:tt)+ }
-        registry $INFO:ident: $NAME:ident = $name:literal, [$($alias:literal),*], $iso:ident,
-            $summary:literal;
-    ) => {
-        $crate::params::model_params! {
-            $(#[$meta])*
-            pub struct $Params in $TABLE { $($fields)+ }
-        }
-        $crate::params::model_common!($Model($Params));
-        $crate::registry::registry_entry! {
-            $INFO: $NAME = $name, [$($alias),*], $iso, $TABLE, $Model::from_values, $summary
-        }
-    };
-}
-pub(crate) use model;
-
 /// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
 /// unit tests, so an error here is a bug in this crate, never a consequence of user input.
 pub(crate) fn expect_default<T>(r: Result<T, ParamError>) -> T {

@@ -329,6 +329,41 @@ macro_rules! registry_entry {
 }
 pub(crate) use registry_entry;
 
+/// The one declaration of a model built from its parameters alone: its parameters
+/// ([`model_params!`](crate::params)), the scaffolding ([`model_common!`](crate::params)) and its registry entry
+/// ([`registry_entry!`](crate::registry)) from one list:
+///
+/// ```text
+/// model! {
+///     /// Parameters of [`Phong`].
+///     pub struct PhongParams in PARAMS for Phong {
+///         n = [50.0] in Range::closed(0.0, 1e5), "specular exponent";
+///     }
+///     registry INFO: NAME = "phong", ["modified-phong"], Always, "summary for `list`";
+/// }
+/// ```
+///
+/// The model itself writes its struct, `new` (with `params.validate(NAME)?`), `properties` and
+/// its `Brdf` impl (with `brdf_properties!(NAME)`).
+macro_rules! model {
+    (
+        $(#[$meta:meta])*
+        pub struct $Params:ident in $TABLE:ident for $Model:ident { $($fields:tt)+ }
+        registry $INFO:ident: $NAME:ident = $name:literal, [$($alias:literal),*], $iso:ident,
+            $summary:literal;
+    ) => {
+        $crate::params::model_params! {
+            $(#[$meta])*
+            pub struct $Params in $TABLE { $($fields)+ }
+        }
+        $crate::params::model_common!($Model($Params));
+        $crate::registry::registry_entry! {
+            $INFO: $NAME = $name, [$($alias),*], $iso, $TABLE, $Model::from_values, $summary
+        }
+    };
+}
+pub(crate) use model;
+
 static MODELS: &[ModelInfo] = &[
     lambert::INFO,
     phong::INFO,

@@ -159,15 +159,7 @@ impl AdaptiveArgs {
     }
 }
 
-/// The ids of the set options, which `--set FILE` conflicts with (the stored ones apply).
-pub(crate) const SET_OPTION_IDS: [&str; 6] = [
-    "slices",
-    "n_max",
-    "max_depth",
-    "grid",
-    "disc_map",
-    "equal_area_from",
-];
+pub(crate) use crate::baseline_args::SET_OPTION_IDS;
 
 /// `--brdf` when no `--set` is given (clap requires it then).
 pub(crate) fn required_spec(args: &BrdfArgs) -> CliResult<&str> {

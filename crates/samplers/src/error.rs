@@ -106,5 +106,20 @@ pub enum RegistryError {
     /// A sampler option is out of its range or fails its sampler's check
     /// ([`crate::options_from`]).
     #[error(transparent)]
-    Option(#[from] crate::OptionError),
+    Option(#[from] OptionError),
+}
+
+/// An option value out of its range, or options that fail their sampler's check.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("sampler `{sampler}`: option `{option}`{}: {reason}",
+    if value.is_empty() { String::new() } else { format!(" = {value}") })]
+pub struct OptionError {
+    /// The sampler the option belongs to.
+    pub sampler: &'static str,
+    /// The option's name (empty when the check concerns the options together).
+    pub option: &'static str,
+    /// The value given (empty when not known).
+    pub value: String,
+    /// Why, in one line (with the valid range).
+    pub reason: String,
 }

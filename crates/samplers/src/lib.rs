@@ -42,8 +42,8 @@ mod registry;
 mod request;
 
 pub use entries::{DISC_GRID, DISC_SAFETY, SAMPLERS, quadtree_disc_density};
-pub use error::{NotApplicable, RegistryError};
-pub use options::{End, OptionError, OptionKind, OptionSpec, options_from};
+pub use error::{NotApplicable, OptionError, RegistryError};
+pub use options::{End, OptionKind, OptionSpec, options_from};
 pub use registry::Registry;
 pub use request::{BuiltDirection, DirectionRequest};
 

@@ -5,7 +5,7 @@
 
 use baselines::BaselineOptions;
 
-use crate::{RegistryError, SamplerEntry};
+use crate::{OptionError, RegistryError, SamplerEntry};
 
 /// One end of a real interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,21 +83,6 @@ pub struct OptionSpec {
     pub help: &'static str,
     /// Its values and the field it sets.
     pub kind: OptionKind,
-}
-
-/// An option value out of its range, or options that fail their sampler's check.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("sampler `{sampler}`: option `{option}`{}: {reason}",
-    if value.is_empty() { String::new() } else { format!(" = {value}") })]
-pub struct OptionError {
-    /// The sampler the option belongs to.
-    pub sampler: &'static str,
-    /// The option's name (empty when the check concerns the options together).
-    pub option: &'static str,
-    /// The value given (empty when not known).
-    pub value: String,
-    /// Why, in one line (with the valid range).
-    pub reason: String,
 }
 
 /// The message of a real interval, e.g. `must be a finite number in [0, 90)`.

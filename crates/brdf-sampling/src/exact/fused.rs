@@ -99,7 +99,9 @@ mod tests {
         for spec in ["phong:n=50", "ward:alpha_x=0.2,alpha_y=0.4"] {
             let (brdf, set) = set_of(spec);
             // The compact tables draw what the trees' own walks draw (`table.rs`).
-            assert!(super::super::table::assert_table_walks_match_trees(&set) >= 2 * set.len());
+            assert!(
+                super::super::table::walks::assert_table_walks_match_trees(&set) >= 2 * set.len()
+            );
             let other: Arc<dyn Brdf> = Arc::new(Counted(Arc::from(parse_spec(spec).unwrap())));
             let (mut r1, mut r2, mut r3) = (
                 Xoshiro256PlusPlus::seed_from_u64(5),

@@ -141,43 +141,48 @@ impl LeafTable {
     }
 }
 
-/// Test support: every interval of `set` has a table, and its walk draws the very points of
-/// the interval tree's own walk (same uniforms, same bits, same trial, violation and sample
-/// counts) for two test densities, one below most leaves' bounds and one above many (the
-/// violations counted alike). Returns the number of walks compared.
+/// The test-only check that every interval's table draws what its tree draws.
 #[cfg(test)]
-pub(super) fn assert_table_walks_match_trees(set: &super::ExactSet) -> usize {
-    use partition_sampler::diagnostics::AuditedDraws;
-    use rand::SeedableRng;
-    use rand::rngs::Xoshiro256PlusPlus;
+pub(super) mod walks {
+    use super::*;
 
-    let mut checked = 0;
-    for cell in &set.cells {
-        assert_eq!(cell.tables.len(), cell.intervals.len());
-        for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
-            let table = table.as_ref().expect("a table for every interval");
-            let m0 = table
-                .entries
-                .iter()
-                .map(|e| f64::from(e.m))
-                .fold(0.0, f64::max);
-            for scale in [0.06, 0.6] {
-                let g = |p: [f64; 2]| scale * m0 * (1.0 - 0.5 * p[0] * p[0]);
-                let (mut r1, mut r2) = (
-                    Xoshiro256PlusPlus::seed_from_u64(3),
-                    Xoshiro256PlusPlus::seed_from_u64(3),
-                );
-                let (mut a1, mut a2) = (Audit::default(), Audit::default());
-                for _ in 0..100 {
-                    let want = iv.tree.sample_envelope_of(&g, &mut r1, &mut a1);
-                    let got = table.draw(&g, &mut r2, &mut a2);
-                    assert_eq!(got, want);
+    /// Test support: every interval of `set` has a table, and its walk draws the very points of
+    /// the interval tree's own walk (same uniforms, same bits, same trial, violation and sample
+    /// counts) for two test densities, one below most leaves' bounds and one above many (the
+    /// violations counted alike). Returns the number of walks compared.
+    pub(in crate::exact) fn assert_table_walks_match_trees(set: &super::super::ExactSet) -> usize {
+        use partition_sampler::diagnostics::AuditedDraws;
+        use rand::SeedableRng;
+        use rand::rngs::Xoshiro256PlusPlus;
+
+        let mut checked = 0;
+        for cell in &set.cells {
+            assert_eq!(cell.tables.len(), cell.intervals.len());
+            for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
+                let table = table.as_ref().expect("a table for every interval");
+                let m0 = table
+                    .entries
+                    .iter()
+                    .map(|e| f64::from(e.m))
+                    .fold(0.0, f64::max);
+                for scale in [0.06, 0.6] {
+                    let g = |p: [f64; 2]| scale * m0 * (1.0 - 0.5 * p[0] * p[0]);
+                    let (mut r1, mut r2) = (
+                        Xoshiro256PlusPlus::seed_from_u64(3),
+                        Xoshiro256PlusPlus::seed_from_u64(3),
+                    );
+                    let (mut a1, mut a2) = (Audit::default(), Audit::default());
+                    for _ in 0..100 {
+                        let want = iv.tree.sample_envelope_of(&g, &mut r1, &mut a1);
+                        let got = table.draw(&g, &mut r2, &mut a2);
+                        assert_eq!(got, want);
+                    }
+                    assert_eq!(a1, a2);
+                    assert_eq!(r1.next_uniform(), r2.next_uniform());
+                    checked += 1;
                 }
-                assert_eq!(a1, a2);
-                assert_eq!(r1.next_uniform(), r2.next_uniform());
-                checked += 1;
             }
         }
+        checked
     }
-    checked
 }

@@ -44,6 +44,7 @@ pub use sgd::{Sgd, SgdChannel};
 pub use strauss::{Strauss, StraussParams};
 pub use ward::{Ward, WardNormalisation, WardParams};
 
-pub(crate) use crate::params::{model, model_common, model_params};
+pub(crate) use crate::params::{model_common, model_params};
+pub(crate) use crate::registry::model;
 pub use properties::Properties;
 pub(crate) use properties::brdf_properties;

@@ -166,12 +166,22 @@ pub(crate) fn applies_to() -> Vec<(Vec<&'static str>, Vec<&'static str>)> {
         })
         .map(|e| e.name)
         .collect();
-    let mut rows = vec![(crate::brdf_args::SET_OPTION_IDS.to_vec(), adaptive)];
+    let mut rows = vec![(SET_OPTION_IDS.to_vec(), adaptive)];
     for o in all_options(SAMPLERS) {
         rows.push((vec![o.name], sampler_names(o.name)));
     }
     rows
 }
+
+/// The ids of the set options, which `--set FILE` conflicts with (the stored ones apply).
+pub(crate) const SET_OPTION_IDS: [&str; 6] = [
+    "slices",
+    "n_max",
+    "max_depth",
+    "grid",
+    "disc_map",
+    "equal_area_from",
+];
 
 #[cfg(test)]
 mod tests {
