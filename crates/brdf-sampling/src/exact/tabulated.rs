@@ -180,8 +180,9 @@ mod tests {
     use super::*;
 
     /// Issue 27 (docs/benchmarks.md §13.12): RGL normaliser nodes are the reference rule at
-    /// `ωo` ([`RGL_REF_NODE_BUDGET`] evaluations), within 3·10⁻⁵ of the same rule at
-    /// 2·10⁶ evaluations (its own error ~10⁻⁶ on this file) inside a slice and grazing. Before, RGL nodes were the leaf quadrature of the interval's
+    /// `ωo` ([`RGL_REF_NODE_BUDGET`] evaluations), within 10⁻⁵ of the same rule at 2·10⁶
+    /// evaluations (measured 1.2·10⁻⁷ and 6·10⁻⁹; its own error ~10⁻⁶ on this file) inside a
+    /// slice and grazing, and within the node's error estimate. Before, RGL nodes were the leaf quadrature of the interval's
     /// tree ([`table_normaliser`] gave `None`), up to 1.1·10⁻⁴ off (`colodur_napoli_4f` at
     /// 37.03°, a node of the 28.45–40.86° interval).
     #[test]
