@@ -4,8 +4,7 @@ use brdf::Vec3;
 use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
 use partition_sampler::UniformSource;
 use samplers::{Capabilities, Registry, SamplerEntry, Support};
-use std::f64::consts::PI;
-use std::sync::Arc;
+use std::{f64::consts::PI, sync::Arc};
 
 /// pdf(ωi) = 3/(2π) cos²θi on the hemisphere (×1.02 where x > 0.5 when broken).
 struct CosSquared(bool);
@@ -25,8 +24,7 @@ impl DirectionSampler for CosSquared {
         0
     }
 }
-
-impl SamplerDiagnostics for CosSquared {}
+impl SamplerDiagnostics for CosSquared {} // no diagnostics: the defaults
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let broken = std::env::args().any(|a| a == "--broken");
