@@ -93,15 +93,11 @@ fn small_run_writes_json_and_csv() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let doc = read_json(&json);
     assert!(doc["reference"]["estimate"].as_f64().unwrap() > 0.0);
     assert!(doc["reference"]["std_err"].as_f64().unwrap() > 0.0);
     let estimators = doc["estimators"].as_array().unwrap();
-    let names: Vec<&str> = estimators
-        .iter()
-        .map(|e| e["estimator"].as_str().unwrap())
-        .collect();
+    let names = estimator_names(&doc);
     for expected in [
         "srbf-product",
         "brdf:cosine",
@@ -227,14 +223,10 @@ fn product_set_adds_a_saved_set_as_a_brdf_sampler() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let doc = read_json(&json);
     assert_eq!(doc["brdf"], "lambert");
     let rows = doc["estimators"].as_array().unwrap();
-    let names: Vec<&str> = rows
-        .iter()
-        .map(|e| e["estimator"].as_str().unwrap())
-        .collect();
+    let names = estimator_names(&doc);
     for expected in [
         "brdf:cosine",
         "brdf:adaptive@l.set",
@@ -263,4 +255,19 @@ fn product_set_adds_a_saved_set_as_a_brdf_sampler() {
         ],
         "built for --brdf lambert",
     );
+}
+
+/// The JSON document `product --json` wrote.
+fn read_json(path: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The estimator names of a `product --json` document, in its order.
+fn estimator_names(doc: &serde_json::Value) -> Vec<&str> {
+    doc["estimators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["estimator"].as_str().unwrap())
+        .collect()
 }
