@@ -86,14 +86,7 @@ fn small_run_writes_json_and_csv() {
         csv.to_str().unwrap(),
     ]);
     let args = with(&extra);
-    let o = brdf_lab(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let doc = read_json(&json);
+    let doc = run_for_json(&args.iter().map(String::as_str).collect::<Vec<_>>(), &json);
     assert!(doc["reference"]["estimate"].as_f64().unwrap() > 0.0);
     assert!(doc["reference"]["std_err"].as_f64().unwrap() > 0.0);
     let estimators = doc["estimators"].as_array().unwrap();
@@ -216,14 +209,7 @@ fn product_set_adds_a_saved_set_as_a_brdf_sampler() {
     ];
     args.extend(small_fits());
     args.extend(["--json", json.to_str().unwrap()]);
-    let o = brdf_lab(&args);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let doc = read_json(&json);
+    let doc = run_for_json(&args, &json);
     assert_eq!(doc["brdf"], "lambert");
     let rows = doc["estimators"].as_array().unwrap();
     let names = estimator_names(&doc);
@@ -257,9 +243,16 @@ fn product_set_adds_a_saved_set_as_a_brdf_sampler() {
     );
 }
 
-/// The JSON document `product --json` wrote.
-fn read_json(path: &std::path::Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+/// Runs `args` (exit 0 required) and reads the JSON document it wrote to `json`.
+fn run_for_json(args: &[&str], json: &std::path::Path) -> serde_json::Value {
+    let o = brdf_lab(args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
 }
 
 /// The estimator names of a `product --json` document, in its order.
