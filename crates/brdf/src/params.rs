@@ -202,7 +202,9 @@ pub(crate) const fn param(
 /// conversions the constructors and the registry use (`values`, `from_values`, `validate`).
 ///
 /// A field reads `name [as "key"] = [default] in range, "doc";` where `default` is a number or
-/// `same_as other_key`; the spec key is the field name unless `as "key"` gives another.
+/// `same_as other_key`; the spec key is the field name unless `as "key"` gives another. The
+/// field's doc comment is generated from the same key, doc string, default and range (extra
+/// `///` lines before a field are appended to it).
 macro_rules! model_params {
     (
         $(#[$meta:meta])*
@@ -227,7 +229,14 @@ macro_rules! model_params {
         $(#[$meta])*
         #[derive(Debug, Clone, Copy, PartialEq)]
         pub struct $Params {
-            $( $(#[$fmeta])* pub $field: f64, )+
+            $(
+                #[doc = concat!(
+                    "Key `", $crate::params::model_params!(@key $field $($key)?), "`: ", $doc,
+                    " (default `", stringify!($($def)+), "`, allowed `", stringify!($range), "`)."
+                )]
+                $(#[$fmeta])*
+                pub $field: f64,
+            )+
         }
 
         impl Default for $Params {

@@ -343,8 +343,25 @@ pub(crate) use registry_entry;
 /// }
 /// ```
 ///
-/// The model itself writes its struct, `new` (with `params.validate(NAME)?`), `properties` and
-/// its `Brdf` impl (with `brdf_properties!(NAME)`).
+/// The model itself then writes its struct, `new` (with `params.validate(NAME)?`), `properties`
+/// and its `Brdf` impl (with `brdf_properties!(NAME)`).
+///
+/// A model whose struct is its parameters plus constants derived from them (the usual case)
+/// declares that struct in the same list instead of `for Model`: its `new` (validate, then the
+/// `let`s and the fields in order, each field a local the later ones may use) is generated.
+///
+/// ```text
+/// model! {
+///     /// Parameters of [`Phong`].
+///     pub struct PhongParams in PARAMS { n = [50.0] in Range::closed(0.0, 1e5), "…"; }
+///     registry INFO: NAME = "phong", ["modified-phong"], Always, "summary for `list`";
+///     /// Modified Phong BRDF.
+///     pub struct Phong(params) {
+///         let scale = (params.n + 2.0) / (2.0 * PI);
+///         spec_scale: f64 = params.ks * scale,
+///     }
+/// }
+/// ```
 macro_rules! model {
     (
         $(#[$meta:meta])*
@@ -359,6 +376,51 @@ macro_rules! model {
         $crate::params::model_common!($Model($Params));
         $crate::registry::registry_entry! {
             $INFO: $NAME = $name, [$($alias),*], $iso, $TABLE, $Model::from_values, $summary
+        }
+    };
+    (
+        $(#[$meta:meta])*
+        pub struct $Params:ident in $TABLE:ident { $($fields:tt)+ }
+        registry $INFO:ident: $NAME:ident = $name:literal, [$($alias:literal),*], $iso:ident,
+            $summary:literal;
+        $(#[$model_meta:meta])*
+        pub struct $Model:ident($p:ident) { $($body:tt)+ }
+    ) => {
+        $crate::registry::model! {
+            $(#[$meta])*
+            pub struct $Params in $TABLE for $Model { $($fields)+ }
+            registry $INFO: $NAME = $name, [$($alias),*], $iso, $summary;
+        }
+        $crate::registry::model!(
+            @struct [$(#[$model_meta])*] $Model($p: $Params) $NAME [] $($body)+
+        );
+    };
+    // The `let`s of the body, collected one by one before the fields.
+    (@struct $attrs:tt $Model:ident($p:ident: $Params:ident) $NAME:ident [$($stmt:tt)*]
+        let $local:pat = $value:expr; $($rest:tt)+
+    ) => {
+        $crate::registry::model!(
+            @struct $attrs $Model($p: $Params) $NAME [$($stmt)* let $local = $value;] $($rest)+
+        );
+    };
+    (@struct [$($attr:tt)*] $Model:ident($p:ident: $Params:ident) $NAME:ident [$($stmt:tt)*]
+        $( $(#[$field_meta:meta])* $field:ident: $Field:ty = $init:expr ),+ $(,)?
+    ) => {
+        $($attr)*
+        #[derive(Debug, Clone)]
+        pub struct $Model {
+            params: $Params,
+            $( $(#[$field_meta])* $field: $Field, )+
+        }
+
+        impl $Model {
+            /// Validate the parameters and build the model.
+            pub fn new($p: $Params) -> Result<Self, $crate::params::ParamError> {
+                $p.validate($NAME)?;
+                $($stmt)*
+                $( let $field: $Field = $init; )+
+                Ok(Self { params: $p, $($field),+ })
+            }
         }
     };
 }

@@ -15,44 +15,27 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::PI;
 
 model! {
     /// Parameters of [`AshikhminShirley`].
-    pub struct AshikhminShirleyParams in PARAMS for AshikhminShirley {
-        /// Exponent along x.
+    pub struct AshikhminShirleyParams in PARAMS {
         nu = [100.0] in Range::closed(0.0, 1e5), "Phong exponent along the tangent x";
-        /// Exponent along y.
         nv = [same_as nu] in Range::closed(0.0, 1e5), "Phong exponent along the bitangent y";
-        /// Specular reflectance.
         rs = [0.3] in Range::closed(0.0, 1.0), "specular reflectance at normal incidence";
-        /// Diffuse reflectance.
         rd = [0.6] in Range::closed(0.0, 1.0), "diffuse reflectance";
     }
     registry INFO: NAME = "ashikhmin-shirley", ["ashikhmin"], WhenParamsEqual,
         "anisotropic Phong with Fresnel and coupled diffuse (Ashikhmin & Shirley 2000)";
-}
-
-/// Ashikhmin–Shirley anisotropic Phong BRDF.
-#[derive(Debug, Clone)]
-pub struct AshikhminShirley {
-    params: AshikhminShirleyParams,
-    spec_scale: f64,
-    diff_scale: f64,
+    /// Ashikhmin–Shirley anisotropic Phong BRDF.
+    pub struct AshikhminShirley(params) {
+        spec_scale: f64 = ((params.nu + 1.0) * (params.nv + 1.0)).sqrt() / (8.0 * PI),
+        diff_scale: f64 = 28.0 * params.rd / (23.0 * PI) * (1.0 - params.rs),
+    }
 }
 
 impl AshikhminShirley {
-    /// Validate the parameters and build the model.
-    pub fn new(params: AshikhminShirleyParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        Ok(Self {
-            params,
-            spec_scale: ((params.nu + 1.0) * (params.nv + 1.0)).sqrt() / (8.0 * PI),
-            diff_scale: 28.0 * params.rd / (23.0 * PI) * (1.0 - params.rs),
-        })
-    }
-
     /// Symmetries and energy: half-turn symmetric for all `nu, nv` (terms in `h_x²`, `h_y²`),
     /// isotropic and mirror-symmetric iff `nu = nv`; reciprocal; conserves energy.
     pub fn properties(&self) -> Properties {

@@ -27,61 +27,45 @@ use crate::geometry::{Vec3, both_above};
 use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, PI};
 
+/// The normal-incidence Fresnel reflectance `R(0)` of `ior + i·kappa`, which the model divides
+/// by: an error unless it is positive.
+fn normal_incidence_reflectance(p: &BeardMaxwellParams) -> Result<f64, ParamError> {
+    let r0 = fresnel_conductor(1.0, p.ior, p.kappa);
+    if !(r0 > 0.0) {
+        return Err(ParamError::Constraint {
+            model: NAME,
+            message: "normal-incidence Fresnel reflectance R(0) must be > 0 (ior ≠ 1 or kappa > 0)"
+                .into(),
+        });
+    }
+    Ok(r0)
+}
+
 model! {
     /// Parameters of [`BeardMaxwell`].
-    pub struct BeardMaxwellParams in PARAMS for BeardMaxwell {
-        /// First-surface reflectance.
+    pub struct BeardMaxwellParams in PARAMS {
         rs = [0.7] in Range::closed(0.0, 1.0), "first-surface (specular) reflectance";
-        /// Volumetric Lambertian reflectance.
         rd = [0.5] in Range::closed(0.0, 1.0), "volumetric Lambertian reflectance";
-        /// Volumetric directional reflectance.
         rv = [0.2] in Range::closed(0.0, 1.0), "volumetric directional reflectance";
-        /// Facet tilt spread (radians).
         sigma = [0.15] in Range::closed(0.005, 1.0), "facet tilt spread σ (radians)";
-        /// Obscuration constant Ω (degrees).
         omega = [1.0] in Range::left_open(0.0, 90.0), "obscuration constant Ω (degrees)";
-        /// Shadowing decay τ (degrees).
         tau = [0.0] in Range::closed(0.0, 90.0), "shadowing decay τ (degrees; 0 = no shadowing recovery)";
-        /// Refractive index (real).
         ior = [0.2] in Range::left_open(0.0, 100.0), "refractive index, real part";
-        /// Extinction coefficient.
         kappa = [3.0] in Range::closed(0.0, 100.0), "refractive index, imaginary part";
     }
     registry INFO: NAME = "beard-maxwell", ["beardmaxwell", "beard"], Always,
         "painted surfaces: first-surface facets + volumetric terms (Maxwell, Beard et al. 1973)";
-}
-
-/// Beard–Maxwell painted-surface BRDF.
-#[derive(Debug, Clone)]
-pub struct BeardMaxwell {
-    params: BeardMaxwellParams,
-    inv_r0: f64,
-    fs_scale: f64,
-    inv_sigma2: f64,
+    /// Beard–Maxwell painted-surface BRDF.
+    pub struct BeardMaxwell(params) {
+        let p = params;
+        let r0 = normal_incidence_reflectance(&p)?;
+        inv_r0: f64 = 1.0 / r0,
+        fs_scale: f64 = p.rs / (4.0 * PI * p.sigma * p.sigma),
+        inv_sigma2: f64 = 1.0 / (p.sigma * p.sigma),
+    }
 }
 
 impl BeardMaxwell {
-    /// Validate the parameters and build the model.
-    pub fn new(params: BeardMaxwellParams) -> Result<Self, ParamError> {
-        let p = params;
-        p.validate(NAME)?;
-        let r0 = fresnel_conductor(1.0, p.ior, p.kappa);
-        if !(r0 > 0.0) {
-            return Err(ParamError::Constraint {
-                model: NAME,
-                message:
-                    "normal-incidence Fresnel reflectance R(0) must be > 0 (ior ≠ 1 or kappa > 0)"
-                        .into(),
-            });
-        }
-        Ok(Self {
-            params,
-            inv_r0: 1.0 / r0,
-            fs_scale: p.rs / (4.0 * PI * p.sigma * p.sigma),
-            inv_sigma2: 1.0 / (p.sigma * p.sigma),
-        })
-    }
-
     /// Symmetries: isotropic, even under `y ↦ −y`, reciprocal; the shadowing term leaves `f_r`
     /// unbounded at the horizon; energy conservation is not guaranteed.
     pub fn properties(&self) -> Properties {

@@ -23,11 +23,8 @@ registry_entry! {
 model_params! {
     /// Parameters of [`Blinn`] (SPEC keys `n`, `ks`, `kd`).
     pub struct BlinnParams in PARAMS {
-        /// Half-vector exponent `n ∈ [0, 10⁵]`.
         n = [100.0] in Range::closed(0.0, 1e5), "half-vector exponent";
-        /// Specular albedo at normal incidence, in `[0, 1]`.
         ks = [0.6] in Range::closed(0.0, 1.0), "specular albedo at normal incidence";
-        /// Diffuse albedo, in `[0, 1]`.
         kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
 }

@@ -17,47 +17,29 @@ use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, PI};
 
 model! {
     /// Parameters of [`CookTorrance`].
-    pub struct CookTorranceParams in PARAMS for CookTorrance {
-        /// RMS slope `m`.
+    pub struct CookTorranceParams in PARAMS {
         m = [0.2] in Range::closed(0.001, 2.0), "RMS microfacet slope (Beckmann)";
-        /// Index of refraction.
         ior = [1.5] in Range::left_open(1.0, 100.0), "relative index of refraction (Fresnel)";
-        /// Specular weight.
         ks = [0.8] in Range::closed(0.0, 1.0), "specular weight";
-        /// Diffuse albedo.
         kd = [0.2] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
     registry INFO: NAME = "cook-torrance", ["torrance", "ct"], Always,
         "Beckmann D, V-cavity G, dielectric Fresnel (Cook & Torrance 1982)";
-}
-
-/// Cook–Torrance BRDF.
-#[derive(Debug, Clone)]
-pub struct CookTorrance {
-    params: CookTorranceParams,
-    diffuse: f64,
-    inv_m2: f64,
-    d_scale: f64,
+    /// Cook–Torrance BRDF.
+    pub struct CookTorrance(params) {
+        let m2 = params.m * params.m;
+        diffuse: f64 = params.kd * FRAC_1_PI,
+        inv_m2: f64 = 1.0 / m2,
+        d_scale: f64 = 1.0 / (PI * m2),
+    }
 }
 
 impl CookTorrance {
-    /// Validate the parameters and build the model.
-    pub fn new(params: CookTorranceParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        let m2 = params.m * params.m;
-        Ok(Self {
-            params,
-            diffuse: params.kd * FRAC_1_PI,
-            inv_m2: 1.0 / m2,
-            d_scale: 1.0 / (PI * m2),
-        })
-    }
-
     /// Symmetries and energy: `n·h`, `ωo·h` and cosines only (isotropic, even under `y ↦ −y`),
     /// reciprocal; conserves energy iff `kd + ks ≤ 1`.
     pub fn properties(&self) -> Properties {

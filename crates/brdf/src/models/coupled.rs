@@ -38,11 +38,8 @@ fn node(i: usize) -> f64 {
 model! {
     /// Parameters of [`Coupled`].
     pub struct CoupledParams in PARAMS for Coupled {
-        /// Beckmann RMS slope.
         m = [0.2] in Range::closed(0.01, 1.0), "RMS microfacet slope (Beckmann)";
-        /// Schlick `f0`.
         f0 = [0.1] in Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence";
-        /// Matte albedo.
         kd = [0.8] in Range::closed(0.0, 1.0), "matte albedo";
     }
     registry INFO: NAME = "coupled", ["kelemen", "kelemen-szirmay-kalos"], Always,

@@ -55,7 +55,7 @@ use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use crate::special::{beckmann_lambda_with_erfc, erfc};
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::LazyLock;
@@ -207,56 +207,32 @@ fn lambert_w0(z: f64) -> f64 {
 
 model! {
     /// Parameters of [`Htsg`].
-    pub struct HtsgParams in PARAMS for Htsg {
-        /// RMS roughness σ0 in µm.
+    pub struct HtsgParams in PARAMS {
         sigma = [0.5] in Range::left_open(0.0, 10.0), "RMS surface height σ0 (µm)";
-        /// Autocorrelation length τ in µm.
         tau = [3.0] in Range::left_open(0.0, 100.0), "autocorrelation length τ (µm)";
-        /// Wavelength in nm.
         lambda = [800.0] in Range::closed(100.0, 10_000.0), "wavelength λ (nm)";
-        /// Real part of the refractive index.
         ior = [1.5] in Range::left_open(0.0, 100.0), "refractive index, real part";
-        /// Extinction coefficient.
         kappa = [0.0] in Range::closed(0.0, 100.0), "refractive index, imaginary part (extinction)";
-        /// Uniform diffuse albedo.
         kd = [0.0] in Range::closed(0.0, 1.0), "uniform-diffuse albedo";
     }
     registry INFO: NAME = "htsg", ["he", "he-torrance-sillion-greenberg"], Always,
         "wave-optics directional diffuse, truncated series (He, Torrance, Sillion & Greenberg 1991)";
-}
-
-/// He–Torrance–Sillion–Greenberg BRDF (directional-diffuse + uniform-diffuse).
-#[derive(Debug, Clone)]
-pub struct Htsg {
-    params: HtsgParams,
-    /// Wavenumber k = 2π/λ in 1/µm.
-    k: f64,
-    /// π²τ²/(4λ²), λ in µm.
-    d_prefactor: f64,
-    /// τ/(2σ0).
-    tau_over_2sigma: f64,
-    /// k²τ²/4 (so that `a = v_xy²τ²/4 = a_scale · (s_x² + s_y²)`).
-    a_scale: f64,
+    /// He–Torrance–Sillion–Greenberg BRDF (directional-diffuse + uniform-diffuse).
+    pub struct Htsg(params) {
+        let HtsgParams { sigma, tau, lambda, .. } = params;
+        let lambda_um = lambda * 1e-3;
+        /// Wavenumber k = 2π/λ in 1/µm.
+        k: f64 = 2.0 * PI / lambda_um,
+        /// π²τ²/(4λ²), λ in µm.
+        d_prefactor: f64 = PI * PI * tau * tau / (4.0 * lambda_um * lambda_um),
+        /// τ/(2σ0).
+        tau_over_2sigma: f64 = tau / (2.0 * sigma),
+        /// k²τ²/4 (so that `a = v_xy²τ²/4 = a_scale · (s_x² + s_y²)`).
+        a_scale: f64 = k * k * tau * tau / 4.0,
+    }
 }
 
 impl Htsg {
-    /// Validate the parameters and build the model.
-    pub fn new(params: HtsgParams) -> Result<Self, ParamError> {
-        let HtsgParams {
-            sigma, tau, lambda, ..
-        } = params;
-        params.validate(NAME)?;
-        let lambda_um = lambda * 1e-3;
-        let k = 2.0 * PI / lambda_um;
-        Ok(Self {
-            params,
-            k,
-            d_prefactor: PI * PI * tau * tau / (4.0 * lambda_um * lambda_um),
-            tau_over_2sigma: tau / (2.0 * sigma),
-            a_scale: k * k * tau * tau / 4.0,
-        })
-    }
-
     /// Single-direction shadowing `S1(θ)` and `K(θ) = tanθ erfc(τ/(2σ0 tanθ))` for `cosθ = c`
     /// (both use `erfc(a)` with `a = τ cotθ/(2σ0)`).
     #[inline]

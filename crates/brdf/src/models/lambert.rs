@@ -6,36 +6,23 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::FRAC_1_PI;
 
 model! {
     /// Parameters of [`Lambert`].
-    pub struct LambertParams in PARAMS for Lambert {
-        /// Albedo ρ ∈ [0, 1].
+    pub struct LambertParams in PARAMS {
         rho = [0.8] in Range::closed(0.0, 1.0), "diffuse albedo ρ";
     }
     registry INFO: NAME = "lambert", ["lambertian", "diffuse"], Always,
         "ideal diffuse ρ/π (Lambert 1760)";
-}
-
-/// Lambertian BRDF `ρ/π`.
-#[derive(Debug, Clone)]
-pub struct Lambert {
-    params: LambertParams,
-    value: f64,
+    /// Lambertian BRDF `ρ/π`.
+    pub struct Lambert(params) {
+        value: f64 = params.rho * FRAC_1_PI,
+    }
 }
 
 impl Lambert {
-    /// Validate the parameters and build the model.
-    pub fn new(params: LambertParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        Ok(Self {
-            params,
-            value: params.rho * FRAC_1_PI,
-        })
-    }
-
     /// Symmetries and energy: constant, so isotropic, symmetric, reciprocal; albedo `rho ≤ 1`.
     pub fn properties(&self) -> Properties {
         Properties::ISOTROPIC_SYMMETRIC | Properties::RECIPROCAL | Properties::CONSERVES_ENERGY

@@ -25,11 +25,8 @@ registry_entry! {
 model_params! {
     /// Parameters of [`Lewis`] (SPEC keys `n`, `ks`, `kd`).
     pub struct LewisParams in PARAMS {
-        /// Half-vector exponent `n ∈ [0, 10⁵]`.
         n = [50.0] in Range::closed(0.0, 1e5), "half-vector exponent";
-        /// Specular coefficient, in `[0, 1]`.
         ks = [0.6] in Range::closed(0.0, 1.0), "specular coefficient";
-        /// Diffuse albedo, in `[0, 1]`.
         kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
 }

@@ -49,11 +49,8 @@ pub enum NormalDistribution {
 model_params! {
     /// Parameters of [`Microfacet`].
     pub struct MicrofacetParams in PARAMS {
-        /// Roughness along x.
         alpha_x as "alpha" = [0.2] in Range::closed(0.001, 2.0), "roughness α along the tangent x";
-        /// Roughness along y.
         alpha_y = [same_as alpha] in Range::closed(0.001, 2.0), "roughness α along the bitangent y";
-        /// Schlick `f0`.
         f0 = [1.0] in Range::closed(0.0, 1.0), "Fresnel reflectance at normal incidence (Schlick)";
     }
 }

@@ -10,38 +10,24 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::PI;
 
 model! {
     /// Parameters of [`Minnaert`].
-    pub struct MinnaertParams in PARAMS for Minnaert {
-        /// Albedo.
+    pub struct MinnaertParams in PARAMS {
         rho = [0.8] in Range::closed(0.0, 1.0), "albedo at normal incidence";
-        /// Exponent k.
         k = [0.7] in Range::closed(0.0, 2.0), "Minnaert limb-darkening exponent";
     }
     registry INFO: NAME = "minnaert", [], Always,
         "lunar limb darkening ρ(k+1)/(2π)(cosθi cosθo)^(k−1) (Minnaert 1941)";
-}
-
-/// Minnaert BRDF.
-#[derive(Debug, Clone)]
-pub struct Minnaert {
-    params: MinnaertParams,
-    scale: f64,
+    /// Minnaert BRDF.
+    pub struct Minnaert(params) {
+        scale: f64 = params.rho * (params.k + 1.0) / (2.0 * PI),
+    }
 }
 
 impl Minnaert {
-    /// Validate the parameters and build the model.
-    pub fn new(params: MinnaertParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        Ok(Self {
-            params,
-            scale: params.rho * (params.k + 1.0) / (2.0 * PI),
-        })
-    }
-
     /// Symmetries and energy: cosines only (isotropic, even under `y ↦ −y`), reciprocal;
     /// conserves energy iff `k ≥ 1`; unbounded at the horizon when `k < 1` and `rho > 0`.
     pub fn properties(&self) -> Properties {

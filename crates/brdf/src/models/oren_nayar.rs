@@ -14,42 +14,27 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
 
 model! {
     /// Parameters of [`OrenNayar`].
-    pub struct OrenNayarParams in PARAMS for OrenNayar {
-        /// Albedo.
+    pub struct OrenNayarParams in PARAMS {
         rho = [0.8] in Range::closed(0.0, 1.0), "albedo ρ";
-        /// Roughness σ in radians.
         sigma = [0.5] in Range::closed(0.0, FRAC_PI_2), "facet slope deviation σ (radians)";
     }
     registry INFO: NAME = "oren-nayar", ["oren"], Always,
         "rough diffuse, qualitative model (Oren & Nayar 1994)";
-}
-
-/// Oren–Nayar rough-diffuse BRDF (qualitative model).
-#[derive(Debug, Clone)]
-pub struct OrenNayar {
-    params: OrenNayarParams,
-    a: f64,
-    b: f64,
+    /// Oren–Nayar rough-diffuse BRDF (qualitative model).
+    pub struct OrenNayar(params) {
+        let s2 = params.sigma * params.sigma;
+        let k = params.rho * FRAC_1_PI;
+        a: f64 = k * (1.0 - 0.5 * s2 / (s2 + 0.33)),
+        b: f64 = k * 0.45 * s2 / (s2 + 0.09),
+    }
 }
 
 impl OrenNayar {
-    /// Validate the parameters and build the model.
-    pub fn new(params: OrenNayarParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        let s2 = params.sigma * params.sigma;
-        let k = params.rho * FRAC_1_PI;
-        Ok(Self {
-            params,
-            a: k * (1.0 - 0.5 * s2 / (s2 + 0.33)),
-            b: k * 0.45 * s2 / (s2 + 0.09),
-        })
-    }
-
     /// Symmetries and energy: `cos(φi − φo)` and angles only (isotropic, even under `y ↦ −y`),
     /// reciprocal; conserves energy only in the Lambertian limit `sigma = 0`.
     pub fn properties(&self) -> Properties {

@@ -11,42 +11,26 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, PI};
 
 model! {
     /// Parameters of [`Phong`].
-    pub struct PhongParams in PARAMS for Phong {
-        /// Cosine-lobe exponent `n ≥ 0`.
+    pub struct PhongParams in PARAMS {
         n = [50.0] in Range::closed(0.0, 1e5), "specular exponent";
-        /// Specular coefficient.
         ks = [0.7] in Range::closed(0.0, 1.0), "specular albedo at normal incidence";
-        /// Diffuse coefficient.
         kd = [0.3] in Range::closed(0.0, 1.0), "diffuse albedo";
     }
     registry INFO: NAME = "phong", ["modified-phong"], Always,
         "modified energy-conserving Phong, kd/π + ks(n+2)/(2π) cos^n α (Phong 1975; Lafortune & Willems 1994)";
-}
-
-/// Modified Phong BRDF.
-#[derive(Debug, Clone)]
-pub struct Phong {
-    params: PhongParams,
-    diffuse: f64,
-    spec_scale: f64,
+    /// Modified Phong BRDF.
+    pub struct Phong(params) {
+        diffuse: f64 = params.kd * FRAC_1_PI,
+        spec_scale: f64 = params.ks * (params.n + 2.0) / (2.0 * PI),
+    }
 }
 
 impl Phong {
-    /// Validate the parameters and build the model.
-    pub fn new(params: PhongParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        Ok(Self {
-            params,
-            diffuse: params.kd * FRAC_1_PI,
-            spec_scale: params.ks * (params.n + 2.0) / (2.0 * PI),
-        })
-    }
-
     /// Symmetries and energy: `ω_r·ωi` and cosines only (isotropic, even under `y ↦ −y`),
     /// reciprocal; conserves energy iff `kd + ks ≤ 1`.
     pub fn properties(&self) -> Properties {

@@ -55,7 +55,7 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use crate::quadrature::GaussLegendre;
 use crate::special::ln_gamma_diff;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -160,46 +160,26 @@ struct Lobe {
 
 model! {
     /// Parameters of [`PoulinFournier`].
-    pub struct PoulinFournierParams in PARAMS for PoulinFournier {
-        /// Centre spacing in cylinder radii.
+    pub struct PoulinFournierParams in PARAMS {
         d = [2.0] in Range::closed(2.0, 100.0), "cylinder spacing in radii (2 = touching)";
-        /// Local Phong exponent.
         n = [20.0] in Range::closed(0.0, 1e4), "Phong exponent of the cylinder surface";
-        /// Local specular albedo.
         ks = [0.6] in Range::closed(0.0, 1.0), "specular albedo of the cylinder surface";
-        /// Local diffuse albedo.
         kd = [0.4] in Range::closed(0.0, 1.0), "diffuse albedo of the cylinder surface";
     }
     registry INFO: NAME = "poulin-fournier", ["poulin"], Never,
         "anisotropic parallel cylinders with Phong surface (Poulin & Fournier 1990)";
-}
-
-/// Poulin–Fournier parallel-cylinder anisotropic BRDF.
-#[derive(Debug, Clone)]
-pub struct PoulinFournier {
-    params: PoulinFournierParams,
-    nodes: [f64; GL_POINTS],
-    weights: [f64; GL_POINTS],
-    spec_scale: f64,
-    lobe_width: f64,
-    /// Whole-lobe rule for `(1 + x)^n (1 − x)^{−1/2}`, weights scaled to sum to `B(n + 1, 1/2)`
-    /// (`None` when `n < 10`).
-    lobe_rule: Option<Rule>,
-    /// `e^{−TAIL_LN/n}`.
-    tail_factor: f64,
-}
-
-impl PoulinFournier {
-    /// Validate the parameters and build the model.
-    pub fn new(params: PoulinFournierParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
+    /// Poulin–Fournier parallel-cylinder anisotropic BRDF.
+    pub struct PoulinFournier(params) {
         let gl = GaussLegendre::new(GL_POINTS);
-        let mut nodes = [0.0; GL_POINTS];
-        let mut weights = [0.0; GL_POINTS];
-        nodes.copy_from_slice(gl.nodes());
-        weights.copy_from_slice(gl.weights());
         let n = params.n;
-        let lobe_rule = (n >= JACOBI_MIN_EXPONENT).then(|| {
+        nodes: [f64; GL_POINTS] = std::array::from_fn(|i| gl.nodes()[i]),
+        weights: [f64; GL_POINTS] = std::array::from_fn(|i| gl.weights()[i]),
+        spec_scale: f64 = params.ks * (n + 2.0) / (2.0 * PI),
+        // cos^n(2Δ) has fallen to ~e^{-8} at 2Δ ≈ 4/√n: use Δ ≈ 2/√(n+1) per side.
+        lobe_width: f64 = 2.0 / (n + 1.0).sqrt(),
+        /// Whole-lobe rule for `(1 + x)^n (1 − x)^{−1/2}`, weights scaled to sum to `B(n + 1, 1/2)`
+        /// (`None` when `n < 10`).
+        lobe_rule: Option<Rule> = (n >= JACOBI_MIN_EXPONENT).then(|| {
             let mut rule = gauss_jacobi(LOBE_NODES, -0.5, n);
             // B(n + 1, 1/2) = Γ(n + 1) Γ(1/2) / Γ(n + 3/2).
             let beta = (ln_gamma_diff(n + 1.0, n + 1.5) + 0.5 * PI.ln()).exp();
@@ -207,19 +187,13 @@ impl PoulinFournier {
                 *w *= beta;
             }
             rule
-        });
-        Ok(Self {
-            params,
-            nodes,
-            weights,
-            spec_scale: params.ks * (n + 2.0) / (2.0 * PI),
-            // cos^n(2Δ) has fallen to ~e^{-8} at 2Δ ≈ 4/√n: use Δ ≈ 2/√(n+1) per side.
-            lobe_width: 2.0 / (n + 1.0).sqrt(),
-            lobe_rule,
-            tail_factor: (-TAIL_LN / n).exp(),
-        })
+        }),
+        /// `e^{−TAIL_LN/n}`.
+        tail_factor: f64 = (-TAIL_LN / n).exp(),
     }
+}
 
+impl PoulinFournier {
     /// Range of cylinder angles γ visible from direction `w` (upper hemisphere), given
     /// `psi = atan2(w_y, w_z)` and `r = |w_yz|`.
     fn visible_range(&self, w: &Vec3, psi: f64, r: f64) -> (f64, f64) {

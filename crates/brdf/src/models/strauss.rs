@@ -20,7 +20,7 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, both_above};
-use crate::params::{ParamError, Range};
+use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
 
 const KF: f64 = 1.12;
@@ -28,27 +28,23 @@ const KG: f64 = 1.01;
 
 model! {
     /// Parameters of [`Strauss`].
-    pub struct StraussParams in PARAMS for Strauss {
-        /// Smoothness.
+    pub struct StraussParams in PARAMS {
         s = [0.8] in Range::closed(0.0, 0.99), "smoothness";
-        /// Metalness.
         m = [0.0] in Range::closed(0.0, 1.0), "metalness";
-        /// Transparency.
         t = [0.0] in Range::closed(0.0, 1.0), "transparency";
-        /// Colour.
         c = [0.8] in Range::closed(0.0, 1.0), "surface colour (grey level)";
     }
     registry INFO: NAME = "strauss", [], Always,
         "smoothness/metalness artist model (Strauss 1990)";
-}
-
-/// Strauss BRDF.
-#[derive(Debug, Clone)]
-pub struct Strauss {
-    params: StraussParams,
-    diffuse: f64,
-    rn: f64,
-    exponent: f64,
+    /// Strauss BRDF.
+    pub struct Strauss(params) {
+        let StraussParams { s, m, t, c } = params;
+        let rd = (1.0 - s * s * s) * (1.0 - t);
+        let d = 1.0 - m * s;
+        diffuse: f64 = d * rd * c * FRAC_1_PI,
+        rn: f64 = (1.0 - t) - rd,
+        exponent: f64 = 3.0 / (1.0 - s),
+    }
 }
 
 #[inline]
@@ -66,20 +62,6 @@ fn strauss_g(x: f64) -> f64 {
 }
 
 impl Strauss {
-    /// Validate the parameters and build the model.
-    pub fn new(params: StraussParams) -> Result<Self, ParamError> {
-        params.validate(NAME)?;
-        let StraussParams { s, m, t, c } = params;
-        let rd = (1.0 - s * s * s) * (1.0 - t);
-        let d = 1.0 - m * s;
-        Ok(Self {
-            params,
-            diffuse: d * rd * c * FRAC_1_PI,
-            rn: (1.0 - t) - rd,
-            exponent: 3.0 / (1.0 - s),
-        })
-    }
-
     /// Symmetries: isotropic, even under `y ↦ −y`; not reciprocal, energy not guaranteed,
     /// unbounded at the horizon.
     pub fn properties(&self) -> Properties {

@@ -45,13 +45,9 @@ pub enum WardNormalisation {
 model_params! {
     /// Parameters of [`Ward`].
     pub struct WardParams in PARAMS {
-        /// RMS slope along x.
         alpha_x = [0.15] in Range::closed(0.001, 1.0), "RMS slope along the tangent x";
-        /// RMS slope along y.
         alpha_y = [same_as alpha_x] in Range::closed(0.001, 1.0), "RMS slope along the bitangent y";
-        /// Specular reflectance.
         rho_s = [0.3] in Range::closed(0.0, 1.0), "specular reflectance";
-        /// Diffuse reflectance.
         rho_d = [0.5] in Range::closed(0.0, 1.0), "diffuse reflectance";
     }
 }
