@@ -400,17 +400,57 @@ impl Htsg {
     }
 }
 
-impl Brdf for Htsg {
-    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+/// The factors of `f_r` that depend on the two directions and the refractive index only (not
+/// on the surface statistics), for directions both above the horizon.
+struct Bistatic {
+    /// `cosθi`.
+    ci: f64,
+    /// `cosθo`.
+    co: f64,
+    /// `ωo + ωi` (unnormalised half vector).
+    s: Vec3,
+    /// `s_x² + s_y²`.
+    sxy2: f64,
+    /// The geometric factor `(|s|²/s_z)²`.
+    geo: f64,
+    /// Fresnel reflectance at the local incidence `|s|/2`.
+    fres: f64,
+}
+
+impl Bistatic {
+    /// `None` unless both directions are above the horizon.
+    #[inline]
+    fn new(wo: &Vec3, wi: &Vec3, params: &HtsgParams) -> Option<Self> {
         if !both_above(wo, wi) {
-            return 0.0;
+            return None;
         }
-        let (ci, co) = (wi.z, wo.z);
         let s = wo + wi;
         let sxy2 = s.x * s.x + s.y * s.y;
         let ss = sxy2 + s.z * s.z;
-        let geo = (ss / s.z) * (ss / s.z);
-        let fres = fresnel_conductor(0.5 * ss.sqrt(), self.params.ior, self.params.kappa);
+        Some(Self {
+            ci: wi.z,
+            co: wo.z,
+            s,
+            sxy2,
+            geo: (ss / s.z) * (ss / s.z),
+            fres: fresnel_conductor(0.5 * ss.sqrt(), params.ior, params.kappa),
+        })
+    }
+}
+
+impl Brdf for Htsg {
+    fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        let Some(Bistatic {
+            ci,
+            co,
+            s,
+            sxy2,
+            geo,
+            fres,
+        }) = Bistatic::new(wo, wi, &self.params)
+        else {
+            return 0.0;
+        };
         let (shadow_i, k_i) = self.shadow_and_k(ci);
         let (shadow_o, k_o) = self.shadow_and_k(co);
         let shadow = shadow_i * shadow_o;
@@ -435,7 +475,8 @@ mod tests {
 
     /// The implementation before the speed work (shadow/K with separate `erfc` calls, Newton
     /// iteration for the effective roughness, Poisson series summed from `m = 1`), kept verbatim
-    /// as the reference the optimised code is compared against. `drop_peak_term` removes the
+    /// as the reference the optimised code is compared against (the direction-only factors,
+    /// [`Bistatic`], which the speed work left alone, are shared). `drop_peak_term` removes the
     /// series term `m = max(1, round(g))` to build a deliberately broken variant.
     struct PreOptimisationReference {
         params: HtsgParams,
@@ -529,15 +570,18 @@ mod tests {
         }
 
         fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-            if !both_above(wo, wi) {
+            // The geometry and Fresnel factors were not part of the speed work: shared.
+            let Some(Bistatic {
+                ci,
+                co,
+                s,
+                sxy2,
+                geo,
+                fres,
+            }) = Bistatic::new(wo, wi, &self.params)
+            else {
                 return 0.0;
-            }
-            let (ci, co) = (wi.z, wo.z);
-            let s = wo + wi;
-            let sxy2 = s.x * s.x + s.y * s.y;
-            let ss = sxy2 + s.z * s.z;
-            let geo = (ss / s.z) * (ss / s.z);
-            let fres = fresnel_conductor(0.5 * ss.sqrt(), self.params.ior, self.params.kappa);
+            };
             let shadow = self.shadow(ci) * self.shadow(co);
             let sigma = self.effective_sigma(ci, co);
             let ks = self.k * sigma * s.z;
