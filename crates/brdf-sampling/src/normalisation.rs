@@ -17,7 +17,7 @@
 //! used by the exact sampler's normaliser tables) starts every piece with orders 5 and 3 and
 //! raises only the worst pieces to order 8 before splitting them.
 
-use brdf::quadrature::GaussLegendre;
+use brdf::quadrature::{ErrorEstimate, GaussLegendre, WorstFirst};
 use partition_sampler::{Density, LeafInfo, Rect};
 
 /// Order of the reported integral.
@@ -96,20 +96,9 @@ struct Piece {
     high: bool,
 }
 
-impl PartialEq for Piece {
-    fn eq(&self, other: &Self) -> bool {
-        self.err.total_cmp(&other.err).is_eq()
-    }
-}
-impl Eq for Piece {}
-impl PartialOrd for Piece {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Piece {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.err.total_cmp(&other.err)
+impl ErrorEstimate for Piece {
+    fn error_estimate(&self) -> f64 {
+        self.err
     }
 }
 
@@ -219,20 +208,20 @@ pub(crate) fn adaptive_quadrature(
             Grading::Fixed => (integrate_leaf(&counted, &rect, &hi), low, true),
             Grading::Graded => (low, integrate_leaf(&counted, &rect, &first), false),
         };
-        Piece {
+        WorstFirst(Piece {
             leaf,
             rect,
             value,
             err: (value - other).abs(),
             high,
-        }
+        })
     };
     let mut n_leaves = 0;
     // Leaves crossing the plane of incidence y = 0 are cut there: isotropic models have kinks
     // in the azimuth difference (functions of |φi − φo|) exactly on it, where a Gauss rule
     // converges slowly and its two orders can agree on a wrong value (schlick-diffuse at
     // θo = 0.5°: 1e-4 off with an estimate of 1e-6 on the uncut single leaf).
-    let mut heap: std::collections::BinaryHeap<Piece> = leaves
+    let mut heap: std::collections::BinaryHeap<WorstFirst<Piece>> = leaves
         .enumerate()
         .inspect(|_| n_leaves += 1)
         .flat_map(|(i, l)| {
@@ -245,7 +234,9 @@ pub(crate) fn adaptive_quadrature(
         .collect();
     let mut err: f64 = heap.iter().map(|p| p.err).sum();
     while factor * err > abs_tol && evals.load(std::sync::atomic::Ordering::Relaxed) < budget {
-        let Some(worst) = heap.pop() else { break };
+        let Some(WorstFirst(worst)) = heap.pop() else {
+            break;
+        };
         err -= worst.err;
         if !worst.high {
             // Raise the order before splitting: the order-5 value becomes the comparison.
@@ -257,7 +248,7 @@ pub(crate) fn adaptive_quadrature(
                 ..worst
             };
             err += p.err;
-            heap.push(p);
+            heap.push(WorstFirst(p));
             continue;
         }
         let r = worst.rect;

@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 
 use crate::brdf::Brdf;
 use crate::geometry::{Vec3, direction_from_angles};
-use crate::quadrature::GaussLegendre;
+use crate::quadrature::{ErrorEstimate, GaussLegendre, WorstFirst};
 
 /// Relative excess over 1 that is tolerated (quadrature and model rounding).
 pub const ALBEDO_TOLERANCE: f64 = 0.01;
@@ -99,26 +99,10 @@ struct Piece {
     err: [f64; 3],
 }
 
-impl Piece {
-    fn key(&self) -> f64 {
+impl ErrorEstimate for Piece {
+    /// The worst channel's error.
+    fn error_estimate(&self) -> f64 {
         self.err.iter().fold(0.0, |a: f64, &b| a.max(b))
-    }
-}
-
-impl PartialEq for Piece {
-    fn eq(&self, other: &Self) -> bool {
-        self.key().total_cmp(&other.key()).is_eq()
-    }
-}
-impl Eq for Piece {}
-impl PartialOrd for Piece {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Piece {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.key().total_cmp(&other.key())
     }
 }
 
@@ -166,18 +150,19 @@ pub fn adaptive_albedo_rgb(brdf: &dyn Brdf, wo: &Vec3) -> ([f64; 3], [f64; 3]) {
     let piece = |u: [f64; 2], psi: [f64; 2]| {
         let value = rule(&hi, u, psi);
         let low = rule(&lo, u, psi);
-        Piece {
+        WorstFirst(Piece {
             u,
             psi,
             value,
             err: [0, 1, 2].map(|c| (value[c] - low[c]).abs()),
-        }
+        })
     };
     let psi_max = if half { 0.0 } else { PI };
     let mut rects = Vec::new();
     initial([0.0, 1.0], [-PI, psi_max], 0, [u_m, 0.0], &mut rects);
-    let mut heap: BinaryHeap<Piece> = rects.into_iter().map(|(u, p)| piece(u, p)).collect();
-    let total_err = |heap: &BinaryHeap<Piece>| {
+    let mut heap: BinaryHeap<WorstFirst<Piece>> =
+        rects.into_iter().map(|(u, p)| piece(u, p)).collect();
+    let total_err = |heap: &BinaryHeap<WorstFirst<Piece>>| {
         let mut e = [0.0; 3];
         for p in heap.iter() {
             add3(&mut e, &p.err);

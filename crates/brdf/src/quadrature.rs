@@ -4,6 +4,46 @@ use crate::brdf::Brdf;
 use crate::geometry::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI};
 
+/// A piece of an adaptive quadrature that knows its error estimate (the order in which
+/// [`WorstFirst`] ranks pieces).
+pub trait ErrorEstimate {
+    /// The piece's error estimate (larger is worse; compared with [`f64::total_cmp`]).
+    fn error_estimate(&self) -> f64;
+}
+
+/// A piece of an adaptive quadrature ordered by its [`ErrorEstimate`] alone, so that a
+/// [`BinaryHeap`](std::collections::BinaryHeap) of them pops the piece with the largest error
+/// first (the work list of every adaptive rule in the workspace). Dereferences to the piece.
+#[derive(Debug, Clone)]
+pub struct WorstFirst<T>(pub T);
+
+impl<T: ErrorEstimate> PartialEq for WorstFirst<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl<T: ErrorEstimate> Eq for WorstFirst<T> {}
+
+impl<T: ErrorEstimate> PartialOrd for WorstFirst<T> {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl<T: ErrorEstimate> Ord for WorstFirst<T> {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.error_estimate().total_cmp(&other.0.error_estimate())
+    }
+}
+
+impl<T> std::ops::Deref for WorstFirst<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.0
+    }
+}
+
 /// Gauss–Legendre rule with `n` nodes on `[-1, 1]` (exact for polynomials of degree `2n − 1`).
 #[derive(Debug, Clone)]
 pub struct GaussLegendre {

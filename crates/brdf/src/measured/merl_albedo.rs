@@ -27,7 +27,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use crate::brdf::Brdf;
 use crate::geometry::Vec3;
 use crate::merl::{MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H};
-use crate::quadrature::GaussLegendre;
+use crate::quadrature::{ErrorEstimate, GaussLegendre, WorstFirst};
 
 /// [`MerlBrdf::albedo_in_bins`]: the integral, its error estimate and the lookups it cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,20 +54,9 @@ struct Piece {
     err: f64,
 }
 
-impl PartialEq for Piece {
-    fn eq(&self, other: &Self) -> bool {
-        self.err.total_cmp(&other.err).is_eq()
-    }
-}
-impl Eq for Piece {}
-impl PartialOrd for Piece {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Piece {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.err.total_cmp(&other.err)
+impl ErrorEstimate for Piece {
+    fn error_estimate(&self) -> f64 {
+        self.err
     }
 }
 
@@ -149,23 +138,23 @@ impl MerlBrdf {
         // The 2-point Gauss rule (`crate::quadrature`, the workspace's one home of Gauss–Legendre
         // nodes) and the midpoint rule on [a, b].
         let gauss = GaussLegendre::new(2);
-        let mut piece = |a: f64, b: f64, evaluations: &mut u64| -> Piece {
+        let mut piece = |a: f64, b: f64, evaluations: &mut u64| -> WorstFirst<Piece> {
             let mut ring = |t: f64| self.ring(&wo, t, &edges, &mut roots, evaluations);
             let value = gauss.integrate(a, b, &mut ring);
             let mid = (b - a) * ring(0.5 * (a + b));
-            Piece {
+            WorstFirst(Piece {
                 a,
                 b,
                 value,
                 err: (value - mid).abs(),
-            }
+            })
         };
-        let mut heap: std::collections::BinaryHeap<Piece> = cuts
+        let mut heap: std::collections::BinaryHeap<WorstFirst<Piece>> = cuts
             .windows(2)
             .filter(|w| w[1] > w[0])
             .map(|w| piece(w[0], w[1], &mut evaluations))
             .collect();
-        let total = |heap: &std::collections::BinaryHeap<Piece>| {
+        let total = |heap: &std::collections::BinaryHeap<WorstFirst<Piece>>| {
             heap.iter()
                 .fold((0.0, 0.0), |(v, e), p| (v + p.value, e + p.err))
         };
