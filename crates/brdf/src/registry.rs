@@ -485,8 +485,8 @@ fn file_path(rest: Option<&str>, missing: SpecError) -> Result<&str, SpecError> 
 /// The preset names of a preset model (`sgd`, `abc`), `None` for other models.
 pub fn preset_names(model: &str) -> Option<Vec<&'static str>> {
     match model {
-        "sgd" => Some(sgd::preset_names()),
-        "abc" => Some(abc::preset_names()),
+        "sgd" => Some(sgd::FITS.names()),
+        "abc" => Some(abc::FITS.names()),
         _ => None,
     }
 }
@@ -519,8 +519,8 @@ fn parse_preset(model: &'static str, rest: Option<&str>) -> Result<Box<dyn Brdf>
         model,
         name: name.to_string(),
         suggestions: match model {
-            "sgd" => sgd::close_matches(name),
-            _ => abc::close_matches(name),
+            "sgd" => sgd::FITS.close_matches(name),
+            _ => abc::FITS.close_matches(name),
         },
     })
 }

@@ -19,9 +19,8 @@ use super::{Properties, brdf_properties};
 use crate::brdf::{Brdf, luminance};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{Vec3, both_above};
-use crate::models::merl_fits::{self, FitRow};
+use crate::models::merl_fits::FitTable;
 use std::f64::consts::FRAC_1_PI;
-use std::sync::OnceLock;
 
 pub(crate) const NAME: &str = "abc";
 
@@ -50,25 +49,13 @@ pub struct Abc {
     params: AbcParams,
 }
 
-fn rows() -> &'static [FitRow] {
-    static ROWS: OnceLock<Vec<FitRow>> = OnceLock::new();
-    ROWS.get_or_init(|| merl_fits::parse_table(TABLE, 1))
-}
-
-/// The preset names (MERL names), in table order.
-pub fn preset_names() -> Vec<&'static str> {
-    rows().iter().map(|r| r.name.as_str()).collect()
-}
-
-/// Up to five preset names close to `name`.
-pub fn close_matches(name: &str) -> Vec<String> {
-    merl_fits::close_matches(name, rows().iter().map(|r| r.name.as_str()))
-}
+/// The embedded table (its preset names and their close matches serve the registry).
+pub(crate) static FITS: FitTable = FitTable::new(TABLE, 1);
 
 impl Abc {
     /// The preset of a MERL material, or `None`.
     pub fn preset(material: &str) -> Option<Self> {
-        let row = rows().iter().find(|r| r.name == material)?;
+        let row = FITS.find(material)?;
         let v = &row.values;
         if v.len() < 9 {
             return None;
@@ -135,7 +122,7 @@ mod tests {
     /// The column mapping of [`Abc::preset`] is the table's header.
     #[test]
     fn columns_follow_the_header() {
-        let h = merl_fits::header(TABLE);
+        let h = crate::models::merl_fits::header(TABLE);
         assert_eq!(
             h,
             [

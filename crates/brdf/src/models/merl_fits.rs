@@ -3,6 +3,8 @@
 //! material, a `name` column then numeric columns; `#` lines are comments; the first
 //! non-comment line is the header.
 
+use std::sync::OnceLock;
+
 /// One fitted material: its names and the numeric columns in header order.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FitRow {
@@ -47,6 +49,52 @@ pub(crate) fn parse_table(text: &str, text_columns: usize) -> Vec<FitRow> {
         });
     }
     rows
+}
+
+/// An embedded fit table, parsed on first use: the presets of a fitted model (`abc`, `sgd`).
+pub(crate) struct FitTable {
+    text: &'static str,
+    text_columns: usize,
+    rows: OnceLock<Vec<FitRow>>,
+}
+
+impl FitTable {
+    /// The table `text` with `text_columns` leading text columns (see [`parse_table`]).
+    pub(crate) const fn new(text: &'static str, text_columns: usize) -> Self {
+        Self {
+            text,
+            text_columns,
+            rows: OnceLock::new(),
+        }
+    }
+
+    fn rows(&self) -> &[FitRow] {
+        self.rows
+            .get_or_init(|| parse_table(self.text, self.text_columns))
+    }
+
+    /// The MERL names, in table order.
+    pub(crate) fn names(&self) -> Vec<&str> {
+        self.rows().iter().map(|r| r.name.as_str()).collect()
+    }
+
+    /// Up to five names (MERL or other) close to `name`, best first.
+    pub(crate) fn close_matches(&self, name: &str) -> Vec<String> {
+        close_matches(
+            name,
+            self.rows()
+                .iter()
+                .flat_map(|r| [r.name.as_str(), r.other_name.as_str()])
+                .filter(|n| !n.is_empty()),
+        )
+    }
+
+    /// The row of a material by its MERL name or its (non-empty) other name.
+    pub(crate) fn find(&self, material: &str) -> Option<&FitRow> {
+        self.rows()
+            .iter()
+            .find(|r| r.name == material || (!r.other_name.is_empty() && r.other_name == material))
+    }
 }
 
 /// The column names of an embedded table (its header line).

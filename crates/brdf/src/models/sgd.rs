@@ -19,9 +19,8 @@
 use super::{Properties, brdf_properties};
 use crate::brdf::{Brdf, luminance};
 use crate::geometry::{Vec3, both_above};
-use crate::models::merl_fits::{self, FitRow};
+use crate::models::merl_fits::FitTable;
 use std::f64::consts::FRAC_1_PI;
-use std::sync::OnceLock;
 
 pub(crate) const NAME: &str = "sgd";
 
@@ -62,33 +61,13 @@ pub struct Sgd {
     channels: [SgdChannel; 3],
 }
 
-fn rows() -> &'static [FitRow] {
-    static ROWS: OnceLock<Vec<FitRow>> = OnceLock::new();
-    ROWS.get_or_init(|| merl_fits::parse_table(TABLE, 2))
-}
-
-/// The preset names (MERL names), in table order.
-pub fn preset_names() -> Vec<&'static str> {
-    rows().iter().map(|r| r.name.as_str()).collect()
-}
-
-/// Up to five preset names close to `name`.
-pub fn close_matches(name: &str) -> Vec<String> {
-    merl_fits::close_matches(
-        name,
-        rows()
-            .iter()
-            .flat_map(|r| [r.name.as_str(), r.other_name.as_str()])
-            .filter(|n| !n.is_empty()),
-    )
-}
+/// The embedded table (its preset names and their close matches serve the registry).
+pub(crate) static FITS: FitTable = FitTable::new(TABLE, 2);
 
 impl Sgd {
     /// The preset of a MERL material (its MERL name or the table's other name), or `None`.
     pub fn preset(material: &str) -> Option<Self> {
-        let row = rows().iter().find(|r| {
-            r.name == material || (!r.other_name.is_empty() && r.other_name == material)
-        })?;
+        let row = FITS.find(material)?;
         // 12 groups of 3 (the last, the fit error, unused).
         if row.values.len() < 33 {
             return None;
@@ -177,7 +156,7 @@ mod tests {
     /// The column mapping of [`Sgd::preset`] is the table's header.
     #[test]
     fn columns_follow_the_header() {
-        let h = merl_fits::header(TABLE);
+        let h = crate::models::merl_fits::header(TABLE);
         let groups = [
             "rhoD", "rhoS", "alpha", "p", "f0", "f1", "kap", "lambda", "c", "k", "theta0",
         ];
