@@ -571,24 +571,16 @@ mod tests {
 
         fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
             // The geometry and Fresnel factors were not part of the speed work: shared.
-            let Some(Bistatic {
-                ci,
-                co,
-                s,
-                sxy2,
-                geo,
-                fres,
-            }) = Bistatic::new(wo, wi, &self.params)
-            else {
+            let Some(b) = Bistatic::new(wo, wi, &self.params) else {
                 return 0.0;
             };
-            let shadow = self.shadow(ci) * self.shadow(co);
-            let sigma = self.effective_sigma(ci, co);
-            let ks = self.k * sigma * s.z;
+            let shadow = self.shadow(b.ci) * self.shadow(b.co);
+            let sigma = self.effective_sigma(b.ci, b.co);
+            let ks = self.k * sigma * b.s.z;
             let g = ks * ks;
-            let a = self.k * self.k * sxy2 * self.params.tau * self.params.tau / 4.0;
+            let a = self.k * self.k * b.sxy2 * self.params.tau * self.params.tau / 4.0;
             let d = self.distribution(g, a);
-            fres * geo * shadow * d / (PI * ci * co) + self.params.kd * FRAC_1_PI
+            b.fres * b.geo * shadow * d / (PI * b.ci * b.co) + self.params.kd * FRAC_1_PI
         }
     }
 
