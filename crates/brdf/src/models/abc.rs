@@ -114,20 +114,3 @@ impl Brdf for Abc {
 
     brdf_properties!(NAME);
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The column mapping of [`Abc::preset`] is the table's header.
-    #[test]
-    fn columns_follow_the_header() {
-        let h = crate::models::merl_fits::header(TABLE);
-        assert_eq!(
-            h,
-            [
-                "name", "kD_r", "kD_g", "kD_b", "A_r", "A_g", "A_b", "B", "C", "ior"
-            ]
-        );
-    }
-}

@@ -134,6 +134,29 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::{abc, sgd};
+
+    /// The column mappings of [`Abc::preset`](abc::Abc::preset) and
+    /// [`Sgd::preset`](sgd::Sgd::preset) are their tables' headers.
+    #[test]
+    fn preset_columns_follow_the_headers() {
+        assert_eq!(
+            header(abc::TABLE),
+            [
+                "name", "kD_r", "kD_g", "kD_b", "A_r", "A_g", "A_b", "B", "C", "ior"
+            ]
+        );
+        let h = header(sgd::TABLE);
+        let groups = [
+            "rhoD", "rhoS", "alpha", "p", "f0", "f1", "kap", "lambda", "c", "k", "theta0",
+        ];
+        for (g, name) in groups.iter().enumerate() {
+            for (ch, suffix) in ["r", "g", "b"].iter().enumerate() {
+                assert_eq!(h[2 + 3 * g + ch], format!("{name}_{suffix}"));
+            }
+        }
+        assert_eq!(&h[..2], &["name", "otherName"]);
+    }
 
     #[test]
     fn close_matches_rank_typos_first() {

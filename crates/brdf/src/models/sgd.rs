@@ -148,23 +148,3 @@ impl Brdf for Sgd {
 
     brdf_properties!(NAME);
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The column mapping of [`Sgd::preset`] is the table's header.
-    #[test]
-    fn columns_follow_the_header() {
-        let h = crate::models::merl_fits::header(TABLE);
-        let groups = [
-            "rhoD", "rhoS", "alpha", "p", "f0", "f1", "kap", "lambda", "c", "k", "theta0",
-        ];
-        for (g, name) in groups.iter().enumerate() {
-            for (ch, suffix) in ["r", "g", "b"].iter().enumerate() {
-                assert_eq!(h[2 + 3 * g + ch], format!("{name}_{suffix}"));
-            }
-        }
-        assert_eq!(&h[..2], &["name", "otherName"]);
-    }
-}
