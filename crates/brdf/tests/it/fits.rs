@@ -6,6 +6,19 @@ use crate::common::pairs_below_85;
 use brdf::models::{Abc, Sgd};
 use brdf::{Brdf, SpecError, Vec3, direction_from_angles, parse_spec, preset_names, rotate_z};
 
+/// Every preset of `sgd` and `abc`: its model, its name and the BRDF its spec builds.
+fn every_preset() -> impl Iterator<Item = (&'static str, &'static str, Box<dyn Brdf>)> {
+    ["sgd", "abc"].into_iter().flat_map(|model| {
+        preset_names(model)
+            .expect("presets")
+            .into_iter()
+            .map(move |n| {
+                let b = parse_spec(&format!("{model}:material={n}")).expect("builds");
+                (model, n, b)
+            })
+    })
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(1e-300)
 }
@@ -38,23 +51,20 @@ fn one_hundred_presets_each() {
 #[test]
 fn declared_symmetries_hold_for_every_preset() {
     let ps = pairs_below_85(21, 60);
-    for model in ["sgd", "abc"] {
-        for n in preset_names(model).expect("presets") {
-            let b = parse_spec(&format!("{model}:material={n}")).expect("builds");
-            assert!(b.is_isotropic() && b.is_mirror_symmetric() && b.is_reciprocal());
-            for (k, (wo, wi)) in ps.iter().enumerate() {
-                let f = b.eval_rgb(wo, wi);
-                assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{n}: {f:?}");
-                let y = b.eval(wo, wi);
-                let m = |v: &Vec3| Vec3::new(v.x, -v.y, v.z);
-                let a = 0.3 + k as f64;
-                for (what, other) in [
-                    ("reciprocity", b.eval(wi, wo)),
-                    ("mirror", b.eval(&m(wo), &m(wi))),
-                    ("rotation", b.eval(&rotate_z(wo, a), &rotate_z(wi, a))),
-                ] {
-                    assert!(rel(y, other) < 1e-9, "{model}:{n} {what}: {y} vs {other}");
-                }
+    for (model, n, b) in every_preset() {
+        assert!(b.is_isotropic() && b.is_mirror_symmetric() && b.is_reciprocal());
+        for (k, (wo, wi)) in ps.iter().enumerate() {
+            let f = b.eval_rgb(wo, wi);
+            assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{n}: {f:?}");
+            let y = b.eval(wo, wi);
+            let m = |v: &Vec3| Vec3::new(v.x, -v.y, v.z);
+            let a = 0.3 + k as f64;
+            for (what, other) in [
+                ("reciprocity", b.eval(wi, wo)),
+                ("mirror", b.eval(&m(wo), &m(wi))),
+                ("rotation", b.eval(&rotate_z(wo, a), &rotate_z(wi, a))),
+            ] {
+                assert!(rel(y, other) < 1e-9, "{model}:{n} {what}: {y} vs {other}");
             }
         }
     }
@@ -66,12 +76,9 @@ fn declared_symmetries_hold_for_every_preset() {
 #[test]
 fn albedos_are_plausible() {
     let wo = direction_from_angles(30.0, 0.0);
-    for model in ["sgd", "abc"] {
-        for n in preset_names(model).expect("presets") {
-            let b = parse_spec(&format!("{model}:material={n}")).expect("builds");
-            let a = brdf::directional_albedo(b.as_ref(), &wo, 48, 96);
-            assert!(a > 0.0 && a < 1.3, "{model}:{n}: albedo {a}");
-        }
+    for (model, n, b) in every_preset() {
+        let a = brdf::directional_albedo(b.as_ref(), &wo, 48, 96);
+        assert!(a > 0.0 && a < 1.3, "{model}:{n}: albedo {a}");
     }
     let abc = Abc::preset("white-diffuse-bball").expect("preset");
     let far = direction_from_angles(60.0, 180.0);
