@@ -46,6 +46,16 @@ pub enum NormalDistribution {
     Ggx,
 }
 
+impl NormalDistribution {
+    /// The registry name of the model with this distribution (`beckmann`, `ggx`).
+    pub fn model_name(self) -> &'static str {
+        match self {
+            NormalDistribution::Beckmann => NAME_BECKMANN,
+            NormalDistribution::Ggx => NAME_GGX,
+        }
+    }
+}
+
 model_params! {
     /// Parameters of [`Microfacet`].
     pub struct MicrofacetParams in PARAMS {
@@ -70,11 +80,7 @@ pub struct Microfacet {
 impl Microfacet {
     /// Validate the parameters and build the model.
     pub fn new(params: MicrofacetParams, dist: NormalDistribution) -> Result<Self, ParamError> {
-        let name = match dist {
-            NormalDistribution::Beckmann => NAME_BECKMANN,
-            NormalDistribution::Ggx => NAME_GGX,
-        };
-        params.validate(name)?;
+        params.validate(dist.model_name())?;
         let (ax, ay) = (params.alpha_x, params.alpha_y);
         Ok(Self {
             params,
@@ -172,9 +178,6 @@ impl Brdf for Microfacet {
         })
     }
     fn name(&self) -> &str {
-        match self.dist {
-            NormalDistribution::Beckmann => NAME_BECKMANN,
-            NormalDistribution::Ggx => NAME_GGX,
-        }
+        self.dist.model_name()
     }
 }
