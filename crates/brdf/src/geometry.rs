@@ -27,6 +27,12 @@ pub fn mirror(wo: &Vec3) -> Vec3 {
     Vec3::new(-wo.x, -wo.y, wo.z)
 }
 
+/// `ω_r·ωi` for the mirror direction `ω_r` of `wo` ([`mirror`]): the cosine of Phong-type lobes.
+#[inline]
+pub(crate) fn cos_to_mirror(wo: &Vec3, wi: &Vec3) -> f64 {
+    -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z
+}
+
 /// Mirror direction of `v` about an arbitrary unit normal `n`: `2 (n·v) n − v`.
 #[inline]
 pub fn reflect_about(v: &Vec3, n: &Vec3) -> Vec3 {

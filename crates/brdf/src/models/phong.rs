@@ -10,7 +10,7 @@
 
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::{Vec3, both_above, cos_to_mirror};
 use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -46,7 +46,7 @@ impl Brdf for Phong {
         if !both_above(wo, wi) {
             return 0.0;
         }
-        let c = -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z;
+        let c = cos_to_mirror(wo, wi);
         let spec = if c > 0.0 {
             self.spec_scale * c.powf(self.params.n)
         } else {

@@ -19,7 +19,7 @@
 
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::{Vec3, both_above, cos_to_mirror};
 use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
 
@@ -75,7 +75,7 @@ impl Brdf for Strauss {
         if !both_above(wo, wi) {
             return 0.0;
         }
-        let c = -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z;
+        let c = cos_to_mirror(wo, wi);
         if c <= 0.0 {
             return self.diffuse;
         }
