@@ -124,6 +124,30 @@ struct CutRules {
     legendre: [Rule; 3],
 }
 
+impl CutRules {
+    /// The coarsest of three rules whose limit is at least the log-`variation` of the power
+    /// over the piece (the last rule beyond the last limit).
+    fn pick<'a>(rules: &'a [Rule; 3], limits: [f64; 2], variation: f64) -> &'a Rule {
+        if variation <= limits[0] {
+            &rules[0]
+        } else if variation <= limits[1] {
+            &rules[1]
+        } else {
+            &rules[2]
+        }
+    }
+
+    /// The Gauss–Jacobi rule in `u` for a log-variation up to 12, 24 or more.
+    fn jacobi_for(&self, variation: f64) -> &Rule {
+        Self::pick(&self.jacobi, [12.0, 24.0], variation)
+    }
+
+    /// The Gauss–Legendre rule in `δ` for a log-variation up to 4, 16 or more.
+    fn legendre_for(&self, variation: f64) -> &Rule {
+        Self::pick(&self.legendre, [4.0, 16.0], variation)
+    }
+}
+
 static CUT_RULES: LazyLock<CutRules> = LazyLock::new(|| {
     let scaled = |points| {
         let mut r = gauss_jacobi(points, -0.5, 0.0);
@@ -285,14 +309,7 @@ impl PoulinFournier {
         let n = self.params.n;
         let span = 1.0 - u_cut;
         let variation = n * (lobe.ln_peak - (lobe.a * u_cut + lobe.b).ln());
-        let rules = &CUT_RULES.jacobi;
-        let rule = if variation <= 12.0 {
-            &rules[0]
-        } else if variation <= 24.0 {
-            &rules[1]
-        } else {
-            &rules[2]
-        };
+        let rule = CUT_RULES.jacobi_for(variation);
         let mut sum = 0.0;
         for (s, w) in rule.s.iter().zip(&rule.weight) {
             let u = 1.0 - span * s;
@@ -313,14 +330,7 @@ impl PoulinFournier {
             n * (c.ln() - lobe.ln_peak)
         };
         let variation = power_ln(lo) - power_ln(hi);
-        let rules = &CUT_RULES.legendre;
-        let rule = if variation <= 4.0 {
-            &rules[0]
-        } else if variation <= 16.0 {
-            &rules[1]
-        } else {
-            &rules[2]
-        };
+        let rule = CUT_RULES.legendre_for(variation);
         let mut sum = 0.0;
         for (s, w) in rule.s.iter().zip(&rule.weight) {
             let c2 = (2.0 * (lo + len * s)).cos();
@@ -469,16 +479,22 @@ mod tests {
             }
         }
 
-        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+        /// The cylinder angles `[γ0, γ1]` seen from both directions, `None` when either is
+        /// below the horizon or the range is empty.
+        fn common_range(&self, wo: &Vec3, wi: &Vec3) -> Option<(f64, f64)> {
             if !both_above(wo, wi) {
-                return 0.0;
+                return None;
             }
             let (lo_o, hi_o) = self.visible_range(wo);
             let (lo_i, hi_i) = self.visible_range(wi);
             let (g0, g1) = (lo_o.max(lo_i), hi_o.min(hi_i));
-            if !(g1 > g0) {
+            (g1 > g0).then_some((g0, g1))
+        }
+
+        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            let Some((g0, g1)) = self.common_range(wo, wi) else {
                 return 0.0;
-            }
+            };
             let (ri, psi_i) = (wi.y.hypot(wi.z), wi.y.atan2(wi.z));
             let (ro, psi_o) = (wo.y.hypot(wo.z), wo.y.atan2(wo.z));
             let prim =
@@ -496,15 +512,9 @@ mod tests {
         /// segment, segments split at the lobe peak `(ψo + ψi)/2`, at the roots of `r·ωi` and
         /// at the peak ± 2^j lobe widths (accurate to ~10⁻¹⁴ for every exponent).
         fn brute_force(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-            if !both_above(wo, wi) {
+            let Some((g0, g1)) = self.common_range(wo, wi) else {
                 return 0.0;
-            }
-            let (lo_o, hi_o) = self.visible_range(wo);
-            let (lo_i, hi_i) = self.visible_range(wi);
-            let (g0, g1) = (lo_o.max(lo_i), hi_o.min(hi_i));
-            if !(g1 > g0) {
-                return 0.0;
-            }
+            };
             let p = *self.params();
             let cosio = wo.dot(wi);
             let integrand = |g: f64| {
