@@ -282,19 +282,11 @@ pub(crate) use model_params;
 macro_rules! model_common {
     ($Model:ident($Params:ident)) => {
         $crate::params::model_common!(@impl $Model($Params));
-        impl Default for $Model {
-            fn default() -> Self {
-                $crate::params::expect_default(Self::new($Params::default()))
-            }
-        }
+        $crate::params::default_from!($Model = Self::new($Params::default()));
     };
     ($Model:ident($Params:ident, $arg:ident : $Arg:ty = $arg_default:expr)) => {
         $crate::params::model_common!(@impl $Model($Params, $arg: $Arg));
-        impl Default for $Model {
-            fn default() -> Self {
-                $crate::params::expect_default(Self::new($Params::default(), $arg_default))
-            }
-        }
+        $crate::params::default_from!($Model = Self::new($Params::default(), $arg_default));
     };
     ($Model:ident($Params:ident, $arg:ident : $Arg:ty)) => {
         $crate::params::model_common!(@impl $Model($Params, $arg: $Arg));
@@ -317,6 +309,19 @@ macro_rules! model_common {
     };
 }
 pub(crate) use model_common;
+
+/// `impl Default for $Model` from a constructor call on built-in defaults
+/// (`default_from!(Model = Self::new(…))`), unwrapped by [`expect_default`].
+macro_rules! default_from {
+    ($Model:ident = $build:expr) => {
+        impl Default for $Model {
+            fn default() -> Self {
+                $crate::params::expect_default($build)
+            }
+        }
+    };
+}
+pub(crate) use default_from;
 
 /// Unwrap a model built from its built-in defaults. The defaults are constants checked by the
 /// unit tests, so an error here is a bug in this crate, never a consequence of user input.

@@ -175,11 +175,7 @@ impl Lafortune {
     }
 }
 
-impl Default for Lafortune {
-    fn default() -> Self {
-        crate::params::expect_default(Self::new(LafortuneParams::default()))
-    }
-}
+crate::params::default_from!(Lafortune = Self::new(LafortuneParams::default()));
 
 impl Brdf for Lafortune {
     #[inline]

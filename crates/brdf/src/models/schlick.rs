@@ -169,11 +169,7 @@ impl Schlick {
     }
 }
 
-impl Default for Schlick {
-    fn default() -> Self {
-        crate::params::expect_default(Self::new(SchlickParams::specular()))
-    }
-}
+crate::params::default_from!(Schlick = Self::new(SchlickParams::specular()));
 
 impl Brdf for Schlick {
     #[inline]
