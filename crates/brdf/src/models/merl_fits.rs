@@ -112,7 +112,7 @@ pub(crate) fn close_matches<'a>(name: &str, names: impl Iterator<Item = &'a str>
     let lower = name.to_ascii_lowercase();
     let mut scored: Vec<(usize, &str)> = names
         .filter_map(|n| {
-            let d = edit_distance(&lower, n);
+            let d = strsim::levenshtein(&lower, n);
             let contains = !lower.is_empty() && (n.contains(&lower) || lower.contains(n));
             (d <= 4 || contains).then_some((if contains { d.min(2) } else { d }, n))
         })
@@ -124,11 +124,6 @@ pub(crate) fn close_matches<'a>(name: &str, names: impl Iterator<Item = &'a str>
         .take(5)
         .map(|(_, n)| n.to_string())
         .collect()
-}
-
-/// Levenshtein distance (for suggestions only), from `strsim`.
-fn edit_distance(a: &str, b: &str) -> usize {
-    strsim::levenshtein(a, b)
 }
 
 #[cfg(test)]
