@@ -127,7 +127,7 @@ struct CutRules {
 impl CutRules {
     /// The coarsest of three rules whose limit is at least the log-`variation` of the power
     /// over the piece (the last rule beyond the last limit).
-    fn pick<'a>(rules: &'a [Rule; 3], limits: [f64; 2], variation: f64) -> &'a Rule {
+    fn pick(rules: &[Rule; 3], limits: [f64; 2], variation: f64) -> &Rule {
         if variation <= limits[0] {
             &rules[0]
         } else if variation <= limits[1] {
