@@ -48,3 +48,23 @@ pub(crate) fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T>
         .and_then(|i| args.get(i + 1))
         .and_then(|v| v.parse().ok())
 }
+
+/// Every model of `brdf::models()` at its defaults, then the synthetic MERL table
+/// `merl(phong:n=50)`: the BRDFs the tables and loops of these examples run over.
+pub(crate) fn all_specs() -> Vec<String> {
+    let mut specs: Vec<String> = brdf::models()
+        .iter()
+        .filter(|m| !m.needs_argument())
+        .map(|m| m.name.to_string())
+        .collect();
+    specs.push("merl(phong:n=50)".to_string());
+    specs
+}
+
+/// The specs of `--specs a;b;…` in `args`, else [`all_specs`].
+pub(crate) fn table_specs(args: &[String]) -> Vec<String> {
+    match arg::<String>(args, "--specs") {
+        Some(list) => list.split(';').map(str::to_string).collect(),
+        None => all_specs(),
+    }
+}
