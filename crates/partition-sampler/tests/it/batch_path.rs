@@ -22,15 +22,9 @@ fn density(rect: Rect) -> TabulatedDensity<SinPiRows> {
         .unwrap()
 }
 
-/// `sample_into` against `len` calls of the one-sample path, from the same generator state:
-/// same samples, same generator state after, same counts.
-fn check_same<D: RegionStats>(s: &QuadTreeSampler<D>, len: usize, seed: u64) -> Audit {
-    let mut one = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut audit = Audit::default();
-    let expected: Vec<Sample2> = (0..len)
-        .map(|_| s.sample_audited(&mut one, &mut audit))
-        .collect();
-    s.reset_stats();
+/// `len` samples of one `sample_into` call from a generator seeded with `seed`, and that
+/// generator after the call.
+fn block_samples<S: Sampler2D>(s: &S, len: usize, seed: u64) -> (Vec<Sample2>, Xoshiro256PlusPlus) {
     let mut block = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut got = vec![
         Sample2 {
@@ -40,6 +34,19 @@ fn check_same<D: RegionStats>(s: &QuadTreeSampler<D>, len: usize, seed: u64) -> 
         len
     ];
     s.sample_into(&mut block, &mut got);
+    (got, block)
+}
+
+/// `sample_into` against `len` calls of the one-sample path, from the same generator state:
+/// same samples, same generator state after, same counts.
+fn check_same<D: RegionStats>(s: &QuadTreeSampler<D>, len: usize, seed: u64) -> Audit {
+    let mut one = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut audit = Audit::default();
+    let expected: Vec<Sample2> = (0..len)
+        .map(|_| s.sample_audited(&mut one, &mut audit))
+        .collect();
+    s.reset_stats();
+    let (got, mut block) = block_samples(s, len, seed);
     assert_eq!(got, expected, "len {len}, seed {seed}");
     assert_eq!(block.next_u64(), one.next_u64(), "uniforms consumed differ");
     let st = s.stats();
@@ -134,15 +141,7 @@ fn piecewise_constant_block_path_equals_one_sample_path() {
     for (k, len) in LENGTHS.into_iter().enumerate() {
         let mut one = Xoshiro256PlusPlus::seed_from_u64(300 + k as u64);
         let expected: Vec<Sample2> = (0..len).map(|_| t.sample(&mut one)).collect();
-        let mut block = Xoshiro256PlusPlus::seed_from_u64(300 + k as u64);
-        let mut got = vec![
-            Sample2 {
-                point: [f64::NAN; 2],
-                pdf: f64::NAN
-            };
-            len
-        ];
-        t.sample_into(&mut block, &mut got);
+        let (got, mut block) = block_samples(&t, len, 300 + k as u64);
         assert_eq!(got, expected);
         assert_eq!(block.next_u64(), one.next_u64());
     }
