@@ -4,8 +4,8 @@
 //! albedo agrees with quadrature.
 
 use baselines::RglNative;
-use brdf::{Brdf, RglBrdf, Vec3, direction_from_angles, directional_albedo, parse_spec};
-use brdf_sampling::DirectionSampler;
+use brdf::{RglBrdf, Vec3, direction_from_angles, directional_albedo, parse_spec};
+use brdf_sampling::{DirectionSampler, sampled_albedo};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use std::path::PathBuf;
@@ -83,20 +83,8 @@ fn the_estimator_finds_the_albedo() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     for th in [0.0, 60.0] {
         let wo = direction_from_angles(th, 0.0);
-        let n = 100_000;
-        let (mut sum, mut sq) = (0.0, 0.0);
-        for _ in 0..n {
-            let d = s.sample(&wo, &mut rng);
-            let w = if d.wi.z > 0.0 && d.pdf > 0.0 {
-                b.eval(&wo, &d.wi) * d.wi.z / d.pdf
-            } else {
-                0.0
-            };
-            sum += w;
-            sq += w * w;
-        }
-        let mean = sum / n as f64;
-        let se = ((sq / n as f64 - mean * mean) / n as f64).sqrt();
+        let e = sampled_albedo(&s, &b, &wo, 100_000, &mut rng);
+        let (mean, se) = (e.mean, e.std_error());
         let reference = directional_albedo(&b, &wo, 96, 192);
         assert!(
             (mean - reference).abs() < 4.0 * se + 2e-3 * reference,
