@@ -323,22 +323,17 @@ mod tests {
     #[test]
     fn half_turn_layout_serves_the_opposite_azimuth_turned_by_pi() {
         let l = layout(4, 4, true);
-        // Slices at φ = 0°, 45°, 90°, 135°; φo = 227° is served by 45° turned by 182°.
-        let c = l.nearest(&direction_from_angles(50.0, 227.0)).unwrap();
-        assert_eq!(c.index % 4, 1);
-        assert_relative_eq!(
-            c.rotation.angle().to_degrees().rem_euclid(360.0),
-            182.0,
-            epsilon = 1e-9
-        );
+        // Slices at φ = 0°, 45°, 90°, 135°; φo = 227° is served by 45° turned by 182°, and
         // φo = 350° is nearest to 180° ≡ slice 0, turned by 350°.
-        let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
-        assert_eq!(c.index % 4, 0);
-        assert_relative_eq!(
-            c.rotation.angle().to_degrees().rem_euclid(360.0),
-            350.0,
-            epsilon = 1e-9
-        );
+        for (phi_o, slice, turn) in [(227.0, 1, 182.0), (350.0, 0, 350.0)] {
+            let c = l.nearest(&direction_from_angles(50.0, phi_o)).unwrap();
+            assert_eq!(c.index % 4, slice);
+            assert_relative_eq!(
+                c.rotation.angle().to_degrees().rem_euclid(360.0),
+                turn,
+                epsilon = 1e-9
+            );
+        }
         assert_relative_eq!(l.phi_of(3).to_degrees(), 135.0, epsilon = 1e-12);
     }
 

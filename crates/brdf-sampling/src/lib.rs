@@ -99,7 +99,7 @@ mod pdf_cells;
 mod persist;
 mod reference;
 mod report;
-mod sampled_albedo;
+mod sampler_checks;
 mod set;
 
 pub use direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
@@ -118,5 +118,5 @@ pub use reference::{
     reference_albedo_with_budget,
 };
 pub use report::{CostMeasurement, SetReport};
-pub use sampled_albedo::{SampledAlbedo, sampled_albedo};
+pub use sampler_checks::{SampledAlbedo, sampled_albedo, upper_hemisphere_integral};
 pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

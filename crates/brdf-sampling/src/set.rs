@@ -476,15 +476,13 @@ impl QuadTreeSet {
     /// Density of `wi` under slice choice `c` alone, w.r.t. solid angle.
     #[inline]
     fn slice_pdf(&self, c: &SliceChoice, wi: &Vec3) -> f64 {
-        if !(wi.z > 0.0) {
-            return 0.0;
+        match self.trees.get(c.index) {
+            Some(tree) if wi.z > 0.0 => tree
+                .density()
+                .map()
+                .area_to_solid_angle(self.slice_area_pdf(c, wi), wi),
+            _ => 0.0,
         }
-        let Some(tree) = self.trees.get(c.index) else {
-            return 0.0;
-        };
-        let map = tree.density().map();
-        let v = c.rotation.undo(wi);
-        map.area_to_solid_angle(tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index), wi)
     }
 
     /// The factor turning tree `index`'s pdf `f / Î_grid` into the set's `f / Î_leaves`.

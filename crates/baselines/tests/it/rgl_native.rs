@@ -5,7 +5,7 @@
 
 use baselines::RglNative;
 use brdf::{RglBrdf, Vec3, direction_from_angles, directional_albedo, parse_spec};
-use brdf_sampling::{DirectionSampler, sampled_albedo};
+use brdf_sampling::{DirectionSampler, sampled_albedo, upper_hemisphere_integral};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use std::path::PathBuf;
@@ -33,19 +33,9 @@ fn sample_and_pdf_agree() {
     }
 }
 
-/// `∫_Ω p dσ` by a midpoint rule in `(cos θ, φ)`, with `pdf` as given.
-fn upper_integral(pdf: &dyn Fn(&Vec3) -> f64) -> f64 {
-    let (nz, nphi) = (600, 600);
-    let mut sum = 0.0;
-    for i in 0..nz {
-        let z = (i as f64 + 0.5) / nz as f64;
-        let r = (1.0 - z * z).sqrt();
-        for j in 0..nphi {
-            let phi = (j as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
-            sum += pdf(&Vec3::new(r * phi.cos(), r * phi.sin(), z));
-        }
-    }
-    sum * std::f64::consts::TAU / (nz * nphi) as f64
+/// `∫_Ω p dσ` by a midpoint rule in `(cos θ, φ)` on 600 × 600 cells, with `pdf` as given.
+fn upper_integral(pdf: &(dyn Fn(&Vec3) -> f64 + Sync)) -> f64 {
+    upper_hemisphere_integral(pdf, 600, 600)
 }
 
 fn fraction_above(s: &RglNative, wo: &Vec3, n: usize) -> f64 {

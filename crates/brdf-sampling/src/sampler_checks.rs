@@ -1,9 +1,11 @@
-//! The albedo estimator of a direction sampler: `f_r(ωo, ωi) cos θi / p(ωi)` averaged over its
-//! samples, the Monte Carlo check of a sampler against a quadrature albedo and the per-sample
-//! variance the studies compare.
+//! Checks of a direction sampler against its BRDF: the albedo estimator
+//! `f_r(ωo, ωi) cos θi / p(ωi)` averaged over its samples (the Monte Carlo check against a
+//! quadrature albedo, and the per-sample variance the studies compare), and `∫ p dσ` over the
+//! upper hemisphere by the midpoint rule.
 
 use brdf::{Brdf, Vec3};
 use partition_sampler::UniformSource;
+use rayon::prelude::*;
 
 use crate::DirectionSampler;
 
@@ -54,6 +56,31 @@ pub fn sampled_albedo(
     }
 }
 
+/// `∫ g dσ` over the upper hemisphere by the midpoint rule on `n_cos × n_phi` equal cells in
+/// `(cos θ, φ)` (equal solid angles, so the rule is the mean of `g` at the cell centres times
+/// 2π). Rows in parallel, summed in order: the result does not depend on the thread count.
+pub fn upper_hemisphere_integral(
+    g: &(dyn Fn(&Vec3) -> f64 + Sync),
+    n_cos: usize,
+    n_phi: usize,
+) -> f64 {
+    let cell = (1.0 / n_cos as f64) * (std::f64::consts::TAU / n_phi as f64);
+    let rows: Vec<f64> = (0..n_cos)
+        .into_par_iter()
+        .map(|i| {
+            let z = (i as f64 + 0.5) / n_cos as f64;
+            let r = (1.0 - z * z).sqrt();
+            (0..n_phi)
+                .map(|j| {
+                    let phi = (j as f64 + 0.5) / n_phi as f64 * std::f64::consts::TAU;
+                    g(&Vec3::new(r * phi.cos(), r * phi.sin(), z))
+                })
+                .sum::<f64>()
+        })
+        .collect();
+    rows.iter().sum::<f64>() * cell
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,29 +114,28 @@ mod tests {
     impl SamplerDiagnostics for Cosine {}
 
     #[test]
-    fn cosine_sampling_of_lambert_has_zero_variance_and_a_wrong_pdf_shows() {
+    fn cosine_sampling_of_lambert_has_zero_variance_and_a_wrong_pdf_shows_in_the_mean() {
         let lambert = brdf::parse_spec("lambert:rho=0.6").unwrap();
         let wo = brdf::direction_from_angles(30.0, 0.0);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-        let exact = sampled_albedo(
-            &Cosine { pdf_scale: 1.0 },
-            lambert.as_ref(),
-            &wo,
-            1000,
-            &mut rng,
-        );
-        assert!((exact.mean - 0.6).abs() < 1e-12, "{exact:?}");
-        assert!(
-            exact.variance < 1e-20 && exact.std_error() < 1e-10,
-            "{exact:?}"
-        );
-        let wrong = sampled_albedo(
-            &Cosine { pdf_scale: 2.0 },
-            lambert.as_ref(),
-            &wo,
-            1000,
-            &mut rng,
-        );
-        assert!((wrong.mean - 0.3).abs() < 1e-12, "{wrong:?}");
+        // A pdf reported twice too high halves the estimate.
+        for (pdf_scale, albedo) in [(1.0, 0.6), (2.0, 0.3)] {
+            let e = sampled_albedo(&Cosine { pdf_scale }, lambert.as_ref(), &wo, 1000, &mut rng);
+            assert!((e.mean - albedo).abs() < 1e-12, "{e:?}");
+            assert!(e.variance < 1e-20 && e.std_error() < 1e-10, "{e:?}");
+        }
+    }
+
+    #[test]
+    fn the_midpoint_rule_integrates_cos_and_the_cosine_pdf() {
+        // ∫ cos θ dσ = π; the cosine pdf integrates to 1, twice that pdf to 2.
+        let cos = upper_hemisphere_integral(&|w| w.z, 64, 128);
+        assert!((cos - std::f64::consts::PI).abs() < 1e-3, "{cos}");
+        for scale in [1.0, 2.0] {
+            let s = Cosine { pdf_scale: scale };
+            let wo = Vec3::new(0.0, 0.0, 1.0);
+            let total = upper_hemisphere_integral(&|w| s.pdf(&wo, w), 64, 128);
+            assert!((total - scale).abs() < 1e-3, "{total}");
+        }
     }
 }
