@@ -16,10 +16,7 @@ use rand::{Rng, SeedableRng};
 
 fn density(rect: Rect) -> TabulatedDensity<SinPiRows> {
     let (w, h) = (64, 32);
-    TabulatedDensity::new(w, h, sun_map(w, h, 40.0), rect)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap()
+    sin_rows(w, h, sun_map(w, h, 40.0), rect)
 }
 
 /// `len` samples of one `sample_into` call from a generator seeded with `seed`, and that
@@ -86,11 +83,7 @@ fn block_path_equals_one_sample_path_on_mapped_frame() {
 
 #[test]
 fn block_path_counts_the_same_violations() {
-    let broken = Broken {
-        inner: density(Rect::UNIT),
-        bound_scale: 0.5,
-        left_integral_scale: 1.0,
-    };
+    let broken = Broken::new(density(Rect::UNIT), 0.5, 1.0);
     let s = QuadTreeBuilder::new().max_depth(3).build(broken).unwrap();
     let a = check_same(&s, 5000, 7);
     assert!(a.violations > 100, "{a:?}");
@@ -99,11 +92,7 @@ fn block_path_counts_the_same_violations() {
 #[test]
 fn block_path_abandons_samples_at_the_trial_cap_like_the_one_sample_path() {
     // Bounds 1e30 too high: acceptance probability ~1e-30, every sample hits the cap.
-    let hopeless = Broken {
-        inner: density(Rect::UNIT),
-        bound_scale: 1e30,
-        left_integral_scale: 1.0,
-    };
+    let hopeless = Broken::new(density(Rect::UNIT), 1e30, 1.0);
     let s = QuadTreeBuilder::new().max_depth(2).build(hopeless).unwrap();
     let a = check_same(&s, 2, 9);
     assert_eq!(a.exhausted, 2, "{a:?}");

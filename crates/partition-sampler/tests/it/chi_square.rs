@@ -6,7 +6,7 @@ use crate::common;
 use common::*;
 use partition_sampler::{
     AllocationMode, Domain, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, SAMPLING_CONFIGS,
-    SampledGridDensity, Sampler2D, SinPiRows, TabulatedDensity, UserBoundDensity,
+    SampledGridDensity, Sampler2D, UserBoundDensity,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -45,6 +45,15 @@ fn fit<D: RegionStats>(
     chi_square_p(&h, masses)
 }
 
+/// `n × n` bins over the square around the unit disc.
+fn disc_bins(n: usize) -> Bins {
+    Bins {
+        rect: Rect::DISC_BOUNDS,
+        nx: n,
+        ny: n,
+    }
+}
+
 /// For the `k`-th of [`SAMPLING_CONFIGS`]: builds `density()` with `builder` set to its scheme
 /// and leaf choice, checks the fit of `n` samples of seed `seed + k` ([`fit`]) and that no
 /// bound was violated, then runs the test's own checks `more` on the sampler.
@@ -75,11 +84,7 @@ fn fit_every_config<D: RegionStats>(
 #[test]
 fn disc_phong_lobe_all_configs() {
     let f = phong_lobe(35.0, 30.0);
-    let bins = Bins {
-        rect: Rect::DISC_BOUNDS,
-        nx: 24,
-        ny: 24,
-    };
+    let bins = disc_bins(24);
     let masses = bins.masses(24, f, in_disc);
     fit_every_config(
         || SampledGridDensity::new(f, Domain::UnitDisc, 256).unwrap(),
@@ -96,16 +101,22 @@ fn disc_phong_lobe_all_configs() {
     );
 }
 
+/// The 64 × 32 map with a sun of 1e5, `nx × ny` bins over the unit square and their masses.
+fn sun_setup(nx: usize, ny: usize) -> (Vec<f64>, Bins, Vec<f64>) {
+    let vals = sun_map(64, 32, 1e5);
+    let bins = Bins {
+        rect: Rect::UNIT,
+        nx,
+        ny,
+    };
+    let masses = sun_map_masses(&vals, 64, 32, &bins);
+    (vals, bins, masses)
+}
+
 #[test]
 fn sun_map_with_sin_rows_all_configs() {
     let (w, h) = (64, 32);
-    let vals = sun_map(w, h, 1e5);
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 32,
-        ny: 16,
-    };
-    let masses = sun_map_masses(&vals, w, h, &bins);
+    let (vals, bins, masses) = sun_setup(32, 16);
     // Î is the exact integral, so the pdf integrates to one.
     let exact: f64 = (0..h)
         .map(|j| {
@@ -116,12 +127,7 @@ fn sun_map_with_sin_rows_all_configs() {
         })
         .sum();
     fit_every_config(
-        || {
-            TabulatedDensity::new(w, h, vals.clone(), Rect::UNIT)
-                .unwrap()
-                .with_row_factor(SinPiRows)
-                .unwrap()
-        },
+        || sin_rows(w, h, vals.clone(), Rect::UNIT),
         QuadTreeBuilder::new(),
         &bins,
         &masses,
@@ -144,17 +150,8 @@ fn sun_map_background_is_fit_when_sun_is_excluded() {
     // The sun holds ~99.6% of the mass; test the background separately with a conditional
     // chi-square over samples that fall outside the sun bin.
     let (w, h) = (64, 32);
-    let vals = sun_map(w, h, 1e5);
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 16,
-        ny: 8,
-    };
-    let mut masses = sun_map_masses(&vals, w, h, &bins);
-    let d = TabulatedDensity::new(w, h, vals, Rect::UNIT)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap();
+    let (vals, bins, mut masses) = sun_setup(16, 8);
+    let d = sin_rows(w, h, vals, Rect::UNIT);
     let s = QuadTreeBuilder::new().build(d).unwrap();
     let sun_bin = masses
         .iter()
@@ -224,11 +221,7 @@ fn user_bound_monotone_density() {
 #[test]
 fn batch_mode_fits_both_allocations() {
     let f = phong_lobe(20.0, 12.0);
-    let bins = Bins {
-        rect: Rect::DISC_BOUNDS,
-        nx: 16,
-        ny: 16,
-    };
+    let bins = disc_bins(16);
     let masses = bins.masses(24, f, in_disc);
     let d = SampledGridDensity::new(f, Domain::UnitDisc, 256).unwrap();
     let s = QuadTreeBuilder::new().build(d).unwrap();

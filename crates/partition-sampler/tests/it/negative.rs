@@ -40,33 +40,14 @@ fn p_value<D: RegionStats>(
 }
 
 fn density(vals: &[f64], w: usize, h: usize) -> TabulatedDensity<SinPiRows> {
-    TabulatedDensity::new(w, h, vals.to_vec(), Rect::UNIT)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap()
-}
-
-/// The map's density with its bounds scaled by `bound_scale` and the integrals of the cells in
-/// the left half by `left_integral_scale`.
-fn broken(
-    vals: &[f64],
-    w: usize,
-    h: usize,
-    bound_scale: f64,
-    left_integral_scale: f64,
-) -> Broken<TabulatedDensity<SinPiRows>> {
-    Broken {
-        inner: density(vals, w, h),
-        bound_scale,
-        left_integral_scale,
-    }
+    sin_rows(w, h, vals.to_vec(), Rect::UNIT)
 }
 
 #[test]
 fn correct_provider_passes() {
     let (vals, w, h) = map();
     let s = QuadTreeBuilder::new()
-        .build(broken(&vals, w, h, 1.0, 1.0))
+        .build(Broken::new(density(&vals, w, h), 1.0, 1.0))
         .unwrap();
     assert!(p_value(&s, &vals, w, h, 1) > ALPHA);
     assert_eq!(s.stats().bound_violations, 0);
@@ -77,7 +58,7 @@ fn too_low_bounds_are_flagged_by_audit_and_rejected_by_chi_square() {
     let (vals, w, h) = map();
     let s = QuadTreeBuilder::new()
         .max_depth(3)
-        .build(broken(&vals, w, h, 0.5, 1.0))
+        .build(Broken::new(density(&vals, w, h), 0.5, 1.0))
         .unwrap();
     let p = p_value(&s, &vals, w, h, 2);
     let st = s.stats();
@@ -94,7 +75,7 @@ fn wrong_integrals_bias_the_paper_scheme_but_not_the_envelope() {
             let s = QuadTreeBuilder::new()
                 .scheme(scheme)
                 .leaf_choice(choice)
-                .build(broken(&vals, w, h, 1.0, 1.5))
+                .build(Broken::new(density(&vals, w, h), 1.0, 1.5))
                 .unwrap();
             let p = p_value(&s, &vals, w, h, seed);
             if biased {
