@@ -17,7 +17,7 @@ use std::time::Instant;
 use baselines::cdf::{CascadeSlice, CdfSampler, SliceCdf, TabulatedSlice};
 use baselines::{CascadeCdf, CdfOptions, CdfReport, TabulatedCdf, UniformHemisphere};
 use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles};
-use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
+use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant, sampled_albedo};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -122,19 +122,7 @@ fn variance(brdf: &dyn Brdf, s: &dyn DirectionSampler, n: usize) -> f64 {
         .iter()
         .map(|&t| {
             let wo = direction_from_angles(t, 20.0);
-            let (mut m, mut m2) = (0.0, 0.0);
-            for _ in 0..per {
-                let d = s.sample(&wo, &mut rng);
-                let w = if d.pdf > 0.0 {
-                    brdf.eval(&wo, &d.wi) * d.wi.z.max(0.0) / d.pdf
-                } else {
-                    0.0
-                };
-                m += w;
-                m2 += w * w;
-            }
-            let mean = m / per as f64;
-            m2 / per as f64 - mean * mean
+            sampled_albedo(s, brdf, &wo, per, &mut rng).variance
         })
         .sum::<f64>()
         / THETA_O.len() as f64

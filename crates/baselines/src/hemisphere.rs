@@ -110,37 +110,30 @@ impl CosineHemisphere {
     }
 }
 
-impl DirectionSampler for UniformHemisphere {
-    fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
-        let u0 = u.next_uniform();
-        let u1 = u.next_uniform();
-        Self::sample_square([u0, u1])
-    }
-    fn pdf(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
-        square_to_uniform_hemisphere_pdf(wi)
-    }
-    fn bytes_used(&self) -> usize {
-        0
-    }
+/// The [`DirectionSampler`] of a fixed warp of the unit square (`$sampler::sample_square`, two
+/// uniforms per sample, independent of `ωo`) whose solid-angle density is `$pdf(ωi)`.
+macro_rules! square_warp_sampler {
+    ($sampler:ty, $pdf:path) => {
+        impl DirectionSampler for $sampler {
+            fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
+                let u0 = u.next_uniform();
+                let u1 = u.next_uniform();
+                Self::sample_square([u0, u1])
+            }
+            fn pdf(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
+                $pdf(wi)
+            }
+            fn bytes_used(&self) -> usize {
+                0
+            }
+        }
+
+        impl SamplerDiagnostics for $sampler {}
+    };
 }
 
-impl SamplerDiagnostics for UniformHemisphere {}
-
-impl DirectionSampler for CosineHemisphere {
-    fn sample(&self, _wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
-        let u0 = u.next_uniform();
-        let u1 = u.next_uniform();
-        Self::sample_square([u0, u1])
-    }
-    fn pdf(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
-        square_to_cosine_hemisphere_pdf(wi)
-    }
-    fn bytes_used(&self) -> usize {
-        0
-    }
-}
-
-impl SamplerDiagnostics for CosineHemisphere {}
+square_warp_sampler!(UniformHemisphere, square_to_uniform_hemisphere_pdf);
+square_warp_sampler!(CosineHemisphere, square_to_cosine_hemisphere_pdf);
 
 #[cfg(test)]
 mod tests {

@@ -17,7 +17,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles, models, parse_spec};
+use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles, parse_spec};
 use brdf_sampling::{
     DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SetOptions, Variant,
     disc::thread_evaluations, reference_albedo,
@@ -27,7 +27,7 @@ use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
 mod support;
-use support::{arg, cpu_seconds, integrate};
+use support::{arg, cpu_seconds, integrate, table_specs};
 
 const N_COS: usize = 128;
 const N_PHI: usize = 256;
@@ -112,15 +112,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let skip: Vec<String> = arg::<String>(&args, "--skip")
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
-    let mut specs: Vec<String> = models()
-        .iter()
-        .filter(|m| !m.needs_argument())
-        .map(|m| m.name.to_string())
-        .collect();
-    specs.push("merl(phong:n=50)".to_string());
-    if let Some(list) = arg::<String>(&args, "--specs") {
-        specs = list.split(';').map(str::to_string).collect();
-    }
+    let specs = table_specs(&args);
     println!(
         "{} random θo ∈ [0°, 89.5°] per model (L1 and ∫pdf at every {}th), {} samples per angle",
         n_angles, l1_every, samples

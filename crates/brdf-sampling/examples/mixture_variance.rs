@@ -8,8 +8,7 @@
 use std::sync::Arc;
 
 use brdf::{Brdf, parse_spec};
-use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
-use partition_sampler::UniformSource;
+use brdf_sampling::{QuadTreeSet, SetOptions, Variant, sampled_albedo};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 
@@ -17,20 +16,8 @@ use rand::rngs::Xoshiro256PlusPlus;
 fn weights(set: &QuadTreeSet, brdf: &dyn Brdf, theta_deg: f64, n: usize) -> (f64, f64) {
     let wo = brdf::direction_from_angles(theta_deg, 20.0);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-    let u: &mut dyn UniformSource = &mut rng;
-    let (mut s, mut s2) = (0.0, 0.0);
-    for _ in 0..n {
-        let d = set.sample(&wo, u);
-        let w = if d.pdf > 0.0 {
-            brdf.eval(&wo, &d.wi) * d.wi.z / d.pdf
-        } else {
-            0.0
-        };
-        s += w;
-        s2 += w * w;
-    }
-    let mean = s / n as f64;
-    (mean, (s2 / n as f64 - mean * mean).max(0.0))
+    let e = sampled_albedo(set, brdf, &wo, n, &mut rng);
+    (e.mean, e.variance)
 }
 
 fn main() {

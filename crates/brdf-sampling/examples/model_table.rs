@@ -17,13 +17,13 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use brdf::{Brdf, MerlBrdf, models, parse_spec};
+use brdf::{Brdf, MerlBrdf, parse_spec};
 use brdf_sampling::{DirectionSampler, QuadTreeSet, SetOptions, Variant};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
 mod support;
-use support::{arg, cpu_seconds};
+use support::{arg, cpu_seconds, table_specs};
 
 struct Row {
     name: String,
@@ -187,15 +187,7 @@ fn main() {
         "", "", "", "", "", "", "", "", "", "", ""
     );
     let mut rows = Vec::new();
-    let mut specs: Vec<String> = models()
-        .iter()
-        .filter(|m| !m.needs_argument())
-        .map(|m| m.name.to_string())
-        .collect();
-    specs.push("merl(phong:n=50)".to_string());
-    if let Some(list) = arg::<String>(&args, "--specs") {
-        specs = list.split(';').map(str::to_string).collect();
-    }
+    let specs = table_specs(&args);
     for spec in specs.iter().filter(|s| wanted(s)) {
         let brdf: Arc<dyn Brdf> =
             if let Some(inner) = spec.strip_prefix("merl(").and_then(|s| s.strip_suffix(')')) {

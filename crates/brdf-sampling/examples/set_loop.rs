@@ -17,18 +17,11 @@ use brdf::parse_spec;
 use brdf_sampling::{
     DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SetOptions, Variant, thread_evaluations,
 };
+use distributions::thread_cpu_seconds;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
-/// CPU seconds (user + system) of the calling thread (clock ticks of 1/100 s); `None` where
-/// `/proc/thread-self/stat` does not exist.
-fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
+mod support;
 
 /// One line per spec: CPU and wall time per sample, evaluations per sample; returns M samples/s
 /// from the thread's CPU time (wall time where CPU time is unavailable).
@@ -96,12 +89,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         run(spec, n, exact)?;
         return Ok(());
     }
-    let mut specs: Vec<String> = brdf::models()
-        .iter()
-        .filter(|m| !m.needs_argument())
-        .map(|m| m.name.to_string())
-        .collect();
-    specs.push("merl(phong:n=50)".to_string());
+    let specs = support::all_specs();
     let mut rates = Vec::new();
     for s in &specs {
         rates.push(run(s, n, exact)?);

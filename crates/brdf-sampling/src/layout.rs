@@ -279,13 +279,17 @@ mod tests {
     use approx::assert_relative_eq;
     use brdf::direction_from_angles;
 
+    fn layout(theta: usize, phi: usize, half_turn: bool) -> SliceLayout {
+        SliceLayout {
+            theta,
+            phi,
+            half_turn,
+        }
+    }
+
     #[test]
     fn nearest_slice_and_rotation() {
-        let l = SliceLayout {
-            theta: 90,
-            phi: 1,
-            half_turn: false,
-        };
+        let l = layout(90, 1, false);
         let c = l.nearest(&direction_from_angles(30.2, 40.0)).unwrap();
         assert_eq!(c.index, 30);
         assert_relative_eq!(l.theta_of(30).to_degrees(), 30.5, epsilon = 1e-12);
@@ -303,11 +307,7 @@ mod tests {
 
     #[test]
     fn anisotropic_nearest_phi_wraps() {
-        let l = SliceLayout {
-            theta: 4,
-            phi: 8,
-            half_turn: false,
-        };
+        let l = layout(4, 8, false);
         // φ = 350° is nearest to φ_0 = 0 with Δ = −10°.
         let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
         assert_eq!(c.index, 2 * 8);
@@ -322,37 +322,24 @@ mod tests {
 
     #[test]
     fn half_turn_layout_serves_the_opposite_azimuth_turned_by_pi() {
-        let l = SliceLayout {
-            theta: 4,
-            phi: 4,
-            half_turn: true,
-        };
-        // Slices at φ = 0°, 45°, 90°, 135°; φo = 227° is served by 45° turned by 182°.
-        let c = l.nearest(&direction_from_angles(50.0, 227.0)).unwrap();
-        assert_eq!(c.index % 4, 1);
-        assert_relative_eq!(
-            c.rotation.angle().to_degrees().rem_euclid(360.0),
-            182.0,
-            epsilon = 1e-9
-        );
+        let l = layout(4, 4, true);
+        // Slices at φ = 0°, 45°, 90°, 135°; φo = 227° is served by 45° turned by 182°, and
         // φo = 350° is nearest to 180° ≡ slice 0, turned by 350°.
-        let c = l.nearest(&direction_from_angles(50.0, 350.0)).unwrap();
-        assert_eq!(c.index % 4, 0);
-        assert_relative_eq!(
-            c.rotation.angle().to_degrees().rem_euclid(360.0),
-            350.0,
-            epsilon = 1e-9
-        );
+        for (phi_o, slice, turn) in [(227.0, 1, 182.0), (350.0, 0, 350.0)] {
+            let c = l.nearest(&direction_from_angles(50.0, phi_o)).unwrap();
+            assert_eq!(c.index % 4, slice);
+            assert_relative_eq!(
+                c.rotation.angle().to_degrees().rem_euclid(360.0),
+                turn,
+                epsilon = 1e-9
+            );
+        }
         assert_relative_eq!(l.phi_of(3).to_degrees(), 135.0, epsilon = 1e-12);
     }
 
     #[test]
     fn neighbour_weights_are_linear_in_theta() {
-        let l = SliceLayout {
-            theta: 9,
-            phi: 1,
-            half_turn: false,
-        };
+        let l = layout(9, 1, false);
         // Centres at 5°, 15°, …, 85°.
         let [a, b] = l.neighbours(&direction_from_angles(12.5, 0.0)).unwrap();
         assert_eq!((a.index, b.index), (0, 1));
@@ -367,26 +354,10 @@ mod tests {
     #[test]
     fn the_locator_chooses_the_layouts_nearest_slice_without_trigonometry() {
         for layout in [
-            SliceLayout {
-                theta: 90,
-                phi: 1,
-                half_turn: false,
-            },
-            SliceLayout {
-                theta: 7,
-                phi: 1,
-                half_turn: false,
-            },
-            SliceLayout {
-                theta: 5,
-                phi: 6,
-                half_turn: false,
-            },
-            SliceLayout {
-                theta: 32,
-                phi: 8,
-                half_turn: true,
-            },
+            layout(90, 1, false),
+            layout(7, 1, false),
+            layout(5, 6, false),
+            layout(32, 8, true),
         ] {
             let locator = SliceLocator::new(layout);
             for i in 0..5000 {

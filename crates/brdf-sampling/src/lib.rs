@@ -99,6 +99,7 @@ mod pdf_cells;
 mod persist;
 mod reference;
 mod report;
+mod sampler_checks;
 mod set;
 
 pub use direction_sampler::{DirSample, DirectionSampler, EvalSample, SamplerDiagnostics};
@@ -109,7 +110,7 @@ pub use disc::{
 pub use error::{SetError, SetFileError};
 pub use exact::{CellLayout, ExactError, ExactOptions, ExactReport, ExactSet};
 pub use layout::{SliceChoice, SliceLayout, SliceLocator, Turn};
-pub use options::{DiscMapPolicy, OptionsError, SetOptions, Variant};
+pub use options::{DiscMapPolicy, OptionsError, SetOptions, Variant, bad_slice_count};
 pub use pdf_cells::{CellCoords, PdfCellRow, PdfCells};
 pub use persist::{MAX_LOADED_MEAN_TRIALS, SET_FORMAT_VERSION};
 pub use reference::{
@@ -117,4 +118,5 @@ pub use reference::{
     reference_albedo_with_budget,
 };
 pub use report::{CostMeasurement, SetReport};
+pub use sampler_checks::{SampledAlbedo, sampled_albedo, upper_hemisphere_integral};
 pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

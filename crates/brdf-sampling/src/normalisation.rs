@@ -251,14 +251,7 @@ pub(crate) fn adaptive_quadrature(
             heap.push(WorstFirst(p));
             continue;
         }
-        let r = worst.rect;
-        let c = r.center();
-        for q in [
-            Rect::new(r.x0, r.y0, c[0], c[1]),
-            Rect::new(c[0], r.y0, r.x1, c[1]),
-            Rect::new(r.x0, c[1], c[0], r.y1),
-            Rect::new(c[0], c[1], r.x1, r.y1),
-        ] {
+        for q in worst.rect.quadrants() {
             let p = piece(worst.leaf, q);
             err += p.err;
             heap.push(p);

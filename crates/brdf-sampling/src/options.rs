@@ -285,18 +285,30 @@ pub enum OptionsError {
     },
 }
 
+/// The first of the slice counts of a sliced sampler's options (`slices` for isotropic
+/// BRDFs, `anisotropic_slices` = `[θ, φ]`) outside `1 ..= max`, named as the options' errors
+/// name it (`slices`, `anisotropic θ slices`, `anisotropic φ slices`); `None` when all fit.
+pub fn bad_slice_count(
+    slices: usize,
+    anisotropic_slices: [usize; 2],
+    max: usize,
+) -> Option<(&'static str, usize)> {
+    [
+        ("slices", slices),
+        ("anisotropic θ slices", anisotropic_slices[0]),
+        ("anisotropic φ slices", anisotropic_slices[1]),
+    ]
+    .into_iter()
+    .find(|&(_, value)| !(1..=max).contains(&value))
+}
+
 impl SetOptions {
     /// Checks every field (see [`OptionsError`]).
     pub fn validate(&self) -> Result<(), OptionsError> {
-        let counts = [
-            ("slices", self.slices),
-            ("anisotropic θ slices", self.anisotropic_slices[0]),
-            ("anisotropic φ slices", self.anisotropic_slices[1]),
-        ];
-        for (what, value) in counts {
-            if value == 0 || value > Self::MAX_SLICES {
-                return Err(OptionsError::InvalidSlices { what, value });
-            }
+        if let Some((what, value)) =
+            bad_slice_count(self.slices, self.anisotropic_slices, Self::MAX_SLICES)
+        {
+            return Err(OptionsError::InvalidSlices { what, value });
         }
         self.tree.validate().map_err(OptionsError::Tree)?;
         if !(self.grid.is_power_of_two() && (4..=Self::MAX_GRID).contains(&self.grid)) {

@@ -30,6 +30,15 @@ const MAGIC: &[u8; 4] = b"BRQS";
 /// Relative tolerance of the BRDF probe check on load.
 const PROBE_TOLERANCE: f64 = 1e-9;
 
+/// The bytes of the file at `path` (a failure as [`SetFileError::Io`]), for every stored set's
+/// `load`.
+pub(crate) fn read_set_file(path: &Path) -> Result<Vec<u8>, SetFileError> {
+    std::fs::read(path).map_err(|source| SetFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// Largest accepted estimate of a loaded slice's mean rejection trials per sample (its leaves'
 /// summed envelope volume over the density at the leaf centres times the leaf areas). Built
 /// sets stay in the single digits (a few hundred for slices of absurd BRDFs, e.g. a MERL
@@ -40,9 +49,7 @@ pub const MAX_LOADED_MEAN_TRIALS: f64 = 1e4;
 
 #[derive(Serialize, Deserialize)]
 struct Stored {
-    spec: String,
-    brdf_name: String,
-    probes: Vec<f64>,
+    head: StoredHead,
     variant: Variant,
     options: SetOptions,
     layout: SliceLayout,
@@ -52,6 +59,28 @@ struct Stored {
     /// Zero floor of each slice's density ([`crate::SUPPORT_FLOOR`]).
     floors: Vec<f64>,
     trees: Vec<Vec<u8>>,
+}
+
+/// The fields every stored set's payload starts with: the BRDF spec it was built from, the
+/// BRDF's name and its [`probes`]. Postcard writes a nested struct as its fields in order, so
+/// a payload holds them exactly as if they were inline.
+#[derive(Serialize, Deserialize)]
+pub(crate) struct StoredHead {
+    /// The BRDF spec (trimmed).
+    pub(crate) spec: String,
+    brdf_name: String,
+    probes: Vec<f64>,
+}
+
+impl StoredHead {
+    /// The head of a set of `brdf` built from `spec`.
+    pub(crate) fn new(spec: String, brdf: &dyn Brdf) -> Self {
+        Self {
+            spec,
+            brdf_name: brdf.name().to_string(),
+            probes: probes(brdf),
+        }
+    }
 }
 
 /// `f_r` at 32 fixed direction pairs (half of them near the mirror direction).
@@ -120,24 +149,23 @@ pub(crate) fn encode<T: Serialize>(magic: &[u8; 4], version: u32, stored: &T) ->
 }
 
 /// The checks every stored set's `from_bytes` starts with, in this order: the given `spec`
-/// (trimmed) is the stored one ([`SetFileError::SpecMismatch`]), `brdf` reproduces the stored
+/// (trimmed) is the one in the stored `head` ([`SetFileError::SpecMismatch`]), `brdf` reproduces the stored
 /// probe values ([`check_probes`]) and the stored options validate (`options`, the result of
 /// their `validate()`; [`SetFileError::Corrupt`]). Shared by [`QuadTreeSet::from_bytes`] and
 /// [`crate::ExactSet::from_bytes`].
 pub(crate) fn check_stored<E: std::fmt::Display>(
-    stored_spec: &str,
+    head: &StoredHead,
     spec: &str,
-    stored_probes: &[f64],
     brdf: &dyn Brdf,
     options: Result<(), E>,
 ) -> Result<(), SetFileError> {
-    if stored_spec != spec.trim() {
+    if head.spec != spec.trim() {
         return Err(SetFileError::SpecMismatch {
-            stored: stored_spec.to_string(),
+            stored: head.spec.clone(),
             given: spec.trim().to_string(),
         });
     }
-    check_probes(stored_probes, brdf)?;
+    check_probes(&head.probes, brdf)?;
     options.map_err(|e| SetFileError::Corrupt(format!("options: {e}")))
 }
 
@@ -186,9 +214,7 @@ impl QuadTreeSet {
     /// Encodes the set: header (magic, version) + postcard payload (see the module docs).
     pub fn to_bytes(&self) -> Vec<u8> {
         let stored = Stored {
-            spec: self.spec.clone(),
-            brdf_name: self.brdf.name().to_string(),
-            probes: probes(self.brdf.as_ref()),
+            head: StoredHead::new(self.spec.clone(), self.brdf.as_ref()),
             variant: self.variant,
             options: self.options,
             layout: self.locator.layout(),
@@ -208,7 +234,7 @@ impl QuadTreeSet {
     /// The BRDF spec recorded in stored bytes (to parse the BRDF before
     /// [`QuadTreeSet::from_bytes`]).
     pub fn stored_spec(bytes: &[u8]) -> Result<String, SetFileError> {
-        decode(bytes).map(|s| s.spec)
+        decode(bytes).map(|s| s.head.spec)
     }
 
     /// Decodes a set written by [`QuadTreeSet::to_bytes`] and re-attaches `brdf`.
@@ -221,8 +247,7 @@ impl QuadTreeSet {
     /// [`SetFileError::Tree`] / [`SetFileError::Attach`] for a bad tree.
     pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
         let s = decode(bytes)?;
-        let options = s.options.validate();
-        check_stored(&s.spec, spec, &s.probes, brdf.as_ref(), options)?;
+        check_stored(&s.head, spec, brdf.as_ref(), s.options.validate())?;
         if layout_for(brdf.as_ref(), &s.options) != s.layout
             || s.layout.len() != s.trees.len()
             || s.maps.len() != s.trees.len()
@@ -279,7 +304,7 @@ impl QuadTreeSet {
         }
         Ok(QuadTreeSet {
             brdf,
-            spec: s.spec,
+            spec: s.head.spec,
             variant: s.variant,
             options: s.options,
             locator: crate::layout::SliceLocator::new(s.layout),
@@ -301,11 +326,7 @@ impl QuadTreeSet {
 
     /// Reads a set from `path` and re-attaches `brdf` (see [`QuadTreeSet::from_bytes`]).
     pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
-        let bytes = std::fs::read(path).map_err(|source| SetFileError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_bytes(&bytes, brdf, spec)
+        Self::from_bytes(&read_set_file(path)?, brdf, spec)
     }
 }
 

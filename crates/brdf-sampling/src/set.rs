@@ -231,19 +231,22 @@ fn build_slice(
         .build_tree(&map)
         .map_err(tree_error)?;
     drop(map);
+    // Both variants check the image map's integrals against the same per-leaf quadrature (the
+    // papers' variant without the mirror symmetry: its leaf values become the leaf
+    // probabilities).
+    let q = per_leaf_quadrature(
+        &Counted {
+            f: &f,
+            counter: &counter,
+        },
+        tree.leaves(),
+        tree.integral(),
+        mirror_y && variant == Variant::Adaptive,
+        Grading::Fixed,
+    );
+    let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
     let norm = match variant {
         Variant::Adaptive => {
-            let counted = Counted {
-                f: &f,
-                counter: &counter,
-            };
-            let q = per_leaf_quadrature(
-                &counted,
-                tree.leaves(),
-                tree.integral(),
-                mirror_y,
-                Grading::Fixed,
-            );
             let (i_leaves, rel_err) = (q.total, q.rel_err);
             // Keep the grid's Î when its own error estimate is the smaller one and is not
             // contradicted by the leaf rule: when the two integrals differ by more than the
@@ -251,7 +254,6 @@ fn build_slice(
             // rule's value is kept — its estimate `|I₈ − I₅|` is the low order's error, so it
             // is pessimistic on rough data such as the Cornell interpolant (acryl_blue at
             // 45.5°: grid 2.0e-3 off claiming 1.0e-3, leaves 4e-5 off claiming 1.1e-3).
-            let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
             let disagreement = ((i_leaves - tree.integral()) / i_leaves).abs();
             if i_leaves.is_finite()
                 && i_leaves > 0.0
@@ -274,18 +276,6 @@ fn build_slice(
             // The papers' scheme picks leaves ∝ I_i, so its pdf f/Î is exact only when every
             // I_i is: replace the image map's I_i by the leaf quadrature's when that is the
             // more accurate (the leaves, bounds and sampling procedure are the papers').
-            let counted = Counted {
-                f: &f,
-                counter: &counter,
-            };
-            let q = per_leaf_quadrature(
-                &counted,
-                tree.leaves(),
-                tree.integral(),
-                false,
-                Grading::Fixed,
-            );
-            let grid_err = tree.integral_rel_err().unwrap_or(f64::INFINITY);
             // Only the estimates decide here: the leaf rule's per-leaf values also set the
             // leaf probabilities, and on the Cornell fixture the disagreement rule of the
             // adaptive variant made this variant's `|∫pdf − 1|` worse (1.1e-3 → 1.6e-3).
@@ -486,15 +476,13 @@ impl QuadTreeSet {
     /// Density of `wi` under slice choice `c` alone, w.r.t. solid angle.
     #[inline]
     fn slice_pdf(&self, c: &SliceChoice, wi: &Vec3) -> f64 {
-        if !(wi.z > 0.0) {
-            return 0.0;
+        match self.trees.get(c.index) {
+            Some(tree) if wi.z > 0.0 => tree
+                .density()
+                .map()
+                .area_to_solid_angle(self.slice_area_pdf(c, wi), wi),
+            _ => 0.0,
         }
-        let Some(tree) = self.trees.get(c.index) else {
-            return 0.0;
-        };
-        let map = tree.density().map();
-        let v = c.rotation.undo(wi);
-        map.area_to_solid_angle(tree.pdf(map.to_disc(&v)) * self.norm_factor(c.index), wi)
     }
 
     /// The factor turning tree `index`'s pdf `f / Î_grid` into the set's `f / Î_leaves`.

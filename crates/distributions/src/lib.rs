@@ -22,7 +22,9 @@ pub mod rect;
 pub use contract::{
     AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,
 };
-pub use parallel::{PAR_CHUNK, Shard, ShardError, chunk_rng, chunk_seed, sample_par};
+pub use parallel::{
+    PAR_CHUNK, Shard, ShardError, chunk_rng, chunk_seed, on_threads, sample_par, thread_cpu_seconds,
+};
 pub use piecewise_constant::{
     ONE_MINUS_EPSILON, PiecewiseConstant1D, PiecewiseConstant2D, PiecewiseConstantError, Sample1,
     clamp_unit, fill_cdf, fill_guide, find_cell, find_cell_guided,

@@ -11,6 +11,32 @@ use crate::contract::{Sample2, Sampler2D};
 /// Samples per chunk of [`sample_par`]; each chunk has its own generator.
 pub const PAR_CHUNK: usize = 4096;
 
+/// `f` run inside a new rayon pool of `threads` threads: how a caller checks that a parallel
+/// result does not depend on the thread count (run it on 1 and on 2 threads, compare).
+///
+/// Errors: the pool cannot be built (e.g. the system refuses to start threads).
+pub fn on_threads<T: Send>(
+    threads: usize,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T, rayon::ThreadPoolBuildError> {
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?
+        .install(f))
+}
+
+/// CPU seconds (user + system) of the calling thread, from `/proc/thread-self/stat` (Linux;
+/// clock ticks of 1/100 s); `None` where that file does not exist or does not parse. The cost
+/// figure of a one-thread sampling loop to quote on a loaded machine.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.get(stat.rfind(')')? + 2..)?;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
 /// SplitMix64 finaliser.
 #[inline]
 pub(crate) fn splitmix64(mut z: u64) -> u64 {
@@ -91,5 +117,26 @@ impl Shard {
     /// Whether item `i` of the full run belongs to this shard.
     pub fn contains(&self, i: usize) -> bool {
         i % self.count == self.index - 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn on_threads_runs_inside_a_pool_of_that_size() {
+        for threads in [1, 3] {
+            let seen = on_threads(threads, rayon::current_num_threads).unwrap();
+            assert_eq!(seen, threads);
+        }
+    }
+
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn thread_cpu_seconds_reads_a_non_decreasing_clock_on_linux() {
+        let before = thread_cpu_seconds().expect("/proc/thread-self/stat readable");
+        let after = thread_cpu_seconds().unwrap();
+        assert!(before >= 0.0 && after >= before, "{before} then {after}");
     }
 }

@@ -63,6 +63,18 @@ impl Rect {
         [0.5 * (self.x0 + self.x1), 0.5 * (self.y0 + self.y1)]
     }
 
+    /// The four quadrants around the centre, in the quadtree's child order (x first):
+    /// `(lo, lo)`, `(hi, lo)`, `(lo, hi)`, `(hi, hi)`.
+    pub fn quadrants(&self) -> [Rect; 4] {
+        let [cx, cy] = self.center();
+        [
+            Rect::new(self.x0, self.y0, cx, cy),
+            Rect::new(cx, self.y0, self.x1, cy),
+            Rect::new(self.x0, cy, cx, self.y1),
+            Rect::new(cx, cy, self.x1, self.y1),
+        ]
+    }
+
     /// Finite bounds with `x0 < x1` and `y0 < y1`.
     pub fn is_valid(&self) -> bool {
         self.x0.is_finite()
@@ -123,6 +135,13 @@ impl Domain {
             Domain::Rect(r) => r.contains(p),
             Domain::UnitDisc => p[0] * p[0] + p[1] * p[1] <= 1.0,
         }
+    }
+
+    /// `f(p)` where `p` is in the domain, else 0: the value at `p` of a density `f` restricted
+    /// to the domain.
+    #[inline]
+    pub fn restrict(&self, p: Point2, f: impl FnOnce(Point2) -> f64) -> f64 {
+        if self.contains(p) { f(p) } else { 0.0 }
     }
 
     /// Area of the domain (π for the disc).
@@ -215,5 +234,25 @@ mod tests {
         assert!(r.contains([2.0, 1.0]) && !r.contains_half_open([2.0, 0.5]));
         assert!(!r.contains([f64::NAN, 0.5]));
         assert!(!Rect::new(0.0, 0.0, 0.0, 1.0).is_valid());
+    }
+
+    #[test]
+    fn restrict_is_zero_outside_the_domain() {
+        let f = |p: Point2| 1.0 + p[0];
+        assert_eq!(Domain::UnitDisc.restrict([0.5, 0.5], f), 1.5);
+        assert_eq!(Domain::UnitDisc.restrict([0.9, 0.9], f), 0.0);
+        assert_eq!(Domain::Rect(Rect::UNIT).restrict([1.0, 0.0], f), 2.0);
+        assert_eq!(Domain::Rect(Rect::UNIT).restrict([f64::NAN, 0.5], f), 0.0);
+    }
+
+    #[test]
+    fn quadrants_tile_the_rect_in_child_order() {
+        let r = Rect::new(-1.0, 0.5, 3.0, 2.5);
+        let q = r.quadrants();
+        assert_eq!(q[0], Rect::new(-1.0, 0.5, 1.0, 1.5));
+        assert_eq!(q[1], Rect::new(1.0, 0.5, 3.0, 1.5));
+        assert_eq!(q[2], Rect::new(-1.0, 1.5, 1.0, 2.5));
+        assert_eq!(q[3], Rect::new(1.0, 1.5, 3.0, 2.5));
+        assert_eq!(q.iter().map(Rect::area).sum::<f64>(), r.area());
     }
 }

@@ -76,6 +76,31 @@ const LOOP: usize = 100_000;
 const BLOCK: usize = 250;
 const PAR: usize = 1_000_000;
 
+/// Group `group`: per sampler, `LOOP` calls of `draw` (one sample each, its value summed) from
+/// a generator seeded with 1.
+fn bench_one_sample_loop<'a>(
+    c: &mut Criterion,
+    group: String,
+    samplers: impl IntoIterator<Item = &'a (&'static str, EnvMapSampler)>,
+    draw: impl Fn(&EnvMapSampler, &mut Xoshiro256PlusPlus) -> f64,
+) {
+    let mut g = c.benchmark_group(group);
+    g.throughput(Throughput::Elements(LOOP as u64));
+    for (name, s) in samplers {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut acc = 0.0;
+                for _ in 0..LOOP {
+                    acc += draw(s, &mut rng);
+                }
+                acc
+            })
+        });
+    }
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
     for (map_name, map) in maps() {
         let mut build = c.benchmark_group(format!("build/{map_name}"));
@@ -103,21 +128,9 @@ fn benches(c: &mut Criterion) {
             }
         }
 
-        let mut g = c.benchmark_group(format!("uv_1t/{map_name}"));
-        g.throughput(Throughput::Elements(LOOP as u64));
-        for (name, s) in &samplers {
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-            g.bench_function(*name, |b| {
-                b.iter(|| {
-                    let mut acc = 0.0;
-                    for _ in 0..LOOP {
-                        acc += s.sample_uv(&mut rng).pdf;
-                    }
-                    acc
-                })
-            });
-        }
-        g.finish();
+        bench_one_sample_loop(c, format!("uv_1t/{map_name}"), &samplers, |s, rng| {
+            s.sample_uv(rng).pdf
+        });
 
         let mut g = c.benchmark_group(format!("uv_block_1t/{map_name}"));
         g.throughput(Throughput::Elements(LOOP as u64));
@@ -143,24 +156,12 @@ fn benches(c: &mut Criterion) {
         }
         g.finish();
 
-        let mut g = c.benchmark_group(format!("dir_1t/{map_name}"));
-        g.throughput(Throughput::Elements(LOOP as u64));
-        for (name, s) in samplers
+        let some = samplers
             .iter()
-            .filter(|(n, _)| matches!(*n, "envelope-alias" | "pwc"))
-        {
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-            g.bench_function(*name, |b| {
-                b.iter(|| {
-                    let mut acc = 0.0;
-                    for _ in 0..LOOP {
-                        acc += s.sample(&mut rng).pdf_sa;
-                    }
-                    acc
-                })
-            });
-        }
-        g.finish();
+            .filter(|(n, _)| matches!(*n, "envelope-alias" | "pwc"));
+        bench_one_sample_loop(c, format!("dir_1t/{map_name}"), some, |s, rng| {
+            s.sample(rng).pdf_sa
+        });
 
         let mut g = c.benchmark_group(format!("uv_par/{map_name}"));
         g.throughput(Throughput::Elements(PAR as u64));

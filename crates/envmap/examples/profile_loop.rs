@@ -10,21 +10,11 @@
 
 use std::time::Instant;
 
-use distributions::{Sample2, Sampler2D};
+use distributions::{Sample2, Sampler2D, thread_cpu_seconds};
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapSampler, LeafChoice, SamplerKind, Scheme, procedural_sky,
 };
 
-/// CPU seconds (user + system) of the calling thread, from `/proc/thread-self/stat` (clock
-/// ticks of 1/100 s); `None` where that file does not exist.
-fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -33,6 +33,18 @@ fn row<D: RegionStats>(label: &str, s: &QuadTreeSampler<D>, build_ms: f64) {
     );
 }
 
+/// The `n_max` values of the sweeps.
+const N_MAX: [f64; 5] = [1.3, 1.6, 2.0, 2.3, 2.6];
+/// The depths of the `max_depth` sweeps.
+const DEPTHS: [u32; 10] = [5, 6, 7, 8, 9, 10, 11, 12, 14, 16];
+
+/// Builds `density` with `builder` and prints its [`row`] with the build's wall time.
+fn timed_row<D: RegionStats>(label: &str, builder: QuadTreeBuilder, density: D) {
+    let t = Instant::now();
+    let s = builder.build(density).expect("build");
+    row(label, &s, t.elapsed().as_secs_f64() * 1e3);
+}
+
 fn header(title: &str) {
     println!("\n{title}");
     println!(
@@ -75,93 +87,43 @@ fn main() {
         header(&format!(
             "n_max sweep, Phong lobe e=1000 on the disc, max_depth 12, {name} scheme"
         ));
-        for n_max in [1.3, 1.6, 2.0, 2.3, 2.6] {
-            let t = Instant::now();
-            let s = QuadTreeBuilder::new()
-                .n_max(n_max)
-                .scheme(scheme)
-                .build(lobe_grid.clone())
-                .expect("build");
-            let ms = t.elapsed().as_secs_f64() * 1e3;
-            row(&format!("n_max {n_max}"), &s, ms);
+        for n_max in N_MAX {
+            let b = QuadTreeBuilder::new().n_max(n_max).scheme(scheme);
+            timed_row(&format!("n_max {n_max}"), b, lobe_grid.clone());
         }
         header(&format!(
             "n_max sweep, 1024x512 map with sun, max_depth 12, {name} scheme"
         ));
-        for n_max in [1.3, 1.6, 2.0, 2.3, 2.6] {
-            let t = Instant::now();
-            let s = QuadTreeBuilder::new()
-                .n_max(n_max)
-                .scheme(scheme)
-                .build(map.clone())
-                .expect("build");
-            let ms = t.elapsed().as_secs_f64() * 1e3;
-            row(&format!("n_max {n_max}"), &s, ms);
+        for n_max in N_MAX {
+            let b = QuadTreeBuilder::new().n_max(n_max).scheme(scheme);
+            timed_row(&format!("n_max {n_max}"), b, map.clone());
         }
     }
     header("max_depth sweep, n_max 2, envelope + alias (lobe)");
-    for d in [5, 6, 7, 8, 9, 10, 11, 12, 14, 16] {
-        let t = Instant::now();
-        let s = QuadTreeBuilder::new()
-            .max_depth(d)
-            .build(lobe_grid.clone())
-            .expect("build");
-        row(
-            &format!("lobe depth {d}"),
-            &s,
-            t.elapsed().as_secs_f64() * 1e3,
-        );
+    for d in DEPTHS {
+        let b = QuadTreeBuilder::new().max_depth(d);
+        timed_row(&format!("lobe depth {d}"), b, lobe_grid.clone());
     }
     header("max_depth sweep, n_max 2, envelope + alias (map)");
-    for d in [5, 6, 7, 8, 9, 10, 11, 12, 14, 16] {
-        let t = Instant::now();
-        let s = QuadTreeBuilder::new()
-            .max_depth(d)
-            .build(map.clone())
-            .expect("build");
-        row(
-            &format!("map depth {d}"),
-            &s,
-            t.elapsed().as_secs_f64() * 1e3,
-        );
+    for d in DEPTHS {
+        let b = QuadTreeBuilder::new().max_depth(d);
+        timed_row(&format!("map depth {d}"), b, map.clone());
     }
     header("volume tolerance sweep, n_max 2, default depth (lobe / map)");
     for tol in [0.0, 1e-8, 1e-6, 1e-4] {
-        let t = Instant::now();
-        let s = QuadTreeBuilder::new()
-            .volume_tolerance(tol)
-            .build(lobe_grid.clone())
-            .expect("build");
-        row(
-            &format!("lobe tol {tol:e}"),
-            &s,
-            t.elapsed().as_secs_f64() * 1e3,
-        );
-        let t = Instant::now();
-        let s = QuadTreeBuilder::new()
-            .volume_tolerance(tol)
-            .build(map.clone())
-            .expect("build");
-        row(
-            &format!("map tol {tol:e}"),
-            &s,
-            t.elapsed().as_secs_f64() * 1e3,
-        );
+        let b = QuadTreeBuilder::new().volume_tolerance(tol);
+        timed_row(&format!("lobe tol {tol:e}"), b, lobe_grid.clone());
+        timed_row(&format!("map tol {tol:e}"), b, map.clone());
     }
     header("leaf choice, n_max 2, default depth");
     for (name, choice) in [
         ("alias", LeafChoice::Alias),
         ("descent", LeafChoice::Descent),
     ] {
-        let s = QuadTreeBuilder::new()
-            .leaf_choice(choice)
-            .build(lobe_grid.clone())
-            .expect("build");
+        let b = QuadTreeBuilder::new().leaf_choice(choice);
+        let s = b.build(lobe_grid.clone()).expect("build");
         row(&format!("lobe {name}"), &s, 0.0);
-        let s = QuadTreeBuilder::new()
-            .leaf_choice(choice)
-            .build(map.clone())
-            .expect("build");
+        let s = b.build(map.clone()).expect("build");
         row(&format!("map {name}"), &s, 0.0);
     }
 }

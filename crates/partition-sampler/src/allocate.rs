@@ -167,22 +167,16 @@ mod tests {
     #[test]
     fn systematic_extra_units_follow_the_uniform() {
         // N p = [0.5, 0.5]: one extra unit goes to stratum 0 when u < 0.5, else to stratum 1.
-        let c = allocate(
-            1,
-            &[1.0, 1.0],
-            AllocationMode::RandomizedRemainder,
-            &mut UniformSequence::new(&[0.2]),
-        )
-        .unwrap();
-        assert_eq!(c, vec![1, 0]);
-        let c = allocate(
-            1,
-            &[1.0, 1.0],
-            AllocationMode::RandomizedRemainder,
-            &mut UniformSequence::new(&[0.7]),
-        )
-        .unwrap();
-        assert_eq!(c, vec![0, 1]);
+        for (u, expected) in [(0.2, vec![1, 0]), (0.7, vec![0, 1])] {
+            let c = allocate(
+                1,
+                &[1.0, 1.0],
+                AllocationMode::RandomizedRemainder,
+                &mut UniformSequence::new(&[u]),
+            )
+            .unwrap();
+            assert_eq!(c, expected, "u = {u}");
+        }
     }
 
     #[test]

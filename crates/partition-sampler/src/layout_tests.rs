@@ -129,12 +129,7 @@ fn peak(
 }
 
 fn schemes() -> impl Strategy<Value = (Scheme, LeafChoice)> {
-    prop_oneof![
-        Just((Scheme::Envelope, LeafChoice::Alias)),
-        Just((Scheme::Envelope, LeafChoice::Descent)),
-        Just((Scheme::Paper, LeafChoice::Alias)),
-        Just((Scheme::Paper, LeafChoice::Descent)),
-    ]
+    proptest::sample::select(crate::SAMPLING_CONFIGS.to_vec())
 }
 
 /// Random domains: the disc, rectangles with dyadic roots (identity frame) and arbitrary

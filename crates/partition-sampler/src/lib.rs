@@ -111,5 +111,5 @@ pub use sampled::{
     Refinement, SampledGridDensity,
 };
 pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows, sin_pi_unit};
-pub use tree::{LeafChoice, LeafInfo, QuadTree, Scheme, TreeCounts, TreeParams};
+pub use tree::{LeafChoice, LeafInfo, QuadTree, SAMPLING_CONFIGS, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;

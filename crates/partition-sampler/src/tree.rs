@@ -35,6 +35,15 @@ pub enum LeafChoice {
     Descent,
 }
 
+/// Every sampling configuration: both [`Scheme`]s with both [`LeafChoice`]s (envelope first,
+/// alias first).
+pub const SAMPLING_CONFIGS: [(Scheme, LeafChoice); 4] = [
+    (Scheme::Envelope, LeafChoice::Alias),
+    (Scheme::Envelope, LeafChoice::Descent),
+    (Scheme::Paper, LeafChoice::Alias),
+    (Scheme::Paper, LeafChoice::Descent),
+];
+
 /// Parameters a tree was built with.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TreeParams {

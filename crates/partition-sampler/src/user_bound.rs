@@ -73,11 +73,7 @@ impl<D, B> std::fmt::Debug for UserBoundDensity<D, B> {
 impl<D: Density, B: Fn(&Rect) -> f64 + Sync> Density for UserBoundDensity<D, B> {
     #[inline]
     fn eval(&self, p: Point2) -> f64 {
-        if self.domain.contains(p) {
-            self.f.eval(p)
-        } else {
-            0.0
-        }
+        self.domain.restrict(p, |p| self.f.eval(p))
     }
 }
 

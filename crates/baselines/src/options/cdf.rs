@@ -123,15 +123,10 @@ impl CdfOptions {
     /// Checks every field (see [`CdfOptionsError`]); the total size is checked by
     /// [`CdfOptions::validate_size`] once the slice count is known.
     pub fn validate(&self) -> Result<(), CdfOptionsError> {
-        let counts = [
-            ("slices", self.slices),
-            ("anisotropic θ slices", self.anisotropic_slices[0]),
-            ("anisotropic φ slices", self.anisotropic_slices[1]),
-        ];
-        for (what, value) in counts {
-            if !(1..=Self::MAX_SLICES).contains(&value) {
-                return Err(CdfOptionsError::Slices { what, value });
-            }
+        if let Some((what, value)) =
+            brdf_sampling::bad_slice_count(self.slices, self.anisotropic_slices, Self::MAX_SLICES)
+        {
+            return Err(CdfOptionsError::Slices { what, value });
         }
         for (what, value) in [("n_z", self.n_z), ("n_phi", self.n_phi)] {
             if !(1..=Self::MAX_CELLS_PER_AXIS).contains(&value) {

@@ -181,11 +181,8 @@ fn compression_shrinks_as_epsilon_grows_and_reports_add_up() {
 fn the_build_does_not_depend_on_the_thread_count() {
     let brdf = parse_spec("ward:alpha_x=0.1,alpha_y=0.25").unwrap();
     let o = small();
-    let serial = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| CascadeCdf::build(brdf.as_ref(), &o).unwrap());
+    let serial =
+        distributions::on_threads(1, || CascadeCdf::build(brdf.as_ref(), &o).unwrap()).unwrap();
     let parallel = CascadeCdf::build(brdf.as_ref(), &o).unwrap();
     assert_eq!(serial.layout(), parallel.layout());
     assert!(serial.layout().half_turn && serial.layout().phi == 2);

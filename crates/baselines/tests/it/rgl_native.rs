@@ -4,8 +4,8 @@
 //! albedo agrees with quadrature.
 
 use baselines::RglNative;
-use brdf::{Brdf, RglBrdf, Vec3, direction_from_angles, directional_albedo, parse_spec};
-use brdf_sampling::DirectionSampler;
+use brdf::{RglBrdf, Vec3, direction_from_angles, directional_albedo, parse_spec};
+use brdf_sampling::{DirectionSampler, sampled_albedo, upper_hemisphere_integral};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use std::path::PathBuf;
@@ -33,19 +33,9 @@ fn sample_and_pdf_agree() {
     }
 }
 
-/// `∫_Ω p dσ` by a midpoint rule in `(cos θ, φ)`, with `pdf` as given.
-fn upper_integral(pdf: &dyn Fn(&Vec3) -> f64) -> f64 {
-    let (nz, nphi) = (600, 600);
-    let mut sum = 0.0;
-    for i in 0..nz {
-        let z = (i as f64 + 0.5) / nz as f64;
-        let r = (1.0 - z * z).sqrt();
-        for j in 0..nphi {
-            let phi = (j as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
-            sum += pdf(&Vec3::new(r * phi.cos(), r * phi.sin(), z));
-        }
-    }
-    sum * std::f64::consts::TAU / (nz * nphi) as f64
+/// `∫_Ω p dσ` by a midpoint rule in `(cos θ, φ)` on 600 × 600 cells, with `pdf` as given.
+fn upper_integral(pdf: &(dyn Fn(&Vec3) -> f64 + Sync)) -> f64 {
+    upper_hemisphere_integral(pdf, 600, 600)
 }
 
 fn fraction_above(s: &RglNative, wo: &Vec3, n: usize) -> f64 {
@@ -83,20 +73,8 @@ fn the_estimator_finds_the_albedo() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     for th in [0.0, 60.0] {
         let wo = direction_from_angles(th, 0.0);
-        let n = 100_000;
-        let (mut sum, mut sq) = (0.0, 0.0);
-        for _ in 0..n {
-            let d = s.sample(&wo, &mut rng);
-            let w = if d.wi.z > 0.0 && d.pdf > 0.0 {
-                b.eval(&wo, &d.wi) * d.wi.z / d.pdf
-            } else {
-                0.0
-            };
-            sum += w;
-            sq += w * w;
-        }
-        let mean = sum / n as f64;
-        let se = ((sq / n as f64 - mean * mean) / n as f64).sqrt();
+        let e = sampled_albedo(&s, &b, &wo, 100_000, &mut rng);
+        let (mean, se) = (e.mean, e.std_error());
         let reference = directional_albedo(&b, &wo, 96, 192);
         assert!(
             (mean - reference).abs() < 4.0 * se + 2e-3 * reference,

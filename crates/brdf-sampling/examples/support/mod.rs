@@ -1,28 +1,9 @@
 //! Helpers shared by this crate's examples (`mod support;`), each of which uses a subset.
 #![allow(dead_code)]
 
-use brdf::Vec3;
-use rayon::prelude::*;
-
-/// `∫ g dω` over the upper hemisphere by the midpoint rule on `n_cos × n_phi` cells in
-/// (cosθ, φ), rows in parallel.
-pub(crate) fn integrate(g: &(dyn Fn(&Vec3) -> f64 + Sync), n_cos: usize, n_phi: usize) -> f64 {
-    let cell = (1.0 / n_cos as f64) * (std::f64::consts::TAU / n_phi as f64);
-    let rows: Vec<f64> = (0..n_cos)
-        .into_par_iter()
-        .map(|i| {
-            let z = (i as f64 + 0.5) / n_cos as f64;
-            let r = (1.0 - z * z).sqrt();
-            (0..n_phi)
-                .map(|j| {
-                    let phi = (j as f64 + 0.5) / n_phi as f64 * std::f64::consts::TAU;
-                    g(&Vec3::new(r * phi.cos(), r * phi.sin(), z))
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    rows.iter().sum::<f64>() * cell
-}
+/// `∫ g dω` over the upper hemisphere by the midpoint rule in (cosθ, φ).
+#[allow(unused_imports)]
+pub(crate) use brdf_sampling::upper_hemisphere_integral as integrate;
 
 /// CPU seconds (user + system) of this process so far, from `/proc/self/stat`; NaN where it
 /// cannot be read.
@@ -47,4 +28,24 @@ pub(crate) fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T>
         .position(|a| a == key)
         .and_then(|i| args.get(i + 1))
         .and_then(|v| v.parse().ok())
+}
+
+/// Every model of `brdf::models()` at its defaults, then the synthetic MERL table
+/// `merl(phong:n=50)`: the BRDFs the tables and loops of these examples run over.
+pub(crate) fn all_specs() -> Vec<String> {
+    let mut specs: Vec<String> = brdf::models()
+        .iter()
+        .filter(|m| !m.needs_argument())
+        .map(|m| m.name.to_string())
+        .collect();
+    specs.push("merl(phong:n=50)".to_string());
+    specs
+}
+
+/// The specs of `--specs a;b;…` in `args`, else [`all_specs`].
+pub(crate) fn table_specs(args: &[String]) -> Vec<String> {
+    match arg::<String>(args, "--specs") {
+        Some(list) => list.split(';').map(str::to_string).collect(),
+        None => all_specs(),
+    }
 }

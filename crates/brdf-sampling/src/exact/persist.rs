@@ -26,8 +26,8 @@ use serde::{Deserialize, Serialize};
 use crate::disc::SliceDensity;
 use crate::error::SetFileError;
 use crate::persist::{
-    MAX_LOADED_MEAN_TRIALS, check_stored, decode_payload, encode, estimated_mean_trials, payload,
-    probes,
+    MAX_LOADED_MEAN_TRIALS, StoredHead, check_stored, decode_payload, encode,
+    estimated_mean_trials, payload, read_set_file,
 };
 
 use super::build::Plan;
@@ -51,9 +51,7 @@ const MAX_TABLE_NODES: usize = 64;
 
 #[derive(Serialize, Deserialize)]
 struct StoredExact {
-    spec: String,
-    brdf_name: String,
-    probes: Vec<f64>,
+    head: StoredHead,
     options: ExactOptions,
     build_seconds: f64,
     cells: Vec<Vec<StoredInterval>>,
@@ -96,9 +94,7 @@ impl ExactSet {
     /// module docs).
     pub fn to_bytes(&self, spec: &str) -> Vec<u8> {
         let stored = StoredExact {
-            spec: spec.trim().to_string(),
-            brdf_name: self.brdf.name().to_string(),
-            probes: probes(self.brdf.as_ref()),
+            head: StoredHead::new(spec.trim().to_string(), self.brdf.as_ref()),
             options: self.options,
             build_seconds: self.build_time.as_secs_f64(),
             cells: self
@@ -119,7 +115,7 @@ impl ExactSet {
     /// The BRDF spec recorded in stored bytes (to parse the BRDF before
     /// [`ExactSet::from_bytes`]).
     pub fn stored_spec(bytes: &[u8]) -> Result<String, SetFileError> {
-        decode(bytes).map(|s| s.spec)
+        decode(bytes).map(|s| s.head.spec)
     }
 
     /// Decodes a set written by [`ExactSet::to_bytes`] and re-attaches `brdf`.
@@ -132,8 +128,7 @@ impl ExactSet {
     /// slice number counts the intervals over all cells).
     pub fn from_bytes(bytes: &[u8], brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
         let s = decode(bytes)?;
-        let options = s.options.validate();
-        check_stored(&s.spec, spec, &s.probes, brdf.as_ref(), options)?;
+        check_stored(&s.head, spec, brdf.as_ref(), s.options.validate())?;
         // The build's own plan (no timing: the node cache does not matter here).
         let plan = Plan::new(brdf.as_ref(), &s.options, Some(false), true);
         if s.cells.len() != plan.phis.len() {
@@ -199,11 +194,7 @@ impl ExactSet {
 
     /// Reads a set from `path` and re-attaches `brdf` (see [`ExactSet::from_bytes`]).
     pub fn load(path: &Path, brdf: Arc<dyn Brdf>, spec: &str) -> Result<Self, SetFileError> {
-        let bytes = std::fs::read(path).map_err(|source| SetFileError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_bytes(&bytes, brdf, spec)
+        Self::from_bytes(&read_set_file(path)?, brdf, spec)
     }
 }
 

@@ -73,19 +73,26 @@ fn check_model(spec: &str, seed: u64, mixture: bool) {
     }
 }
 
-#[test]
-fn lambert() {
-    check_model("lambert", 10, false);
+/// One `#[test]` per `name: spec, seed, mixture;` row, each running
+/// `check_model(spec, seed, mixture)`.
+macro_rules! model_tests {
+    ($($name:ident: $spec:expr, $seed:expr, $mixture:expr;)*) => {
+        $(
+            #[test]
+            fn $name() {
+                check_model($spec, $seed, $mixture);
+            }
+        )*
+    };
 }
 
-#[test]
-fn phong_50() {
-    check_model("phong:n=50", 20, true);
-}
-
-#[test]
-fn phong_1000_sharp() {
-    check_model("phong:n=1000", 30, false);
+model_tests! {
+    lambert: "lambert", 10, false;
+    phong_50: "phong:n=50", 20, true;
+    phong_1000_sharp: "phong:n=1000", 30, false;
+    ggx_alpha_01: "ggx:alpha=0.1", 50, false;
+    oren_nayar: "oren-nayar", 60, false;
+    minnaert_limb_darkening: "minnaert:k=0.5", 80, false;
 }
 
 #[test]
@@ -103,24 +110,9 @@ fn ward_anisotropic() {
 }
 
 #[test]
-fn ggx_alpha_01() {
-    check_model("ggx:alpha=0.1", 50, false);
-}
-
-#[test]
-fn oren_nayar() {
-    check_model("oren-nayar", 60, false);
-}
-
-#[test]
 fn strauss_unbounded_at_horizon_on_the_equal_area_disc() {
     // f_r ∝ 1/cos θi: every slice is on the equal-area disc (density 2 f_r cos θi).
     let set = build("strauss", Variant::Adaptive, &test_options());
     assert_eq!(set.report().equal_area_trees, set.len());
     check_model("strauss", 70, true);
-}
-
-#[test]
-fn minnaert_limb_darkening() {
-    check_model("minnaert:k=0.5", 80, false);
 }

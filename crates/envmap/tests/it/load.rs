@@ -58,7 +58,7 @@ fn rle_component(values: &[u8], out: &mut Vec<u8>) {
     }
 }
 
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 enum Scanlines {
     Flat,
     Rle,
@@ -126,38 +126,30 @@ fn check_hdr(signature: &str, mode: Scanlines) {
     let map = EnvMap::from_bytes(&bytes, MapFormat::Hdr).unwrap();
     assert_eq!((map.width(), map.height()), (w, h));
     for (i, (&q, &got)) in quads.iter().zip(map.rgb()).enumerate() {
-        assert_eq!(got, unrgbe(q), "pixel {i}");
+        assert_eq!(got, unrgbe(q), "{signature} {mode:?}: pixel {i}");
         // And within RGBE precision of the source.
         for c in 0..3 {
             let max = src[i].iter().cloned().fold(0.0, f32::max);
-            assert!((got[c] - src[i][c]).abs() <= max / 64.0, "pixel {i}");
+            assert!(
+                (got[c] - src[i][c]).abs() <= max / 64.0,
+                "{signature} {mode:?}: pixel {i}"
+            );
         }
     }
 }
 
 #[test]
-fn hdr_radiance_signature_flat() {
-    check_hdr("#?RADIANCE", Scanlines::Flat);
-}
-
-#[test]
-fn hdr_radiance_signature_rle() {
-    check_hdr("#?RADIANCE", Scanlines::Rle);
-}
-
-#[test]
-fn hdr_rgbe_signature_flat() {
-    check_hdr("#?RGBE", Scanlines::Flat);
-}
-
-#[test]
-fn hdr_rgbe_signature_rle() {
-    check_hdr("#?RGBE", Scanlines::Rle);
-}
-
-#[test]
-fn hdr_old_style_run_markers() {
-    check_hdr("#?RADIANCE", Scanlines::OldRle);
+fn hdr_signatures_and_scanline_encodings_round_trip() {
+    // Both signatures, flat and RLE scanlines, and old-style run markers.
+    for (signature, mode) in [
+        ("#?RADIANCE", Scanlines::Flat),
+        ("#?RADIANCE", Scanlines::Rle),
+        ("#?RGBE", Scanlines::Flat),
+        ("#?RGBE", Scanlines::Rle),
+        ("#?RADIANCE", Scanlines::OldRle),
+    ] {
+        check_hdr(signature, mode);
+    }
 }
 
 fn hdr_bytes() -> Vec<u8> {
@@ -170,57 +162,46 @@ fn decode_hdr(text: &[u8]) -> Result<EnvMap, EnvMapError> {
     EnvMap::from_bytes(text, MapFormat::Hdr)
 }
 
+/// Checks that `decode` rejects each input with the error whose `Debug` text starts with the
+/// given variant name (and fields, where given).
+fn assert_rejects(decode: impl Fn(&[u8]) -> Result<EnvMap, EnvMapError>, cases: &[(&[u8], &str)]) {
+    for (k, &(bytes, expected)) in cases.iter().enumerate() {
+        match decode(bytes) {
+            Err(e) => assert!(
+                format!("{e:?}").starts_with(expected),
+                "case {k}: {e:?}, expected {expected}"
+            ),
+            Ok(_) => panic!("case {k}: accepted, expected {expected}"),
+        }
+    }
+}
+
 #[test]
 fn hdr_errors() {
     let good = hdr_bytes();
-    assert!(matches!(
-        decode_hdr(b"P6\n1 1\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b""),
-        Err(EnvMapError::Truncated { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n"),
-        Err(EnvMapError::Truncated { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n"),
-        Err(EnvMapError::Truncated { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n-Y 2 +X\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n-Y two +X 3\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n+Y 2 +X 3\n\0\0\0\0\0\0\0\0"),
-        Err(EnvMapError::Decode { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n-Y 0 +X 3\n"),
-        Err(EnvMapError::Empty {
-            width: 3,
-            height: 0
-        })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\n\n-Y 100000 +X 100000\n"),
-        Err(EnvMapError::TooLarge { .. })
-    ));
-    assert!(matches!(
-        decode_hdr(b"#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 1\n\x80\x80\x80\x80"),
-        Err(EnvMapError::Decode { .. })
-    ));
-    // Cut inside the pixel data.
-    assert!(matches!(
-        decode_hdr(&good[..good.len() - 3]),
-        Err(EnvMapError::Truncated { .. })
-    ));
+    assert_rejects(
+        decode_hdr,
+        &[
+            (b"P6\n1 1\n", "MalformedHeader"),
+            (b"", "Truncated"),
+            (b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n", "Truncated"),
+            (b"#?RADIANCE\n\n", "Truncated"),
+            (b"#?RADIANCE\n\n-Y 2 +X\n", "MalformedHeader"),
+            (b"#?RADIANCE\n\n-Y two +X 3\n", "MalformedHeader"),
+            (b"#?RADIANCE\n\n+Y 2 +X 3\n\0\0\0\0\0\0\0\0", "Decode"),
+            (
+                b"#?RADIANCE\n\n-Y 0 +X 3\n",
+                "Empty { width: 3, height: 0 }",
+            ),
+            (b"#?RADIANCE\n\n-Y 100000 +X 100000\n", "TooLarge"),
+            (
+                b"#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 1\n\x80\x80\x80\x80",
+                "Decode",
+            ),
+            // Cut inside the pixel data.
+            (&good[..good.len() - 3], "Truncated"),
+        ],
+    );
     // All black.
     let black = hdr_file("#?RADIANCE", 8, 2, &[[0, 0, 0, 0]; 16], Scanlines::Flat);
     assert!(matches!(decode_hdr(&black), Err(EnvMapError::AllBlack)));
@@ -299,52 +280,24 @@ fn pfm_tolerates_crlf_and_spaces() {
 fn pfm_errors() {
     let pfm = |b: &[u8]| EnvMap::from_bytes(b, MapFormat::Pfm);
     let good = pfm_file(false, true, 3, 2, &test_pixels(3, 2), 1.0);
-    assert!(matches!(pfm(b""), Err(EnvMapError::Truncated { .. })));
-    assert!(matches!(
-        pfm(b"P6\n1 1\n255\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n1 -1\n-1\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n1 1\nabc\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n1 1\n0\n\0\0\0\0\0\0\0\0\0\0\0\0"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n1 1\nnan\n\0\0\0\0\0\0\0\0\0\0\0\0"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n1 1"),
-        Err(EnvMapError::Truncated { .. })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n0 1\n-1\n"),
-        Err(EnvMapError::Empty {
-            width: 0,
-            height: 1
-        })
-    ));
-    assert!(matches!(
-        pfm(b"PF\n99999 99999\n-1\n"),
-        Err(EnvMapError::TooLarge { .. })
-    ));
-    assert!(matches!(
-        pfm(&good[..good.len() - 1]),
-        Err(EnvMapError::Truncated { .. })
-    ));
     let mut long = good.clone();
     long.push(0);
-    assert!(matches!(
-        pfm(&long),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
+    assert_rejects(
+        pfm,
+        &[
+            (b"", "Truncated"),
+            (b"P6\n1 1\n255\n", "MalformedHeader"),
+            (b"PF\n1 -1\n-1\n", "MalformedHeader"),
+            (b"PF\n1 1\nabc\n", "MalformedHeader"),
+            (b"PF\n1 1\n0\n\0\0\0\0\0\0\0\0\0\0\0\0", "MalformedHeader"),
+            (b"PF\n1 1\nnan\n\0\0\0\0\0\0\0\0\0\0\0\0", "MalformedHeader"),
+            (b"PF\n1 1", "Truncated"),
+            (b"PF\n0 1\n-1\n", "Empty { width: 0, height: 1 }"),
+            (b"PF\n99999 99999\n-1\n", "TooLarge"),
+            (&good[..good.len() - 1], "Truncated"),
+            (&long, "MalformedHeader"),
+        ],
+    );
 
     // Bad pixels are named in top-down coordinates: (x 1, y 0) is in the file's last row.
     let mut px = test_pixels(3, 2);
@@ -407,37 +360,23 @@ fn exr_round_trip_and_errors() {
     assert_eq!(map.rgb(), &src[..]);
 
     let exr = |b: &[u8]| EnvMap::from_bytes(b, MapFormat::Exr);
-    assert!(matches!(exr(b"v/"), Err(EnvMapError::Truncated { .. })));
-    assert!(matches!(
-        exr(b"#?RADIANCE\n"),
-        Err(EnvMapError::MalformedHeader { .. })
-    ));
     assert!(exr(&bytes[..bytes.len() / 2]).is_err());
-    let mut px = src.clone();
-    px[w + 3][0] = f32::NAN;
-    assert!(matches!(
-        exr(&exr_file(w, h, &px)),
-        Err(EnvMapError::NonFinitePixel {
-            x: 3,
-            y: 1,
-            channel: 0,
-            ..
-        })
-    ));
-    px[w + 3][0] = -2.0;
-    assert!(matches!(
-        exr(&exr_file(w, h, &px)),
-        Err(EnvMapError::NegativePixel {
-            x: 3,
-            y: 1,
-            channel: 0,
-            ..
-        })
-    ));
-    assert!(matches!(
-        exr(&exr_file(2, 2, &[[0.0; 3]; 4])),
-        Err(EnvMapError::AllBlack)
-    ));
+    // The red channel of pixel (3, 1) replaced by `value`.
+    let with = |value: f32| {
+        let mut px = src.clone();
+        px[w + 3][0] = value;
+        exr_file(w, h, &px)
+    };
+    assert_rejects(
+        exr,
+        &[
+            (b"v/", "Truncated"),
+            (b"#?RADIANCE\n", "MalformedHeader"),
+            (&with(f32::NAN), "NonFinitePixel { x: 3, y: 1, channel: 0,"),
+            (&with(-2.0), "NegativePixel { x: 3, y: 1, channel: 0,"),
+            (&exr_file(2, 2, &[[0.0; 3]; 4]), "AllBlack"),
+        ],
+    );
 }
 
 // ---------------------------------------------------------------- files and garbage

@@ -3,6 +3,7 @@
 
 use std::f64::consts::PI;
 
+use distributions::on_threads;
 use envmap::latlong::{sin_integral, uv_to_direction};
 use envmap::{
     AdaptiveOptions, EnvMap, EnvMapError, EnvMapSampler, LeafChoice, SamplerKind, Scheme,
@@ -19,31 +20,13 @@ const ALPHA: f64 = 1e-3;
 /// Sub-rows per pixel row in the chi-square bins (tests the sin(πv) shape inside a pixel).
 const SUB: usize = 4;
 
-/// Binned chi-square: expected counts below 5 are pooled; a hit in a zero-mass cell fails.
+/// Binned chi-square ([`stats::chi_square_gof`]): expected counts below 5 are pooled; a hit in
+/// a zero-mass cell fails.
 fn chi_square_p(observed: &[u64], probabilities: &[f64]) -> f64 {
-    use statrs::distribution::{ChiSquared, ContinuousCDF};
-    let n: u64 = observed.iter().sum();
-    let (mut stat, mut cells, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
-    for (&o, &p) in observed.iter().zip(probabilities) {
-        let e = p * n as f64;
-        if p == 0.0 {
-            if o > 0 {
-                return 0.0;
-            }
-        } else if e < 5.0 {
-            pooled_o += o as f64;
-            pooled_e += e;
-        } else {
-            stat += (o as f64 - e).powi(2) / e;
-            cells += 1;
-        }
-    }
-    if pooled_e > 0.0 {
-        stat += (pooled_o - pooled_e).powi(2) / pooled_e;
-        cells += 1;
-    }
-    assert!(cells >= 2);
-    ChiSquared::new((cells - 1) as f64).unwrap().sf(stat)
+    let n = observed.iter().sum::<u64>() as f64;
+    let expected: Vec<f64> = probabilities.iter().map(|p| p * n).collect();
+    let test = stats::chi_square_gof(observed, &expected, stats::DEFAULT_MIN_EXPECTED);
+    test.expect("at least two cells").p_value
 }
 
 /// A 16 × 8 map: a smooth gradient, a black band, and a tiny very bright "sun" pixel.
@@ -243,16 +226,8 @@ fn parallel_batches_are_reproducible() {
     for kind in all_kinds() {
         let s = EnvMapSampler::new(&map, kind).unwrap();
         let n = 10_000;
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap()
-            .install(|| s.sample_par(n, 4));
-        let two = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap()
-            .install(|| s.sample_par(n, 4));
+        let one = on_threads(1, || s.sample_par(n, 4)).unwrap();
+        let two = on_threads(2, || s.sample_par(n, 4)).unwrap();
         assert_eq!(one, two, "{kind:?}");
         let uv = s.sample_uv_par(n, 4);
         assert!(
@@ -292,16 +267,8 @@ fn lane_batches_have_the_target_law_and_are_reproducible() {
         let p = chi_square_p(&counts, &masses);
         assert!(p > ALPHA, "{kind:?}: p = {p}");
         let n = 10_000;
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap()
-            .install(|| s.sample_uv_par_lanes(n, 4));
-        let two = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap()
-            .install(|| s.sample_uv_par_lanes(n, 4));
+        let one = on_threads(1, || s.sample_uv_par_lanes(n, 4)).unwrap();
+        let two = on_threads(2, || s.sample_uv_par_lanes(n, 4)).unwrap();
         assert_eq!(one, two, "{kind:?}");
         assert_ne!(s.sample_uv_par_lanes(n, 5), one);
     }

@@ -229,11 +229,7 @@ impl CellSource for Level0<'_> {
 impl<D: Density> Density for SampledGridDensity<D> {
     #[inline]
     fn eval(&self, p: Point2) -> f64 {
-        if self.domain.contains(p) {
-            self.f.eval(p)
-        } else {
-            0.0
-        }
+        self.domain.restrict(p, |p| self.f.eval(p))
     }
 }
 

@@ -16,10 +16,22 @@ use rand::{Rng, SeedableRng};
 
 fn density(rect: Rect) -> TabulatedDensity<SinPiRows> {
     let (w, h) = (64, 32);
-    TabulatedDensity::new(w, h, sun_map(w, h, 40.0), rect)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap()
+    sin_rows(w, h, sun_map(w, h, 40.0), rect)
+}
+
+/// `len` samples of one `sample_into` call from a generator seeded with `seed`, and that
+/// generator after the call.
+fn block_samples<S: Sampler2D>(s: &S, len: usize, seed: u64) -> (Vec<Sample2>, Xoshiro256PlusPlus) {
+    let mut block = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut got = vec![
+        Sample2 {
+            point: [f64::NAN; 2],
+            pdf: f64::NAN
+        };
+        len
+    ];
+    s.sample_into(&mut block, &mut got);
+    (got, block)
 }
 
 /// `sample_into` against `len` calls of the one-sample path, from the same generator state:
@@ -31,15 +43,7 @@ fn check_same<D: RegionStats>(s: &QuadTreeSampler<D>, len: usize, seed: u64) -> 
         .map(|_| s.sample_audited(&mut one, &mut audit))
         .collect();
     s.reset_stats();
-    let mut block = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut got = vec![
-        Sample2 {
-            point: [f64::NAN; 2],
-            pdf: f64::NAN
-        };
-        len
-    ];
-    s.sample_into(&mut block, &mut got);
+    let (got, mut block) = block_samples(s, len, seed);
     assert_eq!(got, expected, "len {len}, seed {seed}");
     assert_eq!(block.next_u64(), one.next_u64(), "uniforms consumed differ");
     let st = s.stats();
@@ -79,11 +83,7 @@ fn block_path_equals_one_sample_path_on_mapped_frame() {
 
 #[test]
 fn block_path_counts_the_same_violations() {
-    let broken = Broken {
-        inner: density(Rect::UNIT),
-        bound_scale: 0.5,
-        left_integral_scale: 1.0,
-    };
+    let broken = Broken::new(density(Rect::UNIT), 0.5, 1.0);
     let s = QuadTreeBuilder::new().max_depth(3).build(broken).unwrap();
     let a = check_same(&s, 5000, 7);
     assert!(a.violations > 100, "{a:?}");
@@ -92,11 +92,7 @@ fn block_path_counts_the_same_violations() {
 #[test]
 fn block_path_abandons_samples_at_the_trial_cap_like_the_one_sample_path() {
     // Bounds 1e30 too high: acceptance probability ~1e-30, every sample hits the cap.
-    let hopeless = Broken {
-        inner: density(Rect::UNIT),
-        bound_scale: 1e30,
-        left_integral_scale: 1.0,
-    };
+    let hopeless = Broken::new(density(Rect::UNIT), 1e30, 1.0);
     let s = QuadTreeBuilder::new().max_depth(2).build(hopeless).unwrap();
     let a = check_same(&s, 2, 9);
     assert_eq!(a.exhausted, 2, "{a:?}");
@@ -134,15 +130,7 @@ fn piecewise_constant_block_path_equals_one_sample_path() {
     for (k, len) in LENGTHS.into_iter().enumerate() {
         let mut one = Xoshiro256PlusPlus::seed_from_u64(300 + k as u64);
         let expected: Vec<Sample2> = (0..len).map(|_| t.sample(&mut one)).collect();
-        let mut block = Xoshiro256PlusPlus::seed_from_u64(300 + k as u64);
-        let mut got = vec![
-            Sample2 {
-                point: [f64::NAN; 2],
-                pdf: f64::NAN
-            };
-            len
-        ];
-        t.sample_into(&mut block, &mut got);
+        let (got, mut block) = block_samples(&t, len, 300 + k as u64);
         assert_eq!(got, expected);
         assert_eq!(block.next_u64(), one.next_u64());
     }

@@ -5,18 +5,11 @@ use crate::common;
 
 use common::*;
 use partition_sampler::{
-    AllocationMode, Domain, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats,
-    SampledGridDensity, Sampler2D, Scheme, SinPiRows, TabulatedDensity, UserBoundDensity,
+    AllocationMode, Domain, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, SAMPLING_CONFIGS,
+    SampledGridDensity, Sampler2D, UserBoundDensity,
 };
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-
-const CONFIGS: [(Scheme, LeafChoice); 4] = [
-    (Scheme::Envelope, LeafChoice::Alias),
-    (Scheme::Envelope, LeafChoice::Descent),
-    (Scheme::Paper, LeafChoice::Alias),
-    (Scheme::Paper, LeafChoice::Descent),
-];
 
 /// Draws `n` samples, checks domain membership and pdf consistency, returns the p-value.
 fn fit<D: RegionStats>(
@@ -52,77 +45,104 @@ fn fit<D: RegionStats>(
     chi_square_p(&h, masses)
 }
 
+/// `n × n` bins over the square around the unit disc.
+fn disc_bins(n: usize) -> Bins {
+    Bins {
+        rect: Rect::DISC_BOUNDS,
+        nx: n,
+        ny: n,
+    }
+}
+
+/// For the `k`-th of [`SAMPLING_CONFIGS`]: builds `density()` with `builder` set to its scheme
+/// and leaf choice, checks the fit of `n` samples of seed `seed + k` ([`fit`]) and that no
+/// bound was violated, then runs the test's own checks `more` on the sampler.
+#[allow(clippy::too_many_arguments)]
+fn fit_every_config<D: RegionStats>(
+    density: impl Fn() -> D,
+    builder: QuadTreeBuilder,
+    bins: &Bins,
+    masses: &[f64],
+    n: usize,
+    seed: u64,
+    domain: Domain,
+    more: impl Fn(&QuadTreeSampler<D>),
+) {
+    for (k, (scheme, choice)) in SAMPLING_CONFIGS.into_iter().enumerate() {
+        let s = builder
+            .scheme(scheme)
+            .leaf_choice(choice)
+            .build(density())
+            .unwrap();
+        let p = fit(&s, bins, masses, n, seed + k as u64, domain);
+        assert_eq!(s.stats().bound_violations, 0, "{scheme:?} {choice:?}");
+        assert!(p > ALPHA, "{scheme:?} {choice:?}: p = {p}");
+        more(&s);
+    }
+}
+
 #[test]
 fn disc_phong_lobe_all_configs() {
     let f = phong_lobe(35.0, 30.0);
-    let bins = Bins {
-        rect: Rect::DISC_BOUNDS,
-        nx: 24,
-        ny: 24,
-    };
+    let bins = disc_bins(24);
     let masses = bins.masses(24, f, in_disc);
-    for (k, (scheme, choice)) in CONFIGS.into_iter().enumerate() {
-        let d = SampledGridDensity::new(f, Domain::UnitDisc, 256).unwrap();
-        let s = QuadTreeBuilder::new()
-            .max_depth(8)
-            .scheme(scheme)
-            .leaf_choice(choice)
-            .build(d)
-            .unwrap();
-        let p = fit(&s, &bins, &masses, 60_000, 11 + k as u64, Domain::UnitDisc);
-        let st = s.stats();
-        assert_eq!(st.bound_violations, 0, "{scheme:?} {choice:?}");
-        assert!(st.expected_mean_trials <= 2.0 + 1e-9, "{st:?}");
-        assert!(p > ALPHA, "{scheme:?} {choice:?}: p = {p}");
-    }
+    fit_every_config(
+        || SampledGridDensity::new(f, Domain::UnitDisc, 256).unwrap(),
+        QuadTreeBuilder::new().max_depth(8),
+        &bins,
+        &masses,
+        60_000,
+        11,
+        Domain::UnitDisc,
+        |s| {
+            let st = s.stats();
+            assert!(st.expected_mean_trials <= 2.0 + 1e-9, "{st:?}");
+        },
+    );
+}
+
+/// The 64 × 32 map with a sun of 1e5, `nx × ny` bins over the unit square and their masses.
+fn sun_setup(nx: usize, ny: usize) -> (Vec<f64>, Bins, Vec<f64>) {
+    let vals = sun_map(64, 32, 1e5);
+    let bins = Bins {
+        rect: Rect::UNIT,
+        nx,
+        ny,
+    };
+    let masses = sun_map_masses(&vals, 64, 32, &bins);
+    (vals, bins, masses)
 }
 
 #[test]
 fn sun_map_with_sin_rows_all_configs() {
     let (w, h) = (64, 32);
-    let vals = sun_map(w, h, 1e5);
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 32,
-        ny: 16,
-    };
-    let masses = sun_map_masses(&vals, w, h, &bins);
-    for (k, (scheme, choice)) in CONFIGS.into_iter().enumerate() {
-        let d = TabulatedDensity::new(w, h, vals.clone(), Rect::UNIT)
-            .unwrap()
-            .with_row_factor(SinPiRows)
-            .unwrap();
-        let s = QuadTreeBuilder::new()
-            .scheme(scheme)
-            .leaf_choice(choice)
-            .build(d)
-            .unwrap();
-        let p = fit(
-            &s,
-            &bins,
-            &masses,
-            80_000,
-            100 + k as u64,
-            Domain::Rect(Rect::UNIT),
-        );
-        let st = s.stats();
-        assert_eq!(st.bound_violations, 0);
-        assert!(p > ALPHA, "{scheme:?} {choice:?}: p = {p}");
-        // Î is the exact integral, so the pdf integrates to one.
-        let exact: f64 = (0..h)
-            .map(|j| {
-                let row = ((std::f64::consts::PI * j as f64 / h as f64).cos()
-                    - (std::f64::consts::PI * (j + 1) as f64 / h as f64).cos())
-                    / std::f64::consts::PI;
-                vals[j * w..(j + 1) * w].iter().sum::<f64>() * row / w as f64
-            })
-            .sum();
-        assert!(
-            (st.integral - exact).abs() <= 1e-12 * exact,
-            "{} vs {exact}",
-            st.integral
-        );
-    }
+    let (vals, bins, masses) = sun_setup(32, 16);
+    // Î is the exact integral, so the pdf integrates to one.
+    let exact: f64 = (0..h)
+        .map(|j| {
+            let row = ((std::f64::consts::PI * j as f64 / h as f64).cos()
+                - (std::f64::consts::PI * (j + 1) as f64 / h as f64).cos())
+                / std::f64::consts::PI;
+            vals[j * w..(j + 1) * w].iter().sum::<f64>() * row / w as f64
+        })
+        .sum();
+    fit_every_config(
+        || sin_rows(w, h, vals.clone(), Rect::UNIT),
+        QuadTreeBuilder::new(),
+        &bins,
+        &masses,
+        80_000,
+        100,
+        Domain::Rect(Rect::UNIT),
+        |s| {
+            let st = s.stats();
+            assert!(
+                (st.integral - exact).abs() <= 1e-12 * exact,
+                "{} vs {exact}",
+                st.integral
+            );
+        },
+    );
 }
 
 #[test]
@@ -130,17 +150,8 @@ fn sun_map_background_is_fit_when_sun_is_excluded() {
     // The sun holds ~99.6% of the mass; test the background separately with a conditional
     // chi-square over samples that fall outside the sun bin.
     let (w, h) = (64, 32);
-    let vals = sun_map(w, h, 1e5);
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 16,
-        ny: 8,
-    };
-    let mut masses = sun_map_masses(&vals, w, h, &bins);
-    let d = TabulatedDensity::new(w, h, vals, Rect::UNIT)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap();
+    let (vals, bins, mut masses) = sun_setup(16, 8);
+    let d = sin_rows(w, h, vals, Rect::UNIT);
     let s = QuadTreeBuilder::new().build(d).unwrap();
     let sun_bin = masses
         .iter()
@@ -173,24 +184,16 @@ fn sampled_gaussian_on_offset_rectangle() {
         ny: 10,
     };
     let masses = bins.masses(16, f, |_| true);
-    for (k, (scheme, choice)) in CONFIGS.into_iter().enumerate() {
-        let d = SampledGridDensity::new(f, Domain::Rect(rect), 128).unwrap();
-        let s = QuadTreeBuilder::new()
-            .scheme(scheme)
-            .leaf_choice(choice)
-            .build(d)
-            .unwrap();
-        let p = fit(
-            &s,
-            &bins,
-            &masses,
-            50_000,
-            300 + k as u64,
-            Domain::Rect(rect),
-        );
-        assert_eq!(s.stats().bound_violations, 0);
-        assert!(p > ALPHA, "{scheme:?} {choice:?}: p = {p}");
-    }
+    fit_every_config(
+        || SampledGridDensity::new(f, Domain::Rect(rect), 128).unwrap(),
+        QuadTreeBuilder::new(),
+        &bins,
+        &masses,
+        50_000,
+        300,
+        Domain::Rect(rect),
+        |_| {},
+    );
 }
 
 #[test]
@@ -203,35 +206,22 @@ fn user_bound_monotone_density() {
         ny: 12,
     };
     let masses = bins.masses(16, f, |_| true);
-    for (k, (scheme, choice)) in CONFIGS.into_iter().enumerate() {
-        let d = UserBoundDensity::new(f, bound, Domain::Rect(Rect::UNIT), 8).unwrap();
-        let s = QuadTreeBuilder::new()
-            .max_depth(6)
-            .scheme(scheme)
-            .leaf_choice(choice)
-            .build(d)
-            .unwrap();
-        let p = fit(
-            &s,
-            &bins,
-            &masses,
-            40_000,
-            500 + k as u64,
-            Domain::Rect(Rect::UNIT),
-        );
-        assert_eq!(s.stats().bound_violations, 0);
-        assert!(p > ALPHA, "{scheme:?} {choice:?}: p = {p}");
-    }
+    fit_every_config(
+        || UserBoundDensity::new(f, bound, Domain::Rect(Rect::UNIT), 8).unwrap(),
+        QuadTreeBuilder::new().max_depth(6),
+        &bins,
+        &masses,
+        40_000,
+        500,
+        Domain::Rect(Rect::UNIT),
+        |_| {},
+    );
 }
 
 #[test]
 fn batch_mode_fits_both_allocations() {
     let f = phong_lobe(20.0, 12.0);
-    let bins = Bins {
-        rect: Rect::DISC_BOUNDS,
-        nx: 16,
-        ny: 16,
-    };
+    let bins = disc_bins(16);
     let masses = bins.masses(24, f, in_disc);
     let d = SampledGridDensity::new(f, Domain::UnitDisc, 256).unwrap();
     let s = QuadTreeBuilder::new().build(d).unwrap();

@@ -207,13 +207,7 @@ fn parallel_output_is_independent_of_thread_count() {
     let d = tab().with_row_factor(SinPiRows).unwrap();
     let s = QuadTreeBuilder::new().build(d).unwrap();
     let n = 3 * partition_sampler::PAR_CHUNK + 17;
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| s.sample_par(n, 42))
-    };
+    let run = |threads: usize| distributions::on_threads(threads, || s.sample_par(n, 42)).unwrap();
     let one = run(1);
     let two = run(2);
     assert_eq!(one.len(), n);

@@ -16,6 +16,15 @@ fn map() -> (Vec<f64>, usize, usize) {
     (sun_map(32, 16, 1.0), 32, 16)
 }
 
+/// The 16 × 8 chi-square bins over the unit square.
+fn bins() -> Bins {
+    Bins {
+        rect: Rect::UNIT,
+        nx: 16,
+        ny: 8,
+    }
+}
+
 fn p_value<D: RegionStats>(
     s: &QuadTreeSampler<D>,
     vals: &[f64],
@@ -23,11 +32,7 @@ fn p_value<D: RegionStats>(
     h: usize,
     seed: u64,
 ) -> f64 {
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 16,
-        ny: 8,
-    };
+    let bins = bins();
     let masses = sun_map_masses(vals, w, h, &bins);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let (hist, _) = bins.histogram((0..60_000).map(|_| s.sample(&mut rng).point));
@@ -35,21 +40,15 @@ fn p_value<D: RegionStats>(
 }
 
 fn density(vals: &[f64], w: usize, h: usize) -> TabulatedDensity<SinPiRows> {
-    TabulatedDensity::new(w, h, vals.to_vec(), Rect::UNIT)
-        .unwrap()
-        .with_row_factor(SinPiRows)
-        .unwrap()
+    sin_rows(w, h, vals.to_vec(), Rect::UNIT)
 }
 
 #[test]
 fn correct_provider_passes() {
     let (vals, w, h) = map();
-    let wrapped = Broken {
-        inner: density(&vals, w, h),
-        bound_scale: 1.0,
-        left_integral_scale: 1.0,
-    };
-    let s = QuadTreeBuilder::new().build(wrapped).unwrap();
+    let s = QuadTreeBuilder::new()
+        .build(Broken::new(density(&vals, w, h), 1.0, 1.0))
+        .unwrap();
     assert!(p_value(&s, &vals, w, h, 1) > ALPHA);
     assert_eq!(s.stats().bound_violations, 0);
 }
@@ -57,12 +56,10 @@ fn correct_provider_passes() {
 #[test]
 fn too_low_bounds_are_flagged_by_audit_and_rejected_by_chi_square() {
     let (vals, w, h) = map();
-    let wrapped = Broken {
-        inner: density(&vals, w, h),
-        bound_scale: 0.5,
-        left_integral_scale: 1.0,
-    };
-    let s = QuadTreeBuilder::new().max_depth(3).build(wrapped).unwrap();
+    let s = QuadTreeBuilder::new()
+        .max_depth(3)
+        .build(Broken::new(density(&vals, w, h), 0.5, 1.0))
+        .unwrap();
     let p = p_value(&s, &vals, w, h, 2);
     let st = s.stats();
     assert!(st.bound_violations > 1000, "{st:?}");
@@ -73,36 +70,26 @@ fn too_low_bounds_are_flagged_by_audit_and_rejected_by_chi_square() {
 fn wrong_integrals_bias_the_paper_scheme_but_not_the_envelope() {
     let (vals, w, h) = map();
     for choice in [LeafChoice::Alias, LeafChoice::Descent] {
-        let paper = Broken {
-            inner: density(&vals, w, h),
-            bound_scale: 1.0,
-            left_integral_scale: 1.5,
-        };
-        let s = QuadTreeBuilder::new()
-            .scheme(Scheme::Paper)
-            .leaf_choice(choice)
-            .build(paper)
-            .unwrap();
-        let p = p_value(&s, &vals, w, h, 3);
-        assert!(
-            p < ALPHA,
-            "perturbed leaf probabilities not detected ({choice:?}): p = {p}"
-        );
-        let env = Broken {
-            inner: density(&vals, w, h),
-            bound_scale: 1.0,
-            left_integral_scale: 1.5,
-        };
-        let s = QuadTreeBuilder::new()
-            .scheme(Scheme::Envelope)
-            .leaf_choice(choice)
-            .build(env)
-            .unwrap();
-        let p = p_value(&s, &vals, w, h, 4);
-        assert!(
-            p > ALPHA,
-            "envelope scheme should be exact with wrong integrals ({choice:?}): p = {p}"
-        );
+        // (scheme, seed, whether the wrong integrals bias it)
+        for (scheme, seed, biased) in [(Scheme::Paper, 3, true), (Scheme::Envelope, 4, false)] {
+            let s = QuadTreeBuilder::new()
+                .scheme(scheme)
+                .leaf_choice(choice)
+                .build(Broken::new(density(&vals, w, h), 1.0, 1.5))
+                .unwrap();
+            let p = p_value(&s, &vals, w, h, seed);
+            if biased {
+                assert!(
+                    p < ALPHA,
+                    "perturbed leaf probabilities not detected ({choice:?}): p = {p}"
+                );
+            } else {
+                assert!(
+                    p > ALPHA,
+                    "envelope scheme should be exact with wrong integrals ({choice:?}): p = {p}"
+                );
+            }
+        }
     }
 }
 
@@ -110,11 +97,7 @@ fn wrong_integrals_bias_the_paper_scheme_but_not_the_envelope() {
 fn chi_square_helper_rejects_a_wrong_distribution() {
     // Uniform points against the masses of a non-uniform map.
     let (vals, w, h) = map();
-    let bins = Bins {
-        rect: Rect::UNIT,
-        nx: 16,
-        ny: 8,
-    };
+    let bins = bins();
     let masses = sun_map_masses(&vals, w, h, &bins);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
     use rand::RngExt;

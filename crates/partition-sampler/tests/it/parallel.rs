@@ -1,5 +1,6 @@
 //! Reproducibility of the generic parallel batch sampler [`partition_sampler::sample_par`].
 
+use distributions::on_threads;
 use partition_sampler::{PAR_CHUNK as CHUNK, PiecewiseConstant2D, Rect, Sampler2D};
 
 fn table() -> PiecewiseConstant2D {
@@ -22,16 +23,8 @@ fn table() -> PiecewiseConstant2D {
 fn result_does_not_depend_on_thread_count() {
     let t = table();
     let n = 3 * CHUNK + 17;
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| t.sample_par(n, 11));
-    let two = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap()
-        .install(|| t.sample_par(n, 11));
+    let one = on_threads(1, || t.sample_par(n, 11)).unwrap();
+    let two = on_threads(2, || t.sample_par(n, 11)).unwrap();
     assert_eq!(one, two);
     assert_eq!(one.len(), n);
     assert_ne!(one, t.sample_par(n, 12));

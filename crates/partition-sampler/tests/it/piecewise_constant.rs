@@ -12,33 +12,13 @@ use rand::rngs::Xoshiro256PlusPlus;
 /// Significance level of every chi-square test in this file.
 const ALPHA: f64 = 1e-3;
 
-/// Binned chi-square goodness of fit: cells whose expected count is below 5 are pooled into one
-/// cell; a sample in a cell of zero expected mass is an immediate failure (p = 0).
+/// Binned chi-square goodness of fit ([`stats::chi_square_gof`]): cells whose expected count is
+/// below 5 are pooled; a sample in a cell of zero expected mass is an immediate failure (p = 0).
 fn chi_square_p(observed: &[u64], probabilities: &[f64]) -> f64 {
-    use statrs::distribution::{ChiSquared, ContinuousCDF};
-    let n: u64 = observed.iter().sum();
-    let (mut stat, mut cells) = (0.0, 0usize);
-    let (mut pooled_o, mut pooled_e) = (0.0, 0.0);
-    for (&o, &p) in observed.iter().zip(probabilities) {
-        let e = p * n as f64;
-        if p == 0.0 {
-            if o > 0 {
-                return 0.0;
-            }
-        } else if e < 5.0 {
-            pooled_o += o as f64;
-            pooled_e += e;
-        } else {
-            stat += (o as f64 - e).powi(2) / e;
-            cells += 1;
-        }
-    }
-    if pooled_e > 0.0 {
-        stat += (pooled_o - pooled_e).powi(2) / pooled_e;
-        cells += 1;
-    }
-    assert!(cells >= 2, "too few cells for a chi-square test");
-    ChiSquared::new((cells - 1) as f64).unwrap().sf(stat)
+    let n = observed.iter().sum::<u64>() as f64;
+    let expected: Vec<f64> = probabilities.iter().map(|p| p * n).collect();
+    let test = stats::chi_square_gof(observed, &expected, stats::DEFAULT_MIN_EXPECTED);
+    test.expect("too few cells for a chi-square test").p_value
 }
 
 const UNIT: Rect = Rect {

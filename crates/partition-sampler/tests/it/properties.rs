@@ -26,12 +26,7 @@ fn rect() -> impl Strategy<Value = Rect> {
 }
 
 fn scheme() -> impl Strategy<Value = (Scheme, LeafChoice)> {
-    prop_oneof![
-        Just((Scheme::Envelope, LeafChoice::Alias)),
-        Just((Scheme::Envelope, LeafChoice::Descent)),
-        Just((Scheme::Paper, LeafChoice::Alias)),
-        Just((Scheme::Paper, LeafChoice::Descent)),
-    ]
+    proptest::sample::select(partition_sampler::SAMPLING_CONFIGS.to_vec())
 }
 
 proptest! {

@@ -4,6 +4,7 @@
 
 use partition_sampler::{
     Density, DensityShape, Domain, IntegralSource, Point2, Rect, RegionEstimate, RegionStats,
+    SinPiRows, TabulatedDensity,
 };
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -171,12 +172,32 @@ pub fn sun_map_masses(vals: &[f64], w: usize, h: usize, bins: &Bins) -> Vec<f64>
     m.iter().map(|v| v / t).collect()
 }
 
+/// The `w × h` table `vals` over `rect` with `sin(πv)` rows (an environment map's density).
+pub fn sin_rows(w: usize, h: usize, vals: Vec<f64>, rect: Rect) -> TabulatedDensity<SinPiRows> {
+    TabulatedDensity::new(w, h, vals, rect)
+        .unwrap()
+        .with_row_factor(SinPiRows)
+        .unwrap()
+}
+
 /// A provider that lies (shared by the negative and the batch-path tests): bounds scaled by `bound_scale`, integrals of cells left of x = 0.5
 /// scaled by `left_integral_scale`.
 pub struct Broken<D> {
     pub inner: D,
     pub bound_scale: f64,
     pub left_integral_scale: f64,
+}
+
+impl<D> Broken<D> {
+    /// `inner` with its bounds scaled by `bound_scale` and its left cells' integrals by
+    /// `left_integral_scale`.
+    pub fn new(inner: D, bound_scale: f64, left_integral_scale: f64) -> Self {
+        Self {
+            inner,
+            bound_scale,
+            left_integral_scale,
+        }
+    }
 }
 
 impl<D: RegionStats> Density for Broken<D> {
