@@ -116,5 +116,6 @@ pub use reference::{
     AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,
     reference_albedo_with_budget,
 };
+pub use reference::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
 pub use report::{CostMeasurement, SetReport};
 pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

@@ -27,6 +27,9 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{LeafInfo, Rect};
 
+mod rgl;
+pub use rgl::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
+
 use crate::disc::DiscMap;
 use crate::normalisation::{Grading, adaptive_quadrature};
 
