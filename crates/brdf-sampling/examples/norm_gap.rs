@@ -163,7 +163,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             if ref_every > 0 {
                 let r = reference_albedo(brdf.as_ref(), &direction_from_angles(t, 0.0))?;
-                line += &format!(" adaptive ref {:.10} (±{:.1e}) |", r.value, r.abs_err / r.value);
+                line += &format!(
+                    " adaptive ref {:.10} (±{:.1e}) |",
+                    r.value,
+                    r.abs_err / r.value
+                );
             }
             println!("{line}");
         }

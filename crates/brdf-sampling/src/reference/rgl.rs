@@ -19,7 +19,9 @@
 //! grids' rows (`vndf`, `ndf` and the `rgb` rows' images), graded towards `φ = ±π/2`, where at
 //! grazing `θo` the horizon's `θmax` swings from ~0 to ~π/2 over `Δφ ≈ cot θo`. The integrand
 //! is the material's own [`Brdf::eval_prepared`] (the tables, not a re-implementation).
-//! Its error is estimated by the same rule at half the order: the difference is returned.
+//! Its error is estimated by the same rule at half the order: the difference is returned. A
+//! mirror-symmetric material ([`Brdf::is_mirror_symmetric`]: every table even in the relative
+//! azimuth) is integrated over `φ ∈ [0, π]` and doubled.
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
@@ -54,9 +56,21 @@ pub fn rgl_albedo_in_cells(
             z: cos_o,
         });
     }
+    albedo_in_cells_of(rgl, rgl, theta_o, order)
+}
+
+/// [`rgl_albedo_in_cells`] with the integrand evaluated through `brdf` (`rgl` itself or a
+/// wrapper of it such as [`brdf::CountingBrdf`], whose count then includes the rule's
+/// evaluations); `rgl` gives the grids. `theta_o` is checked by the caller.
+pub(crate) fn albedo_in_cells_of(
+    brdf: &dyn Brdf,
+    rgl: &RglBrdf,
+    theta_o: f64,
+    order: usize,
+) -> Result<AlbedoEstimate, ReferenceError> {
     let order = order.max(2);
-    let fine = CellRule::new(rgl, theta_o, order);
-    let coarse = CellRule::new(rgl, theta_o, (order / 2).max(1));
+    let fine = CellRule::new(brdf, rgl, theta_o, order);
+    let coarse = CellRule::new(brdf, rgl, theta_o, (order / 2).max(1));
     let (value, e1) = fine.integrate();
     let (low, e2) = coarse.integrate();
     if !(value.is_finite() && low.is_finite()) {
@@ -71,16 +85,16 @@ pub fn rgl_albedo_in_cells(
 
 /// [`rgl_albedo_in_cells`] at [`RGL_CELL_ORDER`]: a reference for RGL data that resolves
 /// 10⁻⁵ (relative) at every `θo` up to 89.9° (docs/benchmarks.md §13.13).
-pub fn rgl_reference_albedo(
-    rgl: &RglBrdf,
-    theta_o: f64,
-) -> Result<AlbedoEstimate, ReferenceError> {
+pub fn rgl_reference_albedo(rgl: &RglBrdf, theta_o: f64) -> Result<AlbedoEstimate, ReferenceError> {
     rgl_albedo_in_cells(rgl, theta_o, RGL_CELL_ORDER)
 }
 
 /// One rule: the material at a prepared `ωo`, the grids' breaks and the Gauss points.
 struct CellRule<'a> {
+    brdf: &'a dyn Brdf,
     rgl: &'a RglBrdf,
+    /// Integrate over `u_m.y ∈ [1/2, 1]` and double (mirror-symmetric tables).
+    half: bool,
     theta_o: f64,
     wo: Vec3,
     q: brdf::Outgoing,
@@ -92,17 +106,19 @@ struct CellRule<'a> {
 }
 
 impl<'a> CellRule<'a> {
-    fn new(rgl: &'a RglBrdf, theta_o: f64, order: usize) -> Self {
+    fn new(brdf: &'a dyn Brdf, rgl: &'a RglBrdf, theta_o: f64, order: usize) -> Self {
         let wo = brdf::direction_from_radians(theta_o, 0.0);
         let g = rgl.grids();
         let mut x_nodes = grid_nodes(g.vndf.0);
         x_nodes.extend(grid_nodes(g.ndf.0));
         sort_merge(&mut x_nodes);
         Self {
+            brdf,
             rgl,
+            half: rgl.is_isotropic() && rgl.is_mirror_symmetric(),
             theta_o,
             wo,
-            q: rgl.prepare(&wo),
+            q: brdf.prepare(&wo),
             gl: GaussLegendre::new(order),
             x_nodes,
             s_nodes: grid_nodes(g.rgb.0),
@@ -130,7 +146,8 @@ impl<'a> CellRule<'a> {
             b.extend([0.25 - d, 0.25 + d, 0.75 - d, 0.75 + d]);
             d *= 2.0;
         }
-        b.retain(|y| (0.0..=1.0).contains(y));
+        let lo = if self.half { 0.5 } else { 0.0 };
+        b.retain(|y| (lo..=1.0).contains(y));
         sort_merge(&mut b);
         b
     }
@@ -155,9 +172,10 @@ impl<'a> CellRule<'a> {
             })
             .collect();
         // Summed in a fixed order: the same value whatever the thread count.
-        lines
+        let (sum, evals) = lines
             .iter()
-            .fold((0.0, 0), |(s, e), &(v, n)| (s + v, e + n))
+            .fold((0.0, 0), |(s, e), &(v, n)| (s + v, e + n));
+        (if self.half { 2.0 * sum } else { sum }, evals)
     }
 
     /// `(∫ f cos θi · 8π² u sin θm (ωo·m) du, evaluations)` along the line `u_m.y = y`.
@@ -197,7 +215,7 @@ impl<'a> CellRule<'a> {
             if !(wi.z > 0.0 && dot > 0.0) {
                 return 0.0;
             }
-            let fc = self.rgl.eval_prepared(&self.q, &wi) * wi.z;
+            let fc = self.brdf.eval_prepared(&self.q, &wi) * wi.z;
             fc * 8.0 * PI * PI * x * st * dot
         };
         let mut total = 0.0;
@@ -221,7 +239,7 @@ fn sort_merge(b: &mut Vec<f64>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn fixture() -> Option<RglBrdf> {
@@ -230,9 +248,59 @@ mod tests {
         match RglBrdf::load(&path) {
             Ok(r) => Some(r),
             Err(e) => {
-                eprintln!("skipped: the RGL fixture {} is missing: {e}", path.display());
+                eprintln!(
+                    "skipped: the RGL fixture {} is missing: {e}",
+                    path.display()
+                );
                 None
             }
+        }
+    }
+
+    /// `cc_ibiza_sunset` from the team's data beside the repository (`../shared`), or `None`
+    /// with the reason printed.
+    pub(crate) fn ibiza() -> Option<RglBrdf> {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/measured/rgl/cc_ibiza_sunset_rgb.bsdf");
+        match RglBrdf::load(&path) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                eprintln!("skipped: {} is not readable: {e}", path.display());
+                None
+            }
+        }
+    }
+
+    /// Issue 27 item 4 (docs/benchmarks.md §13.13): the cell rule agrees with the adaptive
+    /// reference quadrature (an independent rule: equal-area disc, leaves split where orders
+    /// 8 and 5 disagree) where that one is good to a few 10⁻⁶ (30°, 60°), within 5·10⁻⁶ and
+    /// within the reference's own estimate; and its own error (order 8 against 4) is below
+    /// 10⁻⁶ there and at 89.5° (measured: ≤ 1.2·10⁻⁹ apart from the reference at these
+    /// angles on the fixture, 5.5·10⁻⁷ on `cc_ibiza_sunset`; own error ≤ 6·10⁻⁸).
+    #[test]
+    fn cells_agree_with_the_adaptive_reference() {
+        // The fixture at 30° (always there), `cc_ibiza_sunset` at 30° and 60° when present.
+        let mut cases: Vec<(&str, RglBrdf, &[f64])> = fixture()
+            .map(|r| ("paper_white", r, &[30.0][..]))
+            .into_iter()
+            .collect();
+        cases.extend(ibiza().map(|r| ("cc_ibiza_sunset", r, &[30.0, 60.0][..])));
+        for (name, rgl, angles) in &cases {
+            for &deg in angles.iter() {
+                let t = deg.to_radians();
+                let c = rgl_reference_albedo(rgl, t).expect("cells");
+                let wo = brdf::direction_from_radians(t, 0.0);
+                let r = super::super::reference_albedo_with_budget(rgl, &wo, 1_000_000)
+                    .expect("reference");
+                let gap = (c.value / r.value - 1.0).abs();
+                assert!(
+                    gap <= 5e-6 && gap <= r.abs_err / r.value + 1e-7,
+                    "{name} {deg}°: cells {c:?} vs reference {r:?}: {gap:e}"
+                );
+                assert!(c.abs_err <= 1e-6 * c.value, "{name} {deg}°: {c:?}");
+            }
+            let c = rgl_reference_albedo(rgl, 89.5f64.to_radians()).expect("cells");
+            assert!(c.abs_err <= 1e-6 * c.value, "{name} 89.5°: {c:?}");
         }
     }
 
