@@ -145,7 +145,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .as_any()
             .and_then(|a| a.downcast_ref::<brdf::RglBrdf>())
             .ok_or("--cells-orders needs an RGL material")?;
-        println!("grids: {:?}", rgl.grids());
+        println!(
+            "grids: {:?}; mirror-symmetric: {}",
+            rgl.grids(),
+            rgl.is_mirror_symmetric()
+        );
         let orders: Vec<usize> = orders.split(',').filter_map(|v| v.parse().ok()).collect();
         let list = arg::<String>(&args, "--at").ok_or("--cells-orders needs --at")?;
         for t in list.split(',').filter_map(|v| v.parse::<f64>().ok()) {

@@ -19,9 +19,9 @@
 //! grids' rows (`vndf`, `ndf` and the `rgb` rows' images), graded towards `φ = ±π/2`, where at
 //! grazing `θo` the horizon's `θmax` swings from ~0 to ~π/2 over `Δφ ≈ cot θo`. The integrand
 //! is the material's own [`Brdf::eval_prepared`] (the tables, not a re-implementation).
-//! Its error is estimated by the same rule at half the order: the difference is returned. A
-//! mirror-symmetric material ([`Brdf::is_mirror_symmetric`]: every table even in the relative
-//! azimuth) is integrated over `φ ∈ [0, π]` and doubled.
+//! Its error is estimated by the same rule at half the order: the difference is returned.
+//! The whole azimuth range is integrated (the four shared files are not mirror-symmetric
+//! within the reader's tolerance).
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
@@ -93,8 +93,6 @@ pub fn rgl_reference_albedo(rgl: &RglBrdf, theta_o: f64) -> Result<AlbedoEstimat
 struct CellRule<'a> {
     brdf: &'a dyn Brdf,
     rgl: &'a RglBrdf,
-    /// Integrate over `u_m.y ∈ [1/2, 1]` and double (mirror-symmetric tables).
-    half: bool,
     theta_o: f64,
     wo: Vec3,
     q: brdf::Outgoing,
@@ -115,7 +113,6 @@ impl<'a> CellRule<'a> {
         Self {
             brdf,
             rgl,
-            half: rgl.is_isotropic() && rgl.is_mirror_symmetric(),
             theta_o,
             wo,
             q: brdf.prepare(&wo),
@@ -146,8 +143,7 @@ impl<'a> CellRule<'a> {
             b.extend([0.25 - d, 0.25 + d, 0.75 - d, 0.75 + d]);
             d *= 2.0;
         }
-        let lo = if self.half { 0.5 } else { 0.0 };
-        b.retain(|y| (lo..=1.0).contains(y));
+        b.retain(|y| (0.0..=1.0).contains(y));
         sort_merge(&mut b);
         b
     }
@@ -172,10 +168,9 @@ impl<'a> CellRule<'a> {
             })
             .collect();
         // Summed in a fixed order: the same value whatever the thread count.
-        let (sum, evals) = lines
+        lines
             .iter()
-            .fold((0.0, 0), |(s, e), &(v, n)| (s + v, e + n));
-        (if self.half { 2.0 * sum } else { sum }, evals)
+            .fold((0.0, 0), |(s, e), &(v, n)| (s + v, e + n))
     }
 
     /// `(∫ f cos θi · 8π² u sin θm (ωo·m) du, evaluations)` along the line `u_m.y = y`.
