@@ -39,9 +39,9 @@ pub const RGL_CELL_ORDER: usize = 8;
 const MERGE: f64 = 1e-12;
 
 /// The albedo `A(θo) = ∫ f cos θi dωi` of `rgl` at the outgoing polar angle `theta_o`
-/// (radians, `φo = 0`) by the cell rule of the [module docs](self) with `order` points per
-/// piece and per axis; `abs_err` is its difference from the same rule at `order / 2` (at
-/// least 1) points. Errors: `theta_o` outside `[0, π/2)` or not finite; a non-finite
+/// (radians, `φo = 0`) by the cell rule of the [module docs](self) with `order` (at least 2)
+/// points per piece and per axis; `abs_err` is its difference from the same rule at
+/// `order / 2` points. Errors: `theta_o` outside `[0, π/2)` or not finite; a non-finite
 /// integral.
 pub fn rgl_albedo_in_cells(
     rgl: &RglBrdf,
