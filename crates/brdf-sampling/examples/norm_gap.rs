@@ -16,12 +16,17 @@
 //! (`ExactSet::node_rule_at`, no interpolation) splits the gap into the quadrature's part and
 //! the interpolation's.
 //!
+//! RGL materials also get the albedo integrated over the interpolant's own cells
+//! (`rgl_reference_albedo`, with its own error: the same rule at half the order), a reference
+//! that resolves 10⁻⁵ up to 89.9° (docs/benchmarks.md §13.13). `--cells-orders 4,8,16 --at …`
+//! prints that rule alone at several orders (no set built).
+//!
 //! `SPEC` is a model spec (`rgl:PATH`, `cornell:PATH`, `merl:PATH`, …) or `merl(SPEC)`: the
 //! model `SPEC` tabulated in the MERL layout (nearest-bin lookup, `MerlBrdf::tabulate`).
 //!
 //! The angles are `θo_k = 89.5° · (k + 0.37)/n` (`k = 0 … n − 1`: none of them on a regular
-//! node grid, most between the sampler's table nodes, the last ones grazing), plus 89.0°, 89.5°
-//! and 89.9°. For an isotropic BRDF at `φo = 0`, `∫ pdf = A(θo) / Â(θo)` exactly (`pdf =
+//! node grid, most between the sampler's table nodes, the last ones grazing), plus 88°, 88.5°,
+//! 89°, 89.5° and 89.9°. For an isotropic BRDF at `φo = 0`, `∫ pdf = A(θo) / Â(θo)` exactly (`pdf =
 //! f cos / Â`), so `|∫ pdf − 1| = |A / Â − 1|`; `Â` is the set's
 //! [`ExactSet::normaliser`]. `A` is the midpoint rule on `2n × 2n` equal-area
 //! cells (concentric map, see `fine_albedo`): no Gauss rule, no tree, no table, so
@@ -34,7 +39,7 @@ use std::time::Instant;
 use brdf::{Brdf, MerlBrdf, Vec3, direction_from_angles, parse_spec};
 use brdf_sampling::{
     DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SamplerDiagnostics, SetOptions, Variant,
-    reference_albedo,
+    reference_albedo, rgl_albedo_in_cells, rgl_reference_albedo,
 };
 use rayon::prelude::*;
 
@@ -133,6 +138,45 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("wrote {path}");
         return Ok(());
     }
+    if let Some(orders) = arg::<String>(&args, "--cells-orders") {
+        // The cell rule alone (`rgl_albedo_in_cells`) at several orders, against the adaptive
+        // reference quadrature: its convergence, no set built.
+        let rgl = brdf
+            .as_any()
+            .and_then(|a| a.downcast_ref::<brdf::RglBrdf>())
+            .ok_or("--cells-orders needs an RGL material")?;
+        println!(
+            "grids: {:?}; mirror-symmetric: {}",
+            rgl.grids(),
+            rgl.is_mirror_symmetric()
+        );
+        let orders: Vec<usize> = orders.split(',').filter_map(|v| v.parse().ok()).collect();
+        let list = arg::<String>(&args, "--at").ok_or("--cells-orders needs --at")?;
+        for t in list.split(',').filter_map(|v| v.parse::<f64>().ok()) {
+            let mut line = format!("| {t:.3} |");
+            for &o in &orders {
+                let c0 = cpu_seconds();
+                let c = rgl_albedo_in_cells(rgl, t.to_radians(), o)?;
+                line += &format!(
+                    " {:.10} (±{:.1e}, {} ev, {:.2} CPU-s) |",
+                    c.value,
+                    c.abs_err / c.value,
+                    c.evaluations,
+                    cpu_seconds() - c0
+                );
+            }
+            if ref_every > 0 {
+                let r = reference_albedo(brdf.as_ref(), &direction_from_angles(t, 0.0))?;
+                line += &format!(
+                    " adaptive ref {:.10} (±{:.1e}) |",
+                    r.value,
+                    r.abs_err / r.value
+                );
+            }
+            println!("{line}");
+        }
+        return Ok(());
+    }
     let opts = ExactOptions::with_set(SetOptions::default());
     let all_threads = || {
         rayon::broadcast(|_| brdf::thread_evaluations())
@@ -178,15 +222,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut angles: Vec<f64> = (0..n_angles)
         .map(|k| 89.5 * (k as f64 + 0.37) / n_angles as f64)
         .collect();
-    angles.extend([89.0, 89.5, 89.9]);
+    angles.extend([88.0, 88.5, 89.0, 89.5, 89.9]);
     if let Some(list) = arg::<String>(&args, "--at") {
         angles = list.split(',').filter_map(|v| v.parse().ok()).collect();
     }
     let merl = brdf.as_any().and_then(|a| a.downcast_ref::<MerlBrdf>());
     println!(
-        "| θo ° | A (fine) | Â | A/Â − 1 | declared | node rule at θo: A/N − 1 (its estimate) | interpolation N/Â − 1 | ref. quad. A/Â − 1 | in bins A/Â − 1 |"
+        "| θo ° | A (fine) | Â | A/Â − 1 | declared | node rule at θo: A/N − 1 (its estimate) | interpolation N/Â − 1 | ref. quad. A/Â − 1 | in bins A/Â − 1 | RGL cells A_c/Â − 1 (own error) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let rgl = brdf
+        .as_any()
+        .and_then(|a| a.downcast_ref::<brdf::RglBrdf>());
+    let (mut worst_cells, mut worst_cells_at, mut worst_cells_err) = (0.0f64, 0.0, 0.0f64);
+    let mut worst_ref_vs_cells = 0.0f64;
     let (mut worst, mut worst_at, mut worst_check, mut under) = (0.0f64, 0.0, 0.0f64, 0usize);
     let mut worst_adaptive = 0.0f64;
     let (mut worst_ref, mut worst_ref_vs_fine) = (0.0f64, 0.0f64);
@@ -242,8 +291,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // The gap split into the node rule's own error (the rule run at θo itself, no
         // interpolation) and the interpolation's (`ExactSet::node_rule_at`).
         let (node, node_err) = exact.node_rule_at(&wo).unwrap_or((f64::NAN, f64::NAN));
+        // RGL: the albedo integrated over the interpolant's own cells (`rgl_reference_albedo`,
+        // its own error: the same rule at half the order).
+        let cells = rgl.map_or(String::new(), |rgl| {
+            match rgl_reference_albedo(rgl, t.to_radians()) {
+                Ok(c) => {
+                    let g = c.value / a_hat - 1.0;
+                    if g.abs() > worst_cells {
+                        (worst_cells, worst_cells_at) = (g.abs(), t);
+                    }
+                    worst_cells_err = worst_cells_err.max(c.abs_err / c.value);
+                    if r.is_finite() {
+                        worst_ref_vs_cells =
+                            worst_ref_vs_cells.max(((r + 1.0) / (g + 1.0) - 1.0).abs());
+                    }
+                    format!(" {g:+.2e} (±{:.0e}) |", c.abs_err / c.value)
+                }
+                Err(e) => format!(" {e} |"),
+            }
+        });
         println!(
-            "| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {:+.2e} ({node_err:.1e}) | {:+.2e} | {r:+.2e} (±{r_err:.0e}) |{bins}",
+            "| {t:.3} | {a:.8} | {a_hat:.8} | {gap:+.2e} | {declared:.1e} | {:+.2e} ({node_err:.1e}) | {:+.2e} | {r:+.2e} (±{r_err:.0e}) |{bins}{cells}",
             a / node - 1.0,
             node / a_hat - 1.0
         );
@@ -255,6 +323,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if worst_ref > 0.0 {
         println!(
             "{spec}: reference quadrature: max |A_ref/Â − 1| = {worst_ref:.2e}; max |A_ref/A_fine − 1| = {worst_ref_vs_fine:.1e}"
+        );
+    }
+    if rgl.is_some() {
+        println!(
+            "{spec}: RGL cell rule: max |A_cells/Â − 1| = {worst_cells:.2e} at θo = {worst_cells_at:.3}°; its own error ≤ {worst_cells_err:.1e}; max |A_ref/A_cells − 1| = {worst_ref_vs_cells:.1e}"
         );
     }
     if adaptive.is_some() {

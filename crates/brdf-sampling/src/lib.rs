@@ -117,6 +117,7 @@ pub use reference::{
     AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,
     reference_albedo_with_budget,
 };
+pub use reference::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
 pub use report::{CostMeasurement, SetReport};
 pub use sampler_checks::{SampledAlbedo, sampled_albedo, upper_hemisphere_integral};
 pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

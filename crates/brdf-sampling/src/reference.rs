@@ -27,6 +27,12 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{LeafInfo, Rect};
 
+mod rgl;
+pub(crate) use rgl::albedo_in_cells_of;
+#[cfg(test)]
+pub(crate) use rgl::tests::ibiza as rgl_tests_ibiza;
+pub use rgl::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
+
 use crate::disc::DiscMap;
 use crate::normalisation::{Grading, adaptive_quadrature};
 

@@ -133,6 +133,17 @@ pub struct HalfCoords {
     pub m: Vec3,
 }
 
+/// Grid sizes `(nx, ny)` of an [`RglBrdf`]'s bilinear tables ([`RglBrdf::grids`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RglGrids {
+    /// `ndf` (`D`) on the `u_m`-square.
+    pub ndf: (usize, usize),
+    /// `vndf` (the warp's density) on the `u_m`-square.
+    pub vndf: (usize, usize),
+    /// `rgb` (and `luminance`) on the warped square.
+    pub rgb: (usize, usize),
+}
+
 impl RglBrdf {
     /// Reads and validates an RGL `.bsdf` file.
     pub fn load(path: &Path) -> Result<Self, RglError> {
@@ -299,6 +310,18 @@ impl RglBrdf {
         k.sort_by(f64::total_cmp);
         k.dedup_by(|a, b| (*a - *b).abs() <= eps);
         k
+    }
+
+    /// Grid sizes `(nx, ny)` of the bilinear tables `f` is made of: its interpolant is smooth
+    /// inside their cells and has kinks on their edges (`ndf` and `vndf` on the `u_m`-square,
+    /// `rgb` on the warped square). For integrators that follow the kinks.
+    pub fn grids(&self) -> RglGrids {
+        let t = &self.tables;
+        RglGrids {
+            ndf: t.ndf.size(),
+            vndf: t.vndf.table().size(),
+            rgb: t.rgb.size(),
+        }
     }
 
     /// The VNDF warp (half-vector `u_m` from the warped square, conditioned on `θo`).
