@@ -338,19 +338,5 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// `∫ pdf(ωo, ·) dσ` by the midpoint rule on `n × 2n` cells of `(cos θi, φi)`.
 fn fine_pdf(s: &dyn DirectionSampler, wo: &Vec3, n: usize) -> f64 {
-    let np = 2 * n;
-    let rows: Vec<f64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let z = (i as f64 + 0.5) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            (0..np)
-                .map(|j| {
-                    let phi = (j as f64 + 0.5) / np as f64 * std::f64::consts::TAU;
-                    s.pdf(wo, &Vec3::new(r * phi.cos(), r * phi.sin(), z))
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    rows.iter().sum::<f64>() * (1.0 / n as f64) * (std::f64::consts::TAU / np as f64)
+    brdf_sampling::upper_hemisphere_integral(&|wi| s.pdf(wo, wi), n, 2 * n)
 }
