@@ -131,27 +131,70 @@ pub(crate) fn clenshaw(series: &[f64], x: f64) -> f64 {
     x * y1 - y2 + series.first().copied().unwrap_or(0.0)
 }
 
-/// `Σ_k Σ_l c[k · nd + l] T_k(x) T_l(y)`: Clenshaw's recurrence along `y` for all `k` at once
-/// (the rows' recurrences side by side, which the compiler keeps in vector registers), then
-/// along `x`. At most 32 θ coefficients (the table's node limit).
+/// `Σ_k Σ_l c[k · nd + l] T_k(x) T_l(y)`: Clenshaw's recurrence along `x` (θ) for all `l`
+/// at once — the `nd` recurrences side by side over contiguous rows `c[k · nd ..]`, the
+/// table's own order — then along `y` (δ). The δ node counts the build makes (5, 9 and 17:
+/// Lobatto-nested doublings of [`ExactOptions::DEFAULT_PHI_NORMALISER_NODES`]) are compiled
+/// for their length, so the rows stay in registers with no bounds checks; other counts (at
+/// most 32) take the general loop.
+///
+/// [`ExactOptions::DEFAULT_PHI_NORMALISER_NODES`]: super::ExactOptions::DEFAULT_PHI_NORMALISER_NODES
 #[inline]
 fn tensor_clenshaw(c: &[f64], nd: usize, x: f64, y: f64) -> f64 {
-    const MAX: usize = 32;
-    let nt = (c.len() / nd).min(MAX);
-    let (mut y1, mut y2) = ([0.0f64; MAX], [0.0f64; MAX]);
-    let y2x = 2.0 * y;
-    for l in (1..nd).rev() {
-        for k in 0..nt {
-            let v = y2x * y1[k] - y2[k] + c[k * nd + l];
-            y2[k] = y1[k];
-            y1[k] = v;
+    match nd {
+        5 => tensor_clenshaw_of::<5>(c, x, y),
+        9 => tensor_clenshaw_of::<9>(c, x, y),
+        17 => tensor_clenshaw_of::<17>(c, x, y),
+        _ => tensor_clenshaw_any(c, nd, x, y),
+    }
+}
+
+/// [`tensor_clenshaw`] for `ND` δ coefficients per θ row.
+#[inline]
+fn tensor_clenshaw_of<const ND: usize>(c: &[f64], x: f64, y: f64) -> f64 {
+    let (rows, _) = c.as_chunks::<ND>();
+    let Some((first, rest)) = rows.split_first() else {
+        return 0.0;
+    };
+    let x2 = 2.0 * x;
+    let (mut b1, mut b2) = ([0.0f64; ND], [0.0f64; ND]);
+    for row in rest.iter().rev() {
+        for l in 0..ND {
+            let v = x2 * b1[l] - b2[l] + row[l];
+            b2[l] = b1[l];
+            b1[l] = v;
         }
     }
-    let mut rows = [0.0f64; MAX];
-    for k in 0..nt {
-        rows[k] = y * y1[k] - y2[k] + c[k * nd];
+    let mut col = [0.0f64; ND];
+    for l in 0..ND {
+        col[l] = x * b1[l] - b2[l] + first[l];
     }
-    clenshaw(&rows[..nt], x)
+    clenshaw(&col, y)
+}
+
+/// [`tensor_clenshaw`] for any `nd` (at most 32 are read).
+fn tensor_clenshaw_any(c: &[f64], nd: usize, x: f64, y: f64) -> f64 {
+    const MAX: usize = 32;
+    let nd = nd.clamp(1, MAX);
+    let mut rows = c.chunks_exact(nd);
+    let Some(first) = rows.next() else {
+        return 0.0;
+    };
+    let x2 = 2.0 * x;
+    let (mut b1, mut b2) = ([0.0f64; MAX], [0.0f64; MAX]);
+    let (b1, b2) = (&mut b1[..nd], &mut b2[..nd]);
+    for row in rows.rev() {
+        for ((p1, p2), &r) in b1.iter_mut().zip(b2.iter_mut()).zip(row) {
+            let v = x2 * *p1 - *p2 + r;
+            *p2 = *p1;
+            *p1 = v;
+        }
+    }
+    let mut col = [0.0f64; MAX];
+    for (((o, &p1), &p2), &r) in col.iter_mut().zip(b1.iter()).zip(b2.iter()).zip(first) {
+        *o = x * p1 - p2 + r;
+    }
+    clenshaw(&col[..nd], y)
 }
 
 /// A tensor Chebyshev–Lobatto table over `θ ∈ [θ_a, θ_b]` × `δ ∈ [−h, h]` (one δ node when the
@@ -450,8 +493,8 @@ mod tests {
         #[test]
         fn tensor_series_is_the_tensor_interpolant(a in -1.0f64..1.0, w in 0.01f64..2.0,
                                                    h in 0.01f64..1.0,
-                                                   nt in 2usize..12, nd in 2usize..12,
-                                                   v in proptest::collection::vec(0.1f64..10.0, 144),
+                                                   nt in 2usize..12, nd in 2usize..19,
+                                                   v in proptest::collection::vec(0.1f64..10.0, 12 * 18),
                                                    s in 0.0f64..1.0, r in 0.0f64..1.0) {
             let theta = lobatto_nodes(a, a + w, nt);
             let delta = lobatto_nodes(-h, h, nd);
@@ -470,6 +513,26 @@ mod tests {
             for (i, &ti) in theta.iter().enumerate() {
                 for (k, &dk) in delta.iter().enumerate() {
                     prop_assert!((table.eval(ti, dk) - values[i * nd + k]).abs() <= tol);
+                }
+            }
+        }
+    }
+
+    /// The δ lengths compiled for their size (5, 9, 17) do the general loop's arithmetic in
+    /// its order: the same bits.
+    #[test]
+    fn compiled_delta_lengths_are_the_general_loop() {
+        for nd in [5, 9, 17] {
+            for nt in [1, 2, 9, 13] {
+                let c: Vec<f64> = (0..nt * nd)
+                    .map(|i| ((i * 7919 % 97) as f64 - 48.0) / (1.0 + i as f64))
+                    .collect();
+                for (x, y) in [(-1.0, -1.0), (0.3, -0.7), (1.0, 1.0), (-0.2, 0.9)] {
+                    let (a, b) = (
+                        tensor_clenshaw(&c, nd, x, y),
+                        tensor_clenshaw_any(&c, nd, x, y),
+                    );
+                    assert_eq!(a.to_bits(), b.to_bits(), "{nd} {nt} {x} {y}: {a} vs {b}");
                 }
             }
         }

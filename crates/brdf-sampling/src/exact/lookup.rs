@@ -14,6 +14,30 @@ use super::interval::{Interval, Query};
 use super::options::THETA_TOP_DEG;
 use super::set::ExactSet;
 
+/// `x.rem_euclid(p)` for `p > 0`, bit for bit, without the `fmod` call when `|x| < 2p` (a
+/// query's azimuth and its offset from a cell: `atan2` is within `[−π, π]`): there `x % p` is
+/// `x` or `x ∓ p`, exact (Sterbenz), with the sign of `x` (also for a zero result, as `fmod`).
+#[inline]
+pub(super) fn rem_period(x: f64, p: f64) -> f64 {
+    let a = x.abs();
+    let r = if a < p {
+        x
+    } else if a < 2.0 * p {
+        (x - p.copysign(x)).copysign(x)
+    } else {
+        x % p
+    };
+    if r < 0.0 { r + p } else { r }
+}
+
+/// `t.round() as usize` (halves away from zero) for `t ≥ 0` below `2^52` and NaN (0), without
+/// the `round` call: `t − ⌊t⌋` is exact there.
+#[inline]
+pub(super) fn round_index(t: f64) -> usize {
+    let whole = t as i64;
+    (whole + i64::from(t - whole as f64 >= 0.5)) as usize
+}
+
 impl ExactSet {
     /// The tabulated normaliser `A(θo, δ) = ∫ f_r(ωo, ·) cos θi dσ` used by the pdf at `wo`
     /// (`None` below the horizon).
@@ -60,9 +84,9 @@ impl ExactSet {
             let phi = wo.y.atan2(wo.x);
             let n = self.cells.len();
             let step = self.period / n as f64;
-            let k = ((phi.rem_euclid(self.period) / step).round() as usize) % n;
+            let k = round_index(rem_period(phi, self.period) / step) % n;
             let rot = phi - self.cells[k].phi;
-            let mut delta = rot.rem_euclid(self.period);
+            let mut delta = rem_period(rot, self.period);
             if delta > 0.5 * self.period {
                 delta -= self.period;
             }
@@ -193,5 +217,69 @@ impl ExactSet {
             violations: total.violations,
             exhausted: total.exhausted,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{rem_period, round_index};
+    use proptest::prelude::*;
+
+    /// Bit for bit `rem_euclid`, also at the edges (`±p`, `±2p`, signed zeros, NaN).
+    fn same_as_rem_euclid(x: f64, p: f64) -> Result<(), TestCaseError> {
+        let (got, want) = (rem_period(x, p), x.rem_euclid(p));
+        prop_assert!(
+            got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+            "{x} mod {p}: {got:e} vs {want:e}"
+        );
+        Ok(())
+    }
+
+    proptest! {
+        #[test]
+        fn rem_period_is_rem_euclid(x in -30.0f64..30.0, p in 0.1f64..7.0) {
+            same_as_rem_euclid(x, p)?;
+        }
+
+        #[test]
+        fn round_index_is_round(t in 0.0f64..1e6, k in 0u32..1000) {
+            prop_assert_eq!(round_index(t), t.round() as usize);
+            let half = f64::from(k) + 0.5;
+            for h in [half, half.next_down(), half.next_up()] {
+                prop_assert_eq!(round_index(h), h.round() as usize, "{}", h);
+            }
+        }
+    }
+
+    #[test]
+    fn rem_period_at_the_edges() {
+        use std::f64::consts::{PI, TAU};
+        for p in [PI, TAU, PI / 2.0, 0.3] {
+            for x in [
+                0.0,
+                -0.0,
+                p,
+                -p,
+                2.0 * p,
+                -2.0 * p,
+                p.next_up(),
+                p.next_down(),
+                -p.next_up(),
+                -p.next_down(),
+                (2.0 * p).next_down(),
+                -(2.0 * p).next_down(),
+                1e-300,
+                -1e-300,
+                PI,
+                -PI,
+                f64::NAN,
+                1e20,
+                -1e20,
+            ] {
+                same_as_rem_euclid(x, p).unwrap();
+            }
+        }
+        assert_eq!(round_index(f64::NAN), 0);
+        assert_eq!(round_index(0.49999999999999994), 0);
     }
 }
