@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
-use ::samplers::{BuiltDirection, DirectionRequest};
+use ::samplers::{BuiltDirection, DirectionRequest, SamplerEntry};
 use brdf::Vec3;
 use numpy::{PyArray1, PyArray2};
 use partition_sampler::{PAR_CHUNK, UniformSource, chunk_rng};
@@ -182,6 +182,26 @@ impl DirectionSampler {
     fn next_seed(&self, seed: Option<u64>) -> u64 {
         next_seed(self.seed, &self.calls, seed)
     }
+
+    /// The sampler `built` of registry `entry` for `(brdf, spec)`, whose build started at
+    /// `start`.
+    fn built(
+        entry: &SamplerEntry,
+        (brdf, spec): (Arc<dyn brdf::Brdf>, String),
+        built: BuiltDirection,
+        seed: u64,
+        start: Instant,
+    ) -> Self {
+        Self {
+            name: entry.name.to_string(),
+            brdf,
+            spec,
+            built,
+            seed,
+            calls: AtomicU64::new(0),
+            build_seconds: start.elapsed().as_secs_f64(),
+        }
+    }
 }
 
 /// `f = 1`: the BRDF handed to a batch call when the caller evaluates `eval_rgb` itself (a
@@ -214,14 +234,28 @@ fn batch_chunk(
     let mut out = Vec::with_capacity(wos.len());
     sampler.sample_eval_batch(if rgb { &NoEval } else { brdf }, &wos, rng, &mut out);
     for ((&j, o), s) in ks.iter().zip(&wos).zip(&out) {
-        wi[3 * j..3 * j + 3].copy_from_slice(&[s.wi.x, s.wi.y, s.wi.z]);
-        pdf[j] = s.pdf;
-        if s.pdf > 0.0 && s.wi.z > 0.0 {
-            if rgb {
-                f[3 * j..3 * j + 3].copy_from_slice(&brdf.eval_rgb(o, &s.wi));
-            } else {
-                f[j] = s.f;
-            }
+        write_draw(j, o, (&s.wi, s.pdf), brdf, rgb, || s.f, (wi, pdf, f));
+    }
+}
+
+/// Writes draw `j` (`(wi, pdf)` at `wo`) into the output slices, and its `f` where the draw is
+/// valid (`pdf > 0`, `wi` above the horizon): with `rgb` the BRDF's `eval_rgb`, else `lum()`.
+fn write_draw(
+    j: usize,
+    wo: &Vec3,
+    (s_wi, s_pdf): (&Vec3, f64),
+    brdf: &dyn brdf::Brdf,
+    rgb: bool,
+    lum: impl FnOnce() -> f64,
+    (wi, pdf, f): (&mut [f64], &mut [f64], &mut [f64]),
+) {
+    wi[3 * j..3 * j + 3].copy_from_slice(&[s_wi.x, s_wi.y, s_wi.z]);
+    pdf[j] = s_pdf;
+    if s_pdf > 0.0 && s_wi.z > 0.0 {
+        if rgb {
+            f[3 * j..3 * j + 3].copy_from_slice(&brdf.eval_rgb(wo, s_wi));
+        } else {
+            f[j] = lum();
         }
     }
 }
@@ -311,15 +345,7 @@ impl DirectionSampler {
                     .unwrap_or_else(|| value_error(&e))
             })?;
         callable_error(py, &brdf)?;
-        Ok(Self {
-            name: entry.name.to_string(),
-            brdf,
-            spec,
-            built,
-            seed,
-            calls: AtomicU64::new(0),
-            build_seconds: start.elapsed().as_secs_f64(),
-        })
+        Ok(Self::built(entry, (brdf, spec), built, seed, start))
     }
 
     /// Draws one direction per query: returns ``(wi, pdf, f)`` with `wi` (N, 3), `pdf` (N,) per
@@ -408,15 +434,15 @@ impl DirectionSampler {
                                     sampler.sample(o, &mut Lead::new(UArg::row(v, k), &mut rng))
                                 }
                             };
-                            wi_c[3 * j..3 * j + 3].copy_from_slice(&[s.wi.x, s.wi.y, s.wi.z]);
-                            pdf_c[j] = s.pdf;
-                            if s.pdf > 0.0 && s.wi.z > 0.0 {
-                                if rgb {
-                                    f_c[3 * j..3 * j + 3].copy_from_slice(&brdf.eval_rgb(o, &s.wi));
-                                } else {
-                                    f_c[j] = brdf.eval(o, &s.wi);
-                                }
-                            }
+                            write_draw(
+                                j,
+                                o,
+                                (&s.wi, s.pdf),
+                                brdf.as_ref(),
+                                rgb,
+                                || brdf.eval(o, &s.wi),
+                                (&mut *wi_c, &mut *pdf_c, &mut *f_c),
+                            );
                         }
                     });
             })
@@ -565,15 +591,7 @@ impl DirectionSampler {
                 (b.inner, spec)
             }
         };
-        Ok(Self {
-            name: entry.name.to_string(),
-            brdf,
-            spec,
-            built,
-            seed,
-            calls: AtomicU64::new(0),
-            build_seconds: start.elapsed().as_secs_f64(),
-        })
+        Ok(Self::built(entry, (brdf, spec), built, seed, start))
     }
 
     fn __repr__(&self) -> String {

@@ -12,41 +12,31 @@
 //! at a feature of the pdf (a peak, a jump, round-off) that the adaptive quadrature refines
 //! to its depth limit.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use brdf::direction_from_angles;
-use brdf_sampling::DirectionSampler;
-use stats::{
-    Axis, Binning, expected_masses_with, normalisation, projection_cdf_with_singularities,
-};
+use stats::{Axis, expected_masses_with, normalisation, projection_cdf_with_singularities};
+use support::Probe;
 use validation::references::{albedo_reference, lit_reference};
-use validation::{Plan, Tier, build_direction, direction_domain};
+
+mod support;
 
 /// Side of the grid of (cos θ, φ) cells the evaluations are counted in.
 const GRID: usize = 8;
 
 fn main() -> Result<(), String> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [sampler, spec, theta, rest @ ..] = args.as_slice() else {
-        return Err("usage: case_cost SAMPLER BRDF THETA_O [SAMPLES]".into());
-    };
-    let theta: f64 = theta.parse().map_err(|e| format!("THETA_O: {e}"))?;
-    let samples: u64 = match rest.first() {
-        Some(s) => s.parse().map_err(|e| format!("SAMPLES: {e}"))?,
-        None => 200_000,
-    };
-    let entry = samplers::find(sampler).map_err(|e| e.to_string())?;
-    let domain = direction_domain(entry).ok_or("not a direction sampler")?;
-    let brdf: Arc<dyn brdf::Brdf> = Arc::from(brdf::parse_spec(spec).map_err(|e| e.to_string())?);
-    let wo = direction_from_angles(theta, 0.0);
-    let plan = Plan::new(Tier::Full, samples as usize);
-    let binning = plan
-        .resolution
-        .sphere_binning(domain)
-        .map_err(|e| e.to_string())?
-        .ok_or("no direction binning")?;
+    let probe = Probe::from_args("case_cost", 200_000)?;
+    // The sampler's declared singular directions, as the suite grades towards them (PLAIN=1:
+    // none).
+    let singular = probe.singular();
+    let Probe {
+        sampler,
+        brdf,
+        wo,
+        plan,
+        binning,
+    } = probe;
+    let samples = plan.samples as u64;
     let opts = &plan.quadrature;
 
     let started = Instant::now();
@@ -62,8 +52,6 @@ fn main() -> Result<(), String> {
         lit.abs_error
     );
 
-    let sampler: Arc<dyn DirectionSampler> =
-        build_direction(entry, &brdf).map_err(|e| e.to_string())?;
     let cells: Vec<AtomicU64> = (0..GRID * GRID).map(|_| AtomicU64::new(0)).collect();
     let pdf = |w: [f64; 3]| {
         let u = ((w[2] + 1.0) * 0.5 * GRID as f64) as usize;
@@ -103,24 +91,6 @@ fn main() -> Result<(), String> {
             .map(|o| o.detail)
             .map_err(|e| e.to_string())
     })?;
-    // The sampler's declared singular directions, as the suite grades towards them (PLAIN=1:
-    // none).
-    let singular: Vec<[f64; 2]> = if std::env::var_os("PLAIN").is_some() {
-        Vec::new()
-    } else {
-        sampler
-            .singular_directions(&wo)
-            .iter()
-            .filter_map(|d| binning.param_of(&[d.x, d.y, d.z]))
-            .flat_map(|[u, v]| {
-                [
-                    [u, v],
-                    [u, v - std::f64::consts::TAU],
-                    [u, v + std::f64::consts::TAU],
-                ]
-            })
-            .collect()
-    };
     for (axis, name) in [(Axis::U, "KS cos θ"), (Axis::V, "KS φ")] {
         stage(name, &|| {
             let cdf =

@@ -11,54 +11,28 @@
 //! # e.g. analytic ward-original 89 1000000
 //! ```
 
-use std::sync::Arc;
-
-use brdf::{Vec3, direction_from_angles};
-use brdf_sampling::DirectionSampler;
+use brdf::Vec3;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-use stats::{Axis, Binning, projection_cdf, projection_cdf_with_singularities};
-use validation::{Plan, Tier, build_direction, direction_domain};
+use stats::{Axis, projection_cdf, projection_cdf_with_singularities};
+use support::Probe;
+
+mod support;
 
 fn main() -> Result<(), String> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [sampler, spec, theta, rest @ ..] = args.as_slice() else {
-        return Err("usage: ks_probe SAMPLER BRDF THETA_O [SAMPLES]".into());
-    };
-    let theta: f64 = theta.parse().map_err(|e| format!("THETA_O: {e}"))?;
-    let n: usize = match rest.first() {
-        Some(s) => s.parse().map_err(|e| format!("SAMPLES: {e}"))?,
-        None => 1_000_000,
-    };
-    let entry = samplers::find(sampler).map_err(|e| e.to_string())?;
-    let domain = direction_domain(entry).ok_or("not a direction sampler")?;
-    let brdf: Arc<dyn brdf::Brdf> = Arc::from(brdf::parse_spec(spec).map_err(|e| e.to_string())?);
-    let wo = direction_from_angles(theta, 0.0);
-    let plan = Plan::new(Tier::Full, n);
-    let binning = plan
-        .resolution
-        .sphere_binning(domain)
-        .map_err(|e| e.to_string())?
-        .ok_or("no direction binning")?;
-    let s: Arc<dyn DirectionSampler> = build_direction(entry, &brdf).map_err(|e| e.to_string())?;
-    let pdf = |w: [f64; 3]| s.pdf(&wo, &Vec3::new(w[0], w[1], w[2]));
+    let probe = Probe::from_args("ks_probe", 1_000_000)?;
     // As the suite does: graded towards the sampler's declared singular directions, unless
     // PLAIN=1 (the quadrature before that declaration existed).
-    let singular: Vec<[f64; 2]> = if std::env::var_os("PLAIN").is_some() {
-        Vec::new()
-    } else {
-        s.singular_directions(&wo)
-            .iter()
-            .filter_map(|d| binning.param_of(&[d.x, d.y, d.z]))
-            .flat_map(|[u, v]| {
-                [
-                    [u, v],
-                    [u, v - std::f64::consts::TAU],
-                    [u, v + std::f64::consts::TAU],
-                ]
-            })
-            .collect()
-    };
+    let singular = probe.singular();
+    let Probe {
+        sampler: s,
+        wo,
+        plan,
+        binning,
+        ..
+    } = probe;
+    let n = plan.samples;
+    let pdf = |w: [f64; 3]| s.pdf(&wo, &Vec3::new(w[0], w[1], w[2]));
     let cdf = if singular.is_empty() {
         projection_cdf(&binning, &pdf, Axis::U, n as u64, &plan.quadrature)
     } else {
@@ -81,8 +55,9 @@ fn main() -> Result<(), String> {
         .collect();
     us.sort_by(f64::total_cmp);
     let below = |u: f64| us.partition_point(|&x| x <= u) as f64 / n as f64;
-    let rows = plan.resolution.directions[0] * if domain.name() == "sphere" { 2 } else { 1 };
-    let u0 = if domain.name() == "sphere" { -1.0 } else { 0.0 };
+    let sphere = !binning.is_hemisphere();
+    let rows = plan.resolution.directions[0] * if sphere { 2 } else { 1 };
+    let u0 = if sphere { -1.0 } else { 0.0 };
     let width = (1.0 - u0) / rows as f64;
     println!("cos θ row            tabulated   sampled     (σ)   z");
     for r in 0..rows {

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use brdf::Vec3;
-use brdf_sampling::DirectionSampler;
+use brdf_sampling::{DirSample, DirectionSampler};
 use envmap::EnvMapSampler;
 use partition_sampler::{AllocationMode, QuadTreeSampler, RegionStats, Sampler2D, UniformSource};
 
@@ -40,19 +40,11 @@ impl SamplerUnderTest<Dir3> for DirectionAtWo {
     }
 
     fn sample_batch(&self, n: usize, u: &mut dyn UniformSource) -> Vec<(Dir3, f64)> {
-        self.sampler
-            .sample_batch(&self.wo, n, u)
-            .iter()
-            .map(|s| (dir_of(&s.wi), s.pdf))
-            .collect()
+        dir_pairs(&self.sampler.sample_batch(&self.wo, n, u))
     }
 
     fn sample_many(&self, n: usize, u: &mut dyn UniformSource) -> Vec<(Dir3, f64)> {
-        self.sampler
-            .sample_many(&self.wo, n, u)
-            .iter()
-            .map(|s| (dir_of(&s.wi), s.pdf))
-            .collect()
+        dir_pairs(&self.sampler.sample_many(&self.wo, n, u))
     }
 
     fn prefers_batches(&self) -> bool {
@@ -90,13 +82,23 @@ pub struct PlainPlanar<S>(pub S);
 
 impl<S: Sampler2D + Send> SamplerUnderTest<Point2> for PlainPlanar<S> {
     fn sample(&self, u: &mut dyn UniformSource) -> (Point2, f64) {
-        let s = self.0.sample(u);
-        (s.point, s.pdf)
+        planar_draw(&self.0, u)
     }
 
     fn pdf(&self, p: Point2) -> f64 {
         self.0.pdf(p)
     }
+}
+
+/// Direction samples as `(direction, pdf)` pairs.
+fn dir_pairs(samples: &[DirSample]) -> Vec<(Dir3, f64)> {
+    samples.iter().map(|s| (dir_of(&s.wi), s.pdf)).collect()
+}
+
+/// One draw of a planar sampler as `(point, pdf)`.
+fn planar_draw<S: Sampler2D>(sampler: &S, u: &mut dyn UniformSource) -> (Point2, f64) {
+    let s = sampler.sample(u);
+    (s.point, s.pdf)
 }
 
 /// A [`QuadTreeSampler`]: one-sample draws of its configured scheme, batches by its stratified
@@ -105,8 +107,7 @@ pub struct QuadTreePlanar<D>(pub QuadTreeSampler<D>);
 
 impl<D: RegionStats + Send> SamplerUnderTest<Point2> for QuadTreePlanar<D> {
     fn sample(&self, u: &mut dyn UniformSource) -> (Point2, f64) {
-        let s = self.0.sample(u);
-        (s.point, s.pdf)
+        planar_draw(&self.0, u)
     }
 
     fn pdf(&self, p: Point2) -> f64 {

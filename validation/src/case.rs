@@ -8,7 +8,8 @@ use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use stats::{
     Axis, Binning, MarginalMemo, TestOutcome, expected_masses_with, ks_projection_test_with_memo,
-    ks_projection_test_with_singularities, normalisation, pdf_consistency, support_coverage,
+    ks_projection_test_with_singularities, mean_variance, normalisation, pdf_consistency,
+    support_coverage, two_sided_z,
 };
 
 use crate::cells::{CellModel, ExactTests};
@@ -232,22 +233,13 @@ pub fn z_test(
             ),
         );
     }
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
-    let se = (var / n).sqrt();
+    let (mean, var) = mean_variance(values);
+    let se = (var / values.len() as f64).sqrt();
     let sys = ((allowance * reference.value).powi(2) + reference.abs_error.powi(2)).sqrt();
     let total = (se * se + sys * sys)
         .sqrt()
         .max(1e-12 * mean.abs().max(reference.value.abs()));
-    let z = if total > 0.0 {
-        (mean - reference.value) / total
-    } else if mean == reference.value {
-        0.0
-    } else {
-        f64::INFINITY
-    };
-    let p = statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2);
+    let (z, p) = two_sided_z(mean, reference.value, total);
     let detail = format!(
         "mean {mean:.8e} vs reference {:.8e} (rel. dev. {:.2e}); standard error {se:.3e}, systematic allowance {sys:.3e}; z = {z:.3}, n = {}",
         reference.value,

@@ -35,6 +35,18 @@ pub fn brdf_direction_subject(
     let b = Arc::clone(&brdf);
     let lit: ScalarFn<Dir3> =
         Arc::new(move |w| projected_brdf(b.as_ref(), &wo, w) * environment(w));
+    brdf_subject(sampler, domain, target, lit, refs)
+}
+
+/// The subject of a BRDF case: one-sample estimand the albedo (the integral of `target`),
+/// batch estimand the lit radiance (of `lit`), with their references.
+fn brdf_subject<P>(
+    sampler: Arc<dyn SamplerUnderTest<P>>,
+    domain: Domain,
+    target: ScalarFn<P>,
+    lit: ScalarFn<P>,
+    refs: &BrdfReferences,
+) -> Subject<P> {
     Subject {
         sampler,
         domain,
@@ -77,21 +89,7 @@ pub fn brdf_disc_subject(
         Some(w) => b.eval(&wo, &Vec3::new(w[0], w[1], w[2])) * environment(w),
         None => 0.0,
     });
-    Subject {
-        sampler,
-        domain: Domain::Disc,
-        target: Arc::clone(&target),
-        single: Estimand {
-            label: "albedo".into(),
-            integrand: target,
-            reference: refs.albedo.clone(),
-        },
-        batch: Estimand {
-            label: "lit".into(),
-            integrand: lit,
-            reference: refs.lit.clone(),
-        },
-    }
+    brdf_subject(sampler, Domain::Disc, target, lit, refs)
 }
 
 /// Deterministic test values on a `w × h` grid: smooth variation, about one cell in eleven set
@@ -160,14 +158,7 @@ pub fn envmap_subject(sampler: Arc<dyn SamplerUnderTest<Point2>>, map: &EnvMap) 
             total += sum * row * 2.0 * PI * PI / w as f64;
         }
     }
-    let pixel = move |p: Point2| -> Option<usize> {
-        if !(p[0] >= 0.0 && p[0] <= 1.0 && p[1] >= 0.0 && p[1] <= 1.0) {
-            return None;
-        }
-        let x = ((p[0] * w as f64) as usize).min(w - 1);
-        let y = ((p[1] * h as f64) as usize).min(h - 1);
-        Some(y * w + x)
-    };
+    let pixel = move |p: Point2| grid_cell(p, w, h);
     let l = Arc::clone(&lum);
     let target: ScalarFn<Point2> = Arc::new(move |p| match pixel(p) {
         Some(i) => l[i] * (PI * p[1]).sin(),
@@ -189,13 +180,7 @@ pub fn envmap_subject(sampler: Arc<dyn SamplerUnderTest<Point2>>, map: &EnvMap) 
         integrand,
         reference,
     };
-    Subject {
-        sampler,
-        domain: Domain::UnitSquare,
-        target,
-        single: est.clone(),
-        batch: est,
-    }
+    unit_square_subject(sampler, target, est)
 }
 
 /// A subject for a sampler of the step function `values` (`w × h`, row-major, row 0 at
@@ -217,14 +202,7 @@ pub fn grid_subject(
             total += values[y * w + x] * cell;
         }
     }
-    let cell = move |p: Point2| -> Option<usize> {
-        if !(p[0] >= 0.0 && p[0] <= 1.0 && p[1] >= 0.0 && p[1] <= 1.0) {
-            return None;
-        }
-        let x = ((p[0] * w as f64) as usize).min(w - 1);
-        let y = ((p[1] * h as f64) as usize).min(h - 1);
-        Some(y * w + x)
-    };
+    let cell = move |p: Point2| grid_cell(p, w, h);
     let v = Arc::clone(&values);
     let target: ScalarFn<Point2> = Arc::new(move |p| cell(p).map_or(0.0, |i| v[i]));
     let v = Arc::clone(&values);
@@ -239,13 +217,7 @@ pub fn grid_subject(
             rule: "exact: sum over cells of f * [dx dy + (x1^2 - x0^2)(y1^2 - y0^2)/4]".into(),
         },
     };
-    Subject {
-        sampler,
-        domain: Domain::UnitSquare,
-        target,
-        single: est.clone(),
-        batch: est,
-    }
+    unit_square_subject(sampler, target, est)
 }
 
 /// `∫_D g dA` over the unit disc by adaptive quadrature (12 × 12 disc-clipped bins, order 8,
@@ -268,6 +240,32 @@ pub fn disc_integral(g: &(dyn Fn(Point2) -> f64 + Sync)) -> Result<Reference, St
         rule: "adaptive Gauss-Legendre over the unit disc (stats::integrate, 12 x 12 clipped bins, order 8, tolerance 1e-10)"
             .into(),
     })
+}
+
+/// A subject on the unit square whose one estimand `est` serves both unbiasedness tests.
+fn unit_square_subject(
+    sampler: Arc<dyn SamplerUnderTest<Point2>>,
+    target: ScalarFn<Point2>,
+    est: Estimand<Point2>,
+) -> Subject<Point2> {
+    Subject {
+        sampler,
+        domain: Domain::UnitSquare,
+        target,
+        single: est.clone(),
+        batch: est,
+    }
+}
+
+/// The row-major index of the cell of a `w × h` grid on `[0, 1]²` that holds `p` (the last
+/// row and column closed), or `None` outside the square.
+fn grid_cell(p: Point2, w: usize, h: usize) -> Option<usize> {
+    if !(p[0] >= 0.0 && p[0] <= 1.0 && p[1] >= 0.0 && p[1] <= 1.0) {
+        return None;
+    }
+    let x = ((p[0] * w as f64) as usize).min(w - 1);
+    let y = ((p[1] * h as f64) as usize).min(h - 1);
+    Some(y * w + x)
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use study::{Shard, StudyConfig, StudyPlan, StudyResults};
+use study::{StudyConfig, StudyPlan, StudyResults};
 
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
@@ -148,12 +148,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
         config.repetitions = r;
     }
     config.seed = args.seed;
-    let shard = args
-        .shard
-        .as_deref()
-        .map(Shard::parse)
-        .transpose()
-        .map_err(CliError::input)?;
+    let shard = values::shard(args.shard.as_deref())?;
     let plan = StudyPlan::new(config, notes).map_err(CliError::input)?;
     let staging = Staging::new(&args.out)?;
     let images = !args.no_images && shard.is_none();

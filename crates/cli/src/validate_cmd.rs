@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use validation::{ProgressEvent, Shard, ValidateConfig, ValidationReport};
+use validation::{ProgressEvent, ValidateConfig, ValidationReport};
 
 use crate::error::{CliError, CliResult};
 use crate::output::write_atomically;
@@ -85,12 +85,7 @@ pub(crate) fn run(args: &ValidateArgs) -> CliResult<()> {
     if let Some(ValidateSub::Merge(m)) = &args.merge {
         return merge(m);
     }
-    let shard = args
-        .shard
-        .as_deref()
-        .map(Shard::parse)
-        .transpose()
-        .map_err(CliError::input)?;
+    let shard = values::shard(args.shard.as_deref())?;
     crate::output::check_all([
         ("--json", args.json.as_deref()),
         ("--report", args.report.as_deref()),

@@ -128,6 +128,14 @@ pub(crate) fn display_path(path: &Path) -> String {
     }
 }
 
+/// The shard `K/N` of `--shard` (`study` and `validate`), if given; a malformed one is an input
+/// error.
+pub(crate) fn shard(arg: Option<&str>) -> crate::error::CliResult<Option<validation::Shard>> {
+    arg.map(validation::Shard::parse)
+        .transpose()
+        .map_err(crate::error::CliError::input)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

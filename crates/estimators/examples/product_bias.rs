@@ -8,20 +8,14 @@
 
 use baselines::srbf::fit_envmap;
 use baselines::{SrbfOptions, SrbfSampler};
-use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
+use envmap::{AdaptiveOptions, EnvMapSampler};
 use estimators::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
-    estimate_srbf_product, quadrature_reference,
+    Estimate, MisHeuristic, estimate_brdf, estimate_light, estimate_mis, estimate_srbf_product,
+    quadrature_reference,
 };
 
-/// Dim deterministic noise in `[0.05, 0.25)` (a hash of the pixel index).
-fn noise(i: usize) -> f32 {
-    let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
-    x ^= x >> 31;
-    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x ^= x >> 29;
-    (0.05 + 0.2 * ((x >> 11) as f64 / (1u64 << 53) as f64)) as f32
-}
+#[path = "../tests/it/scenes.rs"]
+mod scenes;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -29,17 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n: usize = args.get(2).map_or(Ok(1_000_000), |s| s.parse())?;
     let (w, h) = (256usize, 128usize);
     let xc = ((uc * w as f64).round() as usize) % w;
-    let rgb: Vec<[f32; 3]> = (0..w * h)
-        .map(|i| {
-            let dx = (i % w + w - xc) % w;
-            if dx <= 1 || dx == w - 1 {
-                [300.0; 3]
-            } else {
-                [noise(i); 3]
-            }
-        })
-        .collect();
-    let map = EnvMap::new(w, h, rgb)?;
+    let map = scenes::column(w, h, xc, 0.0, 1.0);
     if let Some(path) = args.get(3) {
         // PFM: little-endian (negative scale), rows bottom to top.
         let mut bytes = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
@@ -53,13 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(path, bytes)?;
     }
     let brdf = brdf::parse_spec("ggx:alpha=0.15")?;
-    let frame = LocalFrame::new([0.3, 0.2, 0.93], 0.0)?;
-    let scene = ProductScene::new(
-        brdf.as_ref(),
-        &map,
-        frame,
-        brdf::direction_from_angles(40.0, 0.0),
-    )?;
+    let scene = scenes::scene(brdf.as_ref(), &map, [0.3, 0.2, 0.93], 0.0, [40.0, 0.0]);
     let (q, q_err) = quadrature_reference(&scene, 8);
     println!("column at u = {uc}: quadrature {q:.6} ± {q_err:.1e}");
     let options = SrbfOptions::default();

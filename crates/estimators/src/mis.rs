@@ -37,6 +37,18 @@ pub(crate) fn check_samples(
     Ok(())
 }
 
+/// The start of an estimate of `n` samples (at least `min`): its clock and its generator
+/// seeded with `seed`.
+pub(crate) fn begin(
+    estimator: &'static str,
+    n: usize,
+    min: usize,
+    seed: u64,
+) -> Result<(Instant, Xoshiro256PlusPlus), EstimatorError> {
+    check_samples(estimator, n, min)?;
+    Ok((Instant::now(), Xoshiro256PlusPlus::seed_from_u64(seed)))
+}
+
 /// Queries per [`DirectionSampler::sample_eval_batch`] call of the one-point estimators.
 pub(crate) const CHUNK: usize = 4096;
 
@@ -53,9 +65,7 @@ pub fn estimate_brdf(
     n: usize,
     seed: u64,
 ) -> Result<Estimate, EstimatorError> {
-    check_samples("brdf", n, 2)?;
-    let start = Instant::now();
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let (start, mut rng) = begin("brdf", n, 2, seed)?;
     let mut m = Moments::default();
     brdf_chunks(scene, sampler, n, &mut rng, |s| {
         m.push(brdf_value(s, |s| scene.integrand_with_f(&s.wi, s.f)));
@@ -173,9 +183,7 @@ pub fn estimate_mis(
     n: usize,
     seed: u64,
 ) -> Result<Estimate, EstimatorError> {
-    check_samples("mis", n, 4)?;
-    let start = Instant::now();
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let (start, mut rng) = begin("mis", n, 4, seed)?;
     let (na, nb) = (n.div_ceil(2), n / 2);
     let light_pdf = |wi: &Vec3| {
         light_sampler.pdf_sa({

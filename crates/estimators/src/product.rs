@@ -359,8 +359,49 @@ mod tests {
     use super::*;
     use crate::{LocalFrame, MisHeuristic, estimate_mis, quadrature_reference};
     use baselines::SrbfOptions;
-    use baselines::srbf::fit_envmap;
+    use baselines::srbf::{EnvSrbf, fit_envmap};
     use envmap::EnvMap;
+
+    /// Width of the tests' maps (height `W / 2`).
+    const W: usize = 128;
+
+    /// A grey `W × W/2` map (`radiance(x, y)`), a BRDF, their SRBF fits and the map's CDF
+    /// sampler.
+    struct Fits {
+        map: EnvMap,
+        brdf: Box<dyn brdf::Brdf>,
+        brdf_fit: SrbfSampler,
+        map_fit: EnvSrbf,
+        light: EnvMapSampler,
+    }
+
+    impl Fits {
+        fn new(radiance: impl Fn(usize, usize) -> f32, spec: &str, options: &SrbfOptions) -> Self {
+            let rgb = (0..W * W / 2)
+                .map(|i| [radiance(i % W, i / W); 3])
+                .collect();
+            let map = EnvMap::new(W, W / 2, rgb).unwrap();
+            let brdf = brdf::parse_spec(spec).unwrap();
+            Self {
+                brdf_fit: SrbfSampler::build(brdf.as_ref(), options).unwrap(),
+                map_fit: fit_envmap(&map, options).unwrap(),
+                light: EnvMapSampler::piecewise_constant(&map).unwrap(),
+                map,
+                brdf,
+            }
+        }
+
+        /// The scene in the frame of `normal` seen from `(θo, φo)` in degrees.
+        fn scene(&self, normal: [f64; 3], [theta_o, phi_o]: [f64; 2]) -> ProductScene<'_> {
+            ProductScene::new(
+                self.brdf.as_ref(),
+                &self.map,
+                LocalFrame::new(normal, 0.0).unwrap(),
+                brdf::direction_from_angles(theta_o, phi_o),
+            )
+            .unwrap()
+        }
+    }
 
     /// `|a − b| / √(σa² + σb²)`.
     fn z(a: &Estimate, b: &Estimate) -> f64 {
@@ -372,16 +413,6 @@ mod tests {
         // Few kept lobes of a map with a uniform background and two bright patches: the
         // pruned mass is large, so the mutant's bias is visible; the correct estimator agrees
         // with an independent MIS reference.
-        let (w, h) = (128, 64);
-        let rgb: Vec<[f32; 3]> = (0..w * h)
-            .map(|i| {
-                let (x, y) = (i % w, i / w);
-                let patch = (y / 8 == 2 && x / 8 == 1) || (y / 8 == 3 && x / 8 == 9);
-                if patch { [30.0; 3] } else { [1.0; 3] }
-            })
-            .collect();
-        let sky = EnvMap::new(w, h, rgb).unwrap();
-        let brdf = brdf::parse_spec("phong:n=20,ks=0.5,kd=0.5").unwrap();
         let options = SrbfOptions {
             slices: 4,
             fit_rows: 12,
@@ -390,21 +421,20 @@ mod tests {
             map_fit_width: 64,
             ..SrbfOptions::default()
         };
-        let brdf_fit = SrbfSampler::build(brdf.as_ref(), &options).unwrap();
-        let map_fit = fit_envmap(&sky, &options).unwrap();
-        let light = EnvMapSampler::piecewise_constant(&sky).unwrap();
-        let frame = LocalFrame::new([0.3, 0.2, 1.0], 0.0).unwrap();
-        let scene = ProductScene::new(
-            brdf.as_ref(),
-            &sky,
-            frame,
-            brdf::direction_from_angles(40.0, 30.0),
-        )
-        .unwrap();
+        let fits = Fits::new(
+            |x, y| {
+                let patch = (y / 8 == 2 && x / 8 == 1) || (y / 8 == 3 && x / 8 == 9);
+                if patch { 30.0 } else { 1.0 }
+            },
+            "phong:n=20,ks=0.5,kd=0.5",
+            &options,
+        );
+        let (brdf_fit, map_fit, light) = (&fits.brdf_fit, &fits.map_fit, &fits.light);
+        let scene = fits.scene([0.3, 0.2, 1.0], [40.0, 30.0]);
         let reference = estimate_mis(
             &scene,
-            &brdf_fit,
-            &light,
+            brdf_fit,
+            light,
             MisHeuristic::Balance,
             "ref",
             400_000,
@@ -419,7 +449,7 @@ mod tests {
             ..ProductSettings::default()
         };
         let (tsai, _) =
-            estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &plain, 40_000, 2).unwrap();
+            estimate_srbf_product(&scene, brdf_fit, map_fit, light, &plain, 40_000, 2).unwrap();
         assert!(z(&tsai, &reference) < 4.0, "{tsai:?} vs {reference:?}");
         for keep in [1, 32] {
             let settings = ProductSettings {
@@ -428,7 +458,7 @@ mod tests {
                 ..ProductSettings::default()
             };
             let (good, stats) =
-                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &settings, 40_000, 2)
+                estimate_srbf_product(&scene, brdf_fit, map_fit, light, &settings, 40_000, 2)
                     .unwrap();
             assert!(keep > 1 || stats.kept_mass_fraction < 0.8, "{stats:?}");
             assert!(
@@ -443,9 +473,9 @@ mod tests {
         };
         let (bad, _) = srbf_product(
             &scene,
-            &brdf_fit,
-            &map_fit,
-            &light,
+            brdf_fit,
+            map_fit,
+            light,
             &settings,
             40_000,
             2,
@@ -468,19 +498,6 @@ mod tests {
     /// is never flagged.
     #[test]
     fn issue_27_bias_is_gone_and_its_mutant_is_detected() {
-        let (w, h) = (128, 64);
-        let rgb: Vec<[f32; 3]> = (0..w * h)
-            .map(|i| {
-                let x = i % w;
-                if x <= 1 || x == w - 1 {
-                    [300.0; 3]
-                } else {
-                    [0.05 + 0.1 * ((i * 7919) % 13) as f32 / 13.0; 3]
-                }
-            })
-            .collect();
-        let map = EnvMap::new(w, h, rgb).unwrap();
-        let brdf = brdf::parse_spec("ggx:alpha=0.15").unwrap();
         let options = SrbfOptions {
             slices: 8,
             map_lobes: 12,
@@ -494,24 +511,26 @@ mod tests {
             brdf_lobes: 2,
             ..SrbfOptions::default()
         };
-        let brdf_fit = SrbfSampler::build(brdf.as_ref(), &options).unwrap();
-        let map_fit = fit_envmap(&map, &options).unwrap();
-        let frame = LocalFrame::new([0.3, 0.2, 0.93], 0.0).unwrap();
-        let scene = ProductScene::new(
-            brdf.as_ref(),
-            &map,
-            frame,
-            brdf::direction_from_angles(40.0, 0.0),
-        )
-        .unwrap();
+        let fits = Fits::new(
+            |x, y| {
+                if x <= 1 || x == W - 1 {
+                    300.0
+                } else {
+                    0.05 + 0.1 * (((y * W + x) * 7919) % 13) as f32 / 13.0
+                }
+            },
+            "ggx:alpha=0.15",
+            &options,
+        );
+        let (brdf_fit, map_fit, light) = (&fits.brdf_fit, &fits.map_fit, &fits.light);
+        let scene = fits.scene([0.3, 0.2, 0.93], [40.0, 0.0]);
         let (q, q_err) = quadrature_reference(&scene, 4);
         assert!(q_err < 1e-4 * q, "{q} ± {q_err}");
-        let light = EnvMapSampler::piecewise_constant(&map).unwrap();
         let settings = options.product_settings();
         let n = 40_000;
         for seed in 0..8 {
             let (good, stats) =
-                estimate_srbf_product(&scene, &brdf_fit, &map_fit, &light, &settings, n, seed)
+                estimate_srbf_product(&scene, brdf_fit, map_fit, light, &settings, n, seed)
                     .unwrap();
             assert!(stats.cosine_samples >= n / 20, "{stats:?}");
             let zg = (good.estimate - q) / good.std_err;
@@ -521,9 +540,9 @@ mod tests {
             );
             let (bad, stats) = srbf_product(
                 &scene,
-                &brdf_fit,
-                &map_fit,
-                &light,
+                brdf_fit,
+                map_fit,
+                light,
                 &settings,
                 n,
                 seed,

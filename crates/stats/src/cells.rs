@@ -29,13 +29,16 @@ pub struct CellRow {
 impl CellRow {
     /// The row's mass `∫ p du dv = (u₁ − u₀) Σ_k d_k (v_{k+1} − v_k)`.
     pub fn mass(&self) -> f64 {
-        let along_v: f64 = self
-            .densities
+        self.mass_per_u() * (self.u[1] - self.u[0])
+    }
+
+    /// The row's mass per unit `u`, `Σ_k d_k (v_{k+1} − v_k)` (its marginal rate along `u`).
+    fn mass_per_u(&self) -> f64 {
+        self.densities
             .iter()
             .zip(self.v_edges.windows(2))
             .map(|(d, e)| d * (e[1] - e[0]))
-            .sum();
-        along_v * (self.u[1] - self.u[0])
+            .sum()
     }
 }
 
@@ -131,15 +134,7 @@ impl PiecewiseConstant {
         for r in &self.rows {
             let du = r.u[1] - r.u[0];
             match axis {
-                Axis::U => {
-                    let rate: f64 = r
-                        .densities
-                        .iter()
-                        .zip(r.v_edges.windows(2))
-                        .map(|(d, e)| d * (e[1] - e[0]))
-                        .sum();
-                    pieces.push((r.u, rate));
-                }
+                Axis::U => pieces.push((r.u, r.mass_per_u())),
                 Axis::V => pieces.extend(
                     r.densities
                         .iter()

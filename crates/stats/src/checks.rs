@@ -358,14 +358,33 @@ pub fn mean_z_test(values: &[f64], reference: f64, alpha: f64) -> Result<TestOut
             format!("estimator value {i} is not finite ({})", values[i]),
         ));
     }
+    let (mean, var) = mean_variance(values);
+    // Floor the standard error at the rounding level of the values, so a zero-variance
+    // estimator is compared with the reference to floating-point accuracy.
+    let se = (var / values.len() as f64)
+        .sqrt()
+        .max(1e-12 * mean.abs().max(reference.abs()));
+    let (z, p) = two_sided_z(mean, reference, se);
+    let detail = format!(
+        "mean {mean:.8e} vs reference {reference:.8e}, standard error {se:.3e}, z = {z:.3}, n = {}",
+        values.len()
+    );
+    Ok(TestOutcome::with_p_value(NAME, z, p, alpha, detail))
+}
+
+/// The sample mean of `values` and their unbiased sample variance `Σ (v − mean)² / (n − 1)`
+/// (`values` should hold at least two).
+pub fn mean_variance(values: &[f64]) -> (f64, f64) {
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
     let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
-    // Floor the standard error at the rounding level of the values, so a zero-variance
-    // estimator is compared with the reference to floating-point accuracy.
-    let se = (var / n)
-        .sqrt()
-        .max(1e-12 * mean.abs().max(reference.abs()));
+    (mean, var)
+}
+
+/// The two-sided z-test of `mean` against `reference` with standard error `se`: `(z, p)` with
+/// `z = (mean − reference) / se` and `p = 2 Φ(−|z|)`. With `se = 0`, `z` is 0 when `mean` equals
+/// `reference` and `+∞` (so `p = 0`) otherwise.
+pub fn two_sided_z(mean: f64, reference: f64, se: f64) -> (f64, f64) {
     let z = if se > 0.0 {
         (mean - reference) / se
     } else if mean == reference {
@@ -373,10 +392,8 @@ pub fn mean_z_test(values: &[f64], reference: f64, alpha: f64) -> Result<TestOut
     } else {
         f64::INFINITY
     };
-    let p = statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2);
-    let detail = format!(
-        "mean {mean:.8e} vs reference {reference:.8e}, standard error {se:.3e}, z = {z:.3}, n = {}",
-        values.len()
-    );
-    Ok(TestOutcome::with_p_value(NAME, z, p, alpha, detail))
+    (
+        z,
+        statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2),
+    )
 }

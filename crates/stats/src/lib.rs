@@ -78,8 +78,8 @@ pub use cdf::{
 pub use cells::{CellRow, PiecewiseConstant};
 pub use checks::{
     COVERAGE_MASS_TOLERANCE, chi_square_test, ks_projection_test, ks_projection_test_with_memo,
-    ks_projection_test_with_singularities, mean_z_test, normalisation, pdf_consistency,
-    support_coverage,
+    ks_projection_test_with_singularities, mean_variance, mean_z_test, normalisation,
+    pdf_consistency, support_coverage, two_sided_z,
 };
 pub use chi_square::{ChiSquareResult, DEFAULT_MIN_EXPECTED, chi_square_gof, chi_square_sf};
 pub use error::StatsError;

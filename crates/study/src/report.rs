@@ -286,6 +286,15 @@ fn ratio_text(e: &Entry) -> String {
     }
 }
 
+/// The samplers of `r` tied with the best, each with its marks and its ratio's interval.
+fn tied_samplers(r: &Ranking) -> Vec<String> {
+    r.entries
+        .iter()
+        .filter(|e| e.verdict == Verdict::Tied)
+        .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
+        .collect()
+}
+
 /// ` ⚠` and ` †` marks of an entry.
 fn marks(e: &Entry) -> String {
     format!(
@@ -323,12 +332,7 @@ pub(crate) fn verdicts(s: &mut String, rankings: &[Ranking]) {
         let Some(best) = r.entries.first() else {
             continue;
         };
-        let tied: Vec<String> = r
-            .entries
-            .iter()
-            .filter(|e| e.verdict == Verdict::Tied)
-            .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
-            .collect();
+        let tied = tied_samplers(r);
         let tied = if tied.is_empty() {
             "none tied".to_string()
         } else {
@@ -524,12 +528,7 @@ pub(crate) fn mis_outcome(s: &mut String, results: &StudyResults) {
     // The tied samplers with their ratio's interval, or (none tied) the runner-up's: every
     // "best" rests on an interval.
     let list = |r: &Ranking| {
-        let tied: Vec<String> = r
-            .entries
-            .iter()
-            .filter(|e| e.verdict == Verdict::Tied)
-            .map(|e| format!("{}{} ({})", e.sampler, marks(e), ratio_text(e)))
-            .collect();
+        let tied = tied_samplers(r);
         match (tied.is_empty(), r.entries.get(1)) {
             (false, _) => format!("tied: {}", tied.join(", ")),
             (true, Some(e)) => format!(

@@ -6,4 +6,5 @@
 //! what `--test NAME` ran before.
 
 mod product_adversarial;
+mod scenes;
 mod srbf_product;

@@ -38,32 +38,7 @@ use estimators::{
 };
 use partition_sampler::UniformSource;
 
-/// Dim deterministic noise in `[0.05, 0.25)` (a hash of the pixel index).
-fn noise(i: usize) -> f32 {
-    let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
-    x ^= x >> 31;
-    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x ^= x >> 29;
-    (0.05 + 0.2 * ((x >> 11) as f64 / (1u64 << 53) as f64)) as f32
-}
-
-/// A `w × h` map of noise with `bright(x, y)` pixels set to that radiance.
-fn map(w: usize, h: usize, bright: impl Fn(usize, usize) -> Option<f32>) -> EnvMap {
-    let rgb = (0..w * h)
-        .map(|i| [bright(i % w, i / w).unwrap_or_else(|| noise(i)); 3])
-        .collect();
-    EnvMap::new(w, h, rgb).unwrap()
-}
-
-/// A 3-pixel column of radiance 300 centred on pixel `xc` (wrapping at the seam), over the
-/// rows whose centre `v` is in `[v0, v1]`.
-fn column(w: usize, h: usize, xc: usize, v0: f64, v1: f64) -> EnvMap {
-    map(w, h, |x, y| {
-        let dx = (x + w - xc) % w;
-        let v = (y as f64 + 0.5) / h as f64;
-        ((dx <= 1 || dx == w - 1) && (v0..=v1).contains(&v)).then_some(300.0)
-    })
-}
+use crate::scenes::{column, map, scene};
 
 /// The shading normal.
 const NORMAL: [f64; 3] = [0.3, 0.2, 0.93];
@@ -150,10 +125,8 @@ impl<'a> Setup<'a> {
         brdf_fit: &'a SrbfSampler,
         options: &'a SrbfOptions,
     ) -> Self {
-        let frame = LocalFrame::new(case.normal, 0.0).unwrap();
-        let wo = brdf::direction_from_angles(40.0, 0.0);
         Self {
-            scene: ProductScene::new(brdf, &case.map, frame, wo).unwrap(),
+            scene: scene(brdf, &case.map, case.normal, 0.0, [40.0, 0.0]),
             brdf_fit,
             map_fit: fit_envmap(&case.map, options).unwrap(),
             adaptive: EnvMapSampler::adaptive(&case.map, AdaptiveOptions::default()).unwrap(),
@@ -372,14 +345,7 @@ fn quadrature_reference_matches_a_closed_form() {
     let one = EnvMap::new(64, 32, vec![[1.0; 3]; 64 * 32]).unwrap();
     let lambert = brdf::parse_spec("lambert").unwrap();
     for normal in [[0.0, 0.0, 1.0], NORMAL, [0.8, 0.2, -0.3]] {
-        let frame = LocalFrame::new(normal, 0.3).unwrap();
-        let scene = ProductScene::new(
-            lambert.as_ref(),
-            &one,
-            frame,
-            brdf::direction_from_angles(40.0, 0.0),
-        )
-        .unwrap();
+        let scene = scene(lambert.as_ref(), &one, normal, 0.3, [40.0, 0.0]);
         let (q, e) = quadrature_reference(&scene, 4);
         let albedo = lambert.eval(&scene.wo, &Vec3::z()) * std::f64::consts::PI;
         assert!(

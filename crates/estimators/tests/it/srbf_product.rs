@@ -13,9 +13,11 @@ use baselines::{CosineHemisphere, SrbfOptions, SrbfSampler};
 use brdf::Brdf;
 use envmap::{AdaptiveOptions, EnvMap, EnvMapSampler};
 use estimators::{
-    Estimate, LocalFrame, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
+    Estimate, MisHeuristic, ProductScene, estimate_brdf, estimate_light, estimate_mis,
     estimate_srbf_product,
 };
+
+use crate::scenes::scene;
 
 /// `(a − b) / √(σa² + σb²)`.
 fn z(a: &Estimate, b: &Estimate) -> f64 {
@@ -58,9 +60,7 @@ fn check(
     let cdf = EnvMapSampler::piecewise_constant(map).unwrap();
     let mut failures = Vec::new();
     for (i, normal) in normals.iter().enumerate() {
-        let frame = LocalFrame::new(*normal, 0.4).unwrap();
-        let wo = brdf::direction_from_angles(35.0, 20.0);
-        let scene = ProductScene::new(brdf, map, frame, wo).unwrap();
+        let scene = scene(brdf, map, *normal, 0.4, [35.0, 20.0]);
         let seed = 100 * i as u64;
         // The reference uses samplers independent of the SRBF fits.
         let reference = reference(&scene, &cdf, n_ref, seed + 1);
@@ -171,14 +171,7 @@ fn reduced_detects_a_biased_estimator() {
     let sky = envmap::procedural_sky(128, 64).unwrap();
     let brdf = brdf::parse_spec("lambert").unwrap();
     let cdf = EnvMapSampler::piecewise_constant(&sky).unwrap();
-    let frame = LocalFrame::new([0.0, 0.0, 1.0], 0.0).unwrap();
-    let scene = ProductScene::new(
-        brdf.as_ref(),
-        &sky,
-        frame,
-        brdf::direction_from_angles(35.0, 20.0),
-    )
-    .unwrap();
+    let scene = scene(brdf.as_ref(), &sky, [0.0, 0.0, 1.0], 0.0, [35.0, 20.0]);
     let reference = reference(&scene, &cdf, 200_000, 1);
     let mut biased = estimate_light(&scene, &cdf, "light", 20_000, 2).unwrap();
     assert!(z(&biased, &reference).abs() < 4.0);

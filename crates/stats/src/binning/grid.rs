@@ -1,6 +1,7 @@
 //! A uniform grid over a rectangle of the parameter plane.
 
 use crate::error::StatsError;
+use crate::quadrature::split;
 
 /// Uniform `n_u × n_v` grid over `[u₀, u₁] × [v₀, v₁]`; cell `b = i_v · n_u + i_u`.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,10 +84,7 @@ impl Grid {
             return None;
         }
         let (iu, iv) = (b % self.nu, b / self.nu);
-        Some((
-            edge_pair(self.u, self.nu, iu),
-            edge_pair(self.v, self.nv, iv),
-        ))
+        Some((split(self.u, self.nu, iu), split(self.v, self.nv, iv)))
     }
 }
 
@@ -96,17 +94,6 @@ fn axis_index(x: f64, r: [f64; 2], n: usize) -> Option<usize> {
     }
     let t = (x - r[0]) / (r[1] - r[0]) * n as f64;
     Some((t as usize).min(n - 1))
-}
-
-fn edge_pair(r: [f64; 2], n: usize, i: usize) -> [f64; 2] {
-    let at = |k: usize| {
-        if k == n {
-            r[1]
-        } else {
-            r[0] + (r[1] - r[0]) * (k as f64 / n as f64)
-        }
-    };
-    [at(i), at(i + 1)]
 }
 
 #[cfg(test)]

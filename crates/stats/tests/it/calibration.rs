@@ -9,8 +9,8 @@ use crate::common;
 
 use common::*;
 use stats::{
-    Axis, Calibration, QuadratureOptions, RectBinning, SphereBinning, StatsError, calibrate,
-    chi_square_gof, expected_masses, histogram, ks_onesample, ks_twosample, project,
+    Axis, Binning, Calibration, QuadratureOptions, RectBinning, SphereBinning, StatsError,
+    calibrate, chi_square_gof, expected_masses, histogram, ks_onesample, ks_twosample, project,
     projection_cdf,
 };
 
@@ -29,17 +29,40 @@ fn check(name: &str, c: &Calibration) {
     );
 }
 
-fn chi_square_rect(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
-    let bins = RectBinning::new(RECT_X, RECT_Y, 8, 8).unwrap();
-    let expected: Vec<f64> = expected_masses(&product_pdf, &bins, n as u64)
+/// Chi-square p-values, one per seed, of `n` points of `points(seed, n)` in `bins` against the
+/// bin masses of `pdf` (minimum expected count 5).
+fn chi_square_calibration<B: Binning + Sync>(
+    seeds: &[u64],
+    alpha: f64,
+    n: usize,
+    bins: &B,
+    pdf: &(dyn Fn(B::Point) -> f64 + Sync),
+    points: impl Fn(u64, usize) -> Vec<B::Point> + Sync,
+) -> Calibration {
+    let expected: Vec<f64> = expected_masses(pdf, bins, n as u64)
         .iter()
         .map(|m| m * n as f64)
         .collect();
     calibrate(seeds, alpha, |seed| {
-        let h = histogram(&bins, &product_points(seed, n));
+        let h = histogram(bins, &points(seed, n));
         Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)
     })
     .unwrap()
+}
+
+/// [`chi_square_calibration`] of the test lobe on 20 × 40 sphere bins.
+fn chi_square_lobe(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
+    let lobe = test_lobe();
+    let bins = SphereBinning::sphere(20, 40).unwrap();
+    chi_square_calibration(seeds, alpha, n, &bins, &|d| lobe.pdf(d), |seed, n| {
+        lobe.points(seed, n)
+    })
+}
+
+/// [`chi_square_calibration`] of the product density on 8 × 8 rectangle bins.
+fn chi_square_rect(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
+    let bins = RectBinning::new(RECT_X, RECT_Y, 8, 8).unwrap();
+    chi_square_calibration(seeds, alpha, n, &bins, &product_pdf, product_points)
 }
 
 fn ks_cos_theta(seeds: &[u64], alpha: f64, n: usize) -> Calibration {
@@ -103,18 +126,7 @@ fn a_test_that_never_rejects_is_flagged() {
 fn false_rejection_rates_are_nominal_over_200_seeds() {
     let seeds: Vec<u64> = (1000..1200).collect();
     // Chi-square on a narrow lobe with 10⁶ samples: the regime where a fixed per-bin rule fails.
-    let bins = SphereBinning::sphere(20, 40).unwrap();
-    let lobe = test_lobe();
-    let n = 1_000_000;
-    let expected: Vec<f64> = expected_masses(&|d| lobe.pdf(d), &bins, n as u64)
-        .iter()
-        .map(|m| m * n as f64)
-        .collect();
-    let lobe_chi2 = calibrate(&seeds, 0.05, |seed| {
-        let h = histogram(&bins, &lobe.points(seed, n));
-        Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)
-    })
-    .unwrap();
+    let lobe_chi2 = chi_square_lobe(&seeds, 0.05, 1_000_000);
     let runs = [
         ("chi-square lobe N=1e6", lobe_chi2),
         (
@@ -142,17 +154,8 @@ fn false_rejection_rates_are_nominal_over_200_seeds() {
 #[ignore = "calibration run at 10⁷ samples: ~3 minutes in release mode"]
 fn chi_square_is_calibrated_at_ten_million_samples() {
     let seeds: Vec<u64> = (5000..5100).collect();
-    let bins = SphereBinning::sphere(20, 40).unwrap();
-    let lobe = test_lobe();
-    let n = 10_000_000;
-    let expected: Vec<f64> = expected_masses(&|d| lobe.pdf(d), &bins, n as u64)
-        .iter()
-        .map(|m| m * n as f64)
-        .collect();
-    let c = calibrate(&seeds, 0.1, |seed| {
-        let h = histogram(&bins, &lobe.points(seed, n));
-        Ok(chi_square_gof(&h.counts, &expected, 5.0)?.p_value)
-    })
-    .unwrap();
-    check("chi-square lobe N=1e7", &c);
+    check(
+        "chi-square lobe N=1e7",
+        &chi_square_lobe(&seeds, 0.1, 10_000_000),
+    );
 }

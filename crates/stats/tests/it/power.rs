@@ -6,9 +6,9 @@ use crate::common;
 
 use common::*;
 use stats::{
-    Axis, DiscBinning, QuadratureOptions, RectBinning, SphereBinning, Suite, chi_square_test,
-    ks_onesample, ks_projection_test, ks_twosample, mean_z_test, normalisation, pdf_consistency,
-    project, support_coverage,
+    Axis, ChiSquareResult, DiscBinning, QuadratureOptions, RectBinning, SphereBinning, Suite,
+    chi_square_test, ks_onesample, ks_projection_test, ks_twosample, mean_z_test, normalisation,
+    pdf_consistency, project, support_coverage,
 };
 use std::f64::consts::{PI, TAU};
 
@@ -20,20 +20,19 @@ fn opts() -> QuadratureOptions {
 
 // ---------------- chi-square ----------------
 
+/// The chi-square test of `points` against the uniform density on the unit disc (20 × 20 bins).
+fn uniform_disc_chi_square(points: &[[f64; 2]]) -> ChiSquareResult {
+    let disc = DiscBinning::new(20, 20).unwrap();
+    chi_square_test(&disc, &uniform_disc_pdf, points, &opts()).unwrap()
+}
+
 #[test]
 fn chi_square_accepts_exact_samplers() {
     let rect = RectBinning::new(RECT_X, RECT_Y, 15, 10).unwrap();
     let r = chi_square_test(&rect, &product_pdf, &product_points(1, 100_000), &opts()).unwrap();
     assert!(r.p_value >= ALPHA, "product density: {}", r.summary());
 
-    let disc = DiscBinning::new(20, 20).unwrap();
-    let r = chi_square_test(
-        &disc,
-        &uniform_disc_pdf,
-        &disc_points(2, 100_000, 1.0),
-        &opts(),
-    )
-    .unwrap();
+    let r = uniform_disc_chi_square(&disc_points(2, 100_000, 1.0));
     assert!(r.p_value >= ALPHA, "uniform disc: {}", r.summary());
 
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
@@ -45,19 +44,6 @@ fn chi_square_accepts_exact_samplers() {
     let r = chi_square_test(&sphere, &|d| lobe.pdf(d), &lobe.points(4, 100_000), &opts()).unwrap();
     assert!(r.p_value >= ALPHA, "Phong lobe: {}", r.summary());
     assert!(r.pooled_cells > 0, "the lobe leaves sparse cells to pool");
-}
-
-#[test]
-fn chi_square_rejects_cosine_samples_reported_as_uniform() {
-    let hemi = SphereBinning::hemisphere(10, 20).unwrap();
-    let r = chi_square_test(
-        &hemi,
-        &uniform_hemisphere_pdf,
-        &cosine_points(3, 10_000),
-        &opts(),
-    )
-    .unwrap();
-    assert!(r.p_value < ALPHA, "{}", r.summary());
 }
 
 #[test]
@@ -84,14 +70,7 @@ fn chi_square_rejects_a_lobe_tilted_by_two_degrees() {
 #[test]
 fn chi_square_rejects_samples_outside_the_support() {
     // The disc shrunk by 1 %: an empty ring where the pdf expects samples.
-    let disc = DiscBinning::new(20, 20).unwrap();
-    let r = chi_square_test(
-        &disc,
-        &uniform_disc_pdf,
-        &disc_points(7, 100_000, 0.99),
-        &opts(),
-    )
-    .unwrap();
+    let r = uniform_disc_chi_square(&disc_points(7, 100_000, 0.99));
     assert!(r.p_value < ALPHA, "{}", r.summary());
     // Directions below the horizon for a hemisphere pdf: samples where the pdf integrates to zero.
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
@@ -124,8 +103,16 @@ fn ks_projections_accept_exact_samplers() {
 }
 
 #[test]
-fn ks_projection_rejects_cosine_samples_reported_as_uniform() {
+fn chi_square_and_ks_projection_reject_cosine_samples_reported_as_uniform() {
     let hemi = SphereBinning::hemisphere(10, 20).unwrap();
+    let r = chi_square_test(
+        &hemi,
+        &uniform_hemisphere_pdf,
+        &cosine_points(3, 10_000),
+        &opts(),
+    )
+    .unwrap();
+    assert!(r.p_value < ALPHA, "{}", r.summary());
     let o = ks_projection_test(
         &hemi,
         &uniform_hemisphere_pdf,

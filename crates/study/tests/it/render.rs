@@ -32,29 +32,24 @@ fn constant_light_lambert_is_exact_for_cosine_sampling() {
         .filter(|i| i % w < 12 && r.reference.rgb[*i][0] > 0.0)
         .collect();
     assert!(lit.len() > 50);
-    let cosine = r
-        .images
-        .iter()
-        .find(|i| i.sampler == "cosine" && i.kind == "equal samples")
-        .unwrap();
+    // The equal-samples image of a sampler.
+    let equal_samples = |sampler: &str| {
+        r.images
+            .iter()
+            .find(|i| i.sampler == sampler && i.kind == "equal samples")
+            .unwrap()
+    };
+    let cosine = equal_samples("cosine");
     for &i in &lit {
         assert!((cosine.rgb[i][1] - 1.6).abs() < 1e-9, "{:?}", cosine.rgb[i]);
     }
     // Uniform sampling is not exact.
-    let uniform = r
-        .images
-        .iter()
-        .find(|i| i.sampler == "uniform" && i.kind == "equal samples")
-        .unwrap();
+    let uniform = equal_samples("uniform");
     assert!(lit.iter().any(|&i| (uniform.rgb[i][1] - 1.6).abs() > 1e-3));
     // The adaptive sampler is ∝ f·cos on the Lambert sphere whatever the slice (all slices
     // are the same there), up to its numerical normaliser: exact in every pixel frame — a
     // check of the renderer's frames and of the estimator.
-    let adaptive = r
-        .images
-        .iter()
-        .find(|i| i.sampler == "adaptive" && i.kind == "equal samples")
-        .unwrap();
+    let adaptive = equal_samples("adaptive");
     for &i in &lit {
         assert!(
             (adaptive.rgb[i][1] - 1.6).abs() < 1e-3 * 1.6,
