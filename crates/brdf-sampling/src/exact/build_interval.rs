@@ -18,6 +18,7 @@ use super::grid::{Grid, TableVar};
 use super::interval::Interval;
 use super::jobs::{Inheritance, Job, Normaliser, NormaliserKey};
 use super::options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+use super::phases::{Lap, PhaseCounts};
 use super::tabulated;
 
 /// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
@@ -86,6 +87,8 @@ pub(super) struct Built {
     /// The axis to halve should its mean trials exceed the cap (`Some(true)`: δ; `None`: that
     /// axis is at its narrowest), see [`split_axis`].
     pub(super) axis: Option<bool>,
+    /// The BRDF evaluations of this build per phase (see [`PhaseCounts`]).
+    pub(super) phases: PhaseCounts,
 }
 
 /// Where and on which disc map one interval is built: its clamped θ range and the names its
@@ -406,6 +409,8 @@ pub(super) fn build_interval(
     job: &Job,
     ctx: &IntervalContext,
 ) -> Result<Built, ExactError> {
+    let mut phases = PhaseCounts::default();
+    let mut lap = Lap::start();
     let span = Span::new(brdf.as_ref(), options, job, ctx);
     let n_delta = delta_node_count(options, ctx.delta);
     let nodes = bound_nodes(brdf, job, ctx, &span, n_delta);
@@ -425,6 +430,7 @@ pub(super) fn build_interval(
     );
     let (tree, points) = envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?;
     drop(f);
+    phases.envelope = lap.take();
     let axis_from = crate::disc::thread_evaluations();
     let axis = split_axis(
         brdf.as_ref(),
@@ -436,6 +442,7 @@ pub(super) fn build_interval(
         options.max_trials,
     );
     let axis_evals = crate::disc::thread_evaluations() - axis_from;
+    phases.axis = lap.take();
     // Node evaluations: the cached nodes counted their misses, the others every point.
     let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
     let build_evals = points * (n_nodes - cached)
@@ -455,6 +462,8 @@ pub(super) fn build_interval(
         &mut normalisers,
     )?;
     let quad_evals = crate::disc::thread_evaluations() - before;
+    phases.quadrature = lap.take();
+    phases.nodes = normalisers.len() as u64;
     let interval = match outcome {
         TableOutcome::Split => None,
         TableOutcome::Table(table, quad_err) => Some(finish_interval(
@@ -469,8 +478,10 @@ pub(super) fn build_interval(
             build_evals + axis_evals + quad_evals,
         )?),
     };
+    phases.finish = lap.take();
     Ok(Built {
         axis,
+        phases,
         interval,
         inheritance: Inheritance {
             nodes: values_of(envelope),
