@@ -291,6 +291,11 @@ fn run_jobs(
                     phases.split_tail.add(&counts);
                 }
                 phases.record(plan, &job, iv.as_ref(), &counts, Some((by_trials, delta)));
+                // Split for its tail: its tree bounds the halves too (`Inheritance`).
+                let mut inheritance = inheritance;
+                if let (false, Some(iv)) = (by_trials, iv) {
+                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
+                }
                 let inheritance = Arc::new(inheritance);
                 for (num, dnum) in job.halves(delta) {
                     next.push(Job {

@@ -428,7 +428,12 @@ pub(super) fn build_interval(
         span.isotropic,
         PEAK_TRACK_DELTAS.max(4 * n_delta - 3),
     );
-    let (tree, points) = envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?;
+    // A parent split for its tail hands down its tree (on the same disc map: its bounds hold
+    // over the parent's interval, so over this one too); otherwise the envelope's own.
+    let (tree, points) = match &job.inherited.tree {
+        Some((tree, map)) if *map == span.map => (tree.clone(), 0),
+        _ => envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?,
+    };
     drop(f);
     phases.envelope = lap.take();
     let axis_from = crate::disc::thread_evaluations();
@@ -486,6 +491,7 @@ pub(super) fn build_interval(
         inheritance: Inheritance {
             nodes: values_of(envelope),
             normalisers,
+            tree: None,
         },
     })
 }
