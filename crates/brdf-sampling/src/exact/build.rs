@@ -282,9 +282,9 @@ fn run_jobs(
             if let Some(delta) = next_axis(options, plan, &job, iv.as_ref(), trials_axis) {
                 // Too many trials (found early, or at a node of the full table), or a
                 // table's interpolation tail.
-                let by_trials = iv.as_ref().is_none_or(|iv| {
-                    iv.worst_trials > options.max_trials && trials_axis.is_some()
-                });
+                let by_trials = iv
+                    .as_ref()
+                    .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
                 if by_trials {
                     phases.split.add(&counts);
                 } else {

@@ -229,6 +229,73 @@ mod tests {
         assert!(phases.kept.quadrature > 0 && phases.kept.nodes > 0);
     }
 
+    /// Oren–Nayar's `A(θo)` has a kink at normal incidence: the intervals there are split for
+    /// their interpolation tail down to the narrowest width. Each such split hands its tree
+    /// to its halves (no envelope evaluated) when they use its disc map, and a fresh tree is
+    /// built where they do not (the equal-area map switched on at 10° here, inside the
+    /// split intervals). Either way the bounds hold (no violation) and the samples follow
+    /// `f cos` (the mean `cos θi` against the reference quadrature, 5σ) in the halves.
+    #[test]
+    fn a_tail_split_hands_its_tree_to_its_halves() {
+        use crate::direction_sampler::{DirectionSampler, SamplerDiagnostics};
+        use rand::SeedableRng;
+        let brdf: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("oren-nayar").unwrap());
+        let mut opts = ExactOptions::default();
+        opts.set.equal_area_from_deg = 10.0;
+        let (set, phases) = ExactSet::build_counted(Arc::clone(&brdf), &opts).unwrap();
+        assert_eq!(phases.total(), phases.counted);
+        // The tail split `r` is a half of (θ only: Oren–Nayar is isotropic).
+        let parent = |r: &IntervalRecord| {
+            phases.log.iter().find(|p| {
+                matches!(p.split, Some((false, _)))
+                    && p.cell == r.cell
+                    && (p.theta_deg[0] == r.theta_deg[0] || p.theta_deg[1] == r.theta_deg[1])
+                    && p.theta_deg[1] - p.theta_deg[0] == 2.0 * (r.theta_deg[1] - r.theta_deg[0])
+            })
+        };
+        let (mut reused, mut fresh_across_maps) = (0, 0);
+        for r in &phases.log {
+            match parent(r) {
+                // The projected map below 10°, the equal-area one from there.
+                Some(p) if (p.theta_deg[1] >= 10.0) != (r.theta_deg[1] >= 10.0) => {
+                    assert!(r.counts.envelope > 0, "{r:?}: a tree on another disc map");
+                    fresh_across_maps += 1;
+                }
+                Some(_) => {
+                    assert_eq!(r.counts.envelope, 0, "{r:?}");
+                    reused += 1;
+                }
+                None => assert!(r.counts.envelope > 0, "{r:?}"),
+            }
+        }
+        assert!(
+            reused >= 2 && fresh_across_maps >= 1,
+            "{reused} {fresh_across_maps}"
+        );
+        let cost = set.measure_cost(20_000, 5);
+        assert_eq!(cost.violations, 0, "{cost:?}");
+        let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(7);
+        for t in [0.3, 2.9, 8.1, 12.3] {
+            let wo = brdf::direction_from_angles(t, 40.0);
+            let n = 40_000;
+            let xs: Vec<f64> = (0..n).map(|_| set.sample(&wo, &mut rng).wi.z).collect();
+            let mean = xs.iter().sum::<f64>() / n as f64;
+            let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+            let cos2 = crate::reference::albedo_of(
+                |wo, wi| brdf.eval(wo, wi) * wi.z,
+                brdf.as_ref(),
+                &wo,
+                crate::REFERENCE_BUDGET,
+            )
+            .unwrap()
+            .value;
+            let a = crate::reference_albedo(brdf.as_ref(), &wo).unwrap().value;
+            let z = (mean - cos2 / a) / (var / n as f64).sqrt();
+            assert!(z.abs() < 5.0, "θo {t}: z = {z}");
+        }
+        assert_eq!(set.bound_violations(), Some(0));
+    }
+
     /// `BRDF_SPEC` (default `poulin-fournier`): the default build's evaluations per phase and
     /// its CPU time on one thread. `cargo test --release -p brdf-sampling --lib
     /// build_phases_of_spec -- --ignored --nocapture` (docs/benchmarks.md §19.7).
