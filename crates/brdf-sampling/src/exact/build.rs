@@ -219,6 +219,7 @@ impl Plan {
             var: self.var,
             cache: self.cache,
             min_width: self.min_width,
+            tail_cap: self.tail_cap,
             table_nodes: self.table_nodes,
             node_cache: Arc::clone(&self.node_cache),
             set_table: self.set_table.clone(),

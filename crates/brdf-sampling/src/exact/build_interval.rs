@@ -71,6 +71,9 @@ pub(super) struct IntervalContext {
     pub(super) cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     pub(super) min_width: f64,
+    /// The largest interpolation tail an interval keeps whatever its nodes' error estimate
+    /// (the plan's `tail_cap`).
+    pub(super) tail_cap: f64,
     /// Integrate the normaliser nodes by a rule of their own (the MERL layout's cells, the
     /// Cornell reference rule: `tabulated.rs`) instead of on the tree's leaves.
     pub(super) table_nodes: bool,
@@ -365,7 +368,14 @@ fn normaliser_table(
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
-        if span.isotropic || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
+        // A θ tail the build splits for (`next_axis` in `build.rs`: the same floor) is not
+        // cured by more δ nodes: the interval is halved in θ whatever they give, and its
+        // halves build tables of their own (a kink of `A` across the interval, e.g.
+        // poulin-fournier's onset of masking, kept doubling to 17 δ nodes before each split).
+        let split_in_theta = table.rel_tail_theta()
+            > options.normaliser_tol.max(quad_err.min(ctx.tail_cap))
+            && job.can_split_theta(&ctx.grid, ctx.min_width);
+        if span.isotropic || split_in_theta || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
             return Ok(TableOutcome::Table(table, quad_err));
         }
         nd = 2 * nd - 1;
