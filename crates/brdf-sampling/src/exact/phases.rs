@@ -299,16 +299,18 @@ mod tests {
     /// An anisotropic interval halved in θ for its table's θ tail does not first double its
     /// δ nodes (they cannot cure a θ tail): poulin-fournier's `A` has a kink along the onset
     /// of masking (`|ψo| = 30°` in the cylinders' cross-section), which crosses its cells.
-    /// A coarse build (wide narrowest interval, loose trial cap): still ≈ 40 CPU-s, 326 s of
-    /// wall on the loaded host, so not in the default test command.
+    /// A coarse build (wide narrowest interval, loose trial cap), yet 326 s of wall on the
+    /// host at a load average of 30: not in the default test command.
     #[test]
-    #[ignore = "a poulin-fournier build (≈ 40 CPU-s)"]
+    #[ignore = "a coarse poulin-fournier build (minutes on a loaded host)"]
     fn a_theta_tail_split_keeps_its_first_delta_nodes() {
         let brdf: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("poulin-fournier").unwrap());
-        let mut opts = ExactOptions::default();
-        opts.min_width_deg = 5.0;
-        opts.max_trials = 8.0;
-        opts.initial_phi_cells = 2;
+        let opts = ExactOptions {
+            min_width_deg: 5.0,
+            max_trials: 8.0,
+            initial_phi_cells: 2,
+            ..ExactOptions::default()
+        };
         let (_, phases) = ExactSet::build_counted(brdf, &opts).unwrap();
         let theta_tail: Vec<&IntervalRecord> = phases
             .log
