@@ -17,6 +17,7 @@ use super::interval::Interval;
 use super::jobs::{Inheritance, Job};
 use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
+use super::phases::{BuildPhases, Lap};
 use super::set::ExactSet;
 use super::set_table::SetTable;
 use super::tabulated;
@@ -63,8 +64,23 @@ impl ExactSet {
         cache: Option<bool>,
         follow_kinks: bool,
     ) -> Result<Self, ExactError> {
+        Self::build_phased(brdf, options, progress, cache, follow_kinks).map(|(set, _)| set)
+    }
+
+    /// [`ExactSet::build_with`], also returning the evaluations per phase (those of
+    /// [`brdf::CountingBrdf`] on the threads that built the intervals: exact on a pool of one
+    /// thread, see [`ExactSet::build_counted`]).
+    pub(super) fn build_phased(
+        brdf: Arc<dyn Brdf>,
+        options: &ExactOptions,
+        progress: Option<crate::Progress<'_>>,
+        cache: Option<bool>,
+        follow_kinks: bool,
+    ) -> Result<(Self, BuildPhases), ExactError> {
         options.validate()?;
         let start = Instant::now();
+        let mut phases = BuildPhases::default();
+        let mut lap = Lap::start();
         let mut plan = Plan::new(brdf.as_ref(), options, cache, follow_kinks);
         if plan.table_nodes && tabulated::tabulates_over_theta(brdf.as_ref()) {
             let breaks: Vec<f64> = (1..plan.n0)
@@ -74,9 +90,10 @@ impl ExactSet {
                 SetTable::build(brdf.as_ref(), 0.0, THETA_TOP_DEG.to_radians(), &breaks)
                     .map(Arc::new);
         }
-        let done = run_jobs(&brdf, options, &plan, progress)?;
+        phases.plan = lap.take();
+        let done = run_jobs(&brdf, options, &plan, progress, &mut phases)?;
         let cells = assemble_cells(done, &plan);
-        Ok(Self {
+        let set = Self {
             brdf,
             options: *options,
             isotropic: plan.isotropic,
@@ -86,7 +103,8 @@ impl ExactSet {
             top_cos: THETA_TOP_DEG.to_radians().cos(),
             build_time: start.elapsed(),
             counters: AuditCounters::new(),
-        })
+        };
+        Ok((set, phases))
     }
 }
 
@@ -201,6 +219,7 @@ impl Plan {
             var: self.var,
             cache: self.cache,
             min_width: self.min_width,
+            tail_cap: self.tail_cap,
             table_nodes: self.table_nodes,
             node_cache: Arc::clone(&self.node_cache),
             set_table: self.set_table.clone(),
@@ -231,6 +250,7 @@ fn run_jobs(
     options: &ExactOptions,
     plan: &Plan,
     progress: Option<crate::Progress<'_>>,
+    phases: &mut BuildPhases,
 ) -> Result<Vec<(usize, Placed)>, ExactError> {
     let mut jobs = plan.initial_jobs();
     let mut done: Vec<(usize, Placed)> = Vec::new();
@@ -255,10 +275,28 @@ fn run_jobs(
                     interval: iv,
                     inheritance,
                     axis: trials_axis,
+                    phases: counts,
                 },
             ) = r?;
             built += 1;
+            phases.built += 1;
             if let Some(delta) = next_axis(options, plan, &job, iv.as_ref(), trials_axis) {
+                // Too many trials (found early, or at a node of the full table), or a
+                // table's interpolation tail.
+                let by_trials = iv
+                    .as_ref()
+                    .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
+                if by_trials {
+                    phases.split.add(&counts);
+                } else {
+                    phases.split_tail.add(&counts);
+                }
+                phases.record(plan, &job, iv.as_ref(), &counts, Some((by_trials, delta)));
+                // Split for its tail: its tree bounds the halves too (`Inheritance`).
+                let mut inheritance = inheritance;
+                if let (false, Some(iv)) = (by_trials, iv) {
+                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
+                }
                 let inheritance = Arc::new(inheritance);
                 for (num, dnum) in job.halves(delta) {
                     next.push(Job {
@@ -270,6 +308,9 @@ fn run_jobs(
                 }
                 queued += 2;
             } else if let Some(iv) = iv {
+                phases.kept.add(&counts);
+                phases.kept_intervals += 1;
+                phases.record(plan, &job, Some(&iv), &counts, None);
                 // Only the edges are kept (the node values go with `job`).
                 done.push((job.cell, (job.num, job.dnum, iv)));
             }

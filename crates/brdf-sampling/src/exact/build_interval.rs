@@ -18,6 +18,7 @@ use super::grid::{Grid, TableVar};
 use super::interval::Interval;
 use super::jobs::{Inheritance, Job, Normaliser, NormaliserKey};
 use super::options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+use super::phases::{Lap, PhaseCounts};
 use super::tabulated;
 
 /// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
@@ -70,6 +71,9 @@ pub(super) struct IntervalContext {
     pub(super) cache: bool,
     /// Narrowest interval (radians, θ and azimuth).
     pub(super) min_width: f64,
+    /// The largest interpolation tail an interval keeps whatever its nodes' error estimate
+    /// (the plan's `tail_cap`).
+    pub(super) tail_cap: f64,
     /// Integrate the normaliser nodes by a rule of their own (the MERL layout's cells, the
     /// Cornell reference rule: `tabulated.rs`) instead of on the tree's leaves.
     pub(super) table_nodes: bool,
@@ -86,6 +90,8 @@ pub(super) struct Built {
     /// The axis to halve should its mean trials exceed the cap (`Some(true)`: δ; `None`: that
     /// axis is at its narrowest), see [`split_axis`].
     pub(super) axis: Option<bool>,
+    /// The BRDF evaluations of this build per phase (see [`PhaseCounts`]).
+    pub(super) phases: PhaseCounts,
 }
 
 /// Where and on which disc map one interval is built: its clamped θ range and the names its
@@ -362,7 +368,14 @@ fn normaliser_table(
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
-        if span.isotropic || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
+        // A θ tail the build splits for (`next_axis` in `build.rs`: the same floor) is not
+        // cured by more δ nodes: the interval is halved in θ whatever they give, and its
+        // halves build tables of their own (a kink of `A` across the interval, e.g.
+        // poulin-fournier's onset of masking, kept doubling to 17 δ nodes before each split).
+        let split_in_theta = table.rel_tail_theta()
+            > options.normaliser_tol.max(quad_err.min(ctx.tail_cap))
+            && job.can_split_theta(&ctx.grid, ctx.min_width);
+        if span.isotropic || split_in_theta || table.rel_tail_delta() <= floor || 2 * nd - 1 > 17 {
             return Ok(TableOutcome::Table(table, quad_err));
         }
         nd = 2 * nd - 1;
@@ -406,6 +419,8 @@ pub(super) fn build_interval(
     job: &Job,
     ctx: &IntervalContext,
 ) -> Result<Built, ExactError> {
+    let mut phases = PhaseCounts::default();
+    let mut lap = Lap::start();
     let span = Span::new(brdf.as_ref(), options, job, ctx);
     let n_delta = delta_node_count(options, ctx.delta);
     let nodes = bound_nodes(brdf, job, ctx, &span, n_delta);
@@ -423,8 +438,14 @@ pub(super) fn build_interval(
         span.isotropic,
         PEAK_TRACK_DELTAS.max(4 * n_delta - 3),
     );
-    let (tree, points) = envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?;
+    // A parent split for its tail hands down its tree (on the same disc map: its bounds hold
+    // over the parent's interval, so over this one too); otherwise the envelope's own.
+    let (tree, points) = match &job.inherited.tree {
+        Some((tree, map)) if *map == span.map => (tree.clone(), 0),
+        _ => envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?,
+    };
     drop(f);
+    phases.envelope = lap.take();
     let axis_from = crate::disc::thread_evaluations();
     let axis = split_axis(
         brdf.as_ref(),
@@ -436,6 +457,7 @@ pub(super) fn build_interval(
         options.max_trials,
     );
     let axis_evals = crate::disc::thread_evaluations() - axis_from;
+    phases.axis = lap.take();
     // Node evaluations: the cached nodes counted their misses, the others every point.
     let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
     let build_evals = points * (n_nodes - cached)
@@ -455,6 +477,8 @@ pub(super) fn build_interval(
         &mut normalisers,
     )?;
     let quad_evals = crate::disc::thread_evaluations() - before;
+    phases.quadrature = lap.take();
+    phases.nodes = normalisers.len() as u64;
     let interval = match outcome {
         TableOutcome::Split => None,
         TableOutcome::Table(table, quad_err) => Some(finish_interval(
@@ -469,12 +493,15 @@ pub(super) fn build_interval(
             build_evals + axis_evals + quad_evals,
         )?),
     };
+    phases.finish = lap.take();
     Ok(Built {
         axis,
+        phases,
         interval,
         inheritance: Inheritance {
             nodes: values_of(envelope),
             normalisers,
+            tree: None,
         },
     })
 }

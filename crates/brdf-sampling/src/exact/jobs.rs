@@ -2,6 +2,10 @@
 
 use std::sync::Arc;
 
+use partition_sampler::QuadTree;
+
+use crate::disc::DiscMap;
+
 use super::density::{NodeKey, NodeValues};
 use super::grid::Grid;
 
@@ -19,10 +23,18 @@ pub(super) struct Job {
 /// What a split interval hands to its children: its caching bound nodes' values, and the
 /// normalisers it integrated, keyed by the bits of the node's table variable and of `δ` (a
 /// child's end is its parent's end with the same bits, so its quadrature is not repeated).
+///
+/// An interval split for its table's interpolation tail (its mean trials met the cap) also
+/// hands down its tree: its leaf bounds hold for every outgoing direction of the interval, so
+/// of each half too, and the children only need tables of their own (each child still checks
+/// its mean trials at its own nodes, and is split with trees of their own when they exceed the
+/// cap).
 #[derive(Default)]
 pub(super) struct Inheritance {
     pub(super) nodes: Vec<(NodeKey, Arc<NodeValues>)>,
     pub(super) normalisers: Vec<(NormaliserKey, Normaliser)>,
+    /// The tree of an interval split for its tail, and its disc map.
+    pub(super) tree: Option<(QuadTree, DiscMap)>,
 }
 
 /// A normaliser node: the bits of its table variable and of `δ`.

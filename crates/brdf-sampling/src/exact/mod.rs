@@ -78,6 +78,7 @@ mod layout;
 mod lookup;
 mod options;
 mod persist;
+mod phases;
 mod probe;
 mod report;
 mod sampler;
@@ -90,6 +91,7 @@ mod walk;
 pub use error::ExactError;
 pub use options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
 pub use persist::EXACT_FORMAT_VERSION;
+pub use phases::{BuildPhases, PhaseCounts};
 pub use report::{CellLayout, ExactReport};
 pub use set::ExactSet;
 
