@@ -13,7 +13,7 @@
 //!   warnings ([`crate::dispersion`]): efficiency divides by it;
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
 //! * relative errors and MSE in batch mode rest on `max(repetitions, batch_repetitions)`
-//!   estimates per N;
+//!   estimates at the budget N, `repetitions` at the others ([`repetitions_at`]);
 //! * timings: after the statistics, nothing else of the study running, on every rayon thread
 //!   at once, each thread with an equal share of the cells (every T-th):
 //!   runs of `timing_samples` samples per cell, interleaved across its cells (run 1 of each,
@@ -25,6 +25,9 @@
 //! * the MIS cells of one (BRDF sampler, map sampler, BRDF, θo, light) under the balance and
 //!   the power heuristic share their draws (the stream of the first): each cell's values are
 //!   exactly those it would get alone from that stream, the heuristic's weights only differ;
+//!   the one-sample BRDF-only cell of that BRDF sampler (BRDF, θo, light) joins the group of
+//!   its first map sampler and takes the estimator's value `g / p` of each of its BRDF draws
+//!   (same law, no draw or evaluation of its own: [`mis_groups`]);
 //! * the CPU time of each phase (builds, map samplers, references, statistics, timings,
 //!   rankings) is in the run's [`crate::RunInfo::phases`].
 //!
@@ -38,8 +41,8 @@
 //! build starts last and runs alone while the other cores idle).
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
-//! `distributions::chunk_seed(seed, i)` (a power-heuristic MIS cell from its balance
-//! partner's) and sums in a fixed order, so its numbers do not
+//! `distributions::chunk_seed(seed, i)` (a power-heuristic MIS cell and a joined BRDF-only
+//! cell from their MIS group's balance cell's) and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it. A shard `K/N` runs every cell of the
 //! BRDFs `b` with `b mod N = K − 1` (not every N-th cell), so its builds are its own.
 
