@@ -13,16 +13,21 @@
 //!   warnings ([`crate::dispersion`]): efficiency divides by it;
 //! * BRDF evaluations per sample: counted on the sampler's calls only ([`CountingBrdf`]);
 //! * relative errors and MSE in batch mode rest on `max(repetitions, batch_repetitions)`
-//!   estimates per N;
+//!   estimates at the budget N, `repetitions` at the others ([`repetitions_at`]);
 //! * timings: after the statistics, nothing else of the study running, on every rayon thread
 //!   at once, each thread with an equal share of the cells (every T-th):
-//!   `timing_repeats` runs of `timing_samples` samples per cell, interleaved across its
-//!   cells (run 1 of each, then run 2, …), on the thread's own CPU clock where the platform
+//!   runs of `timing_samples` samples per cell, interleaved across its cells (run 1 of each,
+//!   then run 2, …), from 5 up to `timing_repeats` runs by a stated stopping rule
+//!   ([`timing_done`]: a cell stops once its median time's standard error is ≤ 5 %), on the
+//!   thread's own CPU clock where the platform
 //!   has one (and the wall clock beside); the median and the spread are kept. Every cell is
 //!   timed under the same condition (the other threads timing too);
 //! * the MIS cells of one (BRDF sampler, map sampler, BRDF, θo, light) under the balance and
 //!   the power heuristic share their draws (the stream of the first): each cell's values are
 //!   exactly those it would get alone from that stream, the heuristic's weights only differ;
+//!   the one-sample BRDF-only cell of that BRDF sampler (BRDF, θo, light) joins the group of
+//!   its first map sampler and takes the estimator's value `g / p` of each of its BRDF draws
+//!   (same law, no draw or evaluation of its own: [`mis_groups`]);
 //! * the CPU time of each phase (builds, map samplers, references, statistics, timings,
 //!   rankings) is in the run's [`crate::RunInfo::phases`].
 //!
@@ -36,8 +41,8 @@
 //! build starts last and runs alone while the other cores idle).
 //!
 //! Reproducibility: cell `i` draws from one `Xoshiro256PlusPlus` seeded with
-//! `distributions::chunk_seed(seed, i)` (a power-heuristic MIS cell from its balance
-//! partner's) and sums in a fixed order, so its numbers do not
+//! `distributions::chunk_seed(seed, i)` (a power-heuristic MIS cell and a joined BRDF-only
+//! cell from their MIS group's balance cell's) and sums in a fixed order, so its numbers do not
 //! depend on the thread count or on which shard runs it. A shard `K/N` runs every cell of the
 //! BRDFs `b` with `b mod N = K − 1` (not every N-th cell), so its builds are its own.
 
@@ -835,9 +840,16 @@ impl StudyPlan {
                         let refs: Vec<Reference> = members.iter().map(|c| find_ref(c)).collect();
                         self.run_cells(&members, t, refs)
                     }
+                    // A BRDF-only member whose MIS group cannot run (its map sampler not
+                    // built) runs alone, from its own stream.
                     Err(e) => members
                         .iter()
-                        .map(|c| failed(c, find_ref(c), e.clone()))
+                        .map(|c| match (c.kind, technique(c)) {
+                            (Kind::Brdf, Ok((t, _))) => {
+                                self.run_cells(&[c], t, vec![find_ref(c)]).remove(0)
+                            }
+                            _ => failed(c, find_ref(c), e.clone()),
+                        })
                         .collect(),
                 };
                 progress(g.len() as u64);
@@ -876,14 +888,17 @@ impl StudyPlan {
         std::thread::scope(|scope| {
             for share in &mut shares {
                 scope.spawn(move || {
-                    let mut reported = 0;
-                    for r in 0..repeats {
-                        for (_, t) in share.iter_mut() {
+                    // Rounds of one repeat of each cell still timing, until every cell of
+                    // the share has met the stopping rule (`timing_done`).
+                    let mut timing: Vec<&mut CellTimer<'_>> =
+                        share.iter_mut().map(|(_, t)| t).collect();
+                    while !timing.is_empty() {
+                        for t in timing.iter_mut() {
                             t.repeat(samples);
                         }
-                        let due = share.len() * (r + 1) / repeats;
-                        progress((due - reported) as u64);
-                        reported = due;
+                        let before = timing.len();
+                        timing.retain(|t| !timing_done(&t.estimator_ns, repeats));
+                        progress((before - timing.len()) as u64);
                     }
                 });
             }
@@ -946,9 +961,11 @@ impl StudyPlan {
         let cfg = &self.config;
         let c = members[0];
         let est = self.estimator(c, technique);
-        let heuristics: Vec<MisHeuristic> = members
+        // Each member's value per draw: `Some(h)` its MIS heuristic's, `None` (a BRDF-only
+        // member) the estimator's value of the BRDF draw alone.
+        let kinds: Vec<Option<MisHeuristic>> = members
             .iter()
-            .filter_map(|m| match m.kind {
+            .map(|m| match m.kind {
                 Kind::Mis { heuristic, .. } => Some(heuristic),
                 _ => None,
             })
@@ -958,11 +975,12 @@ impl StudyPlan {
             cfg.seed,
             c.spec.index as u64,
         ));
+        // The MIS members' evaluations (the whole pair's), and the BRDF-only member's (its
+        // sampler's draws only).
         let mut counter = EvalCounter::default();
-        let reps = match c.spec.mode {
-            Mode::OneSample => cfg.repetitions,
-            Mode::Batch => cfg.repetitions.max(cfg.batch_repetitions),
-        };
+        let mut brdf_counter = EvalCounter::default();
+        let budget = cfg.n_grid.last().copied().unwrap_or(1);
+        let reps = repetitions_at(cfg, c.spec.mode, budget);
         let mut acc: Vec<Accumulator> = references
             .into_iter()
             .map(|reference| Accumulator {
@@ -972,19 +990,19 @@ impl StudyPlan {
                 all_values: Vec::new(),
             })
             .collect();
-        let draw = |n: usize, rng: &mut Xoshiro256PlusPlus, counter: &mut EvalCounter| {
+        let mut draw = |n: usize, rng: &mut Xoshiro256PlusPlus| {
             if k == 1 {
-                vec![est.values(n, rng, counter)]
+                vec![est.values(n, rng, &mut counter)]
             } else {
-                est.mis_values(&heuristics, n, rng, counter)
+                est.mis_values(&kinds, n, rng, &mut counter, &mut brdf_counter)
             }
         };
         for &n in &cfg.n_grid {
             for a in acc.iter_mut() {
                 a.values.clear();
             }
-            for _ in 0..reps {
-                let ys = draw(n, &mut rng, &mut counter);
+            for _ in 0..repetitions_at(cfg, c.spec.mode, n) {
+                let ys = draw(n, &mut rng);
                 for (a, ys) in acc.iter_mut().zip(ys) {
                     let sum: f64 = if c.spec.mode == Mode::OneSample {
                         let start = a.all_values.len();
@@ -1001,7 +1019,7 @@ impl StudyPlan {
             }
         }
         if c.spec.mode == Mode::OneSample {
-            let ys = draw(cfg.variance_samples, &mut rng, &mut counter);
+            let ys = draw(cfg.variance_samples, &mut rng);
             for (a, ys) in acc.iter_mut().zip(ys) {
                 a.all_values.extend(ys);
             }
@@ -1009,7 +1027,16 @@ impl StudyPlan {
         members
             .iter()
             .zip(acc)
-            .map(|(m, a)| self.cell_result(m, technique, &counter, reps, a))
+            .map(|(m, a)| match (m.kind, technique) {
+                (Kind::Brdf, Technique::Mis(pair)) => self.cell_result(
+                    m,
+                    Technique::Brdf(pair.brdf_sampler),
+                    &brdf_counter,
+                    reps,
+                    a,
+                ),
+                _ => self.cell_result(m, technique, &counter, reps, a),
+            })
             .collect()
     }
 
@@ -1248,22 +1275,44 @@ impl Accumulator {
     }
 }
 
+/// Independent estimates of a cell at `n`: `repetitions` (32 by default) at every N of the
+/// grid, and in batch mode `max(repetitions, batch_repetitions)` (256) at the budget (largest)
+/// N, where its variance and MSE rest on those estimates alone. The error curves' intervals at
+/// the smaller N are computed from the count they have, as the one-sample mode's are.
+fn repetitions_at(cfg: &StudyConfig, mode: Mode, n: usize) -> usize {
+    let budget = cfg.n_grid.last().copied().unwrap_or(1);
+    match mode {
+        Mode::Batch if n == budget => cfg.repetitions.max(cfg.batch_repetitions),
+        _ => cfg.repetitions,
+    }
+}
+
 /// The groups of cells (positions in `cells`) whose statistics run together: the MIS cells of
 /// one (BRDF sampler, map sampler, BRDF, θo, light) under each heuristic — the same pair of
 /// draws serves every heuristic, only the weights differ, so each cell's values keep their
 /// law (one BRDF draw and one map draw per sample) and the study draws once instead of once
 /// per heuristic. Each group is led by its first cell (the balance heuristic's in the
-/// config's order), whose stream it uses; every other cell is a group of its own. The cells
-/// of one group are correlated with each other, never with another cell of their own
-/// ranking (a ranking compares cells of one estimator, so one heuristic).
+/// config's order), whose stream it uses. A one-sample BRDF-only cell joins the group of its
+/// BRDF sampler with the first map sampler: its values are the estimator's values of that
+/// group's BRDF draws (`g / p` of each), the map draws between them only skip positions of
+/// the stream, so its values keep their law (independent draws of its sampler) and it costs
+/// no draw or evaluation of its own. Every other cell is a group of its own. The cells of one
+/// group are correlated with each other, never with another cell of their own ranking (a
+/// ranking compares cells of one estimator, so one heuristic, and the cells of one sampler
+/// are in different groups).
 fn mis_groups(cells: &[&PlanCell]) -> Vec<Vec<usize>> {
     /// (BRDF sampler, map sampler, BRDF, θo, light).
     type Pair = (usize, usize, usize, usize, usize);
     let mut groups: Vec<Vec<usize>> = Vec::new();
     let mut lead: Vec<(Pair, usize)> = Vec::new();
+    let mut brdf_only = Vec::new();
     for (i, c) in cells.iter().enumerate() {
         let Kind::Mis { ls, .. } = c.kind else {
-            groups.push(vec![i]);
+            if c.kind == Kind::Brdf && c.spec.mode == Mode::OneSample {
+                brdf_only.push(i);
+            } else {
+                groups.push(vec![i]);
+            }
             continue;
         };
         let key = (c.sampler, ls, c.brdf, c.theta, c.light);
@@ -1275,7 +1324,49 @@ fn mis_groups(cells: &[&PlanCell]) -> Vec<Vec<usize>> {
             }
         }
     }
+    // A one-sample BRDF-only cell joins the MIS group of its BRDF sampler, BRDF, θo and light
+    // with the first map sampler (its BRDF draws are that group's), or runs alone.
+    for i in brdf_only {
+        let c = cells[i];
+        let joined = lead
+            .iter()
+            .filter(|((s, _, b, t, l), _)| {
+                (*s, *b, *t, *l) == (c.sampler, c.brdf, c.theta, c.light)
+            })
+            .min_by_key(|((_, ls, ..), _)| *ls)
+            .map(|&(_, g)| g);
+        match joined {
+            Some(g) => groups[g].push(i),
+            None => groups.push(vec![i]),
+        }
+    }
     groups
+}
+
+/// Fewest timing repeats of a cell (or `timing_repeats` when that is smaller).
+pub(crate) const TIMING_MIN_REPEATS: usize = 5;
+
+/// Relative standard error of a cell's median time at which its repeats stop early.
+pub(crate) const TIMING_PRECISION: f64 = 0.05;
+
+/// The timing repeats' stopping rule, given a cell's times so far (ns, the thread CPU clock):
+/// stop after `max` repeats, or after `r ≥ min(TIMING_MIN_REPEATS, max)` repeats once the
+/// median's standard error on the log scale, `1.2533 s / √r` (`s` the sample standard
+/// deviation of `ln t`, 1.2533 = √(π/2) the median's efficiency factor under normal errors),
+/// is at most [`TIMING_PRECISION`]. The rule looks at the cell's own times only, so a cell's
+/// count does not depend on the others' or on the thread count. The ranking's time term is
+/// `s` itself (the spread of single repeats), which is `√r / 1.2533 ≥ 1.78` times the
+/// median's standard error for `r ≥ 5`, as it was 2.39 times at the fixed 9 repeats.
+pub(crate) fn timing_done(times: &[f64], max: usize) -> bool {
+    let r = times.len();
+    if r >= max {
+        return true;
+    }
+    if r < TIMING_MIN_REPEATS.min(max) {
+        return false;
+    }
+    let se = 1.2533 * log_sd_of(times) / (r as f64).sqrt();
+    se <= TIMING_PRECISION
 }
 
 /// Threads of the timing phase: rayon's (every core, or `RAYON_NUM_THREADS`).
@@ -1408,24 +1499,31 @@ impl Estimator<'_> {
         }
     }
 
-    /// `n` one-sample values of an MIS cell under each of `heuristics`, from one pair of
+    /// `n` one-sample values of an MIS cell under each heuristic of `kinds`, from one pair of
     /// draws per sample (a BRDF draw, then a map draw: [`MisPair::value`]'s order, so the
     /// values under each heuristic are those `MisPair::value` gives from the same stream).
-    /// The other technique's pdf is evaluated once per draw and serves every heuristic.
+    /// The other technique's pdf is evaluated once per draw and serves every heuristic. A
+    /// `None` in `kinds` gets the BRDF-only estimator's value of each BRDF draw
+    /// ([`Self::value`]: `g / p`, from the integrand already evaluated for MIS), its sampler's
+    /// evaluations counted in `brdf_counter`; `counter` counts the whole pair's.
     fn mis_values(
         &self,
-        heuristics: &[MisHeuristic],
+        kinds: &[Option<MisHeuristic>],
         n: usize,
         rng: &mut Xoshiro256PlusPlus,
         counter: &mut EvalCounter,
+        brdf_counter: &mut EvalCounter,
     ) -> Vec<Vec<f64>> {
         let Technique::Mis(pair) = self.technique else {
             return vec![self.values(n, rng, counter)];
         };
         let before = thread_evaluations();
-        let mut out: Vec<Vec<f64>> = heuristics.iter().map(|_| Vec::with_capacity(n)).collect();
+        let mut brdf_evaluations = 0;
+        let mut out: Vec<Vec<f64>> = kinds.iter().map(|_| Vec::with_capacity(n)).collect();
         for _ in 0..n {
+            let drawn = thread_evaluations();
             let s = pair.brdf_sampler.sample(&self.wo, rng);
+            brdf_evaluations += thread_evaluations() - drawn;
             let g = self.integrand(&s.wi);
             let other = (g > 0.0 && s.pdf > 0.0)
                 .then(|| pair.light_sampler.pdf_world(&pair.frame.to_world(&s.wi)));
@@ -1435,7 +1533,12 @@ impl Estimator<'_> {
                 let other = (g > 0.0 && pl > 0.0).then(|| pair.brdf_sampler.pdf(&self.wo, &wi));
                 (g, pl, other)
             });
-            for (h, o) in heuristics.iter().zip(out.iter_mut()) {
+            for (kind, o) in kinds.iter().zip(out.iter_mut()) {
+                let Some(h) = kind else {
+                    // `Self::value`: 0 below the horizon (`g` is 0 there) or where p is 0.
+                    o.push(if s.pdf > 0.0 { g / s.pdf } else { 0.0 });
+                    continue;
+                };
                 let a = estimators::mis_term(*h, g, s.pdf, 1.0, 1.0, || other.unwrap_or(0.0));
                 let v = match light {
                     Some((g, pl, other)) => {
@@ -1448,6 +1551,8 @@ impl Estimator<'_> {
         }
         counter.evaluations += thread_evaluations() - before;
         counter.samples += n as u64;
+        brdf_counter.evaluations += brdf_evaluations;
+        brdf_counter.samples += n as u64;
         out
     }
 
@@ -1893,6 +1998,37 @@ mod shared_draw_tests {
         );
     }
 
+    /// A BRDF-only cell that joins its sampler's MIS group takes that group's BRDF draws (so
+    /// other numbers than from its own stream: the estimator is then run without MIS) with
+    /// the same law: the same evaluations and memory, and a per-sample variance within the
+    /// two runs' intervals (z = 3.29, two-sided 0.1 %, fixed seeds).
+    #[test]
+    fn a_brdf_only_cell_sharing_mis_draws_keeps_its_law() {
+        let both = run(&["mis-balance", "mis-power"]);
+        let alone = run(&[]);
+        let (a, b) = (of(&both, "brdf"), of(&alone, "brdf"));
+        assert_eq!(a.len(), 2);
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.index, &x.sampler), (y.index, &y.sampler));
+            assert!(x.ok() && y.ok());
+            assert_ne!(
+                x.variance, y.variance,
+                "{}: not from the MIS draws",
+                x.sampler
+            );
+            assert_eq!(x.evaluations_per_sample, y.evaluations_per_sample);
+            assert_eq!(x.bytes, y.bytes);
+            let (vx, vy) = (x.variance.value, y.variance.value);
+            let half = (x.variance.ci95.powi(2) + y.variance.ci95.powi(2)).sqrt();
+            assert!(
+                (vx - vy).abs() <= 3.29 / Z95 * half,
+                "{}: variance {vx} vs {vy} ± {half}",
+                x.sampler
+            );
+        }
+    }
+
     /// The sphere sheet of a subset of a study's BRDFs reuses the samplers the study built:
     /// rendering after the run builds nothing more.
     #[test]
@@ -1961,11 +2097,42 @@ mod shared_draw_tests {
         let n = 2000;
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         let shared = est(MisHeuristic::Balance).mis_values(
-            &MisHeuristic::ALL,
+            &MisHeuristic::ALL.map(Some),
             n,
             &mut rng,
             &mut EvalCounter::default(),
+            &mut EvalCounter::default(),
         );
+        // With a BRDF-only member: the same MIS values, and for it the estimator's value of
+        // each BRDF draw — the stream replayed: a BRDF draw, its value, then the map draw.
+        let mut with_brdf = Xoshiro256PlusPlus::seed_from_u64(11);
+        let kinds = [Some(MisHeuristic::Balance), None, Some(MisHeuristic::Power)];
+        let mut brdf_counter = EvalCounter::default();
+        let joint = est(MisHeuristic::Balance).mis_values(
+            &kinds,
+            n,
+            &mut with_brdf,
+            &mut EvalCounter::default(),
+            &mut brdf_counter,
+        );
+        assert_eq!(joint[0], shared[0]);
+        assert_eq!(joint[2], shared[1]);
+        assert_eq!(with_brdf, rng, "the BRDF-only member draws nothing more");
+        let lone = Estimator {
+            technique: Technique::Brdf(sampler.as_ref()),
+            ..est(MisHeuristic::Balance)
+        };
+        let mut replay = Xoshiro256PlusPlus::seed_from_u64(11);
+        let expected: Vec<f64> = (0..n)
+            .map(|_| {
+                let s = sampler.sample(&lone.wo, &mut replay);
+                let _ = cdf.sample_world(&mut replay);
+                lone.value(&s)
+            })
+            .collect();
+        assert_eq!(joint[1], expected);
+        assert_eq!(brdf_counter.samples, n as u64);
+        assert!(joint[1].iter().filter(|v| **v > 0.0).count() > n / 4);
         for (h, values) in MisHeuristic::ALL.into_iter().zip(&shared) {
             let mut alone = Xoshiro256PlusPlus::seed_from_u64(11);
             let v = est(h).values(n, &mut alone, &mut EvalCounter::default());
@@ -1973,5 +2140,88 @@ mod shared_draw_tests {
             assert_eq!(alone, rng, "{h:?}: the stream is consumed differently");
         }
         assert!(shared[0].iter().any(|v| *v > 0.0));
+    }
+}
+
+#[cfg(test)]
+mod cost_rule_tests {
+    use super::*;
+
+    /// Batch-mode cells take `max(repetitions, batch_repetitions)` estimates at the budget N
+    /// only (their MSE and variance rest on those), the other N and the one-sample mode
+    /// `repetitions`.
+    #[test]
+    fn batch_cells_take_their_many_repetitions_at_the_budget_only() {
+        let mut c = StudyConfig::new(vec![], vec![], vec![], vec![]);
+        c.n_grid = vec![1, 25, 2500];
+        c.repetitions = 32;
+        c.batch_repetitions = 256;
+        for n in [1, 25] {
+            assert_eq!(repetitions_at(&c, Mode::Batch, n), 32);
+            assert_eq!(repetitions_at(&c, Mode::OneSample, n), 32);
+        }
+        assert_eq!(repetitions_at(&c, Mode::Batch, 2500), 256);
+        assert_eq!(repetitions_at(&c, Mode::OneSample, 2500), 32);
+        c.repetitions = 300;
+        assert_eq!(repetitions_at(&c, Mode::Batch, 2500), 300);
+    }
+
+    /// Times with a given spread of `ln t` around 1 µs: `r` values `exp(±sd)` alternating.
+    fn times(r: usize, sd: f64) -> Vec<f64> {
+        (0..r)
+            .map(|i| 1000.0 * if i % 2 == 0 { sd.exp() } else { (-sd).exp() })
+            .collect()
+    }
+
+    /// The timing rule: never fewer than 5 repeats (or the configured count when smaller),
+    /// never more than the configured count, and between them a cell stops once its median's
+    /// standard error `1.2533 s / √r` is ≤ 5 %.
+    #[test]
+    fn timing_repeats_stop_by_the_stated_rule() {
+        // Tight times: stop at the fifth repeat, not before.
+        for r in 1..5 {
+            assert!(!timing_done(&times(r, 0.01), 9), "{r}");
+        }
+        assert!(timing_done(&times(5, 0.01), 9));
+        // At 5 repeats the threshold on s is 0.05 √5 / 1.2533 = 0.0892 (s of the alternating
+        // values is a little above `sd`).
+        let s = |r, sd| log_sd_of(&times(r, sd));
+        assert!(s(5, 0.08) < 0.0892 && timing_done(&times(5, 0.08), 9));
+        assert!(s(5, 0.09) > 0.0892 && !timing_done(&times(5, 0.09), 9));
+        // Noisy times: every repeat up to the configured count.
+        for r in 5..9 {
+            assert!(!timing_done(&times(r, 0.5), 9), "{r}");
+        }
+        assert!(timing_done(&times(9, 0.5), 9));
+        // Fewer configured repeats than the minimum: that count.
+        assert!(!timing_done(&times(2, 0.5), 3));
+        assert!(timing_done(&times(3, 0.5), 3));
+        assert!(timing_done(&times(1, 0.0), 1));
+    }
+
+    /// A study's cells take the timing repeats the rule gives their own times: between 5 and
+    /// `timing_repeats`, and fewer than `timing_repeats` only with a median within 5 %.
+    #[test]
+    fn a_study_times_each_cell_by_the_rule() {
+        let mut c = StudyConfig::new(
+            vec!["cosine".into(), "lobe-sphere".into()],
+            vec!["phong:n=20".into()],
+            vec![40.0],
+            vec!["sky".into()],
+        );
+        c.n_grid = vec![2, 8];
+        c.repetitions = 4;
+        c.variance_samples = 300;
+        c.timing_samples = 64;
+        c.timing_repeats = 12;
+        let r = StudyPlan::new(c, Vec::new()).unwrap().run(None, &|_| {});
+        for cell in &r.cells {
+            let t = cell.timing.expect("timed");
+            assert!((5..=12).contains(&t.repeats), "{}", t.repeats);
+            if t.repeats < 12 {
+                let se = 1.2533 * t.estimator_log_sd / (t.repeats as f64).sqrt();
+                assert!(se <= TIMING_PRECISION, "{se}");
+            }
+        }
     }
 }
