@@ -204,8 +204,10 @@ fn outcome(s: &mut String, results: &StudyResults) {
     } else {
         let _ = writeln!(
             s,
-            "Each comparison (BRDF, θo, light; estimator: BRDF sampling alone) names the most efficient sampler (lowest MSE × time at the budget N), the samplers **statistically tied** with it and the ones **significantly worse**: the ratio of efficiencies best / x has an interval that carries the MSE's uncertainty (its 95 % interval and the reference's error) and the time's (the spread of {} interleaved timing repeats, on the timing thread's CPU clock where the platform has one), at the Šidák-corrected level 1 − (1 − α)^(1/m) for the m comparisons with the best, family-wise α = {}; x is tied when the interval contains 1. `(rows …)` are the `index` values of results.csv (one row per N) the sentence rests on. † marks a verdict that the MSEs alone would not give (it rests on the measured times); ⚠ a cell whose spread estimate is unreliable (its interval is optimistic).\n",
+            "Each comparison (BRDF, θo, light; estimator: BRDF sampling alone) names the most efficient sampler (lowest MSE × time at the budget N), the samplers **statistically tied** with it and the ones **significantly worse**: the ratio of efficiencies best / x has an interval that carries the MSE's uncertainty (its 95 % interval and the reference's error) and the time's (the spread of {}–{} interleaved timing repeats, stopped once the median's standard error is ≤ {} %, on the timing thread's CPU clock where the platform has one), at the Šidák-corrected level 1 − (1 − α)^(1/m) for the m comparisons with the best, family-wise α = {}; x is tied when the interval contains 1. `(rows …)` are the `index` values of results.csv (one row per N) the sentence rests on. † marks a verdict that the MSEs alone would not give (it rests on the measured times); ⚠ a cell whose spread estimate is unreliable (its interval is optimistic).\n",
+            crate::harness::TIMING_MIN_REPEATS.min(results.config.timing_repeats),
             results.config.timing_repeats,
+            crate::harness::TIMING_PRECISION * 100.0,
             crate::ranking::ALPHA,
         );
         let brdf_only: Vec<Ranking> = results
