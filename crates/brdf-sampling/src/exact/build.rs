@@ -291,7 +291,13 @@ fn run_jobs(
                 } else {
                     phases.split_tail.add(&counts);
                 }
-                phases.record(plan, &job, iv.as_ref(), &counts, Some((by_trials, delta)));
+                phases.record(
+                    &plan.grid,
+                    &job,
+                    iv.as_ref(),
+                    &counts,
+                    Some((by_trials, delta)),
+                );
                 // Split for its tail: its tree bounds the halves too (`Inheritance`).
                 let mut inheritance = inheritance;
                 if let (false, Some(iv)) = (by_trials, iv) {
@@ -310,7 +316,7 @@ fn run_jobs(
             } else if let Some(iv) = iv {
                 phases.kept.add(&counts);
                 phases.kept_intervals += 1;
-                phases.record(plan, &job, Some(&iv), &counts, None);
+                phases.record(&plan.grid, &job, Some(&iv), &counts, None);
                 // Only the edges are kept (the node values go with `job`).
                 done.push((job.cell, (job.num, job.dnum, iv)));
             }

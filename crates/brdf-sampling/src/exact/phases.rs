@@ -94,13 +94,12 @@ impl BuildPhases {
     /// Adds `job`'s record (`split`: see [`IntervalRecord::split`]).
     pub(super) fn record(
         &mut self,
-        plan: &super::build::Plan,
+        g: &super::grid::Grid,
         job: &super::jobs::Job,
         iv: Option<&super::interval::Interval>,
         counts: &PhaseCounts,
         split: Option<(bool, bool)>,
     ) {
-        let g = &plan.grid;
         self.log.push(IntervalRecord {
             cell: job.cell,
             theta_deg: job.num.map(|n| g.edge(n).to_degrees()),
