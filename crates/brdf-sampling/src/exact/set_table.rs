@@ -33,6 +33,24 @@ pub(crate) const MIN_PIECE_DEG: f64 = 0.45;
 /// Points per piece where the two interpolants are compared.
 const CHECKS: usize = 32;
 
+/// Into how many equal parts a piece is cut when its 9-versus-5 difference is `excess` times
+/// the tolerance and it is `room` times the narrowest piece wide (`room ≥ 2`): `2^m` with `m`
+/// the halvings a 5-node interpolation error (`∝ width⁵`) needs to get below the tolerance,
+/// at least 1 and no narrower than the narrowest piece. Halving one level at a time integrated
+/// every level's nodes on the way down (the pieces go down ~4 levels over most of 20–90° on
+/// the shared Cornell files); a part that still misses the tolerance is cut again, so the
+/// acceptance test and its guarantee are those of single halvings.
+fn split_count(excess: f64, room: f64) -> usize {
+    let wanted = if excess.is_finite() && excess > 1.0 {
+        (excess.log2() / 5.0).ceil().max(1.0)
+    } else {
+        1.0
+    };
+    // Halvings that keep a part at least the narrowest piece wide (room ≥ 2: at least one).
+    let allowed = room.log2().floor().max(1.0);
+    1 << (wanted.min(allowed).min(16.0) as u32)
+}
+
 /// One piece `[lo, hi]` of θo (radians) and its 9-node table of `A` (over θo).
 struct Piece {
     lo: f64,
@@ -99,10 +117,19 @@ impl SetTable {
                 // Below the nodes' own error the difference is their noise, not the
                 // interpolant's: halving would not lower it (measured: every piece went down
                 // to the narrowest with the tolerance alone).
-                if !(diff <= PIECE_TOL.max(node_err)) && 0.5 * (b - a) >= min_width {
-                    let m = 0.5 * (a + b);
-                    next.push((a, m));
-                    next.push((m, b));
+                let tol = PIECE_TOL.max(node_err);
+                if !(diff <= tol) && 0.5 * (b - a) >= min_width {
+                    let parts = split_count(diff / tol, (b - a) / min_width);
+                    let step = (b - a) / parts as f64;
+                    for k in 0..parts {
+                        let lo = if k == 0 { a } else { a + step * k as f64 };
+                        let hi = if k + 1 == parts {
+                            b
+                        } else {
+                            a + step * (k + 1) as f64
+                        };
+                        next.push((lo, hi));
+                    }
                 } else {
                     pieces.push(Piece {
                         lo: a,
@@ -134,5 +161,32 @@ impl SetTable {
         let mut e: Vec<f64> = self.pieces.iter().map(|p| p.lo).collect();
         e.extend(self.pieces.last().map(|p| p.hi));
         e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_count;
+
+    /// A piece is cut into a power of two of parts, at least 2, never narrower than the
+    /// narrowest piece, and into more parts the further its difference is above the tolerance
+    /// (5 halvings per factor 32: a 5-node error ∝ width⁵).
+    #[test]
+    fn split_counts() {
+        assert_eq!(split_count(1.5, 100.0), 2);
+        assert_eq!(split_count(32.0, 100.0), 2);
+        assert_eq!(split_count(33.0, 100.0), 4);
+        assert_eq!(split_count(1e6, 100.0), 16);
+        assert_eq!(split_count(1e6, 5.0), 4);
+        assert_eq!(split_count(1e6, 2.0), 2);
+        assert_eq!(split_count(f64::NAN, 100.0), 2);
+        assert_eq!(split_count(f64::INFINITY, 100.0), 2);
+        for excess in [1.01, 7.0, 1e3, 1e9, 1e300] {
+            for room in [2.0, 3.9, 4.0, 17.0, 1e4] {
+                let n = split_count(excess, room);
+                assert!(n.is_power_of_two() && n >= 2, "{excess} {room}: {n}");
+                assert!(n as f64 <= room, "{excess} {room}: {n}");
+            }
+        }
     }
 }

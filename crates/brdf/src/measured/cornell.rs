@@ -15,7 +15,7 @@
 //! `p(ωo, ωi) = (sin θi sin θo, Δφ/π, cos θi cos θo)` with `Δφ = |φi − φo|` folded into
 //! `[0, π]`: symmetric in `ωi ↔ ωo` (reciprocity), invariant under a common rotation (isotropy)
 //! and under the mirror `φ ↦ −φ`. `f` at a query is the weighted mean `Σ w_k f_k / Σ w_k` over
-//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (a k-d tree, `kiddo`), with Gaussian weights
+//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (a k-d tree searched without allocating), with Gaussian weights
 //! cut at the next (`K + 1`-th) nearest sample's distance:
 //! `w_k = exp(−d_k²/(2h²)) − exp(−d_{K+1}²/(2h²))`, `h` = [`BANDWIDTH`]. A
 //! sample's weight thus falls to 0 as it leaves the neighbour set, so `f` is continuous in the
@@ -26,12 +26,10 @@
 //! the whole hemisphere (also far from every sample, where it tends to the nearest samples'
 //! values). The declared symmetries hold exactly by construction.
 
-use std::num::NonZero;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use colour::{SpectrumToRgb, WavelengthError};
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use thiserror::Error;
 
 use crate::brdf::{Brdf, luminance};
@@ -123,9 +121,14 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
+mod search;
+
 struct Data {
-    tree: ImmutableKdTree<f64, 3>,
+    tree: search::Tree,
     rgb: Vec<[f64; 3]>,
+    /// Each sample's luminance (`eval` blends these: the luminance of the blended RGB, up to
+    /// rounding, without the RGB).
+    lum: Vec<f64>,
     wavelengths: Vec<f64>,
     clamped: Option<NegativeValues>,
 }
@@ -161,6 +164,19 @@ pub fn remap(theta_i: f64, phi_i: f64, theta_o: f64, phi_o: f64) -> [f64; 3] {
 
 /// The remapped point of a pair of unit directions.
 fn remap_dirs(wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+    let (ri, ro) = (wi.x * wi.x + wi.y * wi.y, wo.x * wo.x + wo.y * wo.y);
+    if ri > 0.0 && ro > 0.0 {
+        // Δφ ∈ [0, π] from one `atan2` of |sin Δφ| and cos Δφ (scaled alike): the folded
+        // difference of the two azimuths, up to rounding.
+        let cross = wo.x * wi.y - wo.y * wi.x;
+        let dot = wo.x * wi.x + wo.y * wi.y;
+        return [
+            (ri * ro).sqrt(),
+            cross.abs().atan2(dot) / std::f64::consts::PI,
+            wi.z * wo.z,
+        ];
+    }
+    // A direction on the pole: its azimuth is `atan2`'s of its (signed) zeros, as always.
     let (si, so) = (wi.x.hypot(wi.y), wo.x.hypot(wo.y));
     let mut d = (wi.y.atan2(wi.x) - wo.y.atan2(wo.x)).rem_euclid(std::f64::consts::TAU);
     if d > std::f64::consts::PI {
@@ -276,14 +292,13 @@ impl CornellBrdf {
                 found: points.len(),
             });
         }
-        let tree =
-            ImmutableKdTree::new_from_slice(&points).map_err(|_| CornellError::TooFewSamples {
-                found: points.len(),
-            })?;
+        let tree = search::Tree::new(&points);
+        let lum = rgb.iter().map(|c| luminance(*c)).collect();
         Ok(Self {
             data: Arc::new(Data {
                 tree,
                 rgb,
+                lum,
                 wavelengths,
                 clamped,
             }),
@@ -308,47 +323,74 @@ impl CornellBrdf {
     /// The interpolated RGB at a remapped point (see the module docs: the [`NEIGHBOURS`]
     /// nearest samples with Gaussian weights cut at the next sample's distance).
     pub fn rgb_at(&self, p: &[f64; 3]) -> [f64; 3] {
-        let n = self.data.rgb.len();
-        let k = NonZero::new((NEIGHBOURS + 1).min(n)).unwrap_or(NonZero::<usize>::MIN);
-        let mut found = self
-            .data
-            .tree
-            .query(p)
-            .nearest_n::<SquaredEuclidean<f64>>(k)
-            .execute();
-        found.sort_by(|a, b| a.distance.total_cmp(&b.distance));
-        let nearest = found.first().map_or(0.0, |r| r.distance);
-        // Weights relative to the nearest sample's, so far queries do not underflow.
-        let kernel = |d2: f64| (-(d2 - nearest) / (2.0 * BANDWIDTH * BANDWIDTH)).exp();
-        // With a (k+1)-th sample, its kernel value is subtracted: a sample's weight falls to 0
-        // as it leaves the neighbour set, so the interpolant is continuous.
-        let (blend, cut) = if found.len() > NEIGHBOURS {
-            (&found[..NEIGHBOURS], kernel(found[NEIGHBOURS].distance))
-        } else {
-            (&found[..], 0.0)
-        };
-        let mean = |weight: &dyn Fn(f64) -> f64| {
-            let (mut sum, mut total) = ([0.0; 3], 0.0);
-            for r in blend {
-                let w = weight(r.distance);
-                let c = self.data.rgb[r.item as usize];
-                for ch in 0..3 {
-                    sum[ch] += w * c[ch];
-                }
-                total += w;
+        let near = self.data.tree.nearest(p);
+        let w = weights(&near);
+        let (mut sum, mut total) = ([0.0; 3], 0.0);
+        for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
+            let c = self.data.rgb[i as usize];
+            for ch in 0..3 {
+                sum[ch] += w * c[ch];
             }
-            (total > 0.0).then(|| sum.map(|s| s / total))
-        };
-        mean(&|d2| (kernel(d2) - cut).max(0.0))
-            // Every blended sample as far as the cut one (ties): the plain Gaussian mean.
-            .or_else(|| mean(&kernel))
-            .unwrap_or([0.0; 3])
+            total += w;
+        }
+        if total > 0.0 {
+            sum.map(|s| s / total)
+        } else {
+            [0.0; 3]
+        }
     }
+
+    /// The luminance of [`rgb_at`](Self::rgb_at) (up to rounding), blended from the samples'
+    /// own luminances.
+    pub fn luminance_at(&self, p: &[f64; 3]) -> f64 {
+        let near = self.data.tree.nearest(p);
+        let w = weights(&near);
+        let (mut sum, mut total) = (0.0, 0.0);
+        for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
+            sum += w * self.data.lum[i as usize];
+            total += w;
+        }
+        if total > 0.0 { sum / total } else { 0.0 }
+    }
+}
+
+/// The blending weights of the nearest samples (up to a common factor).
+///
+/// With a cut sample at squared distance `c`, sample `k`'s weight
+/// `exp(−d_k²/2h²) − exp(−c/2h²)` is `exp(−c/2h²) · expm1((c − d_k²)/2h²)`: the common factor
+/// cancels in the weighted mean, so one `expm1` per blended sample (no underflow: squared
+/// distances in the remapped unit cube are at most 3, so the argument is at most 600). When
+/// every blended sample is as far as the cut one, the plain Gaussian mean: equal weights.
+/// Without a cut sample (fewer samples than `K + 1`), the plain Gaussian weights relative to
+/// the nearest.
+fn weights(near: &search::Nearest) -> [f64; NEIGHBOURS] {
+    let inv = 1.0 / (2.0 * BANDWIDTH * BANDWIDTH);
+    let mut w = [0.0; NEIGHBOURS];
+    let blended = near.len.min(NEIGHBOURS);
+    if near.len > NEIGHBOURS {
+        let cut = near.d2[NEIGHBOURS];
+        let mut any = false;
+        for (w, &d2) in w.iter_mut().zip(&near.d2[..blended]) {
+            *w = ((cut - d2) * inv).exp_m1().max(0.0);
+            any |= *w > 0.0;
+        }
+        if !any {
+            w[..blended].fill(1.0);
+        }
+    } else {
+        for (w, &d2) in w.iter_mut().zip(&near.d2[..blended]) {
+            *w = (-(d2 - near.d2[0]) * inv).exp();
+        }
+    }
+    w
 }
 
 impl Brdf for CornellBrdf {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        luminance(self.eval_rgb(wo, wi))
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
+        self.luminance_at(&remap_dirs(wo, wi))
     }
 
     fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
@@ -375,5 +417,222 @@ impl Brdf for CornellBrdf {
     }
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kiddo::{ImmutableKdTree, SquaredEuclidean};
+    use std::num::NonZero;
+
+    /// The interpolant as it was computed before issue 29 (kiddo's `nearest_n` into a `Vec`,
+    /// sorted; weights relative to the nearest sample; RGB, then luminance): the judge of
+    /// the allocation-free search and weights.
+    struct Before {
+        tree: ImmutableKdTree<f64, 3>,
+        rgb: Vec<[f64; 3]>,
+    }
+
+    impl Before {
+        fn new(text: &str) -> Self {
+            let b = CornellBrdf::parse(text).unwrap();
+            // The remapped points again, from the parser's own rule.
+            let mut points = Vec::new();
+            let mut count = None;
+            let mut wl = 0;
+            for line in text.lines() {
+                let line = line.split('#').next().unwrap_or("");
+                let v: Vec<f64> = line
+                    .split_whitespace()
+                    .filter_map(|t| t.parse().ok())
+                    .collect();
+                if v.is_empty() {
+                    continue;
+                }
+                match count {
+                    None => {
+                        count = Some(v[0] as usize);
+                        wl += v.len() - 1;
+                    }
+                    Some(n) if wl < n => wl += v.len(),
+                    Some(_) => points.push(remap(v[0], v[1], v[2], v[3])),
+                }
+            }
+            Self {
+                tree: ImmutableKdTree::new_from_slice(&points).unwrap(),
+                rgb: b.data.rgb.clone(),
+            }
+        }
+
+        fn rgb_at(&self, p: &[f64; 3]) -> [f64; 3] {
+            let k = NonZero::new((NEIGHBOURS + 1).min(self.rgb.len())).unwrap();
+            let mut found = self
+                .tree
+                .query(p)
+                .nearest_n::<SquaredEuclidean<f64>>(k)
+                .execute();
+            found.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+            let nearest = found.first().map_or(0.0, |r| r.distance);
+            let kernel = |d2: f64| (-(d2 - nearest) / (2.0 * BANDWIDTH * BANDWIDTH)).exp();
+            let (blend, cut) = if found.len() > NEIGHBOURS {
+                (&found[..NEIGHBOURS], kernel(found[NEIGHBOURS].distance))
+            } else {
+                (&found[..], 0.0)
+            };
+            let mean = |weight: &dyn Fn(f64) -> f64| {
+                let (mut sum, mut total) = ([0.0; 3], 0.0);
+                for r in blend {
+                    let w = weight(r.distance);
+                    let c = self.rgb[r.item as usize];
+                    for ch in 0..3 {
+                        sum[ch] += w * c[ch];
+                    }
+                    total += w;
+                }
+                (total > 0.0).then(|| sum.map(|s| s / total))
+            };
+            mean(&|d2| (kernel(d2) - cut).max(0.0))
+                .or_else(|| mean(&kernel))
+                .unwrap_or([0.0; 3])
+        }
+
+        /// The old `eval` with the old `remap_dirs` (two `atan2`, two `hypot`).
+        fn eval_rgb(&self, wo: &Vec3, wi: &Vec3) -> [f64; 3] {
+            if !(wo.z > 0.0 && wi.z > 0.0) {
+                return [0.0; 3];
+            }
+            let (si, so) = (wi.x.hypot(wi.y), wo.x.hypot(wo.y));
+            let mut d = (wi.y.atan2(wi.x) - wo.y.atan2(wo.x)).rem_euclid(std::f64::consts::TAU);
+            if d > std::f64::consts::PI {
+                d = std::f64::consts::TAU - d;
+            }
+            self.rgb_at(&[si * so, d / std::f64::consts::PI, wi.z * wo.z])
+        }
+    }
+
+    /// A file of 567 samples of a glossy lobe on a regular grid (many equidistant samples).
+    fn synthetic() -> String {
+        let mut text = String::from("3\n450 550 650\n");
+        for ti in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+            for to in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+                for dp in (0..7).map(|k| (30.0 * k as f64).to_radians()) {
+                    let lobe = ((ti - to).powi(2) + (std::f64::consts::PI - dp).powi(2)) / 0.08;
+                    let f = 0.05 + 3.0 * (-lobe).exp();
+                    let (r, b) = (0.7 * f, 0.2 + f);
+                    text.push_str(&format!("{ti} 0 {to} {dp} {r} {f} {b}\n"));
+                }
+            }
+        }
+        text
+    }
+
+    /// The team's Cornell files when the data repository sits beside this one.
+    fn shared_files() -> Vec<(String, String)> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/measured/cornell");
+        let mut out = Vec::new();
+        for name in ["acryl_blue", "cayman", "krylon_blue"] {
+            match std::fs::read_to_string(dir.join(format!("{name}.brdf"))) {
+                Ok(t) => out.push((name.to_string(), t)),
+                Err(_) => eprintln!("skipped {name}: {} is absent", dir.display()),
+            }
+        }
+        out
+    }
+
+    /// Random direction pairs (xorshift, fixed seed), uniform on the hemisphere, with the
+    /// poles and a shared azimuth now and then.
+    fn pairs(n: usize, mut state: u64) -> Vec<(Vec3, Vec3)> {
+        let mut u = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut dir = |k: usize| {
+            if k.is_multiple_of(997) {
+                return Vec3::new(0.0, 0.0, 1.0);
+            }
+            let (z, phi) = (u(), std::f64::consts::TAU * u());
+            let s = (1.0 - z * z).sqrt();
+            Vec3::new(s * phi.cos(), s * phi.sin(), z)
+        };
+        (0..n).map(|k| (dir(k), dir(k + 500))).collect()
+    }
+
+    /// Largest relative difference of the new `eval` and `eval_rgb` to the old interpolant
+    /// (each RGB channel relative to itself or, if smaller, to the largest channel).
+    fn worst_difference(text: &str, n: usize) -> f64 {
+        let (new, old) = (CornellBrdf::parse(text).unwrap(), Before::new(text));
+        let mut worst = 0.0f64;
+        for (wo, wi) in pairs(n, 0x2545_f491_4f6c_dd1d) {
+            let o = old.eval_rgb(&wo, &wi);
+            let rgb = new.eval_rgb(&wo, &wi);
+            let rel = |a: f64, b: f64| if a == b { 0.0 } else { (a - b).abs() / b.abs() };
+            // A channel far below the others (10⁻¹⁰ of them: the colour matching's
+            // cancellation) is compared to the largest channel.
+            let scale = o.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            for ch in 0..3 {
+                worst = worst.max(rel(rgb[ch], o[ch]).min((rgb[ch] - o[ch]).abs() / scale));
+            }
+            worst = worst.max(rel(new.eval(&wo, &wi), luminance(o)));
+        }
+        worst
+    }
+
+    /// Issue 29: the allocation-free search, the `expm1` weights, the one-`atan2` remap and the
+    /// luminance blended from the samples' luminances change `f` by rounding only: on 20 000
+    /// random pairs per file (and the poles) within 1e-10 relative of the old computation
+    /// (measured 10⁶ pairs per shared file: docs/benchmarks.md §19.6).
+    #[test]
+    fn fast_eval_is_the_old_interpolant() {
+        let mut files = vec![("synthetic".to_string(), synthetic())];
+        files.extend(shared_files());
+        for (name, text) in files {
+            let worst = worst_difference(&text, 20_000);
+            eprintln!("{name}: max relative difference {worst:.1e}");
+            assert!(worst <= 1e-10, "{name}: {worst:e}");
+        }
+    }
+
+    /// The figure of §19.6: 10⁶ random pairs per file (`cargo test --release -p brdf --lib
+    /// fast_eval_on_a_million_pairs -- --ignored --nocapture`).
+    #[test]
+    #[ignore = "10⁶ pairs per file, about a minute"]
+    fn fast_eval_on_a_million_pairs() {
+        for (name, text) in shared_files() {
+            let worst = worst_difference(&text, 1_000_000);
+            eprintln!("{name}: max relative difference on 10⁶ pairs {worst:.2e}");
+            assert!(worst <= 1e-10, "{name}: {worst:e}");
+        }
+    }
+
+    /// Instructions per evaluation, for cachegrind (docs/benchmarks.md §19.6):
+    /// `CORNELL_EVALS=N CORNELL_IMPL=old|new|loop valgrind --tool=cachegrind TEST_BINARY
+    /// eval_cost_probe --ignored --exact`, at two N, the difference divided by the difference of N.
+    #[test]
+    #[ignore = "a cachegrind probe"]
+    fn eval_cost_probe() {
+        let n: usize = std::env::var("CORNELL_EVALS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(10_000);
+        let which = std::env::var("CORNELL_IMPL").unwrap_or_default();
+        let Some((_, text)) = shared_files().into_iter().nth(1) else {
+            return;
+        };
+        let (new_b, old_b) = (CornellBrdf::parse(&text).unwrap(), Before::new(&text));
+        let ps = pairs(n, 7);
+        let mut sum = 0.0;
+        for (wo, wi) in &ps {
+            sum += match which.as_str() {
+                "old" => luminance(old_b.eval_rgb(wo, wi)),
+                "new" => new_b.eval(wo, wi),
+                // The loop alone (pairs and sum), to subtract.
+                _ => wo.z * wi.z,
+            };
+        }
+        eprintln!("sum {sum}");
     }
 }
