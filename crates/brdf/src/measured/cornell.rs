@@ -123,6 +123,9 @@ pub struct NegativeValues {
 
 mod search;
 
+// The search keeps the blended samples and the one their weights are cut at.
+const _: () = assert!(search::K == NEIGHBOURS + 1);
+
 struct Data {
     tree: search::Tree,
     rgb: Vec<[f64; 3]>,
