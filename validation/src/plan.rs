@@ -194,23 +194,17 @@ impl Plan {
     /// The plan of `tier` with `samples` one-sample draws per case.
     pub fn new(tier: Tier, samples: usize) -> Self {
         let batch_size = 256;
-        let (resolution, normalisation_tolerance) = match tier {
-            Tier::Quick => (
-                Resolution {
-                    directions: [16, 32],
-                    disc: 24,
-                    square: [32, 16],
-                },
-                1e-3,
-            ),
-            Tier::Full => (
-                Resolution {
-                    directions: [24, 48],
-                    disc: 32,
-                    square: [64, 32],
-                },
-                1e-3,
-            ),
+        let resolution = match tier {
+            Tier::Quick => Resolution {
+                directions: [16, 32],
+                disc: 24,
+                square: [32, 16],
+            },
+            Tier::Full => Resolution {
+                directions: [24, 48],
+                disc: 32,
+                square: [64, 32],
+            },
         };
         Self {
             tier,
@@ -219,7 +213,8 @@ impl Plan {
             batches: (samples / (2 * batch_size)).max(50),
             resolution: resolution.for_samples(samples),
             quadrature: QuadratureOptions::default(),
-            normalisation_tolerance,
+            // The same for both tiers.
+            normalisation_tolerance: 1e-3,
             pdf_rel_tol: 1e-6,
             support_resolution: 3,
             unbiasedness_allowance: 0.0,

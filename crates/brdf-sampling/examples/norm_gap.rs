@@ -41,28 +41,8 @@ use brdf_sampling::{
     DirectionSampler, ExactOptions, ExactSet, QuadTreeSet, SamplerDiagnostics, SetOptions, Variant,
     reference_albedo, rgl_albedo_in_cells, rgl_reference_albedo,
 };
-use rayon::prelude::*;
-
-fn arg<T: std::str::FromStr>(args: &[String], key: &str) -> Option<T> {
-    args.iter()
-        .position(|a| a == key)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-}
-
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let after = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<&str> = after.split_whitespace().collect();
-    let t = |i: usize| {
-        f.get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    (t(11) + t(12)) / 100.0
-}
+mod support;
+use support::{arg, cpu_seconds};
 
 /// `∫ f(ωo, ωi) cos θi dσ(ωi)` by the midpoint rule on `2n × 2n` cells of the square
 /// `[−1, 1]²`, mapped to the hemisphere by Shirley and Chiu's concentric map followed by the
@@ -71,32 +51,7 @@ fn cpu_seconds() -> f64 {
 /// in `(cos θi, φi)` is 3.5° coarse in θ at the pole at n = 512, which made it 4e-4 off near
 /// normal incidence on the sharp RGL materials).
 fn fine_albedo(brdf: &dyn Brdf, wo: &Vec3, n: usize) -> f64 {
-    let m = 2 * n;
-    let rows: Vec<f64> = (0..m)
-        .into_par_iter()
-        .map(|i| {
-            let a = -1.0 + 2.0 * (i as f64 + 0.5) / m as f64;
-            (0..m)
-                .map(|j| {
-                    let b = -1.0 + 2.0 * (j as f64 + 0.5) / m as f64;
-                    let (r, phi) = if a.abs() > b.abs() {
-                        (a, std::f64::consts::FRAC_PI_4 * (b / a))
-                    } else {
-                        (
-                            b,
-                            std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b),
-                        )
-                    };
-                    let z = 1.0 - r * r;
-                    let s = (r * r * (2.0 - r * r)).max(0.0).sqrt() * r.signum();
-                    let wi = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-                    brdf.eval(wo, &wi) * z
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    let cell = (2.0 / m as f64) * (2.0 / m as f64);
-    2.0 * std::f64::consts::FRAC_PI_4 * cell * rows.iter().sum::<f64>()
+    brdf_sampling::equal_area_hemisphere_integral(&|wi| brdf.eval(wo, wi) * wi.z, n)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -119,5 +119,7 @@ pub use reference::{
 };
 pub use reference::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
 pub use report::{CostMeasurement, SetReport};
-pub use sampler_checks::{SampledAlbedo, sampled_albedo, upper_hemisphere_integral};
+pub use sampler_checks::{
+    SampledAlbedo, equal_area_hemisphere_integral, sampled_albedo, upper_hemisphere_integral,
+};
 pub use set::{FLOOR_PROBES, Progress, QuadTreeSet, SUPPORT_FLOOR, layout_for};

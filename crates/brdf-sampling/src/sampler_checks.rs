@@ -81,6 +81,37 @@ pub fn upper_hemisphere_integral(
     rows.iter().sum::<f64>() * cell
 }
 
+/// `∫ g dσ` over the upper hemisphere by the midpoint rule on `2n × 2n` equal-area cells:
+/// Shirley and Chiu's concentric map of `[−1, 1]²` to the disc, lifted to the hemisphere by
+/// `z = 1 − r²` (`dσ = (π/2) du dv`), so every cell has the same solid angle and the rule's
+/// resolution is uniform over the hemisphere, the pole included (unlike a grid in
+/// `(cos θ, φ)`, [`upper_hemisphere_integral`]). Rows in parallel, summed in order: the
+/// result does not depend on the thread count.
+pub fn equal_area_hemisphere_integral(g: &(dyn Fn(&Vec3) -> f64 + Sync), n: usize) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+    let m = 2 * n;
+    let rows: Vec<f64> = (0..m)
+        .into_par_iter()
+        .map(|i| {
+            let a = -1.0 + 2.0 * (i as f64 + 0.5) / m as f64;
+            (0..m)
+                .map(|j| {
+                    let b = -1.0 + 2.0 * (j as f64 + 0.5) / m as f64;
+                    let (r, phi) = if a.abs() > b.abs() {
+                        (a, FRAC_PI_4 * (b / a))
+                    } else {
+                        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+                    };
+                    let z = 1.0 - r * r;
+                    let s = r * (2.0 - r * r).max(0.0).sqrt();
+                    g(&Vec3::new(s * phi.cos(), s * phi.sin(), z))
+                })
+                .sum::<f64>()
+        })
+        .collect();
+    FRAC_PI_2 * (2.0 / m as f64).powi(2) * rows.iter().sum::<f64>()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,6 +167,24 @@ mod tests {
             let wo = Vec3::new(0.0, 0.0, 1.0);
             let total = upper_hemisphere_integral(&|w| s.pdf(&wo, w), 64, 128);
             assert!((total - scale).abs() < 1e-3, "{total}");
+        }
+    }
+
+    #[test]
+    fn the_equal_area_rule_integrates_constants_and_cos() {
+        // Equal solid angles per cell: ∫ 1 dσ = 2π to rounding; ∫ cos θ dσ = π; a lobe
+        // about the pole (∫ cos^n θ dσ = 2π/(n + 1)); x², which depends on φ (2π/3).
+        use std::f64::consts::PI;
+        let one = equal_area_hemisphere_integral(&|_| 1.0, 64);
+        assert!((one - 2.0 * PI).abs() < 1e-12, "{one}");
+        for (g, exact) in [
+            (&(|w: &Vec3| w.z) as &(dyn Fn(&Vec3) -> f64 + Sync), PI),
+            (&|w: &Vec3| w.z.powi(20), 2.0 * PI / 21.0),
+            (&|w: &Vec3| w.x * w.x, 2.0 * PI / 3.0),
+        ] {
+            // The midpoint rule's O(h²) error on 256 × 256 cells: 1.1e-4 on the cos^20 lobe.
+            let v = equal_area_hemisphere_integral(g, 128);
+            assert!((v / exact - 1.0).abs() < 5e-4, "{v} vs {exact}");
         }
     }
 }

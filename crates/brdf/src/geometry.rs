@@ -27,10 +27,12 @@ pub fn mirror(wo: &Vec3) -> Vec3 {
     Vec3::new(-wo.x, -wo.y, wo.z)
 }
 
-/// `ω_r·ωi` for the mirror direction `ω_r` of `wo` ([`mirror`]): the cosine of Phong-type lobes.
+/// For a pair strictly above the surface ([`both_above`]): `ω_r·ωi` for the mirror direction
+/// `ω_r` of `wo` ([`mirror`]), the cosine of Phong-type lobes; `None` otherwise. The start of
+/// those models' `eval`.
 #[inline]
-pub(crate) fn cos_to_mirror(wo: &Vec3, wi: &Vec3) -> f64 {
-    -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z
+pub(crate) fn above_with_mirror_cos(wo: &Vec3, wi: &Vec3) -> Option<f64> {
+    both_above(wo, wi).then(|| -wo.x * wi.x - wo.y * wi.y + wo.z * wi.z)
 }
 
 /// Mirror direction of `v` about an arbitrary unit normal `n`: `2 (n·v) n − v`.
@@ -65,6 +67,14 @@ pub fn rotate_y(v: &Vec3, angle: f64) -> Vec3 {
 #[inline]
 pub(crate) fn both_above(wo: &Vec3, wi: &Vec3) -> bool {
     wo.z > 0.0 && wi.z > 0.0
+}
+
+/// For a pair strictly above the surface ([`both_above`]): `(cos θi, cos θo, h)` with `h` the
+/// unit half vector of `wo` and `wi`; `None` otherwise. The start of the half-vector models'
+/// `eval`.
+#[inline]
+pub(crate) fn above_with_half(wo: &Vec3, wi: &Vec3) -> Option<(f64, f64, Vec3)> {
+    both_above(wo, wi).then(|| (wi.z, wo.z, (wo + wi).normalize()))
 }
 
 #[cfg(test)]

@@ -63,37 +63,27 @@ pub(crate) struct AdaptiveArgs {
     pub(crate) equal_area_from: f64,
 }
 
-/// The sampler options of `sample`, `eval` and `build`: the adaptive sets' and the baseline
-/// samplers'. Each applies to some samplers only ([`applies_to`]).
+/// A command's sampler options: the adaptive sets' and the baseline samplers' (`B`). Each
+/// applies to some samplers only ([`applies_to`]).
 #[derive(Debug, Args, Clone)]
-pub(crate) struct SamplerArgs {
+pub(crate) struct SamplerOptionArgs<B: Args> {
     #[command(flatten)]
     pub(crate) adaptive: AdaptiveArgs,
     #[command(flatten)]
-    pub(crate) baselines: BaselineArgs,
+    pub(crate) baselines: B,
 }
+
+/// The sampler options of `sample`, `eval` and `build`.
+pub(crate) type SamplerArgs = SamplerOptionArgs<BaselineArgs>;
 
 /// The options of `product`: every sampler option (its `--brdf-sampler`s may be any direction
 /// sampler) and the SRBF product estimator's.
-#[derive(Debug, Args, Clone)]
-pub(crate) struct ProductSamplerArgs {
-    #[command(flatten)]
-    pub(crate) adaptive: AdaptiveArgs,
-    #[command(flatten)]
-    pub(crate) baselines: ProductBaselineArgs,
-}
+pub(crate) type ProductSamplerArgs = SamplerOptionArgs<ProductBaselineArgs>;
 
 /// The name `product_cmd` knows `product`'s sampler options by.
 pub(crate) type SetArgs = ProductSamplerArgs;
 
-impl ProductSamplerArgs {
-    /// The adaptive sets' options.
-    pub(crate) fn options(&self) -> SetOptions {
-        self.adaptive.options()
-    }
-}
-
-impl SamplerArgs {
+impl<B: Args> SamplerOptionArgs<B> {
     /// The adaptive sets' options.
     pub(crate) fn options(&self) -> SetOptions {
         self.adaptive.options()

@@ -30,6 +30,19 @@ impl Default for QuadTreeBuilder {
     }
 }
 
+/// Builder setters: `name(arg: T)` sets the parameter `name` to `arg` and returns the builder.
+macro_rules! setters {
+    ($($(#[$doc:meta])* $name:ident($arg:ident: $ty:ty);)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(mut self, $arg: $ty) -> Self {
+                self.params.$name = $arg;
+                self
+            }
+        )*
+    };
+}
+
 impl QuadTreeBuilder {
     /// The generic defaults ([`TreeParams::default`]): `n_max = 2`, `max_depth = 12`, no
     /// minimum leaf size, [`Scheme::Envelope`], [`LeafChoice::Alias`].
@@ -42,43 +55,22 @@ impl QuadTreeBuilder {
         Self { params }
     }
 
-    /// Split threshold `n_max ≥ 1` (the bound on mean trials per leaf).
-    pub fn n_max(mut self, n_max: f64) -> Self {
-        self.params.n_max = n_max;
-        self
-    }
-
-    /// Maximum depth (root = 0), at most [`MAX_DEPTH_LIMIT`].
-    pub fn max_depth(mut self, max_depth: u32) -> Self {
-        self.params.max_depth = max_depth;
-        self
-    }
-
-    /// Minimum child width and height in domain units (0 = no limit).
-    pub fn min_leaf_size(mut self, size: f64) -> Self {
-        self.params.min_leaf_size = size;
-        self
-    }
-
-    /// Cells whose envelope volume is at most `tol · I_root` (`I_root` = the root's integral
-    /// estimate) are not split: their trials cost at most `tol` per sample each, while splitting
-    /// the far tails of a peaked density (values like 1e-300) would only spend memory. 0 gives
-    /// the papers' pure criterion.
-    pub fn volume_tolerance(mut self, tol: f64) -> Self {
-        self.params.volume_tolerance = tol;
-        self
-    }
-
-    /// Sampling scheme.
-    pub fn scheme(mut self, scheme: Scheme) -> Self {
-        self.params.scheme = scheme;
-        self
-    }
-
-    /// Leaf selection method.
-    pub fn leaf_choice(mut self, choice: LeafChoice) -> Self {
-        self.params.leaf_choice = choice;
-        self
+    setters! {
+        /// Split threshold `n_max ≥ 1` (the bound on mean trials per leaf).
+        n_max(n_max: f64);
+        /// Maximum depth (root = 0), at most [`MAX_DEPTH_LIMIT`].
+        max_depth(max_depth: u32);
+        /// Minimum child width and height in domain units (0 = no limit).
+        min_leaf_size(size: f64);
+        /// Cells whose envelope volume is at most `tol · I_root` (`I_root` = the root's integral
+        /// estimate) are not split: their trials cost at most `tol` per sample each, while
+        /// splitting the far tails of a peaked density (values like 1e-300) would only spend
+        /// memory. 0 gives the papers' pure criterion.
+        volume_tolerance(tol: f64);
+        /// Sampling scheme.
+        scheme(scheme: Scheme);
+        /// Leaf selection method.
+        leaf_choice(choice: LeafChoice);
     }
 
     /// The parameters as set.
@@ -194,19 +186,23 @@ impl RawLeaf {
     /// The stored form: rectangle in the frame's coordinates, rounded outward within the
     /// cell, bound rounded up (see [`crate::leaf`]).
     fn encode(&self, root: &Rect, frame: &Frame, bound_scale: f64) -> Leaf {
-        let (u0, du) = encode_axis(
-            self.rej.x0,
-            self.rej.x1,
-            frame.cell_edges(root.x0, root.width(), self.d, self.ix),
-            frame.origin[0],
-            frame.extent[0],
+        // Axis `k` (0 = x, 1 = y): the rejection interval `[lo, hi]` in the cell `i` of the
+        // root's range `start + [0, size]` at depth `d`.
+        let axis = |k: usize, [lo, hi]: [f64; 2], [start, size]: [f64; 2], i: u64| {
+            let cell = frame.cell_edges(start, size, self.d, i);
+            encode_axis(lo, hi, cell, frame.origin[k], frame.extent[k])
+        };
+        let (u0, du) = axis(
+            0,
+            [self.rej.x0, self.rej.x1],
+            [root.x0, root.width()],
+            self.ix,
         );
-        let (v0, dv) = encode_axis(
-            self.rej.y0,
-            self.rej.y1,
-            frame.cell_edges(root.y0, root.height(), self.d, self.iy),
-            frame.origin[1],
-            frame.extent[1],
+        let (v0, dv) = axis(
+            1,
+            [self.rej.y0, self.rej.y1],
+            [root.y0, root.height()],
+            self.iy,
         );
         Leaf {
             u0,

@@ -225,6 +225,20 @@ impl std::fmt::Debug for SamplerEntry {
     }
 }
 
+/// One builder of a sampler kind other than `direction`: the entry's constructor of that kind
+/// called with the arguments, or [`RegistryError::WrongKind`] for an entry of another kind.
+macro_rules! typed_builder {
+    ($(#[$doc:meta])* $name:ident($($arg:ident: $ty:ty),*) -> $out:ty = $variant:ident, $kind:literal) => {
+        $(#[$doc])*
+        pub fn $name(&self, $($arg: $ty),*) -> Result<$out, RegistryError> {
+            match &self.constructor {
+                Constructor::$variant(build) => build($($arg),*),
+                other => Err(self.wrong_kind($kind, other.kind())),
+            }
+        }
+    };
+}
+
 impl SamplerEntry {
     /// A direction sampler of a BRDF built by `build` (a closure, so it may capture state, e.g.
     /// a Python object), to add to a [`Registry`] with [`Registry::with`]. `build` gets the
@@ -341,43 +355,20 @@ impl SamplerEntry {
         }
     }
 
-    /// Builds this entry's disc sampler of `f_r(ωo, h⁻¹(x))`.
-    pub fn build_disc(
-        &self,
-        brdf: &Arc<dyn Brdf>,
-        wo: &Vec3,
-    ) -> Result<DiscSampler, RegistryError> {
-        match &self.constructor {
-            Constructor::Disc(build) => build(brdf, wo),
-            other => Err(self.wrong_kind("disc", other.kind())),
-        }
-    }
+    typed_builder!(
+        /// Builds this entry's disc sampler of `f_r(ωo, h⁻¹(x))`.
+        build_disc(brdf: &Arc<dyn Brdf>, wo: &Vec3) -> DiscSampler = Disc, "disc"
+    );
 
-    /// Builds this entry's environment-map sampler (`options` for the adaptive ones).
-    pub fn build_envmap(
-        &self,
-        map: &EnvMap,
-        options: &AdaptiveOptions,
-    ) -> Result<EnvMapSampler, RegistryError> {
-        match &self.constructor {
-            Constructor::EnvMap(build) => build(map, options),
-            other => Err(self.wrong_kind("envmap", other.kind())),
-        }
-    }
+    typed_builder!(
+        /// Builds this entry's environment-map sampler (`options` for the adaptive ones).
+        build_envmap(map: &EnvMap, options: &AdaptiveOptions) -> EnvMapSampler = EnvMap, "envmap"
+    );
 
-    /// Builds this entry's grid sampler.
-    pub fn build_grid(
-        &self,
-        width: usize,
-        height: usize,
-        values: Vec<f64>,
-        domain: Rect,
-    ) -> Result<GridSampler, RegistryError> {
-        match &self.constructor {
-            Constructor::Grid(build) => build(width, height, values, domain),
-            other => Err(self.wrong_kind("grid", other.kind())),
-        }
-    }
+    typed_builder!(
+        /// Builds this entry's grid sampler.
+        build_grid(width: usize, height: usize, values: Vec<f64>, domain: Rect) -> GridSampler = Grid, "grid"
+    );
 
     fn wrong_kind(&self, expected: &'static str, found: &'static str) -> RegistryError {
         RegistryError::WrongKind {

@@ -98,6 +98,19 @@ fn direction_pair(
     wo: &Vec3,
     refs: &BrdfReferences,
 ) -> MutantCase {
+    shared_pair(Arc::new(mutant), Arc::new(control), domain, brdf, wo, refs)
+}
+
+/// A mutant/control pair of direction samplers on `domain`, each checked at `wo` against
+/// `brdf`'s references `refs`.
+fn shared_pair(
+    mutant: Arc<dyn DirectionSampler>,
+    control: Arc<dyn DirectionSampler>,
+    domain: Domain,
+    brdf: &Arc<dyn Brdf>,
+    wo: &Vec3,
+    refs: &BrdfReferences,
+) -> MutantCase {
     let wrap = |s: Arc<dyn DirectionSampler>| {
         AnySubject::Direction(brdf_direction_subject(
             Arc::new(DirectionAtWo::new(s, *wo)),
@@ -108,8 +121,8 @@ fn direction_pair(
         ))
     };
     MutantCase {
-        mutant: wrap(Arc::new(mutant)),
-        control: wrap(Arc::new(control)),
+        mutant: wrap(mutant),
+        control: wrap(control),
     }
 }
 
@@ -126,19 +139,20 @@ fn row_scaled_pair(
     let base = build_direction(entry, brdf).map_err(|e| e.to_string())?;
     let broken: Arc<dyn DirectionSampler> =
         Arc::new(RowScaledPdf::new(Arc::clone(&base), wo, 2.0)?);
-    let wrap = |s: Arc<dyn DirectionSampler>| {
-        AnySubject::Direction(brdf_direction_subject(
-            Arc::new(DirectionAtWo::new(s, *wo)),
-            domain,
-            Arc::clone(brdf),
-            *wo,
-            refs,
-        ))
-    };
-    Ok(MutantCase {
-        mutant: wrap(broken),
-        control: wrap(base),
-    })
+    Ok(shared_pair(broken, base, domain, brdf, wo, refs))
+}
+
+/// A lobe mutant on the sphere: `base` with `broken` applied to a copy of it, against `base`.
+fn lobe_pair(
+    base: LobeMixture,
+    broken: impl FnOnce(&mut LobeMixture),
+    brdf: &Arc<dyn Brdf>,
+    wo: &Vec3,
+    refs: &BrdfReferences,
+) -> Result<MutantCase, String> {
+    let mut mutant = base;
+    broken(&mut mutant);
+    Ok(direction_pair(mutant, base, Domain::Sphere, brdf, wo, refs))
 }
 
 /// Phong-like mixture used by the lobe mutants: cosine weight 0.3, exponent 50.
@@ -194,29 +208,6 @@ fn exact_set(
         .map_err(|e| e.to_string())
 }
 
-/// A mutant/control pair of direction samplers on the hemisphere.
-fn hemisphere_pair(
-    mutant: Arc<dyn DirectionSampler>,
-    control: Arc<dyn DirectionSampler>,
-    brdf: &Arc<dyn Brdf>,
-    wo: &Vec3,
-    refs: &BrdfReferences,
-) -> MutantCase {
-    let wrap = |s: Arc<dyn DirectionSampler>| {
-        AnySubject::Direction(brdf_direction_subject(
-            Arc::new(DirectionAtWo::new(s, *wo)),
-            Domain::Hemisphere,
-            Arc::clone(brdf),
-            *wo,
-            refs,
-        ))
-    };
-    MutantCase {
-        mutant: wrap(mutant),
-        control: wrap(control),
-    }
-}
-
 /// Every mutant.
 pub static MUTANTS: &[Mutant] = &[
     Mutant {
@@ -241,14 +232,7 @@ pub static MUTANTS: &[Mutant] = &[
         description: "specular lobe sampled around an axis tilted by 2 degrees in the plane of incidence; pdf of the untilted lobe",
         brdf: "phong:n=50",
         theta_o: 45.0,
-        build: |b, wo, r| {
-            let base = phong_mixture();
-            let broken = LobeMixture {
-                lobe_tilt_deg: 2.0,
-                ..base
-            };
-            Ok(direction_pair(broken, base, Domain::Sphere, b, wo, r))
-        },
+        build: |b, wo, r| lobe_pair(phong_mixture(), |m| m.lobe_tilt_deg = 2.0, b, wo, r),
     },
     Mutant {
         name: "cosine-as-uniform",
@@ -311,11 +295,7 @@ pub static MUTANTS: &[Mutant] = &[
         theta_o: 45.0,
         build: |b, wo, r| {
             let base = LobeMixture::correct(0.35 / 1.2, 50.0);
-            let broken = LobeMixture {
-                pdf_weights: [0.35, 0.85],
-                ..base
-            };
-            Ok(direction_pair(broken, base, Domain::Sphere, b, wo, r))
+            lobe_pair(base, |m| m.pdf_weights = [0.35, 0.85], b, wo, r)
         },
     },
     Mutant {
@@ -328,11 +308,7 @@ pub static MUTANTS: &[Mutant] = &[
                 slice_step: Some(2.0),
                 ..phong_mixture()
             };
-            let broken = LobeMixture {
-                pdf_slice_offset: 1,
-                ..base
-            };
-            Ok(direction_pair(broken, base, Domain::Sphere, b, wo, r))
+            lobe_pair(base, |m| m.pdf_slice_offset = 1, b, wo, r)
         },
     },
     Mutant {
@@ -385,7 +361,7 @@ pub static MUTANTS: &[Mutant] = &[
                 inner: Arc::clone(&control),
                 factor: 1.0 / 1.01,
             });
-            Ok(hemisphere_pair(broken, control, b, wo, r))
+            Ok(shared_pair(broken, control, Domain::Hemisphere, b, wo, r))
         },
     },
     Mutant {
@@ -401,7 +377,14 @@ pub static MUTANTS: &[Mutant] = &[
                 o.normaliser_tol = 1.0;
                 o.set.safety_factor = 1.0;
             })?;
-            Ok(hemisphere_pair(broken, exact_set(b, |_| {})?, b, wo, r))
+            Ok(shared_pair(
+                broken,
+                exact_set(b, |_| {})?,
+                Domain::Hemisphere,
+                b,
+                wo,
+                r,
+            ))
         },
     },
 ];

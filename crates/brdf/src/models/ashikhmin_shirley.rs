@@ -14,7 +14,7 @@
 
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::{Vec3, above_with_half};
 use crate::params::Range;
 use std::f64::consts::PI;
 
@@ -54,11 +54,9 @@ fn pow5(x: f64) -> f64 {
 impl Brdf for AshikhminShirley {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
+        let Some((ci, co, h)) = above_with_half(wo, wi) else {
             return 0.0;
-        }
-        let (ci, co) = (wi.z, wo.z);
-        let h = (wo + wi).normalize();
+        };
         let kh = wi.dot(&h).clamp(1e-12, 1.0);
         let sin2 = h.x * h.x + h.y * h.y;
         let lobe = if sin2 > 1e-300 {

@@ -23,7 +23,7 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_conductor;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::{Vec3, above_with_half};
 use crate::params::{ParamError, Range};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -75,12 +75,10 @@ impl BeardMaxwell {
 
 impl Brdf for BeardMaxwell {
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
+        let Some((ci, co, h)) = above_with_half(wo, wi) else {
             return 0.0;
-        }
+        };
         let p = &self.params;
-        let (ci, co) = (wi.z, wo.z);
-        let h = (wo + wi).normalize();
         let cos_n = h.z.clamp(0.0, 1.0);
         let cos_b = wi.dot(&h).clamp(0.0, 1.0);
         let theta_n = cos_n.acos();

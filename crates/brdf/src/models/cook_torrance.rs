@@ -16,7 +16,7 @@
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
 use crate::fresnel::fresnel_dielectric;
-use crate::geometry::{Vec3, both_above};
+use crate::geometry::{Vec3, above_with_half};
 use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -52,11 +52,9 @@ impl CookTorrance {
 impl Brdf for CookTorrance {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
+        let Some((ci, co, h)) = above_with_half(wo, wi) else {
             return 0.0;
-        }
-        let (ci, co) = (wi.z, wo.z);
-        let h = (wo + wi).normalize();
+        };
         let nh = h.z;
         let vh = wo.dot(&h).max(1e-300);
         let nh2 = nh * nh;

@@ -10,7 +10,7 @@
 
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above, cos_to_mirror};
+use crate::geometry::{Vec3, above_with_mirror_cos};
 use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -43,10 +43,9 @@ impl Phong {
 impl Brdf for Phong {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
+        let Some(c) = above_with_mirror_cos(wo, wi) else {
             return 0.0;
-        }
-        let c = cos_to_mirror(wo, wi);
+        };
         let spec = if c > 0.0 {
             self.spec_scale * c.powf(self.params.n)
         } else {

@@ -19,7 +19,7 @@
 
 use super::{Properties, brdf_properties, model};
 use crate::brdf::Brdf;
-use crate::geometry::{Vec3, both_above, cos_to_mirror};
+use crate::geometry::{Vec3, above_with_mirror_cos};
 use crate::params::Range;
 use std::f64::consts::{FRAC_1_PI, FRAC_2_PI};
 
@@ -72,10 +72,9 @@ impl Strauss {
 impl Brdf for Strauss {
     #[inline]
     fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !both_above(wo, wi) {
+        let Some(c) = above_with_mirror_cos(wo, wi) else {
             return 0.0;
-        }
-        let c = cos_to_mirror(wo, wi);
+        };
         if c <= 0.0 {
             return self.diffuse;
         }

@@ -114,3 +114,14 @@ pub(crate) fn check_version(version: u32) -> Result<(), PiecewiseConstantError> 
         })
     }
 }
+
+/// A table's integral over its domain: `integral` when finite and positive, else
+/// [`PiecewiseConstantError::TotalNotFinite`] (the cell sizes times the sum overflowed or
+/// underflowed).
+pub(super) fn finite_integral(integral: f64) -> Result<f64, PiecewiseConstantError> {
+    if integral.is_finite() && integral > 0.0 {
+        Ok(integral)
+    } else {
+        Err(PiecewiseConstantError::TotalNotFinite)
+    }
+}

@@ -7,7 +7,7 @@ use super::cdf::{
     cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, invert_cell, place,
     validate_values,
 };
-use super::error::{FORMAT_VERSION, check_version};
+use super::error::{FORMAT_VERSION, check_version, finite_integral};
 
 /// One draw of a [`PiecewiseConstant1D`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,10 +76,7 @@ impl PiecewiseConstant1D {
         let mut guide = vec![0u32; values.len()];
         fill_guide(&cdf, &mut guide);
         let n = values.len() as f64;
-        let integral = sum * (max - min) / n;
-        if !(integral.is_finite() && integral > 0.0) {
-            return Err(PiecewiseConstantError::TotalNotFinite);
-        }
+        let integral = finite_integral(sum * (max - min) / n)?;
         Ok(Self {
             values,
             cdf,

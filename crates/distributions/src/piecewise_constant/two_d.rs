@@ -7,7 +7,7 @@ use super::cdf::{
     cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms,
     invert_in, place, scan_from, validate_values,
 };
-use super::error::{FORMAT_VERSION, check_version};
+use super::error::{FORMAT_VERSION, check_version, finite_integral};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
 
 /// A density on a rectangle proportional to a `width × height` grid of non-negative values,
@@ -120,10 +120,7 @@ impl PiecewiseConstant2D {
         })?;
         let total = marginal.sum();
         let cell = [(x1 - x0) / width as f64, (y1 - y0) / height as f64];
-        let integral = total * cell[0] * cell[1];
-        if !(integral.is_finite() && integral > 0.0) {
-            return Err(PiecewiseConstantError::TotalNotFinite);
-        }
+        let integral = finite_integral(total * cell[0] * cell[1])?;
         Ok(Self {
             width,
             height,
