@@ -50,26 +50,15 @@ impl ExactSet {
         options: &ExactOptions,
         progress: Option<crate::Progress<'_>>,
     ) -> Result<Self, ExactError> {
-        Self::build_with(brdf, options, progress, None, true)
+        Self::build_phased(brdf, options, progress, None, true).map(|(set, _)| set)
     }
 
-    /// [`ExactSet::build`]; `cache` forces the node-value cache on or off (`None`: on for
-    /// isotropic BRDFs slower than [`CACHE_ABOVE_NS`] per evaluation). The set is the same
+    /// [`ExactSet::build`] with its evaluations per phase (those of [`brdf::CountingBrdf`] on
+    /// the threads that built the intervals: exact on a pool of one thread, see
+    /// [`ExactSet::build_counted`]); `cache` forces the node-value cache on or off (`None`: on
+    /// for isotropic BRDFs slower than [`CACHE_ABOVE_NS`] per evaluation). The set is the same
     /// either way. `follow_kinks: false` keeps the uniform initial intervals also for a BRDF
     /// with kinks in θo (the behaviour before issue 27, for comparisons).
-    pub(super) fn build_with(
-        brdf: Arc<dyn Brdf>,
-        options: &ExactOptions,
-        progress: Option<crate::Progress<'_>>,
-        cache: Option<bool>,
-        follow_kinks: bool,
-    ) -> Result<Self, ExactError> {
-        Self::build_phased(brdf, options, progress, cache, follow_kinks).map(|(set, _)| set)
-    }
-
-    /// [`ExactSet::build_with`], also returning the evaluations per phase (those of
-    /// [`brdf::CountingBrdf`] on the threads that built the intervals: exact on a pool of one
-    /// thread, see [`ExactSet::build_counted`]).
     pub(super) fn build_phased(
         brdf: Arc<dyn Brdf>,
         options: &ExactOptions,
@@ -138,7 +127,7 @@ pub(super) struct Plan {
 }
 
 impl Plan {
-    /// The plan of `brdf`'s set (see [`ExactSet::build_with`] for `cache` and `follow_kinks`).
+    /// The plan of `brdf`'s set (see [`ExactSet::build_phased`] for `cache` and `follow_kinks`).
     pub(super) fn new(
         brdf: &dyn Brdf,
         options: &ExactOptions,

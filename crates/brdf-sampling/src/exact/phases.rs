@@ -275,21 +275,14 @@ mod tests {
         assert_eq!(cost.violations, 0, "{cost:?}");
         let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(7);
         for t in [0.3, 2.9, 8.1, 12.3] {
-            let wo = brdf::direction_from_angles(t, 40.0);
-            let n = 40_000;
-            let xs: Vec<f64> = (0..n).map(|_| set.sample(&wo, &mut rng).wi.z).collect();
-            let mean = xs.iter().sum::<f64>() / n as f64;
-            let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-            let cos2 = crate::reference::albedo_of(
-                |wo, wi| brdf.eval(wo, wi) * wi.z,
+            let z = super::super::tests::mean_cos_theta_i_z(
+                &set,
                 brdf.as_ref(),
-                &wo,
-                crate::REFERENCE_BUDGET,
-            )
-            .unwrap()
-            .value;
-            let a = crate::reference_albedo(brdf.as_ref(), &wo).unwrap().value;
-            let z = (mean - cos2 / a) / (var / n as f64).sqrt();
+                t,
+                40.0,
+                40_000,
+                &mut rng,
+            );
             assert!(z.abs() < 5.0, "θo {t}: z = {z}");
         }
         assert_eq!(set.bound_violations(), Some(0));

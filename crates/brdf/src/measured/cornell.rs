@@ -423,6 +423,24 @@ impl Brdf for CornellBrdf {
     }
 }
 
+/// A Cornell-format text (a fixture for tests and examples): `f = 0.05 + 3 exp(−(Δθ² + (π −
+/// Δφ)²)/0.08)`, a lobe at the mirror direction, at every `θi, θo ∈ {5°, 15°, …, 85°}` and
+/// `Δφ ∈ {0°, 30°, …, 180°}` (567 samples on a regular grid, so many are equidistant from a
+/// query), over three wavelengths (450, 550, 650 nm) whose values are `spectrum(f)`.
+pub fn lobe_grid_text(spectrum: impl Fn(f64) -> [f64; 3]) -> String {
+    let mut text = String::from("3\n450 550 650\n");
+    for ti in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+        for to in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
+            for dp in (0..7).map(|k| (30.0 * k as f64).to_radians()) {
+                let lobe = ((ti - to).powi(2) + (std::f64::consts::PI - dp).powi(2)) / 0.08;
+                let [a, b, c] = spectrum(0.05 + 3.0 * (-lobe).exp());
+                text.push_str(&format!("{ti} 0 {to} {dp} {a} {b} {c}\n"));
+            }
+        }
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -516,18 +534,7 @@ mod tests {
 
     /// A file of 567 samples of a glossy lobe on a regular grid (many equidistant samples).
     fn synthetic() -> String {
-        let mut text = String::from("3\n450 550 650\n");
-        for ti in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
-            for to in (0..9).map(|k| (5.0 + 10.0 * k as f64).to_radians()) {
-                for dp in (0..7).map(|k| (30.0 * k as f64).to_radians()) {
-                    let lobe = ((ti - to).powi(2) + (std::f64::consts::PI - dp).powi(2)) / 0.08;
-                    let f = 0.05 + 3.0 * (-lobe).exp();
-                    let (r, b) = (0.7 * f, 0.2 + f);
-                    text.push_str(&format!("{ti} 0 {to} {dp} {r} {f} {b}\n"));
-                }
-            }
-        }
-        text
+        super::lobe_grid_text(|f| [0.7 * f, f, 0.2 + f])
     }
 
     /// The team's Cornell files when the data repository sits beside this one.
@@ -588,15 +595,21 @@ mod tests {
     /// luminance blended from the samples' luminances change `f` by rounding only: on 20 000
     /// random pairs per file (and the poles) within 1e-10 relative of the old computation
     /// (measured 10⁶ pairs per shared file: docs/benchmarks.md §19.6).
+    /// Every file's worst relative difference from the old interpolant over `pairs` random
+    /// direction pairs is at most 1e-10 (rounding).
+    fn assert_same_interpolant(files: Vec<(String, String)>, pairs: usize) {
+        for (name, text) in files {
+            let worst = worst_difference(&text, pairs);
+            eprintln!("{name}: max relative difference on {pairs} pairs {worst:.2e}");
+            assert!(worst <= 1e-10, "{name}: {worst:e}");
+        }
+    }
+
     #[test]
     fn fast_eval_is_the_old_interpolant() {
         let mut files = vec![("synthetic".to_string(), synthetic())];
         files.extend(shared_files());
-        for (name, text) in files {
-            let worst = worst_difference(&text, 20_000);
-            eprintln!("{name}: max relative difference {worst:.1e}");
-            assert!(worst <= 1e-10, "{name}: {worst:e}");
-        }
+        assert_same_interpolant(files, 20_000);
     }
 
     /// The figure of §19.6: 10⁶ random pairs per file (`cargo test --release -p brdf --lib
@@ -604,11 +617,7 @@ mod tests {
     #[test]
     #[ignore = "10⁶ pairs per file, about a minute"]
     fn fast_eval_on_a_million_pairs() {
-        for (name, text) in shared_files() {
-            let worst = worst_difference(&text, 1_000_000);
-            eprintln!("{name}: max relative difference on 10⁶ pairs {worst:.2e}");
-            assert!(worst <= 1e-10, "{name}: {worst:e}");
-        }
+        assert_same_interpolant(shared_files(), 1_000_000);
     }
 
     /// Instructions per evaluation, for cachegrind (docs/benchmarks.md §19.6):

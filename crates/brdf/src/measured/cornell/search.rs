@@ -59,6 +59,21 @@ fn bounds(points: &[([f64; 3], u32)]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
+impl Node {
+    /// A node boxing `items`, its children or leaf range set later.
+    fn boxing(items: &[([f64; 3], u32)]) -> Self {
+        let (lo, hi) = bounds(items);
+        Node {
+            lo,
+            hi,
+            first: 0,
+            len: 0,
+            axis: 0,
+            split: 0.0,
+        }
+    }
+}
+
 impl Tree {
     /// The tree of `points` (finite coordinates; the file's order is the index).
     pub(super) fn new(points: &[[f64; 3]]) -> Self {
@@ -68,15 +83,7 @@ impl Tree {
             .map(|(i, p)| (*p, i as u32))
             .collect();
         let mut nodes = Vec::with_capacity(2 * points.len() / LEAF + 2);
-        let (lo, hi) = bounds(&items);
-        nodes.push(Node {
-            lo,
-            hi,
-            first: 0,
-            len: 0,
-            axis: 0,
-            split: 0.0,
-        });
+        nodes.push(Node::boxing(&items));
         // Each inner node's two children are adjacent in `nodes`.
         let mut todo = vec![(0usize, 0usize, items.len())];
         while let Some((node, start, end)) = todo.pop() {
@@ -96,15 +103,7 @@ impl Tree {
             });
             let first = nodes.len();
             for (s, e) in [(start, start + mid), (start + mid, end)] {
-                let (lo, hi) = bounds(&items[s..e]);
-                nodes.push(Node {
-                    lo,
-                    hi,
-                    first: 0,
-                    len: 0,
-                    axis: 0,
-                    split: 0.0,
-                });
+                nodes.push(Node::boxing(&items[s..e]));
                 todo.push((nodes.len() - 1, s, e));
             }
             nodes[node].first = first as u32;
