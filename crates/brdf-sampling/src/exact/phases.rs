@@ -236,7 +236,7 @@ mod tests {
     /// `f cos` (the mean `cos θi` against the reference quadrature, 5σ) in the halves.
     #[test]
     fn a_tail_split_hands_its_tree_to_its_halves() {
-        use crate::direction_sampler::{DirectionSampler, SamplerDiagnostics};
+        use crate::direction_sampler::SamplerDiagnostics;
         use rand::SeedableRng;
         let brdf: Arc<dyn Brdf> = Arc::from(brdf::parse_spec("oren-nayar").unwrap());
         let mut opts = ExactOptions::default();
