@@ -1938,9 +1938,9 @@ mod shared_build_tests {
 mod shared_draw_tests {
     use super::*;
 
-    /// MIS of `cosine` and `phong:n=20` under the sky with the given estimators; the map
-    /// samplers are the study's two.
-    fn run(estimators: &[&str]) -> StudyResults {
+    /// `cosine` and `lobe-sphere` on `phong:n=20` at θo = 40° under the sky, with small counts
+    /// (N ∈ {2, 8}, 4 repetitions, 300 variance samples).
+    pub(super) fn two_samplers_on_phong() -> StudyConfig {
         let mut c = StudyConfig::new(
             vec!["cosine".into(), "lobe-sphere".into()],
             vec!["phong:n=20".into()],
@@ -1950,6 +1950,13 @@ mod shared_draw_tests {
         c.n_grid = vec![2, 8];
         c.repetitions = 4;
         c.variance_samples = 300;
+        c
+    }
+
+    /// MIS of `cosine` and `phong:n=20` under the sky with the given estimators; the map
+    /// samplers are the study's two.
+    fn run(estimators: &[&str]) -> StudyResults {
+        let mut c = two_samplers_on_phong();
         c.timing_samples = 4;
         c.timing_repeats = 1;
         c.estimators = estimators.iter().map(|s| s.to_string()).collect();
@@ -2203,15 +2210,7 @@ mod cost_rule_tests {
     /// `timing_repeats`, and fewer than `timing_repeats` only with a median within 5 %.
     #[test]
     fn a_study_times_each_cell_by_the_rule() {
-        let mut c = StudyConfig::new(
-            vec!["cosine".into(), "lobe-sphere".into()],
-            vec!["phong:n=20".into()],
-            vec![40.0],
-            vec!["sky".into()],
-        );
-        c.n_grid = vec![2, 8];
-        c.repetitions = 4;
-        c.variance_samples = 300;
+        let mut c = super::shared_draw_tests::two_samplers_on_phong();
         c.timing_samples = 64;
         c.timing_repeats = 12;
         let r = StudyPlan::new(c, Vec::new()).unwrap().run(None, &|_| {});
