@@ -326,34 +326,35 @@ impl CornellBrdf {
     /// The interpolated RGB at a remapped point (see the module docs: the [`NEIGHBOURS`]
     /// nearest samples with Gaussian weights cut at the next sample's distance).
     pub fn rgb_at(&self, p: &[f64; 3]) -> [f64; 3] {
+        self.blend(p, |i| self.data.rgb[i])
+    }
+
+    /// The luminance of [`rgb_at`](Self::rgb_at) (up to rounding), blended from the samples'
+    /// own luminances.
+    pub fn luminance_at(&self, p: &[f64; 3]) -> f64 {
+        let [l] = self.blend(p, |i| [self.data.lum[i]]);
+        l
+    }
+
+    /// The weighted mean `Σ w_k v_k / Σ w_k` of `value` over the samples blended at `p` (0
+    /// where every weight is 0).
+    #[inline]
+    fn blend<const C: usize>(&self, p: &[f64; 3], value: impl Fn(usize) -> [f64; C]) -> [f64; C] {
         let near = self.data.tree.nearest(p);
         let w = weights(&near);
-        let (mut sum, mut total) = ([0.0; 3], 0.0);
+        let (mut sum, mut total) = ([0.0; C], 0.0);
         for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
-            let c = self.data.rgb[i as usize];
-            for ch in 0..3 {
-                sum[ch] += w * c[ch];
+            let v = value(i as usize);
+            for ch in 0..C {
+                sum[ch] += w * v[ch];
             }
             total += w;
         }
         if total > 0.0 {
             sum.map(|s| s / total)
         } else {
-            [0.0; 3]
+            [0.0; C]
         }
-    }
-
-    /// The luminance of [`rgb_at`](Self::rgb_at) (up to rounding), blended from the samples'
-    /// own luminances.
-    pub fn luminance_at(&self, p: &[f64; 3]) -> f64 {
-        let near = self.data.tree.nearest(p);
-        let w = weights(&near);
-        let (mut sum, mut total) = (0.0, 0.0);
-        for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
-            sum += w * self.data.lum[i as usize];
-            total += w;
-        }
-        if total > 0.0 { sum / total } else { 0.0 }
     }
 }
 
