@@ -110,6 +110,8 @@ pub use sampled::{
     DEFAULT_REFINEMENT_COARSEST, DEFAULT_REFINEMENT_TOLERANCE, DEFAULT_SAFETY_FACTOR, GridOptions,
     Refinement, SampledGridDensity,
 };
-pub use tabulated::{RowFactor, SinPiRows, TabulatedDensity, UnitRows, sin_pi_unit};
+pub use tabulated::{
+    RowFactor, SinPiRows, TabulatedDensity, UnitRows, sin_pi_unit, sin_pi_unit_block,
+};
 pub use tree::{LeafChoice, LeafInfo, QuadTree, SAMPLING_CONFIGS, Scheme, TreeCounts, TreeParams};
 pub use user_bound::UserBoundDensity;
