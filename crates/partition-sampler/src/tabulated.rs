@@ -423,30 +423,90 @@ impl<R: RowFactor> Density for TabulatedDensity<R> {
         }
     }
 
-    /// Three passes per chunk of [`EVAL_CHUNK`] points: all cell values are loaded first
-    /// (independent loads, so the cache misses of a block overlap) together with the row
-    /// coordinates `t`, then the row factors of the whole chunk in one
-    /// [`RowFactor::eval_block`] call (vector lanes for [`SinPiRows`]), then the products.
-    /// Same values as [`Self::eval`], bit for bit.
+    /// Four passes per chunk of [`EVAL_CHUNK`] points, in structure-of-arrays form and
+    /// compiled for the best vector extension of this CPU (`pulp`'s runtime dispatch, AVX2
+    /// where present): the cell indices and row coordinates `t` of the chunk (arithmetic and
+    /// compares only, in vector lanes), then the cell values (independent loads, so the cache
+    /// misses of a chunk overlap), then the row factors in one [`RowFactor::eval_block`] call
+    /// (vector lanes for [`SinPiRows`]), then the products. Same values as [`Self::eval`], bit
+    /// for bit: the same expressions in the same order, no fused multiply-adds, and the cell
+    /// index truncated through `i32` — equal to [`floor_index`]'s `u32` for the points inside
+    /// the grid (`0 ≤ fx ≤ W < 2³¹`, checked at construction); points outside get no load.
     #[inline]
     fn eval_block(&self, points: &[Point2], out: &mut [f64]) {
+        pulp::Arch::new().dispatch(EvalBlock {
+            density: self,
+            points,
+            out,
+        });
+    }
+}
+
+/// [`TabulatedDensity::eval_block`]'s passes as a `pulp` operation (inlined into, and compiled
+/// for, each instruction set `pulp` dispatches to).
+struct EvalBlock<'a, R: RowFactor> {
+    density: &'a TabulatedDensity<R>,
+    points: &'a [Point2],
+    out: &'a mut [f64],
+}
+
+impl<R: RowFactor> pulp::WithSimd for EvalBlock<'_, R> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        let d = self.density;
+        let mut cells = [0u64; EVAL_CHUNK];
         let mut ts = [0.0f64; EVAL_CHUNK];
         let mut gs = [0.0f64; EVAL_CHUNK];
-        for (pc, oc) in points.chunks(EVAL_CHUNK).zip(out.chunks_mut(EVAL_CHUNK)) {
+        for (pc, oc) in self
+            .points
+            .chunks(EVAL_CHUNK)
+            .zip(self.out.chunks_mut(EVAL_CHUNK))
+        {
             let n = pc.len().min(oc.len());
-            for ((o, t), &p) in oc.iter_mut().zip(&mut ts).zip(pc) {
-                let fy = (p[1] - self.domain.y0) * self.sy;
-                *t = fy * self.inv_h;
-                *o = match self.cell_index(p) {
-                    Some((k, _)) => self.values[k],
-                    None => -1.0,
-                };
+            d.cells_of(&pc[..n], &mut cells[..n], &mut ts[..n]);
+            for (o, &k) in oc[..n].iter_mut().zip(&cells[..n]) {
+                // `u64::MAX` (outside) finds no value: the marker −1 (values are ≥ 0, checked
+                // at construction).
+                *o = usize::try_from(k)
+                    .ok()
+                    .and_then(|k| d.values.get(k))
+                    .copied()
+                    .unwrap_or(-1.0);
             }
-            self.factor.eval_block(&ts[..n], &mut gs[..n]);
-            for (o, &g) in oc.iter_mut().zip(&gs[..n]) {
-                // A negative marker is "outside": values are ≥ 0 (checked at construction).
+            d.factor.eval_block(&ts[..n], &mut gs[..n]);
+            for (o, &g) in oc[..n].iter_mut().zip(&gs[..n]) {
                 *o = if *o < 0.0 { 0.0 } else { *o * g };
             }
+        }
+    }
+}
+
+impl<R: RowFactor> TabulatedDensity<R> {
+    /// For each point: its index in `values` ([`Self::cell_index`]'s), or `u64::MAX` outside
+    /// the domain, and its row coordinate `t = fy / H` (what [`Density::eval`] passes to the
+    /// row factor). Free of branches (compares combined by `&`, selects), so the loop
+    /// vectorises; the cell index goes through `i32`, which for `0 ≤ fx ≤ W < 2³¹` truncates
+    /// as [`floor_index`]'s `u32` does.
+    #[inline(always)]
+    fn cells_of(&self, points: &[Point2], cells: &mut [u64], ts: &mut [f64]) {
+        let (x0, y0, sx, sy, inv_h) =
+            (self.domain.x0, self.domain.y0, self.sx, self.sy, self.inv_h);
+        let (w, h) = (index_to_f64(self.width), index_to_f64(self.height));
+        // `width, height ≤ u32::MAX / 2` (checked at construction): the last indices fit i32.
+        let last_i = i32::try_from(self.width - 1).unwrap_or(i32::MAX);
+        let last_j = i32::try_from(self.height - 1).unwrap_or(i32::MAX);
+        let width = self.width as u64;
+        for ((c, t), p) in cells.iter_mut().zip(ts.iter_mut()).zip(points) {
+            let fx = (p[0] - x0) * sx;
+            let fy = (p[1] - y0) * sy;
+            *t = fy * inv_h;
+            let inside = (fx >= 0.0) & (fx <= w) & (fy >= 0.0) & (fy <= h);
+            let i = (fx as i32).min(last_i) as u32;
+            let j = (fy as i32).min(last_j) as u32;
+            let cell = u64::from(j) * width + u64::from(i);
+            *c = if inside { cell } else { u64::MAX };
         }
     }
 }
@@ -572,9 +632,41 @@ mod tests {
             .unwrap()
             .with_row_factor(SinPiRows)
             .unwrap();
-        let pts: Vec<Point2> = (0..400)
+        let mut pts: Vec<Point2> = (0..400)
             .map(|k| [-1.5 + 0.013 * k as f64, 1.8 + 0.0071 * k as f64])
             .collect();
+        // The domain's edges and their float neighbours (fx = W and fy = H are inside, in the
+        // last cell), cell edges, signed zeros, NaN and infinities.
+        let (xs, ys) = ([-1.0, 3.0, 1.0 / 7.0, 0.0], [2.0, 4.5, 2.5, 0.0]);
+        for &x in &xs {
+            for &y in &ys {
+                for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, -1.0)] {
+                    let nx = if dx > 0.0 {
+                        x.next_up()
+                    } else if dx < 0.0 {
+                        x.next_down()
+                    } else {
+                        x
+                    };
+                    let ny = if dy > 0.0 {
+                        y.next_up()
+                    } else if dy < 0.0 {
+                        y.next_down()
+                    } else {
+                        y
+                    };
+                    pts.push([nx, ny]);
+                }
+            }
+        }
+        pts.extend([
+            [-0.0, 3.0],
+            [1.0, -0.0],
+            [f64::NAN, 3.0],
+            [1.0, f64::NAN],
+            [f64::INFINITY, 3.0],
+            [1.0, f64::NEG_INFINITY],
+        ]);
         let mut out = vec![f64::NAN; pts.len()];
         d.eval_block(&pts, &mut out);
         for (p, o) in pts.iter().zip(&out) {
