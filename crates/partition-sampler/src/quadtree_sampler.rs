@@ -597,7 +597,10 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
     /// bit for bit — counted locally and added to the shared counters once. With
     /// [`Scheme::Envelope`] and [`LeafChoice::Alias`] on a rectangle the trials are run in
     /// blocks ([`Self::fill_blocks`]): candidates first, then their densities in one
-    /// [`Density::eval_block`](crate::Density::eval_block) call, then the accept pass.
+    /// [`Density::eval_block`](crate::Density::eval_block) call, then the accept pass — the
+    /// whole block path compiled for the best vector extension of this CPU (`pulp`'s runtime
+    /// dispatch: AVX2 where present, the x86-64 baseline otherwise; integer and IEEE
+    /// operations without fused multiply-adds, so the same samples on every path).
     fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
         let mut a = Audit::default();
         let blocked = !self.disc
@@ -605,9 +608,17 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
             && self.tree.params.scheme == Scheme::Envelope
             && self.tree.params.leaf_choice == LeafChoice::Alias;
         if blocked && self.identity {
-            self.fill_blocks::<false, U>(u, out, &mut a);
+            a = pulp::Arch::new().dispatch(FillBlocks::<false, D, U> {
+                sampler: self,
+                u,
+                out,
+            });
         } else if blocked {
-            self.fill_blocks::<true, U>(u, out, &mut a);
+            a = pulp::Arch::new().dispatch(FillBlocks::<true, D, U> {
+                sampler: self,
+                u,
+                out,
+            });
         } else {
             for s in out.iter_mut() {
                 *s = self.draw(u, &mut a);
@@ -626,5 +637,26 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
 
     fn bytes_used(&self) -> usize {
         self.memory().total
+    }
+}
+
+/// [`QuadTreeSampler::fill_blocks`] as a `pulp` operation, so that its passes are inlined
+/// into (and compiled for) each instruction set `pulp` dispatches to; returns its counts.
+struct FillBlocks<'a, const MAP: bool, D, U: ?Sized> {
+    sampler: &'a QuadTreeSampler<D>,
+    u: &'a mut U,
+    out: &'a mut [Sample2],
+}
+
+impl<const MAP: bool, D: RegionStats, U: UniformSource + ?Sized> pulp::WithSimd
+    for FillBlocks<'_, MAP, D, U>
+{
+    type Output = Audit;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Audit {
+        let mut a = Audit::default();
+        self.sampler.fill_blocks::<MAP, U>(self.u, self.out, &mut a);
+        a
     }
 }

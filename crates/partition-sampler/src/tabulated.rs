@@ -637,7 +637,7 @@ mod tests {
             .collect();
         // The domain's edges and their float neighbours (fx = W and fy = H are inside, in the
         // last cell), cell edges, signed zeros, NaN and infinities.
-        let (xs, ys) = ([-1.0, 3.0, 1.0 / 7.0, 0.0], [2.0, 4.5, 2.5, 0.0]);
+        let (xs, ys): ([f64; 4], [f64; 4]) = ([-1.0, 3.0, 1.0 / 7.0, 0.0], [2.0, 4.5, 2.5, 0.0]);
         for &x in &xs {
             for &y in &ys {
                 for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, -1.0)] {
