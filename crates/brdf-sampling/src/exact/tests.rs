@@ -524,3 +524,59 @@ fn cornell_set_table_is_within_1e4_between_its_nodes() {
     }
     assert!(worst <= 1e-4, "set table: max |A/Â − 1| = {worst:e}");
 }
+
+/// poulin-fournier's normaliser at θo from 10° to 89° (φo = 45°): the graded leaf rule on a
+/// 16 × 16 partition against the cylinder rule (`normalisation::cylinder_quadrature`), at the
+/// node budget and to the target (docs/benchmarks.md §19.9). A diagnostic (prints, checks
+/// only that the two rules agree within their estimates at the large budget):
+/// `cargo test --release -p brdf-sampling --lib pf_node_rules -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn pf_node_rules() {
+    use crate::disc::DiscMap;
+    use crate::normalisation::{
+        EVALUATION_BUDGET, Grading, TOL, adaptive_quadrature, cylinder_quadrature,
+    };
+    use density::QueryDensity;
+    use partition_sampler::{LeafInfo, Rect};
+    let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("poulin-fournier").unwrap());
+    let h = 0.125;
+    let cells: Vec<LeafInfo> = (0..256)
+        .map(|k| {
+            let (x, y) = (-1.0 + h * (k % 16) as f64, -1.0 + h * (k / 16) as f64);
+            LeafInfo {
+                rect: Rect::new(x, y, x + h, y + h),
+                max_bound: 1.0,
+                integral: 0.0,
+                volume: 0.0,
+            }
+        })
+        .collect();
+    for t in [10.0, 30.0, 50.0, 70.0, 85.0, 89.0] {
+        let wo = brdf::direction_from_angles(t, 45.0);
+        let q = QueryDensity::new(brdf.as_ref(), wo, 0.0, DiscMap::Projected);
+        let g = |p: [f64; 2]| q.at(p);
+        let tol = TOL * 0.5;
+        let mut big = Vec::new();
+        for budget in [EVALUATION_BUDGET, 2_000_000] {
+            let leaf = adaptive_quadrature(
+                &g,
+                cells.iter().copied(),
+                tol,
+                false,
+                budget,
+                Grading::Graded,
+            );
+            let cyl = cylinder_quadrature(&g, tol, false, budget);
+            for (name, r) in [("leaf", &leaf), ("cylinder", &cyl)] {
+                eprintln!(
+                    "θo {t:4}° {name:8} budget {budget:7}: A {:.10} abs_err {:.2e} evaluations {}",
+                    r.total, r.abs_err, r.evaluations
+                );
+            }
+            big = vec![(leaf.total, leaf.abs_err), (cyl.total, cyl.abs_err)];
+        }
+        let ((a, ea), (b, eb)) = (big[0], big[1]);
+        assert!((a - b).abs() <= ea + eb, "θo {t}: {a} vs {b}");
+    }
+}
