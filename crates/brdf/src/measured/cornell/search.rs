@@ -204,8 +204,7 @@ impl Tree {
     }
 
     /// The `K` nearest samples of `q` (all of them if fewer), ties by the file's index,
-    /// without the cache (the judge of [`Tree::nearest_cached`] in the tests).
-    #[cfg(test)]
+    /// without the cache.
     pub(super) fn nearest(&self, q: &[f64; 3]) -> Nearest {
         self.nearest_n::<K>(q)
     }
@@ -265,20 +264,28 @@ impl Tree {
     pub(super) fn nearest_cached(&self, q: &[f64; 3]) -> Nearest {
         CACHE.with(|cell| {
             let mut slot = cell.borrow_mut();
-            if let Some(near) = slot
+            let (hood, misses) = &mut *slot;
+            if let Some(near) = hood
                 .as_ref()
                 .filter(|h| h.tree == self.id)
                 .and_then(|h| h.nearest(q))
             {
+                *misses = 0;
                 return near;
             }
+            // Queries that do not follow one another (a renderer's) would pay the wider
+            // search at every call: after a miss that followed a miss, the plain search, and
+            // a new neighbourhood only every `REANCHOR`-th miss in a row.
+            *misses = misses.wrapping_add(1);
+            if *misses > 1 && *misses % REANCHOR != 0 {
+                return self.nearest(q);
+            }
             let wide = self.nearest_n::<{ CANDIDATES + 1 }>(q);
-            let hood = Neighbourhood::new(self, q, &wide);
+            *hood = Some(Neighbourhood::new(self, q, &wide));
             let mut near = Nearest::empty();
             for j in 0..wide.len.min(K) {
                 near.offer(wide.d2[j], wide.index[j]);
             }
-            *slot = Some(hood);
             near
         })
     }
@@ -291,9 +298,14 @@ static NEXT_TREE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::n
 pub(super) const CANDIDATES: usize = 32;
 
 std::thread_local! {
-    /// The last neighbourhood searched on this thread (of whichever tree).
-    static CACHE: std::cell::RefCell<Option<Neighbourhood>> = const { std::cell::RefCell::new(None) };
+    /// The last neighbourhood searched on this thread (of whichever tree) and the misses
+    /// in a row since its last hit.
+    static CACHE: std::cell::RefCell<(Option<Neighbourhood>, u32)> =
+        const { std::cell::RefCell::new((None, 0)) };
 }
+
+/// A run of misses builds a new neighbourhood every this many misses.
+const REANCHOR: u32 = 8;
 
 /// The [`CANDIDATES`] samples nearest to an anchor point `a` and the distance `reach` of the
 /// next one (infinite when the file has no more samples). Every other sample is at least
@@ -460,7 +472,7 @@ mod tests {
                     }
                     steps += 1;
                     hits += CACHE
-                        .with(|c| c.borrow().as_ref().and_then(|h| h.nearest(&q)))
+                        .with(|c| c.borrow().0.as_ref().and_then(|h| h.nearest(&q)))
                         .is_some() as usize;
                 }
                 let (a, b) = (tree.nearest_cached(&q), tree.nearest(&q));
