@@ -35,16 +35,82 @@ pub(super) struct Tree {
     /// The file's index of each sample of `points`.
     index: Vec<u32>,
     nodes: Vec<Node>,
+    /// Each sample's point by the file's index.
+    by_index: Vec<[f64; 3]>,
+    /// This tree's identity in the per-thread neighbourhood cache (unique per process).
+    id: u64,
 }
 
-/// The `len` (≤ [`K`]) nearest samples, by increasing squared distance.
-pub(super) struct Nearest {
+/// The `len` (≤ `N`) nearest samples, by increasing `(squared distance, file index)`.
+pub(super) struct Best<const N: usize> {
     /// Squared distances.
-    pub(super) d2: [f64; K],
+    pub(super) d2: [f64; N],
     /// The file's sample indices.
-    pub(super) index: [u32; K],
-    /// How many were found (`K` unless the file has fewer samples).
+    pub(super) index: [u32; N],
+    /// How many were found (`N` unless the file has fewer samples).
     pub(super) len: usize,
+}
+
+/// The [`K`] nearest samples of a query.
+pub(super) type Nearest = Best<K>;
+
+impl<const N: usize> Best<N> {
+    fn empty() -> Self {
+        Self {
+            d2: [f64::INFINITY; N],
+            index: [0; N],
+            len: 0,
+        }
+    }
+
+    /// Whether `(d2, i)` would be kept (before the worst kept one, or room left).
+    #[inline]
+    fn admits(&self, d2: f64, i: u32) -> bool {
+        self.len < N || before(d2, i, self.d2[N - 1], self.index[N - 1])
+    }
+
+    /// Keeps `(d2, i)` if it is among the best `N`, the order kept.
+    #[inline]
+    fn offer(&mut self, d2: f64, i: u32) {
+        if self.len < N {
+            self.len += 1;
+        } else if !before(d2, i, self.d2[N - 1], self.index[N - 1]) {
+            return;
+        }
+        let mut j = self.len - 1;
+        while j > 0 && before(d2, i, self.d2[j - 1], self.index[j - 1]) {
+            self.d2[j] = self.d2[j - 1];
+            self.index[j] = self.index[j - 1];
+            j -= 1;
+        }
+        self.d2[j] = d2;
+        self.index[j] = i;
+    }
+
+    /// The largest squared distance kept when full, else infinity (a box farther than this
+    /// holds no sample that would be kept; one at exactly this distance may, by its index).
+    #[inline]
+    fn bound(&self) -> f64 {
+        if self.len < N {
+            f64::INFINITY
+        } else {
+            self.d2[N - 1]
+        }
+    }
+}
+
+/// The order of the search: by squared distance, ties by the file's index (so the samples
+/// kept are the same whatever the order they are visited in).
+#[inline]
+fn before(d2: f64, i: u32, d2b: f64, ib: u32) -> bool {
+    d2 < d2b || (d2 == d2b && i < ib)
+}
+
+/// Squared distance of `p` to `q` (the one formula of every path, so their bits agree).
+#[inline]
+fn dist2(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    let (a, b, c) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+    a * a + b * b + c * c
 }
 
 fn bounds(points: &[([f64; 3], u32)]) -> ([f64; 3], [f64; 3]) {
@@ -114,6 +180,8 @@ impl Tree {
             points: items.iter().map(|x| x.0).collect(),
             index: items.iter().map(|x| x.1).collect(),
             nodes,
+            by_index: points.to_vec(),
+            id: NEXT_TREE.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
     }
 
@@ -135,13 +203,15 @@ impl Tree {
         s
     }
 
-    /// The `K` nearest samples of `q` (all of them if fewer).
+    /// The `K` nearest samples of `q` (all of them if fewer), ties by the file's index,
+    /// without the cache.
     pub(super) fn nearest(&self, q: &[f64; 3]) -> Nearest {
-        let mut best = Nearest {
-            d2: [f64::INFINITY; K],
-            index: [0; K],
-            len: 0,
-        };
+        self.nearest_n::<K>(q)
+    }
+
+    /// The `N` nearest samples of `q` (all of them if fewer), ties by the file's index.
+    fn nearest_n<const N: usize>(&self, q: &[f64; 3]) -> Best<N> {
+        let mut best = Best::<N>::empty();
         // Depth ≤ log2(samples / LEAF) + 1 (median splits); each level leaves at most one
         // pending sibling, so 40 entries serve any u32 count of samples.
         let mut stack_node = [0u32; 40];
@@ -150,29 +220,17 @@ impl Tree {
         while top > 0 {
             top -= 1;
             let (n, bd) = (stack_node[top] as usize, stack_d2[top]);
-            if best.len == K && bd >= best.d2[K - 1] {
+            if bd > best.bound() {
                 continue;
             }
             let node = &self.nodes[n];
             if node.len > 0 {
                 let (s, e) = (node.first as usize, (node.first + node.len) as usize);
                 for (p, &i) in self.points[s..e].iter().zip(&self.index[s..e]) {
-                    let (a, b, c) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-                    let d2 = a * a + b * b + c * c;
-                    if best.len < K {
-                        best.len += 1;
-                    } else if d2 >= best.d2[K - 1] {
-                        continue;
+                    let d2 = dist2(p, q);
+                    if best.admits(d2, i) {
+                        best.offer(d2, i);
                     }
-                    // Insert, keeping d2 increasing.
-                    let mut j = best.len - 1;
-                    while j > 0 && best.d2[j - 1] > d2 {
-                        best.d2[j] = best.d2[j - 1];
-                        best.index[j] = best.index[j - 1];
-                        j -= 1;
-                    }
-                    best.d2[j] = d2;
-                    best.index[j] = i;
                 }
             } else {
                 let (l, r) = (node.first as usize, node.first as usize + 1);
@@ -188,7 +246,7 @@ impl Tree {
                     continue;
                 }
                 let far_d2 = self.box_d2(far, q);
-                if best.len < K || far_d2 < best.d2[K - 1] {
+                if far_d2 <= best.bound() {
                     stack_node[top] = far as u32;
                     stack_d2[top] = far_d2;
                     top += 1;
@@ -199,6 +257,113 @@ impl Tree {
             }
         }
         best
+    }
+
+    /// [`Tree::nearest`] through this thread's neighbourhood cache (see [`Neighbourhood`]):
+    /// the same samples in the same order, so the same interpolated value to the bit.
+    pub(super) fn nearest_cached(&self, q: &[f64; 3]) -> Nearest {
+        CACHE.with(|cell| {
+            let mut slot = cell.borrow_mut();
+            let (hood, misses) = &mut *slot;
+            if let Some(near) = hood
+                .as_ref()
+                .filter(|h| h.tree == self.id)
+                .and_then(|h| h.nearest(q))
+            {
+                *misses = 0;
+                return near;
+            }
+            // Queries that do not follow one another (a renderer's) would pay the wider
+            // search at every call: after a miss that followed a miss, the plain search, and
+            // a new neighbourhood only every `REANCHOR`-th miss in a row.
+            *misses = misses.wrapping_add(1);
+            if *misses > 1 && *misses % REANCHOR != 0 {
+                return self.nearest(q);
+            }
+            let wide = self.nearest_n::<{ CANDIDATES + 1 }>(q);
+            *hood = Some(Neighbourhood::new(self, q, &wide));
+            let mut near = Nearest::empty();
+            for j in 0..wide.len.min(K) {
+                near.offer(wide.d2[j], wide.index[j]);
+            }
+            near
+        })
+    }
+}
+
+/// Source of the trees' identities.
+static NEXT_TREE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Samples kept around a query by the neighbourhood cache.
+pub(super) const CANDIDATES: usize = 32;
+
+std::thread_local! {
+    /// The last neighbourhood searched on this thread (of whichever tree) and the misses
+    /// in a row since its last hit.
+    static CACHE: std::cell::RefCell<(Option<Neighbourhood>, u32)> =
+        const { std::cell::RefCell::new((None, 0)) };
+}
+
+/// A run of misses builds a new neighbourhood every this many misses.
+const REANCHOR: u32 = 8;
+
+/// The [`CANDIDATES`] samples nearest to an anchor point `a` and the distance `reach` of the
+/// next one (infinite when the file has no more samples). Every other sample is at least
+/// `reach − |q − a|` from a query `q`; when the [`K`]-th nearest candidate of `q` is closer
+/// than that, the `K` nearest samples of `q` are candidates, and the search among the
+/// candidates alone (the same order, ties by index) finds exactly what the tree would. A
+/// quadrature's nodes come in small pieces, so most of them fall in the last neighbourhood.
+pub(super) struct Neighbourhood {
+    tree: u64,
+    anchor: [f64; 3],
+    points: [[f64; 3]; CANDIDATES],
+    index: [u32; CANDIDATES],
+    len: usize,
+    reach: f64,
+}
+
+impl Neighbourhood {
+    fn new(tree: &Tree, anchor: &[f64; 3], wide: &Best<{ CANDIDATES + 1 }>) -> Self {
+        let len = wide.len.min(CANDIDATES);
+        let mut points = [[0.0; 3]; CANDIDATES];
+        let mut index = [0u32; CANDIDATES];
+        for j in 0..len {
+            index[j] = wide.index[j];
+            points[j] = tree.by_index[wide.index[j] as usize];
+        }
+        let reach = if wide.len > CANDIDATES {
+            wide.d2[CANDIDATES].sqrt()
+        } else {
+            f64::INFINITY
+        };
+        Self {
+            tree: tree.id,
+            anchor: *anchor,
+            points,
+            index,
+            len,
+            reach,
+        }
+    }
+
+    /// The `K` nearest samples of `q` if they are provably among the candidates.
+    #[inline]
+    fn nearest(&self, q: &[f64; 3]) -> Option<Nearest> {
+        let shift = dist2(q, &self.anchor).sqrt();
+        if !(shift < self.reach) {
+            return None;
+        }
+        let mut near = Nearest::empty();
+        for (p, &i) in self.points[..self.len].iter().zip(&self.index[..self.len]) {
+            let d2 = dist2(p, q);
+            if near.admits(d2, i) {
+                near.offer(d2, i);
+            }
+        }
+        // Every sample outside is at least `reach − shift` away: strictly farther than the
+        // last one kept (with a relative margin far above the rounding of the distances).
+        let kept = near.bound().sqrt();
+        (self.reach.is_infinite() || (kept + shift) * (1.0 + 1e-9) < self.reach).then_some(near)
     }
 }
 
@@ -262,6 +427,63 @@ mod tests {
                 seen.dedup();
                 assert_eq!(seen.len(), n, "a sample found twice");
             }
+        }
+    }
+
+    /// The cached search finds the same samples in the same order (bit for bit) as the
+    /// tree's, on walks of small steps (a quadrature's nodes: mostly hits) with jumps (misses),
+    /// on random points, on a grid full of equidistant samples and on a file smaller than the
+    /// neighbourhood; it answers most of the small steps from the cache.
+    #[test]
+    fn cached_search_is_the_tree_search() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let random: Vec<[f64; 3]> = (0..1500)
+            .map(|_| [uniform(), uniform(), uniform()])
+            .collect();
+        let grid: Vec<[f64; 3]> = (0..512)
+            .map(|i| {
+                [
+                    (i % 8) as f64 / 7.0,
+                    (i / 8 % 8) as f64 / 7.0,
+                    (i / 64) as f64 / 7.0,
+                ]
+            })
+            .collect();
+        let small: Vec<[f64; 3]> = (0..20).map(|i| [i as f64 / 19.0, 0.5, 0.5]).collect();
+        for (name, points) in [("random", random), ("grid", grid), ("small", small)] {
+            let tree = Tree::new(&points);
+            let mut q = [0.5, 0.5, 0.5];
+            let (mut hits, mut steps) = (0usize, 0usize);
+            for k in 0..20_000 {
+                if k % 200 == 0 {
+                    q = [uniform(), uniform(), uniform()];
+                } else if k % 3 == 0 {
+                    // On the grid's planes: ties.
+                    q = [(k % 8) as f64 / 7.0, q[1], (k / 8 % 8) as f64 / 7.0];
+                } else {
+                    for c in &mut q {
+                        *c += 0.004 * (uniform() - 0.5);
+                    }
+                    steps += 1;
+                    hits += CACHE
+                        .with(|c| c.borrow().0.as_ref().and_then(|h| h.nearest(&q)))
+                        .is_some() as usize;
+                }
+                let (a, b) = (tree.nearest_cached(&q), tree.nearest(&q));
+                assert_eq!(a.len, b.len, "{name} {q:?}");
+                for j in 0..a.len {
+                    assert_eq!(a.index[j], b.index[j], "{name} {q:?}: {j}");
+                    assert_eq!(a.d2[j].to_bits(), b.d2[j].to_bits(), "{name} {q:?}: {j}");
+                }
+            }
+            eprintln!("{name}: {hits} of {steps} small steps from the cache");
+            assert!(hits * 2 > steps, "{name}: {hits} of {steps}");
         }
     }
 }
