@@ -164,12 +164,16 @@ pub struct StudyConfig {
     pub lights: Vec<String>,
     /// Sample counts N of the error curves (strictly increasing).
     pub n_grid: Vec<usize>,
-    /// Independent estimates per N (for the 95 % confidence intervals).
+    /// Independent estimates per N (for the 95 % confidence intervals). One-sample cells draw
+    /// them nested: each repetition is one stream of `N_max` (the grid's last N) values, its
+    /// estimate at each N the mean of the stream's first N (independent across repetitions,
+    /// correlated across the N of one repetition).
     pub repetitions: usize,
     /// Independent estimates per N in batch mode, whose MSE rests on them alone (the
     /// one-sample mode's rests on every value drawn): `max(repetitions, batch_repetitions)`.
     pub batch_repetitions: usize,
-    /// One-sample values drawn for the per-sample variance.
+    /// One-sample values drawn for the per-sample variance and the MSE at the budget, beyond
+    /// the repetitions' streams (`repetitions × N_max` values, which they also use).
     pub variance_samples: usize,
     /// Samples per timing run.
     pub timing_samples: usize,

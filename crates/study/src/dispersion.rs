@@ -12,7 +12,8 @@
 //! whose spread estimate rests on a few values.
 //!
 //! * One-sample mode ([`one_sample_stats`], [`one_sample_mse`]): every value the cell drew
-//!   (the error-curve repetitions and the extra variance draws, all independent) gives
+//!   (the error-curve repetitions' streams of `N_max` values each and the extra variance
+//!   draws, all independent) gives
 //!   `σ̂²` (unbiased sample variance) and `b̂ = ȳ − L_ref`; the estimate is
 //!   `σ̂² + N · max(0, b̂² − σ̂²/n)` (`b̂²` minus its expected sampling part).
 //! * Batch mode ([`batch_mse`]): the `R` estimates `L̂_N,r` at the budget N (stratified
@@ -211,9 +212,9 @@ mod tests {
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};
 
-    /// The study's default counts: the error grid's repetitions (32 × Σ N of the papers' grid)
-    /// plus 20 000 extra one-sample values.
-    const GRID_VALUES: usize = 32 * (1 + 25 + 100 + 225 + 400 + 900 + 1600 + 2500);
+    /// The study's default counts: the error grid's nested repetitions (32 streams of the
+    /// papers' budget N = 2 500) plus 20 000 extra one-sample values.
+    const GRID_VALUES: usize = 32 * 2500;
     const EXTRA_VALUES: usize = 20_000;
     const BUDGET: usize = 2500;
 

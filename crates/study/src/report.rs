@@ -27,7 +27,7 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
     let _ = writeln!(s, "# brdf-lab study report ({})\n", cfg.preset);
     let _ = writeln!(
         s,
-        "Samplers: {}. BRDFs: {}. θo: {} (φo = 0). N ∈ {{{}}}, {} repetitions per N, {} one-sample values for the variance, seed {}, {} outgoing slices for the adaptive sets. {} cells{}.\n",
+        "Samplers: {}. BRDFs: {}. θo: {} (φo = 0). N ∈ {{{}}}, {} repetitions per N (one-sample cells: nested, each repetition one stream of the largest N's values, its estimate at each N the mean of the stream's first N), {} more one-sample values for the variance and the MSE, seed {}, {} outgoing slices for the adaptive sets. {} cells{}.\n",
         cfg.samplers.join(", "),
         cfg.brdfs
             .iter()
@@ -71,7 +71,9 @@ pub fn report_markdown(results: &StudyResults, assets: &ReportAssets) -> String 
         "\n## What is measured\n\n",
         "For each cell the estimator of L_r(ωo) = ∫ f_r L cosθ dσ is (1/N) Σ Y(f_r ⊙ L) cosθ / p_σ with the sampler's ",
         "solid-angle pdf (samples below the horizon count 0). *Relative error* is the mean over the repetitions of ",
-        "|L̂ − L_ref| / L_ref (± half-width of the 95 % interval). *Variance* is the per-sample variance of the estimator ",
+        "|L̂ − L_ref| / L_ref (± half-width of the 95 % interval; one-sample mode: each repetition's estimates at the ",
+        "N of the grid are the means of the first N values of one stream, so its curve's points are correlated across N ",
+        "while the repetitions stay independent at each N, and each band holds per N). *Variance* is the per-sample variance of the estimator ",
         "(one-sample mode: of f L cos/p over every value the cell drew; batch mode: N·Var(L̂_N) at the largest N). ",
         "*MSE* is the per-sample mean squared error against the reference at the budget (largest) N, ",
         "N·E[(L̂_N − L)²] = σ² + N·b²: one-sample mode σ̂² + N·max(0, b̂² − σ̂²/n) from all n values with b̂ = ȳ − L_ref, ",
