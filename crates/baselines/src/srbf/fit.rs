@@ -95,14 +95,27 @@ pub struct SrbfFit {
 /// the joint bound-constrained Levenberg–Marquardt refinement of [`super::lm`] (scale-free
 /// convergence test; what the BRDF slices use).
 pub fn fit(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfError> {
-    fit_with(target, settings, Refiner::LevenbergMarquardt)
+    fit_with(target, settings, Refiner::LevenbergMarquardt, None)
+}
+
+/// [`fit`] warm-started from `start` (e.g. the converged lobes of the neighbouring `θo`
+/// slice): the refinement starts from whichever of `start` (bandwidths clamped to the box,
+/// amplitudes refitted by NNLS, topped up to `settings.lobes` by greedy residual peaks) and
+/// the greedy guess has the lower error on `target`, so it
+/// is never started worse than [`fit`] is. An empty `start` is [`fit`].
+pub fn fit_from(
+    target: &FitTarget,
+    settings: &FitSettings,
+    start: &[SgLobe],
+) -> Result<SrbfFit, SrbfError> {
+    fit_with(target, settings, Refiner::LevenbergMarquardt, Some(start))
 }
 
 /// [`fit`] with the bound-free L-BFGS refinement instead (the environment map's fit: its 64
 /// lobes make the Levenberg–Marquardt normal equations 256 × 256, measured 30× slower there
 /// for no better product sampling; docs/benchmarks.md).
 pub fn fit_lbfgs(target: &FitTarget, settings: &FitSettings) -> Result<SrbfFit, SrbfError> {
-    fit_with(target, settings, Refiner::Lbfgs)
+    fit_with(target, settings, Refiner::Lbfgs, None)
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -115,6 +128,7 @@ fn fit_with(
     target: &FitTarget,
     settings: &FitSettings,
     refiner: Refiner,
+    warm: Option<&[SgLobe]>,
 ) -> Result<SrbfFit, SrbfError> {
     settings.validate("fit")?;
     let mut settings = *settings;
@@ -126,7 +140,33 @@ fn fit_with(
     let mut lobes = greedy_guess(target, settings);
     nnls_amplitudes(target, &mut lobes);
     lobes.retain(|l| l.amplitude > 0.0);
-    let initial_rel_l2 = target.errors(&lobes).0;
+    let mut initial_rel_l2 = target.errors(&lobes).0;
+    if let Some(warm) = warm.filter(|w| !w.is_empty() && w.len() <= settings.lobes) {
+        let mut warm: Vec<SgLobe> = warm
+            .iter()
+            .filter(|l| l.amplitude > 0.0 && l.amplitude.is_finite() && l.lambda.is_finite())
+            .map(|l| SgLobe {
+                lambda: l.lambda.clamp(settings.lambda_min, settings.lambda_max),
+                amplitude: l.amplitude,
+                axis: l.axis,
+            })
+            .collect();
+        nnls_amplitudes(target, &mut warm);
+        warm.retain(|l| l.amplitude > 0.0);
+        if !warm.is_empty() && warm.len() < settings.lobes {
+            // Lobes the neighbour's fit dropped (c = 0) are placed again on the residual:
+            // without it they are lost down the chain (measured: 248 → 211 lobes and +31 %
+            // mean rel. L2 on ggx:alpha=0.2).
+            warm = greedy_extend(target, settings, warm);
+            nnls_amplitudes(target, &mut warm);
+            warm.retain(|l| l.amplitude > 0.0);
+        }
+        let warm_l2 = target.errors(&warm).0;
+        if !warm.is_empty() && warm_l2 < initial_rel_l2 {
+            lobes = warm;
+            initial_rel_l2 = warm_l2;
+        }
+    }
     let (mut iterations, mut converged) = (0, true);
     if !lobes.is_empty() && settings.max_iter > 0 {
         let (refined, its, conv) = match refiner {
@@ -183,8 +223,21 @@ fn fit_with(
 
 /// A broad moment-fitted lobe, then greedy residual peaks (baselines.md §C.2 steps 1–5).
 fn greedy_guess(target: &FitTarget, settings: &FitSettings) -> Vec<SgLobe> {
+    greedy_extend(target, settings, Vec::with_capacity(settings.lobes))
+}
+
+/// [`greedy_guess`] continued from `lobes`: the floor lobe only if `lobes` is empty, then
+/// residual peaks (of the target minus `lobes`) until `settings.lobes` lobes (the warm start's
+/// top-up: a lobe the previous slice's fit dropped at `c = 0` is placed again).
+fn greedy_extend(
+    target: &FitTarget,
+    settings: &FitSettings,
+    mut lobes: Vec<SgLobe>,
+) -> Vec<SgLobe> {
     let mut residual = target.values.clone();
-    let mut lobes = Vec::with_capacity(settings.lobes);
+    for (d, r) in target.directions.iter().zip(residual.iter_mut()) {
+        *r -= lobes.iter().map(|l| l.eval(d)).sum::<f64>();
+    }
     // Lobe 1 (with K ≥ 2): the floor. Peaks alone leave a wide, low part of the target (a
     // diffuse term, a sky behind a sun) to the lobes' e^{−2λ} tails, which no sampler built on
     // them can recover. The floor is the moment fit of the target clipped at its solid-angle-
@@ -192,6 +245,7 @@ fn greedy_guess(target: &FitTarget, settings: &FitSettings) -> Vec<SgLobe> {
     // direction and the concentration of the mean resultant length R̄ (Banerjee et al. 2005:
     // κ ≈ R̄(3 − R̄²)/(1 − R̄²)), amplitude by least squares on the clipped target.
     if settings.lobes >= 2
+        && lobes.is_empty()
         && let Some(lobe) = floor_lobe(target, settings)
     {
         for (d, r) in target.directions.iter().zip(residual.iter_mut()) {
@@ -544,6 +598,57 @@ pub(super) mod tests {
         let fit = fit(&target, &settings).unwrap();
         assert!(fit.report.rel_l2 < 1e-3, "{:?}", fit.report);
         assert!(fit.report.rel_l2 <= fit.report.initial_rel_l2);
+    }
+
+    #[test]
+    fn warm_start_from_a_neighbouring_fit_reaches_the_same_error_in_fewer_steps() {
+        // Two neighbouring "slices": the same mixture, the sharp lobe moved by 0.005 rad. (At
+        // 0.05 rad, 0.4 of the lobe's width, the greedy guess starts lower and is taken.)
+        let a = two_lobes([60.0, 3.0]);
+        let mut b = a;
+        b[0].axis = Vec3::new(0.0, (0.6435f64 + 0.005).sin(), (0.6435f64 + 0.005).cos());
+        // A floor the lobes cannot represent exactly, so the fits end at a positive error.
+        let floor = |d: &Vec3| 0.05 * d.z.max(0.0);
+        let ta = sphere_target(
+            |d| a.iter().map(|l| l.eval(d)).sum::<f64>() + floor(d),
+            96,
+            48,
+        );
+        let tb = sphere_target(
+            |d| b.iter().map(|l| l.eval(d)).sum::<f64>() + floor(d),
+            96,
+            48,
+        );
+        let settings = FitSettings {
+            lobes: 4,
+            lambda_min: 0.5,
+            lambda_max: 1e3,
+            max_iter: 2000,
+        };
+        let fa = fit(&ta, &settings).unwrap();
+        let cold = fit(&tb, &settings).unwrap();
+        let warm = fit_from(&tb, &settings, &fa.lobes).unwrap();
+        assert!(cold.report.converged && warm.report.converged);
+        assert!(
+            warm.report.initial_rel_l2 < cold.report.initial_rel_l2,
+            "{:?} vs {:?}",
+            warm.report,
+            cold.report
+        );
+        assert!(
+            warm.report.rel_l2 <= 1.02 * cold.report.rel_l2,
+            "{:?} vs {:?}",
+            warm.report,
+            cold.report
+        );
+        assert!(
+            warm.report.iterations < cold.report.iterations,
+            "{:?} vs {:?}",
+            warm.report,
+            cold.report
+        );
+        // An empty start is the cold fit.
+        assert_eq!(fit_from(&tb, &settings, &[]).unwrap().lobes, cold.lobes);
     }
 
     #[test]

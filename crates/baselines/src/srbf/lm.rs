@@ -64,46 +64,103 @@ struct Lm<'a> {
     log_max: f64,
 }
 
+/// Below this exponent `λ(η·ξ − 1)` a lobe's value `e^{λ(η·ξ−1)} < e^{−40} ≈ 4·10⁻¹⁸` is taken
+/// as 0 (and its `exp` not evaluated): a relative change below f64 rounding of the model at
+/// any point a broader lobe or the target reaches, and it spares most `exp`s of narrow lobes.
+const EXP_CUTOFF: f64 = -40.0;
+
 impl Lm<'_> {
-    /// `‖r‖²` of `lobes`.
-    fn cost(&self, lobes: &[SgLobe]) -> f64 {
+    /// `‖r‖²` of `lobes`, storing `s_i e^{λ_k(η_i·ξ_k − 1)}` (row-major, `K` per point) in
+    /// `cache` for [`Self::normal_equations`] (so each `exp` is evaluated once per point and
+    /// trial step, not again for the accepted step's normal equations).
+    fn cost(&self, lobes: &[SgLobe], cache: &mut Vec<f64>) -> f64 {
         let t = self.target;
+        let k = lobes.len();
+        cache.clear();
+        cache.resize(k * t.len(), 0.0);
         let mut cost = 0.0;
-        for ((d, &f), &s) in t.directions().iter().zip(t.values()).zip(&self.scale) {
-            let model: f64 = lobes.iter().map(|l| l.eval(d)).sum();
-            let r = s * (model - f);
+        for (((d, &f), &s), row) in t
+            .directions()
+            .iter()
+            .zip(t.values())
+            .zip(&self.scale)
+            .zip(cache.chunks_exact_mut(k.max(1)))
+        {
+            let mut model = 0.0;
+            for (l, e) in lobes.iter().zip(row.iter_mut()) {
+                let arg = l.lambda * (d.dot(&l.axis) - 1.0);
+                if arg >= EXP_CUTOFF {
+                    *e = s * arg.exp();
+                    model += l.amplitude * *e;
+                }
+            }
+            let r = model - s * f;
             cost += r * r;
         }
         cost
     }
 
     /// `‖r‖²`, `H = JᵀJ` and `g = Jᵀr` at `lobes`, parameters `(c, ln λ, u, w)` per lobe with
-    /// `u = w = 0` at the current axes.
+    /// `u = w = 0` at the current axes, from the `cache` that [`Self::cost`] filled for the
+    /// same `lobes`. `J` is never formed: each point adds its row's rank-1 update to the upper
+    /// triangle of `H`, over the lobes that reach it only (a lobe below [`EXP_CUTOFF`] there
+    /// has a zero row block), and the lower triangle is mirrored at the end.
     fn normal_equations(
         &self,
         lobes: &[SgLobe],
         frames: &[(Vec3, Vec3)],
+        cache: &[f64],
     ) -> (f64, DMatrix<f64>, DVector<f64>) {
         let t = self.target;
-        let rows = t.len();
-        let mut jac = DMatrix::<f64>::zeros(rows, P * lobes.len());
-        let mut r = DVector::<f64>::zeros(rows);
-        for (k, (l, (t1, t2))) in lobes.iter().zip(frames).enumerate() {
-            for (i, (d, &s)) in t.directions().iter().zip(&self.scale).enumerate() {
-                let cos = d.dot(&l.axis);
-                let sg = s * (l.lambda * (cos - 1.0)).exp();
-                r[i] += l.amplitude * sg;
+        let k = lobes.len();
+        let n = P * k;
+        // Column-major `n × n` (nalgebra's layout); entry (p, q) at `p + n q`, filled for p ≤ q.
+        let mut h = vec![0.0; n * n];
+        let mut g = vec![0.0; n];
+        let mut idx: Vec<usize> = Vec::with_capacity(n);
+        let mut val: Vec<f64> = Vec::with_capacity(n);
+        let mut cost = 0.0;
+        for (((d, &f), &s), row) in t
+            .directions()
+            .iter()
+            .zip(t.values())
+            .zip(&self.scale)
+            .zip(cache.chunks_exact(k.max(1)))
+        {
+            idx.clear();
+            val.clear();
+            let mut r = -s * f;
+            for (j, ((l, (t1, t2)), &sg)) in lobes.iter().zip(frames).zip(row).enumerate() {
+                if sg == 0.0 {
+                    continue;
+                }
+                r += l.amplitude * sg;
                 let clg = sg * l.amplitude * l.lambda;
-                jac[(i, P * k)] = sg;
-                jac[(i, P * k + 1)] = clg * (cos - 1.0);
-                jac[(i, P * k + 2)] = clg * d.dot(t1);
-                jac[(i, P * k + 3)] = clg * d.dot(t2);
+                idx.extend([P * j, P * j + 1, P * j + 2, P * j + 3]);
+                val.extend([
+                    sg,
+                    clg * (d.dot(&l.axis) - 1.0),
+                    clg * d.dot(t1),
+                    clg * d.dot(t2),
+                ]);
+            }
+            cost += r * r;
+            for (a, (&p, &vp)) in idx.iter().zip(&val).enumerate() {
+                g[p] += vp * r;
+                let col = &mut h[n * p..n * p + n];
+                // Upper triangle by columns: entries (q, p) for q ≤ p, i.e. the first `a + 1`
+                // active indices.
+                for (&q, &vq) in idx[..=a].iter().zip(&val[..=a]) {
+                    col[q] += vq * vp;
+                }
             }
         }
-        for ((ri, &f), &s) in r.iter_mut().zip(t.values()).zip(&self.scale) {
-            *ri -= s * f;
+        for p in 0..n {
+            for q in 0..p {
+                h[p + n * q] = h[q + n * p];
+            }
         }
-        (r.norm_squared(), jac.tr_mul(&jac), jac.tr_mul(&r))
+        (cost, DMatrix::from_vec(n, n, h), DVector::from_vec(g))
     }
 
     /// Whether variable `i` (of lobe `i / P`) is held at a bound this iteration.
@@ -222,10 +279,14 @@ pub(crate) fn refine(
     let (mut cost, mut h, mut g) = (0.0, DMatrix::zeros(0, 0), DVector::zeros(0));
     let mut frames: Vec<(Vec3, Vec3)> = Vec::new();
     let mut free: Vec<usize> = Vec::new();
+    // The `exp`s of the current lobes (see `Lm::cost`) and of the last trial.
+    let mut cache = Vec::new();
+    let mut trial_cache = Vec::new();
+    lm.cost(&lobes, &mut cache);
     loop {
         if fresh {
             frames = lobes.iter().map(|l| tangents(&l.axis)).collect();
-            (cost, h, g) = lm.normal_equations(&lobes, &frames);
+            (cost, h, g) = lm.normal_equations(&lobes, &frames, &cache);
             free = (0..g.len()).filter(|&i| !lm.held(&lobes, &g, i)).collect();
             // The scale-free test: the undamped model's best decrease, relative to the cost.
             let gn = Lm::solve(&h, &g, &free, 1e-10);
@@ -261,10 +322,11 @@ pub(crate) fn refine(
         let (trial, taken) = lm.step(&lobes, &frames, &free, &delta);
         // Predicted decrease of the linear model for the step taken: −(2gᵀδ + δᵀHδ).
         let predicted = -(2.0 * g.dot(&taken) + taken.dot(&(&h * &taken)));
-        let trial_cost = lm.cost(&trial);
+        let trial_cost = lm.cost(&trial, &mut trial_cache);
         let rho = (cost - trial_cost) / predicted;
         if trial_cost.is_finite() && trial_cost < cost && predicted > 0.0 && rho > 0.0 {
             lobes = trial;
+            std::mem::swap(&mut cache, &mut trial_cache);
             mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
             nu = 2.0;
             fresh = true;
@@ -285,6 +347,92 @@ mod tests {
     use super::*;
 
     use crate::srbf::fit::tests::{sphere_target, two_lobes};
+
+    #[test]
+    fn accumulated_normal_equations_equal_the_explicit_jacobian_products() {
+        // Three lobes, one narrow (λ = 400: most points below the exp cutoff) and one at
+        // c = 0, on a target unlike the model, so every block of H and g is exercised.
+        let target = sphere_target(|d| 0.3 + (d.z + d.x).max(0.0).powi(3), 48, 24);
+        let lobes = [
+            SgLobe {
+                axis: Vec3::new(0.0, 0.6, 0.8),
+                lambda: 400.0,
+                amplitude: 2.0,
+            },
+            SgLobe {
+                axis: Vec3::new(-0.8, 0.0, 0.6),
+                lambda: 3.0,
+                amplitude: 0.5,
+            },
+            SgLobe {
+                axis: Vec3::new(0.0, 0.0, 1.0),
+                lambda: 10.0,
+                amplitude: 0.0,
+            },
+        ];
+        let lm = Lm {
+            target: &target,
+            scale: target.weights().iter().map(|a| a.sqrt()).collect(),
+            lambda_min: 0.5,
+            lambda_max: 1e3,
+            log_min: 0.5f64.ln(),
+            log_max: 1e3f64.ln(),
+        };
+        let frames: Vec<(Vec3, Vec3)> = lobes.iter().map(|l| tangents(&l.axis)).collect();
+        // The explicit Jacobian, every entry by its formula (no cutoff).
+        let n = P * lobes.len();
+        let mut jac = DMatrix::<f64>::zeros(target.len(), n);
+        let mut r = DVector::<f64>::zeros(target.len());
+        for (i, ((d, &f), &s)) in target
+            .directions()
+            .iter()
+            .zip(target.values())
+            .zip(&lm.scale)
+            .enumerate()
+        {
+            r[i] = -s * f;
+            for (k, (l, (t1, t2))) in lobes.iter().zip(&frames).enumerate() {
+                let cos = d.dot(&l.axis);
+                let sg = s * (l.lambda * (cos - 1.0)).exp();
+                r[i] += l.amplitude * sg;
+                let clg = sg * l.amplitude * l.lambda;
+                jac[(i, P * k)] = sg;
+                jac[(i, P * k + 1)] = clg * (cos - 1.0);
+                jac[(i, P * k + 2)] = clg * d.dot(t1);
+                jac[(i, P * k + 3)] = clg * d.dot(t2);
+            }
+        }
+        let (h_ref, g_ref) = (jac.tr_mul(&jac), jac.tr_mul(&r));
+        let mut cache = Vec::new();
+        let cost = lm.cost(&lobes, &mut cache);
+        let (cost2, h, g) = lm.normal_equations(&lobes, &frames, &cache);
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+        assert!(
+            rel(cost, r.norm_squared()) < 1e-12,
+            "{cost} vs {}",
+            r.norm_squared()
+        );
+        assert!(rel(cost2, r.norm_squared()) < 1e-12);
+        let h_scale = h_ref.amax();
+        for p in 0..n {
+            assert!(
+                (g[p] - g_ref[p]).abs() <= 1e-12 * g_ref.amax(),
+                "g[{p}]: {} vs {}",
+                g[p],
+                g_ref[p]
+            );
+            for q in 0..n {
+                assert!(
+                    (h[(p, q)] - h_ref[(p, q)]).abs() <= 1e-12 * h_scale,
+                    "H[{p},{q}]: {} vs {}",
+                    h[(p, q)],
+                    h_ref[(p, q)]
+                );
+            }
+        }
+        // The narrow lobe's block is not trivially zero (the cutoff keeps its support).
+        assert!(h_ref[(0, 0)] > 1e-6 * h_scale);
+    }
 
     #[test]
     fn recovers_a_mixture_from_a_perturbed_start_and_holds_bounds() {

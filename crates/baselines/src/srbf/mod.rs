@@ -41,7 +41,7 @@ pub mod vmf;
 
 pub use envfit::{EnvSrbf, fit_envmap};
 pub use error::SrbfError;
-pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit, fit_lbfgs};
+pub use fit::{FitReport, FitSettings, FitTarget, SrbfFit, fit, fit_from, fit_lbfgs};
 pub use product::ProductSettings;
 pub use sampler::{SrbfReport, SrbfSampler};
 pub use vmf::SgLobe;
