@@ -23,11 +23,13 @@ pub(super) fn turn_from_cell(wo: &Vec3, cell: Turn) -> Turn {
     }
 }
 
-/// Largest `tan h` (cell half-width `h` ≈ 14°) for which [`cell_offset`] takes `δ` from
-/// [`atan_small`]; wider cells keep `atan2`.
-pub(super) const TAN_HALF_MAX: f64 = 0.25;
+/// Largest `tan h` (cell half-width `h` ≈ 26.6°) for which [`cell_offset`] takes `δ` from
+/// [`atan_halved`]; wider cells keep `atan2`. Half-turn-symmetric sets of 4 or more cells
+/// over π (anisotropic Ward's default: 4, `h` = 22.5°) and full-turn sets of 7 or more
+/// qualify.
+pub(super) const TAN_HALF_MAX: f64 = 0.5;
 
-/// Terms of [`atan_small`]'s series: for `|t| ≤` [`TAN_HALF_MAX`] the first omitted term is
+/// Terms of [`atan_small`]'s series: for `|t| ≤ 0.25` the first omitted term is
 /// below `0.25^26 / 27 < 2^−56` relative to `t`.
 const ATAN_TERMS: usize = 13;
 
@@ -43,7 +45,7 @@ const ATAN_COEFFS: [f64; ATAN_TERMS] = {
     c
 };
 
-/// `atan t` for `|t| ≤` [`TAN_HALF_MAX`] (also a little beyond), by its Taylor series
+/// `atan t` for `|t| ≤ 0.25` (also a little beyond), by its Taylor series
 /// (Horner in `t²`): within a few ulp of libm's `atan`, without the call.
 #[inline]
 pub(super) fn atan_small(t: f64) -> f64 {
@@ -53,6 +55,13 @@ pub(super) fn atan_small(t: f64) -> f64 {
         p = p * s + c;
     }
     t * p
+}
+
+/// `atan t` for `|t| ≤` [`TAN_HALF_MAX`]: `2 atan(t / (1 + √(1 + t²)))`, the half angle's
+/// tangent being at most 0.25 there ([`atan_small`]). Within a few ulp of libm's `atan`.
+#[inline]
+pub(super) fn atan_halved(t: f64) -> f64 {
+    2.0 * atan_small(t / (1.0 + (1.0 + t * t).sqrt()))
 }
 
 /// A coarse `atan2(s, c)` for `(c, s)` on the unit circle (the octant, then
@@ -78,7 +87,7 @@ fn coarse_angle(c: f64, s: f64) -> f64 {
 /// (issue 29): `(k, turn, δ)` with `turn` the rotation by `φo − φ_k` ([`turn_from_cell`]) and
 /// `δ ∈ [−h, h]` (to rounding) its angle reduced modulo the `period`. The cell comes from a
 /// coarse angle ([`coarse_angle`]) and is moved to a neighbour when `|tan δ| > tan h`; `δ` is
-/// then `atan(turn.sin / turn.cos)` ([`atan_small`]: `|tan δ| ≤ tan h` is small), which is the
+/// then `atan(turn.sin / turn.cos)` ([`atan_halved`]: `|tan δ| ≤ tan h` is small), which is the
 /// offset reduced modulo π, and modulo 2π too since `|δ| < π/2`. `None` when the cells are
 /// wider than [`TAN_HALF_MAX`] allows or the coarse cell is more than one cell off (the caller
 /// then takes `atan2`). `phi_turns[k]` is cell `k`'s `(cos φ_k, sin φ_k)`, `φ_k = k · period / n`.
@@ -114,7 +123,7 @@ pub(super) fn cell_offset(
         } else if t < -tan_half {
             k = if k == 0 { n - 1 } else { k - 1 };
         } else {
-            return Some((k, turn, atan_small(t)));
+            return Some((k, turn, atan_halved(t)));
         }
     }
     None
@@ -162,16 +171,24 @@ mod tests {
                 "{t}: {got:e} vs {want:e}");
         }
 
+        /// The same for the halved form over the cells it serves.
+        #[test]
+        fn atan_halved_is_atan(t in -0.5001f64..0.5001) {
+            let (got, want) = (atan_halved(t), t.atan());
+            prop_assert!((got - want).abs() <= 6.0 * f64::EPSILON * want.abs(),
+                "{t}: {got:e} vs {want:e}");
+        }
+
         /// Without `atan2`, the same cell as the `atan2` path (but within 1e-12 rad of a cell
         /// edge, where either neighbour is right), the same rotation, and `δ` to 2e-15 rad (the
         /// `atan2` path's own rounding near π),
-        /// inside `[−h, h]`: half-turn periods with 7–64 cells and full turns with 13–64.
+        /// inside `[−h, h]`: half-turn periods with 4–64 cells and full turns with 7–64.
         #[test]
         fn cell_offset_is_the_atan2_path(theta in 0.0f64..1.5707, phi in -7.0f64..7.0,
-                                         n in 7usize..=64, full in proptest::bool::ANY,
+                                         n in 4usize..=64, full in proptest::bool::ANY,
                                          edge in proptest::bool::ANY, side in -1.0f64..1.0) {
             use std::f64::consts::{PI, TAU};
-            let (period, n) = if full { (TAU, n.max(13)) } else { (PI, n) };
+            let (period, n) = if full { (TAU, n.max(7)) } else { (PI, n) };
             let step = period / n as f64;
             let half = 0.5 * step;
             // Half the cases right at a cell edge (within 1e-9 rad), where the coarse angle
@@ -198,8 +215,8 @@ mod tests {
     fn wide_cells_keep_atan2() {
         let wo = brdf::direction_from_angles(40.0, 100.0);
         let turns = |k: usize| Turn::from_angle(k as f64);
-        let h = std::f64::consts::PI / 12.0; // 6 cells over π
-        assert!(cell_offset(&wo, std::f64::consts::PI, h.tan(), turns, 6).is_none());
+        let h = std::f64::consts::PI / 6.0; // 3 cells over π
+        assert!(cell_offset(&wo, std::f64::consts::PI, h.tan(), turns, 3).is_none());
         assert!(cell_offset(&wo, std::f64::consts::TAU, 0.1, turns, 1).is_none());
     }
 
