@@ -218,6 +218,8 @@ pub(crate) struct ChebyshevTable {
     delta_scale: f64,
     /// One δ node: the trimmed series in the monomial basis, `p(x) = Σ_i power[i] xⁱ`, kept
     /// only where the conversion is well conditioned ([`monomial_of`]); empty otherwise.
+    /// Several: the tensor series in the monomial basis, `power[i · delta.len() + j]` of
+    /// `xⁱ yʲ`, on the same condition ([`tensor_monomial_of`]).
     power: Vec<f64>,
 }
 
@@ -261,6 +263,109 @@ fn monomial_of(series: &[f64], min_abs: f64) -> Option<Vec<f64>> {
     (cond <= POWER_COND * min_abs).then_some(out)
 }
 
+/// The monomial coefficients of `T_0 … T_{n−1}`: row `k` holds `T_k`'s (integers, exact in
+/// `f64` for `n ≤ 32`).
+fn chebyshev_monomials(n: usize) -> Vec<Vec<f64>> {
+    let mut t: Vec<Vec<f64>> = Vec::with_capacity(n);
+    for k in 0..n {
+        let mut row = vec![0.0; n];
+        match k {
+            0 => row[0] = 1.0,
+            1 => row[1] = 1.0,
+            _ => {
+                for (i, r) in row.iter_mut().enumerate() {
+                    let up = if i > 0 { 2.0 * t[k - 1][i - 1] } else { 0.0 };
+                    *r = up - t[k - 2][i];
+                }
+            }
+        }
+        t.push(row);
+    }
+    t
+}
+
+/// The monomial coefficients `a[i · nd + j]` (of `xⁱ yʲ`) of the tensor series `series`
+/// (`series[k · nd + l]` of `T_k(x) T_l(y)`), or `None` when the conversion would lose more
+/// than [`POWER_COND`] · ε relative to `min_abs`: `Σ_{k,l} |b_kl| ‖T_k‖₁ ‖T_l‖₁` bounds
+/// `Σ |a_ij|`, hence Horner's rounding on `[−1, 1]²`, as [`monomial_of`]'s criterion does for one
+/// variable (issue 29: two Horner passes cost fewer operations per coefficient than the
+/// tensor Clenshaw recurrence).
+fn tensor_monomial_of(series: &[f64], nd: usize, min_abs: f64) -> Option<Vec<f64>> {
+    let nt = series.len() / nd;
+    let (tx, ty) = (chebyshev_monomials(nt), chebyshev_monomials(nd));
+    let norm = |row: &Vec<f64>| row.iter().map(|c| c.abs()).sum::<f64>();
+    let (nx, ny): (Vec<f64>, Vec<f64>) =
+        (tx.iter().map(norm).collect(), ty.iter().map(norm).collect());
+    let mut cond = 0.0;
+    for k in 0..nt {
+        for l in 0..nd {
+            cond += series[k * nd + l].abs() * nx[k] * ny[l];
+        }
+    }
+    if !(cond <= POWER_COND * min_abs) {
+        return None;
+    }
+    // Along y for every θ coefficient k, then along x.
+    let mut half = vec![0.0; nt * nd];
+    for k in 0..nt {
+        for (l, tl) in ty.iter().enumerate() {
+            let b = series[k * nd + l];
+            for (j, &c) in tl.iter().enumerate() {
+                half[k * nd + j] += b * c;
+            }
+        }
+    }
+    let mut out = vec![0.0; nt * nd];
+    for (k, tk) in tx.iter().enumerate() {
+        for (i, &c) in tk.iter().enumerate() {
+            for j in 0..nd {
+                out[i * nd + j] += c * half[k * nd + j];
+            }
+        }
+    }
+    Some(out)
+}
+
+/// `Σ_i Σ_j a[i · nd + j] xⁱ yʲ`: Horner's rule along `x` for all `j` side by side over the
+/// contiguous rows, then along `y`; the δ node counts the build makes (5, 9, 17) compiled for
+/// their length, as [`tensor_clenshaw`].
+#[inline]
+fn tensor_horner(a: &[f64], nd: usize, x: f64, y: f64) -> f64 {
+    match nd {
+        5 => tensor_horner_of::<5>(a, x, y),
+        9 => tensor_horner_of::<9>(a, x, y),
+        17 => tensor_horner_of::<17>(a, x, y),
+        _ => tensor_horner_any(a, nd, x, y),
+    }
+}
+
+/// [`tensor_horner`] for `ND` δ coefficients per θ row.
+#[inline]
+fn tensor_horner_of<const ND: usize>(a: &[f64], x: f64, y: f64) -> f64 {
+    let (rows, _) = a.as_chunks::<ND>();
+    let mut acc = [0.0f64; ND];
+    for row in rows.iter().rev() {
+        for l in 0..ND {
+            acc[l] = acc[l] * x + row[l];
+        }
+    }
+    acc.iter().rev().fold(0.0, |s, &c| s * y + c)
+}
+
+/// [`tensor_horner`] for any `nd` (at most 32 are read).
+fn tensor_horner_any(a: &[f64], nd: usize, x: f64, y: f64) -> f64 {
+    const MAX: usize = 32;
+    let nd = nd.clamp(1, MAX);
+    let mut acc = [0.0f64; MAX];
+    let acc = &mut acc[..nd];
+    for row in a.chunks_exact(nd).rev() {
+        for (s, &r) in acc.iter_mut().zip(row) {
+            *s = *s * x + r;
+        }
+    }
+    acc.iter().rev().fold(0.0, |s, &c| s * y + c)
+}
+
 /// The tensor Chebyshev series of `values` (`values[i · nd + k]` at the Lobatto nodes `i` of
 /// θ and `k` of δ): [`chebyshev_series`] along δ for every θ node, then along θ for every δ
 /// coefficient; `out[k · nd + l]` multiplies `T_k(x) T_l(y)`.
@@ -292,10 +397,11 @@ impl ChebyshevTable {
         };
         let min_abs = values.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
         let power = if delta.len() == 1 {
-            monomial_of(&series, min_abs).unwrap_or_default()
+            monomial_of(&series, min_abs)
         } else {
-            Vec::new()
-        };
+            tensor_monomial_of(&series, delta.len(), min_abs)
+        }
+        .unwrap_or_default();
         Self {
             power,
             series,
@@ -311,7 +417,8 @@ impl ChebyshevTable {
 
     /// The interpolant at `(θ, δ)` (arguments outside the box are clamped to it). One δ node:
     /// Horner's rule on [`Self::power`] when it was kept, else Clenshaw's recurrence; a tensor
-    /// table: [`tensor_clenshaw`], out of line.
+    /// table: [`tensor_horner`] on [`Self::power`] when it was kept, else [`tensor_clenshaw`],
+    /// out of line.
     #[inline]
     pub(crate) fn eval(&self, theta: f64, delta: f64) -> f64 {
         let x = ((theta - self.centre) * self.scale).clamp(-1.0, 1.0);
@@ -327,6 +434,9 @@ impl ChebyshevTable {
     #[inline(never)]
     fn eval_tensor(&self, x: f64, delta: f64) -> f64 {
         let y = ((delta - self.delta_centre) * self.delta_scale).clamp(-1.0, 1.0);
+        if !self.power.is_empty() {
+            return tensor_horner(&self.power, self.delta.len(), x, y);
+        }
         tensor_clenshaw(&self.series, self.delta.len(), x, y)
     }
 
@@ -536,6 +646,66 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A smooth normaliser-like tensor table (9 θ × 5, 9 and 7 δ nodes) takes the monomial
+    /// (Horner) path and agrees with the tensor Clenshaw form and the tensor barycentric
+    /// interpolant to 1e-13 relative over its box; a table of wild values keeps the Chebyshev
+    /// form. The compiled δ lengths are the general loop, bit for bit.
+    #[test]
+    fn tensor_monomial_form_is_the_same_polynomial_where_kept() {
+        let f = |t: f64, d: f64| (0.3 + t.cos()).powf(1.7) * (1.0 + 0.2 * (2.0 * d + 0.3).cos());
+        for nd in [5, 7, 9] {
+            let theta = lobatto_nodes(0.1, 0.6, 9);
+            let delta = lobatto_nodes(-0.2, 0.2, nd);
+            let values: Vec<f64> = theta
+                .iter()
+                .flat_map(|&t| delta.iter().map(move |&d| f(t, d)))
+                .collect();
+            let table = ChebyshevTable::new(theta.clone(), delta.clone(), values.clone());
+            assert_eq!(
+                table.power.len(),
+                9 * nd,
+                "smooth table: monomial form kept"
+            );
+            for k in 0..=40 {
+                for m in 0..=10 {
+                    let (t, d) = (0.1 + 0.5 * k as f64 / 40.0, -0.2 + 0.4 * m as f64 / 10.0);
+                    let x = ((t - table.centre) * table.scale).clamp(-1.0, 1.0);
+                    let y = ((d - table.delta_centre) * table.delta_scale).clamp(-1.0, 1.0);
+                    let (horner, cheb) =
+                        (table.eval(t, d), tensor_clenshaw(&table.series, nd, x, y));
+                    assert!(
+                        (horner - cheb).abs() <= 1e-13 * cheb.abs(),
+                        "{t} {d}: {horner} vs {cheb}"
+                    );
+                    let rows: Vec<f64> = (0..9)
+                        .map(|i| interpolate(&delta, &values[i * nd..(i + 1) * nd], d))
+                        .collect();
+                    let bary = interpolate(&theta, &rows, t);
+                    assert!(
+                        (horner - bary).abs() <= 1e-13 * bary.abs(),
+                        "{t} {d}: {horner} vs {bary}"
+                    );
+                    assert_eq!(
+                        tensor_horner(&table.power, nd, x, y).to_bits(),
+                        tensor_horner_any(&table.power, nd, x, y).to_bits()
+                    );
+                }
+            }
+        }
+        let wild: Vec<f64> = (0..9 * 5)
+            .map(|j| if j % 2 == 0 { 10.0 } else { 0.1 })
+            .collect();
+        let table = ChebyshevTable::new(
+            lobatto_nodes(0.0, 1.0, 9),
+            lobatto_nodes(-0.2, 0.2, 5),
+            wild,
+        );
+        assert!(
+            table.power.is_empty(),
+            "ill-conditioned: Chebyshev form kept"
+        );
     }
 
     #[test]

@@ -13,6 +13,10 @@ pub(super) struct Cell {
     pub(super) phi: f64,
     /// `(cos, sin)` of `phi`: a query's rotation from the cell's frame without trigonometry.
     pub(super) phi_turn: Turn,
+    /// `tan h` of the cells' half-width `h` (the same for every cell of a set; 0 for isotropic
+    /// sets): a query's offset `δ` lies in this cell when `|tan δ| ≤ tan h`
+    /// ([`super::walk::cell_offset`]).
+    pub(super) tan_half: f64,
     /// Upper θ edges of the strips (radians), increasing; the last is π/2.
     pub(super) upper: Vec<f64>,
     /// The same edges as search keys ([`TableVar::key`]), increasing.
@@ -80,6 +84,7 @@ impl Cell {
         Self {
             phi,
             phi_turn: Turn::from_angle(phi),
+            tan_half: grid.half.tan(),
             upper,
             keys,
             guide,

@@ -80,6 +80,14 @@ impl ExactSet {
                 Turn::IDENTITY
             };
             (0, turn, 0.0)
+        } else if let Some(found) = super::walk::cell_offset(
+            wo,
+            self.period,
+            self.cells[0].tan_half,
+            |k| self.cells[k].phi_turn,
+            self.cells.len(),
+        ) {
+            found
         } else {
             let phi = wo.y.atan2(wo.x);
             let n = self.cells.len();
