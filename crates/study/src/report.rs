@@ -186,11 +186,12 @@ fn run_section(s: &mut String, results: &StudyResults) {
     ) {
         let _ = writeln!(
             s,
-            "* timings on the {} clock; their spread (standard deviation of ln t over the {} interleaved repeats of a cell): {cpu}; on the wall clock: {wall}.",
+            "* timings on the {} clock; their spread (standard deviation of ln t over a cell's {}–{} interleaved repeats, stopped by the rule of the Outcome section): {cpu}; on the wall clock: {wall}.",
             match clock {
                 crate::Clock::ThreadCpu => "timing thread's CPU-time",
                 crate::Clock::Wall => "wall",
             },
+            crate::harness::TIMING_MIN_REPEATS.min(results.config.timing_repeats),
             results.config.timing_repeats,
         );
     }

@@ -13,30 +13,7 @@ use super::grid::TableVar;
 use super::interval::{Interval, Query};
 use super::options::THETA_TOP_DEG;
 use super::set::ExactSet;
-
-/// `x.rem_euclid(p)` for `p > 0`, bit for bit, without the `fmod` call when `|x| < 2p` (a
-/// query's azimuth and its offset from a cell: `atan2` is within `[−π, π]`): there `x % p` is
-/// `x` or `x ∓ p`, exact (Sterbenz), with the sign of `x` (also for a zero result, as `fmod`).
-#[inline]
-pub(super) fn rem_period(x: f64, p: f64) -> f64 {
-    let a = x.abs();
-    let r = if a < p {
-        x
-    } else if a < 2.0 * p {
-        (x - p.copysign(x)).copysign(x)
-    } else {
-        x % p
-    };
-    if r < 0.0 { r + p } else { r }
-}
-
-/// `t.round() as usize` (halves away from zero) for `t ≥ 0` below `2^52` and NaN (0), without
-/// the `round` call: `t − ⌊t⌋` is exact there.
-#[inline]
-pub(super) fn round_index(t: f64) -> usize {
-    let whole = t as i64;
-    (whole + i64::from(t - whole as f64 >= 0.5)) as usize
-}
+use super::walk::{rem_period, round_index};
 
 impl ExactSet {
     /// The tabulated normaliser `A(θo, δ) = ∫ f_r(ωo, ·) cos θi dσ` used by the pdf at `wo`

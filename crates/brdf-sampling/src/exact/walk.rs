@@ -109,8 +109,8 @@ pub(super) fn cell_offset(
         (1.0, 0.0)
     };
     let step = period / n as f64;
-    let phi = super::lookup::rem_period(coarse_angle(c, s), period);
-    let mut k = super::lookup::round_index(phi / step) % n;
+    let phi = rem_period(coarse_angle(c, s), period);
+    let mut k = round_index(phi / step) % n;
     for _ in 0..2 {
         let cell = phi_turns(k);
         let turn = Turn {
@@ -127,6 +127,30 @@ pub(super) fn cell_offset(
         }
     }
     None
+}
+
+/// `x.rem_euclid(p)` for `p > 0`, bit for bit, without the `fmod` call when `|x| < 2p` (a
+/// query's azimuth and its offset from a cell: `atan2` is within `[−π, π]`): there `x % p` is
+/// `x` or `x ∓ p`, exact (Sterbenz), with the sign of `x` (also for a zero result, as `fmod`).
+#[inline]
+pub(super) fn rem_period(x: f64, p: f64) -> f64 {
+    let a = x.abs();
+    let r = if a < p {
+        x
+    } else if a < 2.0 * p {
+        (x - p.copysign(x)).copysign(x)
+    } else {
+        x % p
+    };
+    if r < 0.0 { r + p } else { r }
+}
+
+/// `t.round() as usize` (halves away from zero) for `t ≥ 0` below `2^52` and NaN (0), without
+/// the `round` call: `t − ⌊t⌋` is exact there.
+#[inline]
+pub(super) fn round_index(t: f64) -> usize {
+    let whole = t as i64;
+    (whole + i64::from(t - whole as f64 >= 0.5)) as usize
 }
 
 #[cfg(test)]
@@ -150,7 +174,7 @@ mod tests {
 
     /// The cell and offset of the `atan2` path `locate` takes for wide cells.
     fn reference(wo: &Vec3, period: f64, n: usize) -> (usize, f64) {
-        use super::super::lookup::{rem_period, round_index};
+        use super::super::walk::{rem_period, round_index};
         let phi = wo.y.atan2(wo.x);
         let step = period / n as f64;
         let k = round_index(rem_period(phi, period) / step) % n;
