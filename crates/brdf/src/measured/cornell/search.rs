@@ -371,21 +371,19 @@ impl Neighbourhood {
 mod tests {
     use super::*;
 
-    /// Against a brute-force scan: the same sorted distances (ties may pick other samples at
-    /// the same distance), on random points and on a grid full of ties.
-    #[test]
-    fn nearest_matches_a_scan() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut uniform = move || {
+    /// A xorshift64 stream of uniforms in [0, 1) (53 bits) from `state`.
+    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let random: Vec<[f64; 3]> = (0..700)
-            .map(|_| [uniform(), uniform(), uniform()])
-            .collect();
-        let grid: Vec<[f64; 3]> = (0..512)
+        }
+    }
+
+    /// The 8 × 8 × 8 grid on the unit cube: every query has many equidistant samples.
+    fn tie_grid() -> Vec<[f64; 3]> {
+        (0..512)
             .map(|i| {
                 [
                     (i % 8) as f64 / 7.0,
@@ -393,7 +391,18 @@ mod tests {
                     (i / 64) as f64 / 7.0,
                 ]
             })
+            .collect()
+    }
+
+    /// Against a brute-force scan: the same sorted distances (ties may pick other samples at
+    /// the same distance), on random points and on a grid full of ties.
+    #[test]
+    fn nearest_matches_a_scan() {
+        let mut uniform = xorshift(0x9e37_79b9_7f4a_7c15);
+        let random: Vec<[f64; 3]> = (0..700)
+            .map(|_| [uniform(), uniform(), uniform()])
             .collect();
+        let grid = tie_grid();
         for points in [random, grid, (0..5).map(|i| [i as f64, 0.0, 0.0]).collect()] {
             let tree = Tree::new(&points);
             for k in 0..3000 {
@@ -436,25 +445,11 @@ mod tests {
     /// neighbourhood; it answers most of the small steps from the cache.
     #[test]
     fn cached_search_is_the_tree_search() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(0x2545_f491_4f6c_dd1d);
         let random: Vec<[f64; 3]> = (0..1500)
             .map(|_| [uniform(), uniform(), uniform()])
             .collect();
-        let grid: Vec<[f64; 3]> = (0..512)
-            .map(|i| {
-                [
-                    (i % 8) as f64 / 7.0,
-                    (i / 8 % 8) as f64 / 7.0,
-                    (i / 64) as f64 / 7.0,
-                ]
-            })
-            .collect();
+        let grid = tie_grid();
         let small: Vec<[f64; 3]> = (0..20).map(|i| [i as f64 / 19.0, 0.5, 0.5]).collect();
         for (name, points) in [("random", random), ("grid", grid), ("small", small)] {
             let tree = Tree::new(&points);
