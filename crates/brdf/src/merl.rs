@@ -546,15 +546,7 @@ mod tests {
     /// each axis, a few ulps either side.
     #[test]
     fn index_of_is_the_std_bin_at_random_and_at_edges() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            // SplitMix64.
-            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = crate::test_support::splitmix_uniforms(0x2545_f491_4f6c_dd1d_u64);
         let dir = |u: f64, v: f64| {
             let z = u.max(1e-9);
             let s = (1.0 - z * z).sqrt();

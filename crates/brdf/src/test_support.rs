@@ -48,3 +48,14 @@ pub(crate) fn compare_to_reference(
     }
     (worst, max_rel, max_abs)
 }
+
+/// A SplitMix64 stream of uniforms in [0, 1) (53 bits) from `state` (fixed-seed test inputs).
+pub(crate) fn splitmix_uniforms(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -900,15 +900,7 @@ mod tests {
     #[test]
     fn evaluation_matches_the_std_angles_on_random_pairs() {
         let b = fixture();
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = || {
-            // SplitMix64.
-            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = crate::test_support::splitmix_uniforms(0x9e37_79b9_7f4a_7c15_u64);
         let mut pairs = Vec::with_capacity(100_000);
         for k in 0..100_000 {
             let wo = direction(uniform(), uniform(), k % 64 == 0);
