@@ -609,16 +609,14 @@ pub(super) mod tests {
         b[0].axis = Vec3::new(0.0, (0.6435f64 + 0.005).sin(), (0.6435f64 + 0.005).cos());
         // A floor the lobes cannot represent exactly, so the fits end at a positive error.
         let floor = |d: &Vec3| 0.05 * d.z.max(0.0);
-        let ta = sphere_target(
-            |d| a.iter().map(|l| l.eval(d)).sum::<f64>() + floor(d),
-            96,
-            48,
-        );
-        let tb = sphere_target(
-            |d| b.iter().map(|l| l.eval(d)).sum::<f64>() + floor(d),
-            96,
-            48,
-        );
+        let target_of = |lobes: &[SgLobe]| {
+            sphere_target(
+                |d| lobes.iter().map(|l| l.eval(d)).sum::<f64>() + floor(d),
+                96,
+                48,
+            )
+        };
+        let (ta, tb) = (target_of(&a), target_of(&b));
         let settings = FitSettings {
             lobes: 4,
             lambda_min: 0.5,

@@ -70,6 +70,16 @@ struct Lm<'a> {
 const EXP_CUTOFF: f64 = -40.0;
 
 impl Lm<'_> {
+    /// The target's points: direction `η_i`, value `f_i` and residual scale `s_i`.
+    fn points(&self) -> impl Iterator<Item = (&Vec3, f64, f64)> {
+        let t = self.target;
+        t.directions()
+            .iter()
+            .zip(t.values())
+            .zip(&self.scale)
+            .map(|((d, &f), &s)| (d, f, s))
+    }
+
     /// `‖r‖²` of `lobes`, storing `s_i e^{λ_k(η_i·ξ_k − 1)}` (row-major, `K` per point) in
     /// `cache` for [`Self::normal_equations`] (so each `exp` is evaluated once per point and
     /// trial step, not again for the accepted step's normal equations).
@@ -79,13 +89,7 @@ impl Lm<'_> {
         cache.clear();
         cache.resize(k * t.len(), 0.0);
         let mut cost = 0.0;
-        for (((d, &f), &s), row) in t
-            .directions()
-            .iter()
-            .zip(t.values())
-            .zip(&self.scale)
-            .zip(cache.chunks_exact_mut(k.max(1)))
-        {
+        for ((d, f, s), row) in self.points().zip(cache.chunks_exact_mut(k.max(1))) {
             let mut model = 0.0;
             for (l, e) in lobes.iter().zip(row.iter_mut()) {
                 let arg = l.lambda * (d.dot(&l.axis) - 1.0);
@@ -111,7 +115,6 @@ impl Lm<'_> {
         frames: &[(Vec3, Vec3)],
         cache: &[f64],
     ) -> (f64, DMatrix<f64>, DVector<f64>) {
-        let t = self.target;
         let k = lobes.len();
         let n = P * k;
         // Column-major `n × n` (nalgebra's layout); entry (p, q) at `p + n q`, filled for p ≤ q.
@@ -120,13 +123,7 @@ impl Lm<'_> {
         let mut idx: Vec<usize> = Vec::with_capacity(n);
         let mut val: Vec<f64> = Vec::with_capacity(n);
         let mut cost = 0.0;
-        for (((d, &f), &s), row) in t
-            .directions()
-            .iter()
-            .zip(t.values())
-            .zip(&self.scale)
-            .zip(cache.chunks_exact(k.max(1)))
-        {
+        for ((d, f, s), row) in self.points().zip(cache.chunks_exact(k.max(1))) {
             idx.clear();
             val.clear();
             let mut r = -s * f;
