@@ -5,6 +5,7 @@ use crate::layout::Turn;
 use super::grid::{Grid, TableVar};
 use super::interval::Interval;
 use super::table::LeafTable;
+use super::walk::TAN_HALF_MAX;
 
 /// One azimuth cell: its centre and its intervals. The cell is cut into θ **strips** at every
 /// interval's θ edges; a strip holds the intervals that cover it, ordered by δ (one, unless
@@ -19,18 +20,27 @@ pub(super) struct Cell {
     pub(super) tan_half: f64,
     /// Upper θ edges of the strips (radians), increasing; the last is π/2.
     pub(super) upper: Vec<f64>,
-    /// The same edges as search keys ([`TableVar::key`]), increasing.
+    /// The same edges as search keys, increasing: `1 − cos θ` for anisotropic cells (a query
+    /// is placed by its `cos θo` without `acos`, whatever the table variable; see
+    /// [`Cell::search_key`]), otherwise the table variable's key ([`TableVar::key`]).
     pub(super) keys: Vec<f64>,
     /// Guide table over the keys `[0, range]`: `guide[g]` is the strip of the key
     /// `g · range / GUIDE_LEN`, where the search for any key of bucket `g` starts (see
     /// [`Cell::interval_of`]).
     pub(super) guide: Vec<u32>,
     pub(super) range: f64,
+    /// The variable of [`Cell::keys`] ([`search_var`]).
+    pub(super) search: TableVar,
     /// Strip `s` holds the intervals `members[strips[s]..strips[s + 1]]`; empty when every
     /// strip holds one interval, the strip's own index (no azimuth split in the cell).
     pub(super) strips: Vec<u32>,
-    /// Upper δ edge of each strip entry, increasing within a strip.
-    pub(super) delta_upper: Vec<f64>,
+    /// The strip search's keys of the upper δ edge of each strip entry (increasing within a
+    /// strip): `tan δ` when the set's cells are narrow
+    /// enough for [`super::walk::cell_offset`] (`tan h ≤` [`TAN_HALF_MAX`]: a query's `tan δ`
+    /// is known before its `atan`), otherwise `δ` itself; see [`Cell::by_tan`].
+    pub(super) delta_keys: Vec<f64>,
+    /// Whether [`Cell::delta_keys`] hold `tan δ` (the strip search takes `tan δ` then).
+    pub(super) by_tan: bool,
     /// The interval of each strip entry.
     pub(super) members: Vec<u32>,
     /// The intervals, ordered by θ, then δ.
@@ -54,12 +64,13 @@ impl Cell {
         edges.sort_unstable();
         edges.dedup();
         let upper: Vec<f64> = edges.iter().map(|&e| grid.edge(e)).collect();
-        let mut keys: Vec<f64> = upper.iter().map(|&t| var.key(var.of(t))).collect();
+        let search = search_var(var, grid.half);
+        let mut keys: Vec<f64> = upper.iter().map(|&t| search.key(search.of(t))).collect();
         // Monotone despite rounding (the search needs sorted keys).
         for i in 1..keys.len() {
             keys[i] = keys[i].max(keys[i - 1]);
         }
-        let range = var.key_range();
+        let range = search.key_range();
         let guide = interval_guide(&keys, range);
         let (mut strips, mut delta_upper, mut entries) = (vec![0u32], Vec::new(), Vec::new());
         let mut lower = 0u64;
@@ -79,36 +90,58 @@ impl Cell {
             lower = e;
         }
         let plain = entries.len() == edges.len();
+        let tan_half = grid.half.tan();
+        let by_tan =
+            grid.half > 0.0 && grid.half < std::f64::consts::FRAC_PI_2 && tan_half <= TAN_HALF_MAX;
+        let delta_keys = delta_upper
+            .iter()
+            .map(|&d: &f64| if by_tan { d.tan() } else { d })
+            .collect();
         let intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
         let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
         Self {
             phi,
             phi_turn: Turn::from_angle(phi),
-            tan_half: grid.half.tan(),
+            tan_half,
             upper,
             keys,
             guide,
             range,
+            search,
             strips: if plain { Vec::new() } else { strips },
-            delta_upper: if plain { Vec::new() } else { delta_upper },
+            delta_keys: if plain { Vec::new() } else { delta_keys },
+            by_tan,
             members: if plain { Vec::new() } else { entries },
             intervals,
             tables,
         }
     }
 
-    /// The interval of the search key `key` and azimuth offset `delta`.
+    /// The interval of the search key `key` ([`Cell::search_key`]) and azimuth key `dkey`:
+    /// `tan δ` when [`Cell::by_tan`], otherwise the offset `δ` (the two order the strip's
+    /// entries alike: `tan` is increasing on `|δ| ≤ h < π/2`).
     #[inline]
-    pub(super) fn interval_of(&self, key: f64, delta: f64) -> usize {
+    pub(super) fn interval_of(&self, key: f64, dkey: f64) -> usize {
         let s = guided_interval(&self.keys, &self.guide, self.range, key);
         if self.strips.is_empty() {
             return s;
         }
         let (mut j, last) = (self.strips[s] as usize, self.strips[s + 1] as usize - 1);
-        while j < last && self.delta_upper[j] < delta {
+        while j < last && self.delta_keys[j] < dkey {
             j += 1;
         }
         self.members[j] as usize
+    }
+
+    /// The θ search key of a query with `cos θo = cos` and table variable `v`: `1 − cos θo`
+    /// for anisotropic cells (no `acos` on the way to the interval: the walk need not wait for
+    /// it; [`search_var`]), otherwise the table variable's key ([`TableVar::key`]).
+    #[inline]
+    pub(super) fn search_key(&self, cos: f64, v: f64) -> f64 {
+        match self.search {
+            TableVar::Cos => 1.0 - cos,
+            TableVar::Theta => v,
+        }
     }
 
     /// The intervals of strip `s`, ordered by δ.
@@ -133,6 +166,12 @@ impl Cell {
             })
             .collect()
     }
+}
+
+/// The variable a cell's θ search runs on: `cos θo` for anisotropic cells (`half > 0`), so
+/// that a query needs no `acos` to find its interval, otherwise the table variable `var`.
+pub(super) fn search_var(var: TableVar, half: f64) -> TableVar {
+    if half > 0.0 { TableVar::Cos } else { var }
 }
 
 /// The guide table of the interval edges `upper` (increasing, not empty) over `[0, range]`:

@@ -44,7 +44,8 @@ impl ExactSet {
         }
         let wo = &served;
         let cos = wo.z.min(1.0);
-        let (cell, turn, delta) = if self.isotropic {
+        // `dkey`: the strip search's azimuth key (`tan δ` or `δ`, `Cell::by_tan`).
+        let (cell, turn, delta, dkey) = if self.isotropic {
             // The rotation that takes the frame's ωo (at φ = 0) to the query's, without
             // trigonometry: (cos φo, sin φo) = (x, y)/r.
             let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
@@ -56,7 +57,7 @@ impl ExactSet {
             } else {
                 Turn::IDENTITY
             };
-            (0, turn, 0.0)
+            (0, turn, 0.0, 0.0)
         } else if let Some(found) = super::walk::cell_offset(
             wo,
             self.period,
@@ -75,17 +76,24 @@ impl ExactSet {
             if delta > 0.5 * self.period {
                 delta -= self.period;
             }
-            (
-                k,
-                super::walk::turn_from_cell(wo, self.cells[k].phi_turn),
-                delta,
-            )
+            let turn = super::walk::turn_from_cell(wo, self.cells[k].phi_turn);
+            let dkey = if self.cells[k].by_tan {
+                turn.sin / turn.cos
+            } else {
+                delta
+            };
+            (k, turn, delta, dkey)
         };
         let var = match self.var {
             TableVar::Cos => cos,
+            // Anisotropic sets: θo without `acos` (`walk::theta_of`; within a few ulp).
+            TableVar::Theta if !self.isotropic => {
+                super::walk::theta_of(cos, (wo.x * wo.x + wo.y * wo.y).sqrt())
+            }
             TableVar::Theta => cos.acos(),
         };
-        let interval = self.cells[cell].interval_of(self.var.key(var), delta);
+        let c = &self.cells[cell];
+        let interval = c.interval_of(c.search_key(cos, var), dkey);
         Some(Query {
             cell,
             interval,

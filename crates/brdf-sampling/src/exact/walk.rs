@@ -46,15 +46,21 @@ const ATAN_COEFFS: [f64; ATAN_TERMS] = {
 };
 
 /// `atan t` for `|t| ≤ 0.25` (also a little beyond), by its Taylor series
-/// (Horner in `t²`): within a few ulp of libm's `atan`, without the call.
+/// (Estrin's scheme in `t²`): within a few ulp of libm's `atan`, without the call.
 #[inline]
 pub(super) fn atan_small(t: f64) -> f64 {
+    // Estrin's scheme in `s = t²` (pairs, then pairs of pairs by `s²`, `s⁴`, `s⁸`): the same
+    // polynomial as Horner's rule with a dependency chain of 4 multiply-adds instead of 12
+    // (the query's `δ` and `θo` wait on it; issue 29).
+    let c = &ATAN_COEFFS;
     let s = t * t;
-    let mut p = ATAN_COEFFS[ATAN_TERMS - 1];
-    for &c in ATAN_COEFFS[..ATAN_TERMS - 1].iter().rev() {
-        p = p * s + c;
-    }
-    t * p
+    let (s2, s4) = (s * s, s * s * (s * s));
+    let s8 = s4 * s4;
+    let (p01, p23, p45) = (c[0] + c[1] * s, c[2] + c[3] * s, c[4] + c[5] * s);
+    let (p67, p89, pab) = (c[6] + c[7] * s, c[8] + c[9] * s, c[10] + c[11] * s);
+    let (q0, q1, q2) = (p01 + p23 * s2, p45 + p67 * s2, p89 + pab * s2);
+    let (r0, r1) = (q0 + q1 * s4, q2 + c[12] * s4);
+    t * (r0 + r1 * s8)
 }
 
 /// `atan t` for `|t| ≤` [`TAN_HALF_MAX`]: `2 atan(t / (1 + √(1 + t²)))`, the half angle's
@@ -64,7 +70,18 @@ pub(super) fn atan_halved(t: f64) -> f64 {
     2.0 * atan_small(t / (1.0 + (1.0 + t * t).sqrt()))
 }
 
-/// A coarse `atan2(s, c)` for `(c, s)` on the unit circle (the octant, then
+/// The polar angle `θ = acos z` of a unit direction with `z = cos θ ≥ 0` and `r = √(x² + y²) =
+/// sin θ`, without `acos` (issue 29: a libm call with branches and a table, on every
+/// anisotropic query): `tan(θ/2) = r / (1 + z) ≤ 1`, halved once more to `≤ tan(π/8) < 0.5`,
+/// then [`atan_halved`], so `θ = 4 atan_halved(·)`. Branch-free; within a few ulp of
+/// `z.acos()` (tested).
+#[inline]
+pub(super) fn theta_of(z: f64, r: f64) -> f64 {
+    let t = r / (1.0 + z);
+    4.0 * atan_halved(t / (1.0 + (1.0 + t * t).sqrt()))
+}
+
+/// A coarse `atan2(s, c)` for `(c, s)` ≠ 0 (the octant, then
 /// `z (π/4 + 0.273 (1 − z))` for `z ∈ [0, 1]`): within 0.005 rad of the true angle, in
 /// `[−π, π]`. Only picks the cell [`cell_offset`] starts from.
 #[inline]
@@ -88,7 +105,9 @@ fn coarse_angle(c: f64, s: f64) -> f64 {
 /// `δ ∈ [−h, h]` (to rounding) its angle reduced modulo the `period`. The cell comes from a
 /// coarse angle ([`coarse_angle`]) and is moved to a neighbour when `|tan δ| > tan h`; `δ` is
 /// then `atan(turn.sin / turn.cos)` ([`atan_halved`]: `|tan δ| ≤ tan h` is small), which is the
-/// offset reduced modulo π, and modulo 2π too since `|δ| < π/2`. `None` when the cells are
+/// offset reduced modulo π, and modulo 2π too since `|δ| < π/2`; `tan δ` is returned too (the
+/// strip search of [`super::layout::Cell::interval_of`] takes it, so that the walk need not
+/// wait for the `atan`). `None` when the cells are
 /// wider than [`TAN_HALF_MAX`] allows or the coarse cell is more than one cell off (the caller
 /// then takes `atan2`). `phi_turns[k]` is cell `k`'s `(cos φ_k, sin φ_k)`, `φ_k = k · period / n`.
 #[inline]
@@ -98,18 +117,22 @@ pub(super) fn cell_offset(
     tan_half: f64,
     phi_turns: impl Fn(usize) -> Turn,
     n: usize,
-) -> Option<(usize, Turn, f64)> {
+) -> Option<(usize, Turn, f64, f64)> {
     if !(tan_half <= TAN_HALF_MAX) || n < 2 {
         return None;
     }
-    let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
-    let (c, s) = if r > 0.0 {
+    // The cell and `tan δ` from `(x, y)` itself (both are invariant to its scale): the strip
+    // search and the walk need not wait for the square root and divisions of the rotation.
+    let r2 = wo.x * wo.x + wo.y * wo.y;
+    let (x, y) = if r2 > 0.0 { (wo.x, wo.y) } else { (1.0, 0.0) };
+    let r = r2.sqrt();
+    let (c, s) = if r2 > 0.0 {
         (wo.x / r, wo.y / r)
     } else {
         (1.0, 0.0)
     };
     let step = period / n as f64;
-    let phi = rem_period(coarse_angle(c, s), period);
+    let phi = rem_period(coarse_angle(x, y), period);
     let mut k = round_index(phi / step) % n;
     for _ in 0..2 {
         let cell = phi_turns(k);
@@ -117,13 +140,13 @@ pub(super) fn cell_offset(
             cos: c * cell.cos + s * cell.sin,
             sin: s * cell.cos - c * cell.sin,
         };
-        let t = turn.sin / turn.cos;
+        let t = (y * cell.cos - x * cell.sin) / (x * cell.cos + y * cell.sin);
         if t > tan_half {
             k = if k + 1 == n { 0 } else { k + 1 };
         } else if t < -tan_half {
             k = if k == 0 { n - 1 } else { k - 1 };
         } else {
-            return Some((k, turn, atan_halved(t)));
+            return Some((k, turn, atan_halved(t), t));
         }
     }
     None
@@ -203,6 +226,23 @@ mod tests {
                 "{t}: {got:e} vs {want:e}");
         }
 
+        /// `θ` without `acos`: within 8 ulp (relative) of the polar angle the direction was made
+        /// from, normal and horizon included, and within 4 ulp of π/2 of libm's `acos` where
+        /// `acos` is well conditioned (θ ≥ 0.1; near the normal `acos z` itself loses digits).
+        #[test]
+        fn theta_of_is_acos(theta in 0.0f64..=std::f64::consts::FRAC_PI_2, phi in -3.2f64..3.2) {
+            let wo = brdf::direction_from_radians(theta, phi);
+            let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
+            let got = theta_of(wo.z, r);
+            prop_assert!((got - theta).abs() <= 8.0 * f64::EPSILON * theta,
+                "θ {theta}: {got:e}");
+            if theta >= 0.1 {
+                let want = wo.z.acos();
+                prop_assert!((got - want).abs() <= 4.0 * f64::EPSILON * std::f64::consts::FRAC_PI_2,
+                    "θ {theta}: {got:e} vs acos {want:e}");
+            }
+        }
+
         /// Without `atan2`, the same cell as the `atan2` path (but within 1e-12 rad of a cell
         /// edge, where either neighbour is right), the same rotation, and `δ` to 2e-15 rad (the
         /// `atan2` path's own rounding near π),
@@ -221,7 +261,8 @@ mod tests {
             let wo = brdf::direction_from_radians(theta, phi);
             let turns = |k: usize| Turn::from_angle(k as f64 * period / n as f64);
             let got = cell_offset(&wo, period, half.tan(), turns, n);
-            let (k, t, delta) = got.expect("cells this narrow are always served");
+            let (k, t, delta, tan) = got.expect("cells this narrow are always served");
+            prop_assert!((tan - t.sin / t.cos).abs() <= 4.0 * f64::EPSILON, "tan δ {tan:e}");
             let (k_ref, d_ref) = reference(&wo, period, n);
             prop_assert_eq!(t, turn_from_cell(&wo, turns(k)));
             prop_assert!(delta.abs() <= half * (1.0 + 1e-12), "δ {delta} outside ±{half}");
