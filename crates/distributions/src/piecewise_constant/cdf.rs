@@ -99,7 +99,7 @@ pub(crate) fn find_cell_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, u: f64) -> (us
 /// Fills the guide table of a normalised CDF (`cdf.len() = n + 1`, `cdf[0] = 0`,
 /// `cdf[n] = 1`, non-decreasing, CDF value `key(entry)`): `guide[g]` is the cell that
 /// [`find_cell`] returns for `u = g / G`, `G = guide.len() ≥ 1`. O(n + G).
-pub(crate) fn fill_guide_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [u32]) {
+pub(crate) fn fill_guide_by<T, G: GuideEntry>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [G]) {
     let n = cdf.len() - 1;
     let g_len = guide.len() as f64;
     let mut i = 0usize;
@@ -108,7 +108,44 @@ pub(crate) fn fill_guide_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [
         while i + 1 < n && key(&cdf[i + 1]) <= x {
             i += 1;
         }
-        *slot = i as u32;
+        *slot = G::from_cell(i);
+    }
+}
+
+/// The integer type of a guide table's entries: `u32`, or `u16` for rows of at most 65 536
+/// cells (half the bytes, so more of a large table's guides stay in cache; the same cells).
+pub(crate) trait GuideEntry: Copy + Default {
+    /// The largest cell index the type holds.
+    const MAX_CELL: usize;
+    /// The entry of cell `i ≤ MAX_CELL`.
+    fn from_cell(i: usize) -> Self;
+    /// The cell index of the entry.
+    fn cell(self) -> usize;
+}
+
+impl GuideEntry for u32 {
+    const MAX_CELL: usize = u32::MAX as usize;
+    #[inline(always)]
+    fn from_cell(i: usize) -> Self {
+        debug_assert!(i <= Self::MAX_CELL);
+        i as u32
+    }
+    #[inline(always)]
+    fn cell(self) -> usize {
+        self as usize
+    }
+}
+
+impl GuideEntry for u16 {
+    const MAX_CELL: usize = u16::MAX as usize;
+    #[inline(always)]
+    fn from_cell(i: usize) -> Self {
+        debug_assert!(i <= Self::MAX_CELL);
+        i as u16
+    }
+    #[inline(always)]
+    fn cell(self) -> usize {
+        self as usize
     }
 }
 
@@ -133,14 +170,14 @@ pub fn find_cell_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f64) {
 /// up while the next edge is ≤ `u`, so it ends at the largest `i < n` with `cdf[i] ≤ u`,
 /// exactly what the binary search finds). The expected scan is O(1) when `G ≈ n`.
 #[inline(always)]
-pub(crate) fn find_cell_guided_by<T>(
+pub(crate) fn find_cell_guided_by<T, G: GuideEntry>(
     cdf: &[T],
     key: impl Fn(&T) -> f64,
-    guide: &[u32],
+    guide: &[G],
     u: f64,
 ) -> (usize, f64) {
     let g = guide_bucket(u, guide.len());
-    scan_by(cdf, key, guide[g] as usize, u)
+    scan_by(cdf, key, guide[g].cell(), u)
 }
 
 /// The guide-table bucket `min(⌊u·G⌋, G − 1)` of `u` for a guide of `G ≥ 1` entries.
@@ -156,6 +193,15 @@ pub(crate) fn scan_from(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) 
     scan_by(cdf, |e| e[0], start, u)
 }
 
+/// How many CDF entries past the guide's start [`scan_by`] compares in one branch-free step.
+pub(crate) const SCAN_WINDOW: usize = 4;
+
+/// The cell of `u` from a start cell: down while `cdf[i] > u` (only through the rounding of a
+/// guide bucket: predicted not taken), then up by the count of entries `≤ u` among the next
+/// [`SCAN_WINDOW`] — branch-free, so a varying number of up-steps costs no mispredicted loop
+/// exit; the count equals the steps of a one-by-one scan because the CDF is non-decreasing and
+/// `cdf[n] = 1 > u` (indices past `n` read `cdf[n]`). A full window (a run of more than
+/// `SCAN_WINDOW − 1` cells inside one guide bucket: rare with one bucket per cell) repeats.
 #[inline(always)]
 fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usize, f64) {
     let n = cdf.len() - 1;
@@ -163,8 +209,16 @@ fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usiz
     while i > 0 && key(&cdf[i]) > u {
         i -= 1;
     }
-    while i + 1 < n && key(&cdf[i + 1]) <= u {
-        i += 1;
+    loop {
+        let mut steps = 0;
+        for k in 1..=SCAN_WINDOW {
+            steps += usize::from(key(&cdf[(i + k).min(n)]) <= u);
+        }
+        // `min`: an unclamped `u ≥ 1` would count `cdf[n]` too.
+        i = (i + steps).min(n - 1);
+        if steps < SCAN_WINDOW || i == n - 1 {
+            break;
+        }
     }
     let (lo, hi) = (key(&cdf[i]), key(&cdf[i + 1]));
     let du = ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);

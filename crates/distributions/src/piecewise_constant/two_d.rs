@@ -4,8 +4,8 @@ use crate::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource
 use serde::{Deserialize, Serialize};
 
 use super::cdf::{
-    cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms,
-    invert_in, place, scan_from, validate_values,
+    GuideEntry, SCAN_WINDOW, cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by,
+    guide_bucket, in_2d_terms, invert_in, place, scan_from, validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
@@ -49,7 +49,7 @@ pub struct PiecewiseConstant2D {
     /// Guide tables of the conditional CDFs, `width` entries per row, concatenated: one
     /// cache line read and a short scan instead of ~log₂(width) dependent probes of a long row.
     /// The warp is unchanged (same cell, same position, bit for bit).
-    conditional_guide: Vec<u32>,
+    conditional_guide: RowGuides,
     /// `1 / ∫f`: the pdf of a cell is its value times this.
     inv_integral: f64,
     /// Cell sizes `Δx`, `Δy` and their inverses.
@@ -105,13 +105,11 @@ impl PiecewiseConstant2D {
                     .map(|(&c, &v)| [c, v]),
             );
         }
-        let mut conditional_guide = vec![0u32; height * width];
-        for (entries, guide) in conditional
-            .chunks_exact(width + 1)
-            .zip(conditional_guide.chunks_exact_mut(width))
-        {
-            fill_guide_by(entries, |e| e[0], guide);
-        }
+        let conditional_guide = if width - 1 <= u16::MAX_CELL {
+            RowGuides::Narrow(row_guides(&conditional, width))
+        } else {
+            RowGuides::Wide(row_guides(&conditional, width))
+        };
         // The row sums are finite and non-negative unless one overflowed: the 1D table's
         // `NonFiniteValue` of a row sum is the 2D table's overflowing total.
         let marginal = PiecewiseConstant1D::new(row_sums, y0, y1).map_err(|e| match e {
@@ -230,12 +228,43 @@ impl Sampler2D for PiecewiseConstant2D {
     /// of every sample of the block, loaded together so that their cache misses overlap; then
     /// the conditional scans and the points.
     fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
+        match &self.conditional_guide {
+            RowGuides::Narrow(g) => self.sample_block(u, out, g),
+            RowGuides::Wide(g) => self.sample_block(u, out, g),
+        }
+    }
+
+    /// `f_rc / ∫f` w.r.t. area for `p` in cell `(c, r)`; 0 outside the domain.
+    fn pdf(&self, p: Point2) -> f64 {
+        match self.locate(p) {
+            Some(((c, _), (r, _))) => self.entry(c, r)[1] * self.inv_integral,
+            None => 0.0,
+        }
+    }
+
+    fn bytes_used(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.conditional.capacity() * std::mem::size_of::<[f64; 2]>()
+            + (self.marginal.bytes_used() - std::mem::size_of::<PiecewiseConstant1D>())
+            + self.conditional_guide.bytes()
+    }
+}
+
+impl PiecewiseConstant2D {
+    /// [`Sampler2D::sample_into`] over the row guides `guides` (the table's own).
+    #[inline(always)]
+    fn sample_block<U: UniformSource + ?Sized, G: GuideEntry>(
+        &self,
+        u: &mut U,
+        out: &mut [Sample2],
+        guides: &[G],
+    ) {
         const BLOCK: usize = 64;
         let w = self.width;
         let mut cols = [0.0f64; BLOCK];
         let mut rows = [(0usize, 0.0f64); BLOCK];
         let mut guide_at = [0usize; BLOCK];
-        let mut starts = [0u32; BLOCK];
+        let mut starts = [0usize; BLOCK];
         let mut firsts = [0.0f64; BLOCK];
         for chunk in out.chunks_mut(BLOCK) {
             for j in 0..chunk.len() {
@@ -253,37 +282,24 @@ impl Sampler2D for PiecewiseConstant2D {
             // (one entry per 4 or 16 cells, more of them cached, longer scans) measured
             // slower: docs/benchmarks.md §20.5.
             for j in 0..chunk.len() {
-                starts[j] = self.conditional_guide[guide_at[j]];
+                starts[j] = guides[guide_at[j]].cell();
             }
             // Then the conditional entry each scan starts from, the same way (in the scan
             // loop below these misses would wait behind its data-dependent branches).
             for j in 0..chunk.len() {
-                firsts[j] = self.conditional[rows[j].0 * (w + 1) + starts[j] as usize][0];
+                let at = rows[j].0 * (w + 1) + starts[j];
+                firsts[j] = self.conditional[at][0]
+                    + self.conditional[at + SCAN_WINDOW.min(w - starts[j])][0];
             }
             std::hint::black_box(&firsts);
             for (j, slot) in chunk.iter_mut().enumerate() {
                 let (row, dv) = rows[j];
                 let start = row * (w + 1);
                 let entries = &self.conditional[start..start + w + 1];
-                let (col, du) = scan_from(entries, starts[j] as usize, cols[j]);
+                let (col, du) = scan_from(entries, starts[j], cols[j]);
                 *slot = self.place_sample(row, dv, col, du, entries[col][1]);
             }
         }
-    }
-
-    /// `f_rc / ∫f` w.r.t. area for `p` in cell `(c, r)`; 0 outside the domain.
-    fn pdf(&self, p: Point2) -> f64 {
-        match self.locate(p) {
-            Some(((c, _), (r, _))) => self.entry(c, r)[1] * self.inv_integral,
-            None => 0.0,
-        }
-    }
-
-    fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.conditional.capacity() * std::mem::size_of::<[f64; 2]>()
-            + (self.marginal.bytes_used() - std::mem::size_of::<PiecewiseConstant1D>())
-            + self.conditional_guide.capacity() * std::mem::size_of::<u32>()
     }
 }
 
@@ -294,8 +310,12 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
         let (row, dv) = self.marginal.find(u[1]);
         let start = row * (self.width + 1);
         let entries = &self.conditional[start..start + self.width + 1];
-        let guide = &self.conditional_guide[row * self.width..(row + 1) * self.width];
-        let (col, du) = find_cell_guided_by(entries, |e| e[0], guide, clamp_unit(u[0]));
+        let guides = row * self.width..(row + 1) * self.width;
+        let u0 = clamp_unit(u[0]);
+        let (col, du) = match &self.conditional_guide {
+            RowGuides::Narrow(g) => find_cell_guided_by(entries, |e| e[0], &g[guides], u0),
+            RowGuides::Wide(g) => find_cell_guided_by(entries, |e| e[0], &g[guides], u0),
+        };
         self.place_sample(row, dv, col, du, entries[col][1])
     }
 
@@ -310,6 +330,37 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
         let u1 = self.marginal.invert_cell(r, dv);
         Some([u0, u1])
     }
+}
+
+/// The guide tables of the conditional rows (`width` entries per row, concatenated), in the
+/// narrowest entry type that holds a column index: `u16` up to 65 536 columns (1 MB instead of
+/// 2 MB for a 1024 × 512 map), `u32` beyond. The same start cells either way.
+#[derive(Debug, Clone, PartialEq)]
+enum RowGuides {
+    Narrow(Vec<u16>),
+    Wide(Vec<u32>),
+}
+
+impl RowGuides {
+    /// Heap bytes.
+    fn bytes(&self) -> usize {
+        match self {
+            RowGuides::Narrow(g) => g.capacity() * std::mem::size_of::<u16>(),
+            RowGuides::Wide(g) => g.capacity() * std::mem::size_of::<u32>(),
+        }
+    }
+}
+
+/// The guide table of each row of `conditional` (rows of `width + 1` `[cdf, value]` entries).
+fn row_guides<G: GuideEntry>(conditional: &[[f64; 2]], width: usize) -> Vec<G> {
+    let mut guides = vec![G::default(); conditional.len() / (width + 1) * width];
+    for (entries, guide) in conditional
+        .chunks_exact(width + 1)
+        .zip(guides.chunks_exact_mut(width))
+    {
+        fill_guide_by(entries, |e| e[0], guide);
+    }
+    guides
 }
 
 /// Serialised form: the inputs and a format version; deserialisation re-validates them.
@@ -346,7 +397,7 @@ impl From<PiecewiseConstant2D> for Table2DData {
 
 #[cfg(test)]
 mod tests {
-    use super::super::cdf::{find_cell, place};
+    use super::super::cdf::{ONE_MINUS_EPSILON, find_cell, place};
     use super::*;
 
     /// Tables with empty cells and rows, a spike, and a non-unit, non-square domain.
@@ -405,6 +456,106 @@ mod tests {
                 assert!((s.pdf - pdf).abs() <= 1e-14 * pdf, "u {u:?}");
                 let inv = t.invert(s.point).unwrap();
                 assert!((inv[1] - u[1]).abs() < 1e-9 && (inv[0] - u[0]).abs() < 1e-9);
+            }
+        }
+    }
+
+    /// SplitMix64 uniforms in `[0, 1)` (53 bits).
+    fn splitmix_uniforms(seed: u64, n: usize) -> Vec<f64> {
+        let mut state = seed;
+        (0..n)
+            .map(|_| {
+                state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                let mut z = state;
+                z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+                z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+                ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn guided_walks_and_the_block_path_are_the_plain_binary_search() {
+        // The guided walks (one-sample path) and the block path against the plain binary
+        // search of each CDF, bit for bit: random u (seed 29), u = 0, 1 − ε, 1, NaN, every
+        // CDF value and its float neighbours; tables with zero-weight rows and columns, a
+        // spike, runs of tiny cells, and one wider than a `u16` guide holds.
+        let mut t = tables();
+        let wide: Vec<f64> = (0..70_000 * 2)
+            .map(|k| if k % 7 == 0 { 0.0 } else { (k % 13) as f64 })
+            .collect();
+        t.push(PiecewiseConstant2D::new(70_000, 2, wide, Rect::UNIT).unwrap());
+        let tiny: Vec<f64> = (0..40 * 6)
+            .map(|k| match (k / 40, k % 40) {
+                (1, _) | (_, 3) => 0.0,
+                (_, c) if c > 30 => 1e-12,
+                _ => 1.0 + (k % 5) as f64,
+            })
+            .collect();
+        t.push(PiecewiseConstant2D::new(40, 6, tiny, Rect::UNIT).unwrap());
+        for t in &t {
+            let (w, h) = (t.width(), t.height());
+            let values = t.values();
+            let sums: Vec<f64> = values.chunks_exact(w).map(|r| r.iter().sum()).collect();
+            let mut row_cdf = vec![0.0; h + 1];
+            fill_cdf(&sums, &mut row_cdf);
+            let mut edges = vec![0.0, -0.0, ONE_MINUS_EPSILON, 1.0, f64::NAN, 0.5];
+            edges.extend(
+                row_cdf
+                    .iter()
+                    .flat_map(|&c| [c, c.next_down(), c.next_up()]),
+            );
+            let mut cdfs = vec![0.0; h * (w + 1)];
+            for (row, cdf) in values.chunks_exact(w).zip(cdfs.chunks_exact_mut(w + 1)) {
+                fill_cdf(row, cdf);
+            }
+            for cdf in cdfs.chunks_exact(w + 1).step_by((h / 8).max(1)) {
+                let step = (w / 300).max(1);
+                edges.extend(
+                    cdf.iter()
+                        .step_by(step)
+                        .flat_map(|&c| [c, c.next_down(), c.next_up()]),
+                );
+            }
+            let random = splitmix_uniforms(29, 4000);
+            // Pairs (u0, u1): random × random, edge × random, random × edge, edge × edge.
+            let mut us = random.clone();
+            for (k, &e) in edges.iter().enumerate() {
+                let r = random[k % random.len()];
+                us.extend([e, r, r, e, e, edges[(k * 7 + 3) % edges.len()]]);
+            }
+            let d = t.domain();
+            let (dx, dy) = ((d.x1 - d.x0) / w as f64, (d.y1 - d.y0) / h as f64);
+            let mut block = vec![
+                Sample2 {
+                    point: [0.0; 2],
+                    pdf: 0.0
+                };
+                us.len() / 2
+            ];
+            t.sample_into(&mut crate::UniformSequence::new(&us), &mut block);
+            for (pair, b) in us.chunks_exact(2).zip(&block) {
+                let (u0, u1) = (clamp_unit(pair[0]), clamp_unit(pair[1]));
+                let (row, dv) = find_cell(&row_cdf, u1);
+                let (col, du) = find_cell(&cdfs[row * (w + 1)..(row + 1) * (w + 1)], u0);
+                let x = place(d.x0, d.x1, dx, w as f64 / (d.x1 - d.x0), col, du);
+                let y = place(d.y0, d.y1, dy, h as f64 / (d.y1 - d.y0), row, dv);
+                let one = t.sample_square([pair[0], pair[1]]);
+                assert_eq!(
+                    [one.point[0].to_bits(), one.point[1].to_bits()],
+                    [x.to_bits(), y.to_bits()],
+                    "u {pair:?}, {w} × {h}"
+                );
+                assert_eq!(
+                    one.pdf,
+                    values[row * w + col] * t.inv_integral,
+                    "u {pair:?}"
+                );
+                assert_eq!(
+                    [b.point[0].to_bits(), b.point[1].to_bits(), b.pdf.to_bits()],
+                    [x.to_bits(), y.to_bits(), one.pdf.to_bits()],
+                    "block path, u {pair:?}, {w} × {h}"
+                );
             }
         }
     }
