@@ -221,8 +221,13 @@ fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usiz
         }
     }
     let (lo, hi) = (key(&cdf[i]), key(&cdf[i + 1]));
-    let du = ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
-    (i, du)
+    (i, cell_position(lo, hi, u))
+}
+
+/// The position in `[0, 1)` of `u` inside the CDF interval `[lo, hi)` of its cell.
+#[inline(always)]
+pub(crate) fn cell_position(lo: f64, hi: f64, u: f64) -> f64 {
+    ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON)
 }
 
 /// The uniform number mapped by the CDF to position `du ∈ [0,1]` inside cell `i`.

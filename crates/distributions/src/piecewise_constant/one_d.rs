@@ -145,6 +145,12 @@ impl PiecewiseConstant1D {
         place(self.min, self.max, self.cell, self.inv_cell, index, du)
     }
 
+    /// The guide table of [`Self::cdf`] (one entry per cell, [`fill_guide`]).
+    #[inline(always)]
+    pub(crate) fn guide(&self) -> &[u32] {
+        &self.guide
+    }
+
     /// `Σ values` (unnormalised, before the cell width).
     pub(crate) fn sum(&self) -> f64 {
         self.sum

@@ -4,8 +4,8 @@ use crate::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource
 use serde::{Deserialize, Serialize};
 
 use super::cdf::{
-    GuideEntry, SCAN_WINDOW, cell_of, clamp_unit, fill_cdf, fill_guide_by, find_cell_guided_by,
-    guide_bucket, in_2d_terms, invert_in, place, scan_from, validate_values,
+    GuideEntry, SCAN_WINDOW, cell_of, cell_position, clamp_unit, fill_cdf, fill_guide_by,
+    find_cell_guided_by, guide_bucket, in_2d_terms, invert_in, place, scan_from, validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
@@ -259,46 +259,126 @@ impl PiecewiseConstant2D {
         out: &mut [Sample2],
         guides: &[G],
     ) {
-        const BLOCK: usize = 64;
-        let w = self.width;
-        let mut cols = [0.0f64; BLOCK];
-        let mut rows = [(0usize, 0.0f64); BLOCK];
-        let mut guide_at = [0usize; BLOCK];
-        let mut starts = [0usize; BLOCK];
-        let mut firsts = [0.0f64; BLOCK];
+        const BLOCK: usize = Lanes::LEN;
+        let mut u0 = [0.0f64; BLOCK];
+        let mut u1 = [0.0f64; BLOCK];
+        let mut lanes = Lanes::default();
         for chunk in out.chunks_mut(BLOCK) {
-            for j in 0..chunk.len() {
-                let u0 = clamp_unit(u.next_uniform());
-                let u1 = clamp_unit(u.next_uniform());
-                let (row, dv) = self.marginal.find(u1);
-                cols[j] = u0;
-                rows[j] = (row, dv);
-                guide_at[j] = row * w + guide_bucket(u0, w);
+            let m = chunk.len();
+            for j in 0..m {
+                u0[j] = clamp_unit(u.next_uniform());
+                u1[j] = clamp_unit(u.next_uniform());
             }
-            // The guide entries (4 bytes per cell, mostly out of cache on a large map), loaded
-            // for the whole block in a loop of a few instructions per sample, so that many of
-            // their misses are in flight at once (inside the loop above, whose generator and
-            // row search take tens of instructions per sample, few would be). Coarser guides
-            // (one entry per 4 or 16 cells, more of them cached, longer scans) measured
-            // slower: docs/benchmarks.md §20.5.
-            for j in 0..chunk.len() {
-                starts[j] = guides[guide_at[j]].cell();
+            self.walk_block(guides, &u0[..m], &u1[..m], &mut lanes, chunk);
+        }
+    }
+
+    /// The walks of one block of at most [`Lanes::LEN`] samples (clamped uniforms `u0` for the
+    /// columns, `u1` for the rows), in structure-of-arrays passes of branch-free lane code:
+    /// every row walk (guide entry, then the count of the next [`SCAN_WINDOW`] CDF entries
+    /// `≤ u`), then every conditional guide load, then every column walk, then the points.
+    /// Within a pass no lane waits for another, so the block's cache misses overlap. A lane
+    /// whose window did not settle the cell (its guide entry above `u`, or a full window: both
+    /// rare) is redone by the scalar scan, so the cells are exactly the binary search's.
+    #[inline(always)]
+    fn walk_block<G: GuideEntry>(
+        &self,
+        guides: &[G],
+        u0: &[f64],
+        u1: &[f64],
+        l: &mut Lanes,
+        out: &mut [Sample2],
+    ) {
+        let m = out.len();
+        let (w, h) = (self.width, self.height);
+        let mcdf = self.marginal.cdf();
+        let mguide = self.marginal.guide();
+        let cond = &self.conditional[..];
+        // Rows.
+        for j in 0..m {
+            let u = u1[j];
+            let i = (mguide[guide_bucket(u, h)] as usize).min(h - 1);
+            let mut steps = 0;
+            for k in 1..=SCAN_WINDOW {
+                steps += usize::from(mcdf[(i + k).min(h)] <= u);
             }
-            // Then the conditional entry each scan starts from, the same way (in the scan
-            // loop below these misses would wait behind its data-dependent branches).
-            for j in 0..chunk.len() {
-                let at = rows[j].0 * (w + 1) + starts[j];
-                firsts[j] = self.conditional[at][0]
-                    + self.conditional[at + SCAN_WINDOW.min(w - starts[j])][0];
+            l.redo[j] = (mcdf[i] > u) | (steps == SCAN_WINDOW);
+            l.row[j] = (i + steps).min(h - 1);
+        }
+        for j in 0..m {
+            if l.redo[j] {
+                l.row[j] = self.marginal.find(u1[j]).0;
             }
-            std::hint::black_box(&firsts);
-            for (j, slot) in chunk.iter_mut().enumerate() {
-                let (row, dv) = rows[j];
-                let start = row * (w + 1);
-                let entries = &self.conditional[start..start + w + 1];
-                let (col, du) = scan_from(entries, starts[j], cols[j]);
-                *slot = self.place_sample(row, dv, col, du, entries[col][1]);
+        }
+        for j in 0..m {
+            let r = l.row[j];
+            l.dv[j] = cell_position(mcdf[r], mcdf[r + 1], u1[j]);
+            l.base[j] = r * (w + 1);
+            l.start[j] = r * w + guide_bucket(u0[j], w);
+        }
+        // The guide entries (mostly out of cache on a large map), then the conditional
+        // entries at both ends of each window, each in a loop of a few instructions per lane:
+        // so that the whole block's misses are in flight at once (a window pass of ~30
+        // instructions per lane would hold only a dozen lanes in the reorder buffer).
+        // Coarser guides (one entry per 4 or 16 cells) measured slower: §20.5.
+        for j in 0..m {
+            l.start[j] = guides[l.start[j]].cell().min(w - 1);
+        }
+        for j in 0..m {
+            let at = l.base[j] + l.start[j];
+            l.touch[j] = cond[at][0] + cond[at + SCAN_WINDOW.min(w - l.start[j])][0];
+        }
+        std::hint::black_box(&l.touch);
+        // Columns.
+        for j in 0..m {
+            let (u, b, i) = (u0[j], l.base[j], l.start[j]);
+            let mut steps = 0;
+            for k in 1..=SCAN_WINDOW {
+                steps += usize::from(cond[b + (i + k).min(w)][0] <= u);
             }
+            l.redo[j] = (cond[b + i][0] > u) | (steps == SCAN_WINDOW);
+            l.col[j] = (i + steps).min(w - 1);
+        }
+        for j in 0..m {
+            if l.redo[j] {
+                let b = l.base[j];
+                l.col[j] = scan_from(&cond[b..b + w + 1], l.start[j], u0[j]).0;
+            }
+        }
+        for (j, slot) in out.iter_mut().enumerate() {
+            let at = l.base[j] + l.col[j];
+            let du = cell_position(cond[at][0], cond[at + 1][0], u0[j]);
+            *slot = self.place_sample(l.row[j], l.dv[j], l.col[j], du, cond[at][1]);
+        }
+    }
+}
+
+/// Per-lane scratch of [`PiecewiseConstant2D::walk_block`], structure of arrays.
+struct Lanes {
+    row: [usize; Lanes::LEN],
+    dv: [f64; Lanes::LEN],
+    base: [usize; Lanes::LEN],
+    start: [usize; Lanes::LEN],
+    col: [usize; Lanes::LEN],
+    redo: [bool; Lanes::LEN],
+    touch: [f64; Lanes::LEN],
+}
+
+impl Lanes {
+    /// Samples per block.
+    const LEN: usize = 64;
+}
+
+impl Default for Lanes {
+    fn default() -> Self {
+        Self {
+            row: [0; Self::LEN],
+            dv: [0.0; Self::LEN],
+            base: [0; Self::LEN],
+            start: [0; Self::LEN],
+            col: [0; Self::LEN],
+            redo: [false; Self::LEN],
+            touch: [0.0; Self::LEN],
         }
     }
 }
