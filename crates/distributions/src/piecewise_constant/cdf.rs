@@ -193,8 +193,38 @@ pub(crate) fn scan_from(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) 
     scan_by(cdf, |e| e[0], start, u)
 }
 
+/// [`scan_from`] one cell at a time (a data-dependent loop: cheaper than the branch-free
+/// window where its step count is predictable, dearer where it is not). The same cell and
+/// position.
+#[inline(always)]
+pub(crate) fn scan_stepwise(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) {
+    scan_stepwise_by(cdf, |e| e[0], start, u)
+}
+
+/// [`scan_by`] one cell at a time.
+#[inline(always)]
+pub(crate) fn scan_stepwise_by<T>(
+    cdf: &[T],
+    key: impl Fn(&T) -> f64,
+    start: usize,
+    u: f64,
+) -> (usize, f64) {
+    let n = cdf.len() - 1;
+    let mut i = start.min(n - 1);
+    while i > 0 && key(&cdf[i]) > u {
+        i -= 1;
+    }
+    while i + 1 < n && key(&cdf[i + 1]) <= u {
+        i += 1;
+    }
+    (i, cell_position(key(&cdf[i]), key(&cdf[i + 1]), u))
+}
+
 /// How many CDF entries past the guide's start [`scan_by`] compares in one branch-free step.
 pub(crate) const SCAN_WINDOW: usize = 4;
+
+/// Guide buckets per cell of the tables' guide tables.
+pub(crate) const GUIDE_PER_CELL: usize = 2;
 
 /// The cell of `u` from a start cell: down while `cdf[i] > u` (only through the rounding of a
 /// guide bucket: predicted not taken), then up by the count of entries `≤ u` among the next

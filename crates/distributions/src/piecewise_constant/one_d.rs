@@ -4,8 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use super::PiecewiseConstantError;
 use super::cdf::{
-    cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, invert_cell, place,
-    validate_values,
+    GUIDE_PER_CELL, cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, guide_bucket,
+    invert_cell, place, scan_stepwise_by, validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 
@@ -73,7 +73,7 @@ impl PiecewiseConstant1D {
         if !(sum > 0.0) {
             return Err(PiecewiseConstantError::AllZero);
         }
-        let mut guide = vec![0u32; values.len()];
+        let mut guide = vec![0u32; values.len() * GUIDE_PER_CELL];
         fill_guide(&cdf, &mut guide);
         let n = values.len() as f64;
         let integral = finite_integral(sum * (max - min) / n)?;
@@ -136,6 +136,14 @@ impl PiecewiseConstant1D {
     #[inline(always)]
     pub(crate) fn find(&self, u: f64) -> (usize, f64) {
         find_cell_guided(&self.cdf, &self.guide, clamp_unit(u))
+    }
+
+    /// [`Self::find`] by the one-cell-at-a-time scan (the same cell and position).
+    #[inline(always)]
+    pub(crate) fn find_stepwise(&self, u: f64) -> (usize, f64) {
+        let u = clamp_unit(u);
+        let g = guide_bucket(u, self.guide.len());
+        scan_stepwise_by(&self.cdf, |&c| c, self.guide[g] as usize, u)
     }
 
     /// The point at position `du ∈ [0, 1)` of cell `index`, in `[min, max)` and inside that

@@ -4,8 +4,9 @@ use crate::{InvertibleSampler2D, Point2, Rect, Sample2, Sampler2D, UniformSource
 use serde::{Deserialize, Serialize};
 
 use super::cdf::{
-    GuideEntry, SCAN_WINDOW, cell_of, cell_position, clamp_unit, fill_cdf, fill_guide_by,
-    find_cell_guided_by, guide_bucket, in_2d_terms, invert_in, place, scan_from, validate_values,
+    GUIDE_PER_CELL, GuideEntry, SCAN_WINDOW, cell_of, cell_position, clamp_unit, fill_cdf,
+    fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms, invert_in, place, scan_from,
+    scan_stepwise, validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
@@ -50,6 +51,12 @@ pub struct PiecewiseConstant2D {
     /// cache line read and a short scan instead of ~log₂(width) dependent probes of a long row.
     /// The warp is unchanged (same cell, same position, bit for bit).
     conditional_guide: RowGuides,
+    /// The probability that a sample's conditional guide bucket holds a cell boundary (so
+    /// that its scan takes a data-dependent number of steps): [`Self::scan_unpredictability`].
+    unpredictable: f64,
+    /// Whether the block path walks by the branch-free window (`unpredictable` above
+    /// [`Self::WINDOW_ABOVE`]) or one cell at a time (predictable step counts: fewer instructions).
+    windowed: bool,
     /// `1 / ∫f`: the pdf of a cell is its value times this.
     inv_integral: f64,
     /// Cell sizes `Δx`, `Δy` and their inverses.
@@ -116,6 +123,7 @@ impl PiecewiseConstant2D {
             PiecewiseConstantError::NonFiniteValue { .. } => PiecewiseConstantError::TotalNotFinite,
             other => other,
         })?;
+        let unpredictable = unpredictability(&conditional, &conditional_guide, &marginal, width);
         let total = marginal.sum();
         let cell = [(x1 - x0) / width as f64, (y1 - y0) / height as f64];
         let integral = finite_integral(total * cell[0] * cell[1])?;
@@ -126,11 +134,27 @@ impl PiecewiseConstant2D {
             conditional,
             marginal,
             conditional_guide,
+            unpredictable,
+            windowed: unpredictable > Self::WINDOW_ABOVE,
             inv_integral: 1.0 / integral,
             cell,
             inv_cell: [width as f64 / (x1 - x0), height as f64 / (y1 - y0)],
         })
     }
+
+    /// The probability that a sample's conditional guide bucket (one of `2·width` per row)
+    /// holds a cell boundary, i.e. that its column scan takes a data-dependent number of
+    /// steps: `Σ_rows P(row) · (buckets of the row holding a boundary) / buckets`. Above
+    /// [`Self::WINDOW_ABOVE`] the block path walks both CDFs by a branch-free window of
+    /// [`SCAN_WINDOW`] entries (mispredicted loop exits would cost more than its
+    /// instructions), below it one cell at a time. Either way the same cells.
+    pub fn scan_unpredictability(&self) -> f64 {
+        self.unpredictable
+    }
+
+    /// The [`Self::scan_unpredictability`] above which the block path walks by the
+    /// branch-free window (chosen from the shared maps, docs/benchmarks.md §23.3).
+    pub const WINDOW_ABOVE: f64 = 0.1;
 
     /// Number of columns.
     pub fn width(&self) -> usize {
@@ -297,7 +321,12 @@ impl PiecewiseConstant2D {
         // Rows.
         for j in 0..m {
             let u = u1[j];
-            let i = (mguide[guide_bucket(u, h)] as usize).min(h - 1);
+            if !self.windowed {
+                l.row[j] = self.marginal.find_stepwise(u).0;
+                l.redo[j] = false;
+                continue;
+            }
+            let i = (mguide[guide_bucket(u, mguide.len())] as usize).min(h - 1);
             let mut steps = 0;
             for k in 1..=SCAN_WINDOW {
                 steps += usize::from(mcdf[(i + k).min(h)] <= u);
@@ -314,7 +343,8 @@ impl PiecewiseConstant2D {
             let r = l.row[j];
             l.dv[j] = cell_position(mcdf[r], mcdf[r + 1], u1[j]);
             l.base[j] = r * (w + 1);
-            l.start[j] = r * w + guide_bucket(u0[j], w);
+            let gw = w * GUIDE_PER_CELL;
+            l.start[j] = r * gw + guide_bucket(u0[j], gw);
         }
         // The guide entries (mostly out of cache on a large map), then the conditional
         // entries at both ends of each window, each in a loop of a few instructions per lane:
@@ -332,6 +362,11 @@ impl PiecewiseConstant2D {
         // Columns.
         for j in 0..m {
             let (u, b, i) = (u0[j], l.base[j], l.start[j]);
+            if !self.windowed {
+                l.col[j] = scan_stepwise(&cond[b..b + w + 1], i, u).0;
+                l.redo[j] = false;
+                continue;
+            }
             let mut steps = 0;
             for k in 1..=SCAN_WINDOW {
                 steps += usize::from(cond[b + (i + k).min(w)][0] <= u);
@@ -390,7 +425,8 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
         let (row, dv) = self.marginal.find(u[1]);
         let start = row * (self.width + 1);
         let entries = &self.conditional[start..start + self.width + 1];
-        let guides = row * self.width..(row + 1) * self.width;
+        let gw = self.width * GUIDE_PER_CELL;
+        let guides = row * gw..(row + 1) * gw;
         let u0 = clamp_unit(u[0]);
         let (col, du) = match &self.conditional_guide {
             RowGuides::Narrow(g) => find_cell_guided_by(entries, |e| e[0], &g[guides], u0),
@@ -431,12 +467,50 @@ impl RowGuides {
     }
 }
 
+/// [`PiecewiseConstant2D::scan_unpredictability`] of the rows and guides of a table.
+fn unpredictability(
+    conditional: &[[f64; 2]],
+    guides: &RowGuides,
+    marginal: &PiecewiseConstant1D,
+    width: usize,
+) -> f64 {
+    let starts: Vec<usize> = match guides {
+        RowGuides::Narrow(g) => g.iter().map(|s| s.cell()).collect(),
+        RowGuides::Wide(g) => g.iter().map(|s| s.cell()).collect(),
+    };
+    let gw = width * GUIDE_PER_CELL;
+    let mcdf = marginal.cdf();
+    let mut p = 0.0;
+    for (r, (entries, row_starts)) in conditional
+        .chunks_exact(width + 1)
+        .zip(starts.chunks_exact(gw))
+        .enumerate()
+    {
+        // A bucket holds a boundary when the next bucket starts in another cell, or (the
+        // last) when it does not start in the last cell; zero-width cells count as steps.
+        let _ = entries;
+        let moving = (0..gw)
+            .filter(|&g| {
+                let next = if g + 1 < gw {
+                    row_starts[g + 1]
+                } else {
+                    width - 1
+                };
+                next != row_starts[g]
+            })
+            .count();
+        p += (mcdf[r + 1] - mcdf[r]) * moving as f64 / gw as f64;
+    }
+    p
+}
+
 /// The guide table of each row of `conditional` (rows of `width + 1` `[cdf, value]` entries).
 fn row_guides<G: GuideEntry>(conditional: &[[f64; 2]], width: usize) -> Vec<G> {
-    let mut guides = vec![G::default(); conditional.len() / (width + 1) * width];
+    let gw = width * GUIDE_PER_CELL;
+    let mut guides = vec![G::default(); conditional.len() / (width + 1) * gw];
     for (entries, guide) in conditional
         .chunks_exact(width + 1)
-        .zip(guides.chunks_exact_mut(width))
+        .zip(guides.chunks_exact_mut(gw))
     {
         fill_guide_by(entries, |e| e[0], guide);
     }
@@ -573,7 +647,17 @@ mod tests {
             })
             .collect();
         t.push(PiecewiseConstant2D::new(40, 6, tiny, Rect::UNIT).unwrap());
-        for t in &t {
+        // Each table walked both ways: the branch-free window and one cell at a time.
+        let both: Vec<PiecewiseConstant2D> = t
+            .iter()
+            .flat_map(|t| {
+                [true, false].map(|windowed| PiecewiseConstant2D {
+                    windowed,
+                    ..t.clone()
+                })
+            })
+            .collect();
+        for t in &both {
             let (w, h) = (t.width(), t.height());
             let values = t.values();
             let sums: Vec<f64> = values.chunks_exact(w).map(|r| r.iter().sum()).collect();
