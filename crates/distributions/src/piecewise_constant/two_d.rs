@@ -276,6 +276,8 @@ impl Sampler2D for PiecewiseConstant2D {
 
 impl PiecewiseConstant2D {
     /// [`Sampler2D::sample_into`] over the row guides `guides` (the table's own).
+    // Lane loops: each pass indexes several per-lane arrays by the lane number.
+    #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     fn sample_block<U: UniformSource + ?Sized, G: GuideEntry>(
         &self,
@@ -283,6 +285,9 @@ impl PiecewiseConstant2D {
         out: &mut [Sample2],
         guides: &[G],
     ) {
+        if !self.windowed {
+            return self.sample_block_stepwise(u, out, guides);
+        }
         const BLOCK: usize = Lanes::LEN;
         let mut u0 = [0.0f64; BLOCK];
         let mut u1 = [0.0f64; BLOCK];
@@ -297,6 +302,52 @@ impl PiecewiseConstant2D {
         }
     }
 
+    /// The block path of tables whose scans take predictable step counts (see
+    /// [`Self::scan_unpredictability`]): per sample, the uniforms, the row (one cell at a
+    /// time) and the guide index; then the block's guide entries and first conditional
+    /// entries, each in a loop of its own so that their misses overlap; then the column scans
+    /// (one cell at a time) and the points. The same samples as the windowed passes.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn sample_block_stepwise<U: UniformSource + ?Sized, G: GuideEntry>(
+        &self,
+        u: &mut U,
+        out: &mut [Sample2],
+        guides: &[G],
+    ) {
+        const BLOCK: usize = Lanes::LEN;
+        let w = self.width;
+        let gw = w * GUIDE_PER_CELL;
+        let mut cols = [0.0f64; BLOCK];
+        let mut rows = [(0usize, 0.0f64); BLOCK];
+        let mut starts = [0usize; BLOCK];
+        let mut firsts = [0.0f64; BLOCK];
+        for chunk in out.chunks_mut(BLOCK) {
+            for j in 0..chunk.len() {
+                let u0 = clamp_unit(u.next_uniform());
+                let u1 = clamp_unit(u.next_uniform());
+                let (row, dv) = self.marginal.find_stepwise(u1);
+                cols[j] = u0;
+                rows[j] = (row, dv);
+                starts[j] = row * gw + guide_bucket(u0, gw);
+            }
+            for j in 0..chunk.len() {
+                starts[j] = guides[starts[j]].cell().min(w - 1);
+            }
+            for j in 0..chunk.len() {
+                firsts[j] = self.conditional[rows[j].0 * (w + 1) + starts[j]][0];
+            }
+            std::hint::black_box(&firsts);
+            for (j, slot) in chunk.iter_mut().enumerate() {
+                let (row, dv) = rows[j];
+                let start = row * (w + 1);
+                let entries = &self.conditional[start..start + w + 1];
+                let (col, du) = scan_stepwise(entries, starts[j], cols[j]);
+                *slot = self.place_sample(row, dv, col, du, entries[col][1]);
+            }
+        }
+    }
+
     /// The walks of one block of at most [`Lanes::LEN`] samples (clamped uniforms `u0` for the
     /// columns, `u1` for the rows), in structure-of-arrays passes of branch-free lane code:
     /// every row walk (guide entry, then the count of the next [`SCAN_WINDOW`] CDF entries
@@ -304,6 +355,8 @@ impl PiecewiseConstant2D {
     /// Within a pass no lane waits for another, so the block's cache misses overlap. A lane
     /// whose window did not settle the cell (its guide entry above `u`, or a full window: both
     /// rare) is redone by the scalar scan, so the cells are exactly the binary search's.
+    // Lane loops: each pass indexes several per-lane arrays by the lane number.
+    #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     fn walk_block<G: GuideEntry>(
         &self,
@@ -321,11 +374,6 @@ impl PiecewiseConstant2D {
         // Rows.
         for j in 0..m {
             let u = u1[j];
-            if !self.windowed {
-                l.row[j] = self.marginal.find_stepwise(u).0;
-                l.redo[j] = false;
-                continue;
-            }
             let i = (mguide[guide_bucket(u, mguide.len())] as usize).min(h - 1);
             let mut steps = 0;
             for k in 1..=SCAN_WINDOW {
@@ -362,11 +410,6 @@ impl PiecewiseConstant2D {
         // Columns.
         for j in 0..m {
             let (u, b, i) = (u0[j], l.base[j], l.start[j]);
-            if !self.windowed {
-                l.col[j] = scan_stepwise(&cond[b..b + w + 1], i, u).0;
-                l.redo[j] = false;
-                continue;
-            }
             let mut steps = 0;
             for k in 1..=SCAN_WINDOW {
                 steps += usize::from(cond[b + (i + k).min(w)][0] <= u);
