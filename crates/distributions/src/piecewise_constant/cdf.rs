@@ -187,15 +187,7 @@ pub(crate) fn guide_bucket(u: f64, g_len: usize) -> usize {
 }
 
 /// The scan of [`find_cell_guided_by`] from cell `start` (a guide entry) over `[cdf, value]`
-/// entries: the cell and position [`find_cell`] gives for `u`.
-#[inline(always)]
-pub(crate) fn scan_from(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) {
-    scan_by(cdf, |e| e[0], start, u)
-}
-
-/// [`scan_from`] one cell at a time (a data-dependent loop: cheaper than the branch-free
-/// window where its step count is predictable, dearer where it is not). The same cell and
-/// position.
+/// entries, one cell at a time: the cell and position [`find_cell`] gives for `u`.
 #[inline(always)]
 pub(crate) fn scan_stepwise(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) {
     scan_stepwise_by(cdf, |e| e[0], start, u)
@@ -220,38 +212,19 @@ pub(crate) fn scan_stepwise_by<T>(
     (i, cell_position(key(&cdf[i]), key(&cdf[i + 1]), u))
 }
 
-/// How many CDF entries past the guide's start [`scan_by`] compares in one branch-free step.
+/// How many CDF entries past the guide's start the 2D block path's branch-free walks compare
+/// in one step (`PiecewiseConstant2D`'s windowed block path).
 pub(crate) const SCAN_WINDOW: usize = 4;
 
-/// Guide buckets per cell of the tables' guide tables.
+/// Guide buckets per cell of the tables' guide tables (fewer cell boundaries per bucket: a
+/// scan's step count is more often 0).
 pub(crate) const GUIDE_PER_CELL: usize = 2;
 
-/// The cell of `u` from a start cell: down while `cdf[i] > u` (only through the rounding of a
-/// guide bucket: predicted not taken), then up by the count of entries `≤ u` among the next
-/// [`SCAN_WINDOW`] — branch-free, so a varying number of up-steps costs no mispredicted loop
-/// exit; the count equals the steps of a one-by-one scan because the CDF is non-decreasing and
-/// `cdf[n] = 1 > u` (indices past `n` read `cdf[n]`). A full window (a run of more than
-/// `SCAN_WINDOW − 1` cells inside one guide bucket: rare with one bucket per cell) repeats.
+/// The cell of `u` from a start cell, one cell at a time: down while `cdf[i] > u` (only
+/// through the rounding of a guide bucket), then up while the next edge is `≤ u`.
 #[inline(always)]
 fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usize, f64) {
-    let n = cdf.len() - 1;
-    let mut i = start.min(n - 1);
-    while i > 0 && key(&cdf[i]) > u {
-        i -= 1;
-    }
-    loop {
-        let mut steps = 0;
-        for k in 1..=SCAN_WINDOW {
-            steps += usize::from(key(&cdf[(i + k).min(n)]) <= u);
-        }
-        // `min`: an unclamped `u ≥ 1` would count `cdf[n]` too.
-        i = (i + steps).min(n - 1);
-        if steps < SCAN_WINDOW || i == n - 1 {
-            break;
-        }
-    }
-    let (lo, hi) = (key(&cdf[i]), key(&cdf[i + 1]));
-    (i, cell_position(lo, hi, u))
+    scan_stepwise_by(cdf, key, start, u)
 }
 
 /// The position in `[0, 1)` of `u` inside the CDF interval `[lo, hi)` of its cell.

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::cdf::{
     GUIDE_PER_CELL, GuideEntry, SCAN_WINDOW, cell_of, cell_position, clamp_unit, fill_cdf,
-    fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms, invert_in, place, scan_from,
-    scan_stepwise, validate_values,
+    fill_guide_by, find_cell_guided_by, guide_bucket, in_2d_terms, invert_in, place, scan_stepwise,
+    validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 use super::{PiecewiseConstant1D, PiecewiseConstantError};
@@ -384,7 +384,7 @@ impl PiecewiseConstant2D {
         }
         for j in 0..m {
             if l.redo[j] {
-                l.row[j] = self.marginal.find(u1[j]).0;
+                l.row[j] = self.marginal.find_stepwise(u1[j]).0;
             }
         }
         for j in 0..m {
@@ -420,7 +420,7 @@ impl PiecewiseConstant2D {
         for j in 0..m {
             if l.redo[j] {
                 let b = l.base[j];
-                l.col[j] = scan_from(&cond[b..b + w + 1], l.start[j], u0[j]).0;
+                l.col[j] = scan_stepwise(&cond[b..b + w + 1], l.start[j], u0[j]).0;
             }
         }
         for (j, slot) in out.iter_mut().enumerate() {
