@@ -123,7 +123,10 @@ impl PiecewiseConstant2D {
             PiecewiseConstantError::NonFiniteValue { .. } => PiecewiseConstantError::TotalNotFinite,
             other => other,
         })?;
-        let unpredictable = unpredictability(&conditional, &conditional_guide, &marginal, width);
+        let unpredictable = match &conditional_guide {
+            RowGuides::Narrow(g) => unpredictability(&conditional, g, marginal.cdf(), width),
+            RowGuides::Wide(g) => unpredictability(&conditional, g, marginal.cdf(), width),
+        };
         let total = marginal.sum();
         let cell = [(x1 - x0) / width as f64, (y1 - y0) / height as f64];
         let integral = finite_integral(total * cell[0] * cell[1])?;
@@ -511,35 +514,38 @@ impl RowGuides {
 }
 
 /// [`PiecewiseConstant2D::scan_unpredictability`] of the rows and guides of a table.
-fn unpredictability(
+fn unpredictability<G: GuideEntry>(
     conditional: &[[f64; 2]],
-    guides: &RowGuides,
-    marginal: &PiecewiseConstant1D,
+    guides: &[G],
+    mcdf: &[f64],
     width: usize,
 ) -> f64 {
-    let starts: Vec<usize> = match guides {
-        RowGuides::Narrow(g) => g.iter().map(|s| s.cell()).collect(),
-        RowGuides::Wide(g) => g.iter().map(|s| s.cell()).collect(),
-    };
     let gw = width * GUIDE_PER_CELL;
-    let mcdf = marginal.cdf();
     let mut p = 0.0;
-    for (r, (entries, row_starts)) in conditional
+    for (r, (entries, row)) in conditional
         .chunks_exact(width + 1)
-        .zip(starts.chunks_exact(gw))
+        .zip(guides.chunks_exact(gw))
         .enumerate()
     {
-        // A bucket holds a boundary when the next bucket starts in another cell, or (the
-        // last) when it does not start in the last cell; zero-width cells count as steps.
-        let _ = entries;
+        // Bucket g holds a boundary when the cell of its last u (just below (g + 1)/G) is not
+        // the cell its guide entry names: the next entry's cell, or the one before it when
+        // that cell starts exactly at the bucket's end.
         let moving = (0..gw)
             .filter(|&g| {
-                let next = if g + 1 < gw {
-                    row_starts[g + 1]
-                } else {
-                    width - 1
+                let this = row[g].cell();
+                let last = match row.get(g + 1) {
+                    None => width - 1,
+                    Some(next) => {
+                        let next = next.cell();
+                        let end = (g + 1) as f64 / gw as f64;
+                        if next > this && entries[next][0] >= end {
+                            next - 1
+                        } else {
+                            next
+                        }
+                    }
                 };
-                next != row_starts[g]
+                last != this
             })
             .count();
         p += (mcdf[r + 1] - mcdf[r]) * moving as f64 / gw as f64;
@@ -765,6 +771,24 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn scan_unpredictability_counts_buckets_with_a_boundary_inside() {
+        // Equal cells: every boundary sits on a bucket edge (2 buckets per cell), no scan
+        // steps. One cell of 3 among 1s: boundaries inside buckets, in both rows alike.
+        let flat = PiecewiseConstant2D::new(8, 2, vec![1.0; 16], Rect::UNIT).unwrap();
+        assert_eq!(flat.scan_unpredictability(), 0.0);
+        assert!(!flat.windowed);
+        let mut v = vec![1.0; 8];
+        v[2] = 3.0;
+        let v: Vec<f64> = v.iter().chain(&v).copied().collect();
+        let bumpy = PiecewiseConstant2D::new(8, 2, v, Rect::UNIT).unwrap();
+        let p = bumpy.scan_unpredictability();
+        // CDF 0, .1, .2, .5, .6, …, 1 against bucket edges k/16: boundaries .1, .2, .6, .7,
+        // .8, .9 fall inside buckets 1, 3, 9, 11, 12, 14 (0.5 is the edge 8/16): 6 of 16.
+        assert_eq!(p, 6.0 / 16.0);
+        assert!(bumpy.windowed);
     }
 
     #[test]
