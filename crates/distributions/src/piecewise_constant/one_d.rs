@@ -36,7 +36,7 @@ pub struct Sample1 {
 pub struct PiecewiseConstant1D {
     values: Vec<f64>,
     cdf: Vec<f64>,
-    /// Guide table of `cdf` (`n` entries, [`fill_guide`]): the search starts there instead of
+    /// Guide table of `cdf` (`2n` entries, [`fill_guide`]): the search starts there instead of
     /// a binary search (the same cell and position, bit for bit).
     guide: Vec<u32>,
     /// `Σ values`, as [`fill_cdf`] summed them (a 2D table's marginal gives it its total).

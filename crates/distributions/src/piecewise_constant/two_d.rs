@@ -47,7 +47,7 @@ pub struct PiecewiseConstant2D {
     /// The marginal over rows: the 1D table of the row sums on `[y0, y1]` (its guide table
     /// starts the row search; its warp places the `y` coordinate).
     marginal: PiecewiseConstant1D,
-    /// Guide tables of the conditional CDFs, `width` entries per row, concatenated: one
+    /// Guide tables of the conditional CDFs, `2·width` entries per row, concatenated: one
     /// cache line read and a short scan instead of ~log₂(width) dependent probes of a long row.
     /// The warp is unchanged (same cell, same position, bit for bit).
     conditional_guide: RowGuides,
@@ -494,9 +494,10 @@ impl InvertibleSampler2D for PiecewiseConstant2D {
     }
 }
 
-/// The guide tables of the conditional rows (`width` entries per row, concatenated), in the
-/// narrowest entry type that holds a column index: `u16` up to 65 536 columns (1 MB instead of
-/// 2 MB for a 1024 × 512 map), `u32` beyond. The same start cells either way.
+/// The guide tables of the conditional rows (`2·width` entries per row, concatenated), in the
+/// narrowest entry type that holds a column index: `u16` up to 65 536 columns (2 MB for a
+/// 1024 × 512 map, as one `u32` entry per cell took), `u32` beyond. The same start cells
+/// either way.
 #[derive(Debug, Clone, PartialEq)]
 enum RowGuides {
     Narrow(Vec<u16>),
