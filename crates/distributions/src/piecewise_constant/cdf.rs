@@ -99,7 +99,7 @@ pub(crate) fn find_cell_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, u: f64) -> (us
 /// Fills the guide table of a normalised CDF (`cdf.len() = n + 1`, `cdf[0] = 0`,
 /// `cdf[n] = 1`, non-decreasing, CDF value `key(entry)`): `guide[g]` is the cell that
 /// [`find_cell`] returns for `u = g / G`, `G = guide.len() ≥ 1`. O(n + G).
-pub(crate) fn fill_guide_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [u32]) {
+pub(crate) fn fill_guide_by<T, G: GuideEntry>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [G]) {
     let n = cdf.len() - 1;
     let g_len = guide.len() as f64;
     let mut i = 0usize;
@@ -108,7 +108,44 @@ pub(crate) fn fill_guide_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, guide: &mut [
         while i + 1 < n && key(&cdf[i + 1]) <= x {
             i += 1;
         }
-        *slot = i as u32;
+        *slot = G::from_cell(i);
+    }
+}
+
+/// The integer type of a guide table's entries: `u32`, or `u16` for rows of at most 65 536
+/// cells (half the bytes, so more of a large table's guides stay in cache; the same cells).
+pub(crate) trait GuideEntry: Copy + Default {
+    /// The largest cell index the type holds.
+    const MAX_CELL: usize;
+    /// The entry of cell `i ≤ MAX_CELL`.
+    fn from_cell(i: usize) -> Self;
+    /// The cell index of the entry.
+    fn cell(self) -> usize;
+}
+
+impl GuideEntry for u32 {
+    const MAX_CELL: usize = u32::MAX as usize;
+    #[inline(always)]
+    fn from_cell(i: usize) -> Self {
+        debug_assert!(i <= Self::MAX_CELL);
+        i as u32
+    }
+    #[inline(always)]
+    fn cell(self) -> usize {
+        self as usize
+    }
+}
+
+impl GuideEntry for u16 {
+    const MAX_CELL: usize = u16::MAX as usize;
+    #[inline(always)]
+    fn from_cell(i: usize) -> Self {
+        debug_assert!(i <= Self::MAX_CELL);
+        i as u16
+    }
+    #[inline(always)]
+    fn cell(self) -> usize {
+        self as usize
     }
 }
 
@@ -133,14 +170,14 @@ pub fn find_cell_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f64) {
 /// up while the next edge is ≤ `u`, so it ends at the largest `i < n` with `cdf[i] ≤ u`,
 /// exactly what the binary search finds). The expected scan is O(1) when `G ≈ n`.
 #[inline(always)]
-pub(crate) fn find_cell_guided_by<T>(
+pub(crate) fn find_cell_guided_by<T, G: GuideEntry>(
     cdf: &[T],
     key: impl Fn(&T) -> f64,
-    guide: &[u32],
+    guide: &[G],
     u: f64,
 ) -> (usize, f64) {
     let g = guide_bucket(u, guide.len());
-    scan_by(cdf, key, guide[g] as usize, u)
+    scan_by(cdf, key, guide[g].cell(), u)
 }
 
 /// The guide-table bucket `min(⌊u·G⌋, G − 1)` of `u` for a guide of `G ≥ 1` entries.
@@ -150,14 +187,20 @@ pub(crate) fn guide_bucket(u: f64, g_len: usize) -> usize {
 }
 
 /// The scan of [`find_cell_guided_by`] from cell `start` (a guide entry) over `[cdf, value]`
-/// entries: the cell and position [`find_cell`] gives for `u`.
+/// entries, one cell at a time: the cell and position [`find_cell`] gives for `u`.
 #[inline(always)]
-pub(crate) fn scan_from(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) {
-    scan_by(cdf, |e| e[0], start, u)
+pub(crate) fn scan_stepwise(cdf: &[[f64; 2]], start: usize, u: f64) -> (usize, f64) {
+    scan_stepwise_by(cdf, |e| e[0], start, u)
 }
 
+/// [`scan_by`] one cell at a time.
 #[inline(always)]
-fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usize, f64) {
+pub(crate) fn scan_stepwise_by<T>(
+    cdf: &[T],
+    key: impl Fn(&T) -> f64,
+    start: usize,
+    u: f64,
+) -> (usize, f64) {
     let n = cdf.len() - 1;
     let mut i = start.min(n - 1);
     while i > 0 && key(&cdf[i]) > u {
@@ -166,9 +209,28 @@ fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usiz
     while i + 1 < n && key(&cdf[i + 1]) <= u {
         i += 1;
     }
-    let (lo, hi) = (key(&cdf[i]), key(&cdf[i + 1]));
-    let du = ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON);
-    (i, du)
+    (i, cell_position(key(&cdf[i]), key(&cdf[i + 1]), u))
+}
+
+/// How many CDF entries past the guide's start the 2D block path's branch-free walks compare
+/// in one step (`PiecewiseConstant2D`'s windowed block path).
+pub(crate) const SCAN_WINDOW: usize = 4;
+
+/// Guide buckets per cell of the tables' guide tables (fewer cell boundaries per bucket: a
+/// scan's step count is more often 0).
+pub(crate) const GUIDE_PER_CELL: usize = 2;
+
+/// The cell of `u` from a start cell, one cell at a time: down while `cdf[i] > u` (only
+/// through the rounding of a guide bucket), then up while the next edge is `≤ u`.
+#[inline(always)]
+fn scan_by<T>(cdf: &[T], key: impl Fn(&T) -> f64, start: usize, u: f64) -> (usize, f64) {
+    scan_stepwise_by(cdf, key, start, u)
+}
+
+/// The position in `[0, 1)` of `u` inside the CDF interval `[lo, hi)` of its cell.
+#[inline(always)]
+pub(crate) fn cell_position(lo: f64, hi: f64, u: f64) -> f64 {
+    ((u - lo) / (hi - lo)).clamp(0.0, ONE_MINUS_EPSILON)
 }
 
 /// The uniform number mapped by the CDF to position `du ∈ [0,1]` inside cell `i`.

@@ -4,8 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use super::PiecewiseConstantError;
 use super::cdf::{
-    cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, invert_cell, place,
-    validate_values,
+    GUIDE_PER_CELL, cell_of, clamp_unit, fill_cdf, fill_guide, find_cell_guided, guide_bucket,
+    invert_cell, place, scan_stepwise_by, validate_values,
 };
 use super::error::{FORMAT_VERSION, check_version, finite_integral};
 
@@ -36,7 +36,7 @@ pub struct Sample1 {
 pub struct PiecewiseConstant1D {
     values: Vec<f64>,
     cdf: Vec<f64>,
-    /// Guide table of `cdf` (`n` entries, [`fill_guide`]): the search starts there instead of
+    /// Guide table of `cdf` (`2n` entries, [`fill_guide`]): the search starts there instead of
     /// a binary search (the same cell and position, bit for bit).
     guide: Vec<u32>,
     /// `Σ values`, as [`fill_cdf`] summed them (a 2D table's marginal gives it its total).
@@ -73,7 +73,7 @@ impl PiecewiseConstant1D {
         if !(sum > 0.0) {
             return Err(PiecewiseConstantError::AllZero);
         }
-        let mut guide = vec![0u32; values.len()];
+        let mut guide = vec![0u32; values.len() * GUIDE_PER_CELL];
         fill_guide(&cdf, &mut guide);
         let n = values.len() as f64;
         let integral = finite_integral(sum * (max - min) / n)?;
@@ -138,11 +138,25 @@ impl PiecewiseConstant1D {
         find_cell_guided(&self.cdf, &self.guide, clamp_unit(u))
     }
 
+    /// [`Self::find`] by the one-cell-at-a-time scan (the same cell and position).
+    #[inline(always)]
+    pub(crate) fn find_stepwise(&self, u: f64) -> (usize, f64) {
+        let u = clamp_unit(u);
+        let g = guide_bucket(u, self.guide.len());
+        scan_stepwise_by(&self.cdf, |&c| c, self.guide[g] as usize, u)
+    }
+
     /// The point at position `du ∈ [0, 1)` of cell `index`, in `[min, max)` and inside that
     /// cell as [`Self::pdf`] locates it.
     #[inline(always)]
     pub(crate) fn place(&self, index: usize, du: f64) -> f64 {
         place(self.min, self.max, self.cell, self.inv_cell, index, du)
+    }
+
+    /// The guide table of [`Self::cdf`] (one entry per cell, [`fill_guide`]).
+    #[inline(always)]
+    pub(crate) fn guide(&self) -> &[u32] {
+        &self.guide
     }
 
     /// `Σ values` (unnormalised, before the cell width).
