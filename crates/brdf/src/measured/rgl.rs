@@ -914,10 +914,10 @@ impl RglBrdf {
             if run.owner == owner && run.slice == i && run.weight_bits == w.to_bits() {
                 if run.slot > 0 {
                     // Still this material's slot (the address may have been reused).
-                    if let Some(p) = cache.slots.get(run.slot - 1).and_then(OnceLock::get) {
-                        if p.matches(owner, i, w) {
-                            return run.slot;
-                        }
+                    if let Some(p) = cache.slots.get(run.slot - 1).and_then(OnceLock::get)
+                        && p.matches(owner, i, w)
+                    {
+                        return run.slot;
                     }
                     run.slot = 0;
                 }
@@ -1219,7 +1219,7 @@ mod tests {
             }
             Err(_) => println!("skipping the shared RGL files: {} is absent", dir.display()),
         }
-        let mut uniform = crate::test_support::splitmix_uniforms(0x5eed_0f_5_11ce_u64);
+        let mut uniform = crate::test_support::splitmix_uniforms(0x05ee_d0f5_11ce_u64);
         for (f, b) in files.iter().enumerate() {
             let (n_wo, n_wi) = if f == 0 { (400, 250) } else { (100, 100) };
             let slices: Vec<f64> = b.theta_slices().to_vec();
@@ -1262,7 +1262,7 @@ mod tests {
     #[test]
     fn prepare_keeps_slices_of_repeated_blends_only() {
         let b = fixture();
-        let mut uniform = crate::test_support::splitmix_uniforms(0x0dd_ba11_u64);
+        let mut uniform = crate::test_support::splitmix_uniforms(0x0ddb_a11d_u64);
         // Random ωo: a new blend per call, no slice.
         for _ in 0..5_000 {
             let q = b.prepare(&direction(uniform(), uniform(), false));
