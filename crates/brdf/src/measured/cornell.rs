@@ -340,7 +340,7 @@ impl CornellBrdf {
     /// where every weight is 0).
     #[inline]
     fn blend<const C: usize>(&self, p: &[f64; 3], value: impl Fn(usize) -> [f64; C]) -> [f64; C] {
-        let near = self.data.tree.nearest_cached(p);
+        let near = self.data.tree.nearest_fast(p);
         let w = weights(&near);
         let (mut sum, mut total) = ([0.0; C], 0.0);
         for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
