@@ -600,6 +600,12 @@ mod tests {
     /// direction pairs is at most 1e-10 (rounding).
     fn assert_same_interpolant(files: Vec<(String, String)>, pairs: usize) {
         for (name, text) in files {
+            let (mean, largest) = CornellBrdf::parse(&text)
+                .unwrap()
+                .data
+                .tree
+                .grid_occupancy();
+            eprintln!("{name}: {mean:.1} candidates per grid cell, at most {largest}");
             let worst = worst_difference(&text, pairs);
             eprintln!("{name}: max relative difference on {pairs} pairs {worst:.2e}");
             assert!(worst <= 1e-10, "{name}: {worst:e}");

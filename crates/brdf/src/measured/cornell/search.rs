@@ -235,6 +235,11 @@ impl Tree {
         }
     }
 
+    /// The grid's candidates per cell: `(mean, largest)`.
+    pub(super) fn grid_occupancy(&self) -> (f64, usize) {
+        self.grid.occupancy()
+    }
+
     /// The [`K`] nearest samples of `q`, ties by the file's index, the same samples in the
     /// same order (so the same interpolated value to the bit) as [`Tree::nearest`]: from
     /// `q`'s cell of the [`Grid`] when `q` is in the remapped unit cube (every pair of
@@ -434,13 +439,16 @@ impl Grid {
                 let p = &tree.by_index[i as usize];
                 box_box_d2(p, p, &lo, &hi) <= r2
             }));
-            candidates[first..].sort_by(|&a, &b| {
-                let (da, db) = (
-                    dist2(&tree.by_index[a as usize], &centre),
-                    dist2(&tree.by_index[b as usize], &centre),
-                );
-                da.total_cmp(&db).then(a.cmp(&b))
-            });
+            far.clear();
+            far.extend(
+                candidates[first..]
+                    .iter()
+                    .map(|&i| (dist2(&tree.by_index[i as usize], &centre), i)),
+            );
+            far.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (c, &(_, i)) in candidates[first..].iter_mut().zip(&far) {
+                *c = i;
+            }
             start.push(candidates.len() as u32);
         }
         Self { start, candidates }
@@ -464,7 +472,6 @@ impl Grid {
     }
 
     /// Candidates per cell: `(mean, largest)`.
-    #[cfg(test)]
     fn occupancy(&self) -> (f64, usize) {
         let n = self.start.len() - 1;
         let largest = self.start.windows(2).map(|w| (w[1] - w[0]) as usize).max();
