@@ -208,7 +208,7 @@ impl Tree {
             id: NEXT_TREE.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             grid: Grid::default(),
         };
-        tree.grid = Grid::new(&tree);
+        tree.grid = Grid::new();
         tree
     }
 
@@ -235,9 +235,13 @@ impl Tree {
         }
     }
 
-    /// The grid's candidates per cell: `(mean, largest)`.
+    /// The grid's candidates per cell, every cell listed: `(mean, largest)`.
     pub(super) fn grid_occupancy(&self) -> (f64, usize) {
-        self.grid.occupancy()
+        let sizes: Vec<usize> = (0..self.grid.cells.len())
+            .map(|c| self.grid.list(self, c).len())
+            .collect();
+        let mean = sizes.iter().sum::<usize>() as f64 / sizes.len().max(1) as f64;
+        (mean, sizes.iter().copied().max().unwrap_or(0))
     }
 
     /// The [`K`] nearest samples of `q`, ties by the file's index, the same samples in the
@@ -249,12 +253,8 @@ impl Tree {
         let Some(cell) = self.grid.cell(q) else {
             return self.nearest_cached(q);
         };
-        let (s, e) = (
-            self.grid.start[cell] as usize,
-            self.grid.start[cell + 1] as usize,
-        );
         let mut best = Nearest::empty();
-        for &i in &self.grid.candidates[s..e] {
+        for &i in self.grid.list(self, cell) {
             let d2 = dist2(&self.by_index[i as usize], q);
             if best.admits(d2, i) {
                 best.offer(d2, i);
@@ -381,9 +381,9 @@ const GRID_PAD: f64 = 1e-9;
 /// Candidate lists on a uniform grid of [`GRID`]³ cells over the remapped unit cube
 /// `[0, 1]³`, where every pair of directions maps: each cell keeps every sample that can be
 /// among the [`K`] nearest of a point of its (widened) box, nearest to the cell's centre
-/// first. A query scans its cell's list (~20 samples on the shared files) with the search's
-/// own order (squared distance, ties by the file's index), so it keeps exactly the samples
-/// the tree would, in the same order.
+/// first. A query scans its cell's list (~35 samples per cell on the shared files) with the
+/// search's own order (squared distance, ties by the file's index), so it keeps exactly the
+/// samples the tree would, in the same order.
 ///
 /// A cell's list: with `R` the `K`-th smallest distance from a sample to the *farthest*
 /// point of the box, every point of the box has `K` samples within `R`, so its `K` nearest
@@ -391,73 +391,76 @@ const GRID_PAD: f64 = 1e-9;
 /// to the box is at most `R` (with a relative margin of 10⁻⁹ for rounding) is kept. The
 /// samples beyond `d_K(centre) + half diagonal` of the box are never needed for `R`, so
 /// only those are visited (the tree's box search).
+///
+/// The lists are made when a query first needs them (a list is a function of the samples
+/// and the cell alone, so whichever thread makes it, it is the same): a file read for a few
+/// evaluations pays for a few cells, not for all (≈ 26 000 instructions a cell).
 #[derive(Default)]
 struct Grid {
-    /// Cell `c`'s candidates are `candidates[start[c]..start[c + 1]]`.
-    start: Vec<u32>,
-    /// File indices.
-    candidates: Vec<u32>,
+    /// Each cell's candidates (file indices), once made.
+    cells: Vec<std::sync::OnceLock<Box<[u32]>>>,
 }
 
 impl Grid {
-    fn new(tree: &Tree) -> Self {
+    fn new() -> Self {
+        Self {
+            cells: (0..GRID * GRID * GRID)
+                .map(|_| std::sync::OnceLock::new())
+                .collect(),
+        }
+    }
+
+    /// Cell `c`'s candidates, made on first use.
+    #[inline]
+    fn list<'a>(&'a self, tree: &Tree, c: usize) -> &'a [u32] {
+        self.cells[c].get_or_init(|| Self::candidates(tree, c))
+    }
+
+    /// Cell `c`'s candidates (see the type's docs).
+    fn candidates(tree: &Tree, c: usize) -> Box<[u32]> {
         let g = GRID;
         let h = 1.0 / g as f64;
-        let mut start = Vec::with_capacity(g * g * g + 1);
-        let mut candidates = Vec::new();
+        let ijk = [c % g, c / g % g, c / (g * g)];
+        let lo = ijk.map(|i| i as f64 * h - GRID_PAD);
+        let hi = ijk.map(|i| (i + 1) as f64 * h + GRID_PAD);
+        let centre = [0, 1, 2].map(|d| 0.5 * (lo[d] + hi[d]));
+        let half_diag = 0.5 * dist2(&lo, &hi).sqrt();
+        let best = tree.nearest_n::<K>(&centre);
         let mut near = Vec::new();
-        let mut far: Vec<(f64, u32)> = Vec::new();
-        start.push(0);
-        for c in 0..g * g * g {
-            let ijk = [c % g, c / g % g, c / (g * g)];
-            let lo = ijk.map(|i| i as f64 * h - GRID_PAD);
-            let hi = ijk.map(|i| (i + 1) as f64 * h + GRID_PAD);
-            let centre = [0, 1, 2].map(|d| 0.5 * (lo[d] + hi[d]));
-            let half_diag = 0.5 * dist2(&lo, &hi).sqrt();
-            let best = tree.nearest_n::<K>(&centre);
-            near.clear();
-            if best.len < K {
-                near.extend(0..tree.by_index.len() as u32);
-            } else {
-                // Every point of the box has `K` samples within this (1-Lipschitz `d_K`).
-                let reach = (best.d2[K - 1].sqrt() + half_diag) * (1.0 + 1e-9);
-                tree.within_box(&lo, &hi, reach, &mut near);
-            }
-            let r2 = if near.len() < K {
-                f64::INFINITY
-            } else {
-                far.clear();
-                far.extend(
-                    near.iter()
-                        .map(|&i| (farthest_d2(&tree.by_index[i as usize], &lo, &hi), i)),
-                );
-                far.select_nth_unstable_by(K - 1, |a, b| a.0.total_cmp(&b.0));
-                far[K - 1].0 * (1.0 + 1e-9)
-            };
-            let first = candidates.len();
-            candidates.extend(near.iter().copied().filter(|&i| {
+        if best.len < K {
+            near.extend(0..tree.by_index.len() as u32);
+        } else {
+            // Every point of the box has `K` samples within this (1-Lipschitz `d_K`).
+            let reach = (best.d2[K - 1].sqrt() + half_diag) * (1.0 + 1e-9);
+            tree.within_box(&lo, &hi, reach, &mut near);
+        }
+        let r2 = if near.len() < K {
+            f64::INFINITY
+        } else {
+            let mut far: Vec<f64> = near
+                .iter()
+                .map(|&i| farthest_d2(&tree.by_index[i as usize], &lo, &hi))
+                .collect();
+            far.select_nth_unstable_by(K - 1, f64::total_cmp);
+            far[K - 1] * (1.0 + 1e-9)
+        };
+        let mut keyed: Vec<(f64, u32)> = near
+            .iter()
+            .copied()
+            .filter(|&i| {
                 let p = &tree.by_index[i as usize];
                 box_box_d2(p, p, &lo, &hi) <= r2
-            }));
-            far.clear();
-            far.extend(
-                candidates[first..]
-                    .iter()
-                    .map(|&i| (dist2(&tree.by_index[i as usize], &centre), i)),
-            );
-            far.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for (c, &(_, i)) in candidates[first..].iter_mut().zip(&far) {
-                *c = i;
-            }
-            start.push(candidates.len() as u32);
-        }
-        Self { start, candidates }
+            })
+            .map(|i| (dist2(&tree.by_index[i as usize], &centre), i))
+            .collect();
+        keyed.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        keyed.into_iter().map(|(_, i)| i).collect()
     }
 
     /// The cell of `q` if `q` is in the unit cube (up to [`GRID_PAD`]), else `None`.
     #[inline]
     fn cell(&self, q: &[f64; 3]) -> Option<usize> {
-        if self.start.is_empty() {
+        if self.cells.is_empty() {
             return None;
         }
         let mut c = 0;
@@ -469,16 +472,6 @@ impl Grid {
             c = c * GRID + ((x * GRID as f64) as usize).min(GRID - 1);
         }
         Some(c)
-    }
-
-    /// Candidates per cell: `(mean, largest)`.
-    fn occupancy(&self) -> (f64, usize) {
-        let n = self.start.len() - 1;
-        let largest = self.start.windows(2).map(|w| (w[1] - w[0]) as usize).max();
-        (
-            self.candidates.len() as f64 / n as f64,
-            largest.unwrap_or(0),
-        )
     }
 }
 
@@ -653,7 +646,7 @@ mod tests {
             ("small", small),
         ] {
             let tree = Tree::new(&points);
-            let (mean, largest) = tree.grid.occupancy();
+            let (mean, largest) = tree.grid_occupancy();
             eprintln!("{name}: {mean:.1} candidates per cell, at most {largest}");
             for k in 0..30_000 {
                 let mut q = [uniform(), uniform(), uniform()];
