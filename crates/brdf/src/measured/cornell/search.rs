@@ -236,6 +236,7 @@ impl Tree {
     }
 
     /// The grid's candidates per cell, every cell listed: `(mean, largest)`.
+    #[cfg(test)]
     pub(super) fn grid_occupancy(&self) -> (f64, usize) {
         let sizes: Vec<usize> = (0..self.grid.cells.len())
             .map(|c| self.grid.list(self, c).len())
@@ -466,7 +467,7 @@ impl Grid {
         let mut c = 0;
         for d in (0..3).rev() {
             let x = q[d];
-            if !(x >= -GRID_PAD && x <= 1.0 + GRID_PAD) {
+            if !(-GRID_PAD..=1.0 + GRID_PAD).contains(&x) {
                 return None;
             }
             c = c * GRID + ((x * GRID as f64) as usize).min(GRID - 1);
