@@ -1,6 +1,8 @@
 //! The `K + 1` nearest samples of a remapped point without a heap allocation: a small k-d tree
 //! over the samples (built once per file; boxes per node, leaves of at most [`LEAF`] samples)
-//! and a search that keeps the best candidates sorted in a stack array.
+//! and a search that keeps the best candidates sorted in a stack array. Queries in the
+//! remapped unit cube (every pair of directions) scan the candidate list of their cell of a
+//! uniform grid instead ([`Tree::nearest_fast`]): the same samples in the same order.
 //!
 //! The result is the same set of distances as any exact nearest-neighbour search (ties
 //! between equidistant samples may pick other samples at the same distance, which leaves the
