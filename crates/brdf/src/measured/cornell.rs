@@ -15,7 +15,7 @@
 //! `p(ωo, ωi) = (sin θi sin θo, Δφ/π, cos θi cos θo)` with `Δφ = |φi − φo|` folded into
 //! `[0, π]`: symmetric in `ωi ↔ ωo` (reciprocity), invariant under a common rotation (isotropy)
 //! and under the mirror `φ ↦ −φ`. `f` at a query is the weighted mean `Σ w_k f_k / Σ w_k` over
-//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (candidate lists on a grid over the remapped cube, a k-d tree beside it; no allocation per query), with Gaussian weights
+//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (candidate lists on a grid over the remapped cube, each made on its first query; a k-d tree beside it), with Gaussian weights
 //! cut at the next (`K + 1`-th) nearest sample's distance:
 //! `w_k = exp(−d_k²/(2h²)) − exp(−d_{K+1}²/(2h²))`, `h` = [`BANDWIDTH`]. A
 //! sample's weight thus falls to 0 as it leaves the neighbour set, so `f` is continuous in the
