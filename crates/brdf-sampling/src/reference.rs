@@ -314,6 +314,44 @@ mod tests {
         }
     }
 
+    /// Instructions per evaluation inside a Cornell normaliser node, for cachegrind
+    /// (docs/benchmarks.md §23.7): the set table's node rule (the reference rule at `ωo`,
+    /// `NODE_BUDGET` evaluations, default 150 000) at `NODE_THETA` degrees (default 30.5) on
+    /// `CORNELL_FILE` (default the team's `cayman`), `NODE_REPEAT` times (default 1).
+    /// `valgrind --tool=cachegrind --cache-sim=no TEST_BINARY cornell_node_cost_probe
+    /// --ignored --exact` at two repeats: the difference divided by the evaluations of one
+    /// node (printed) is the cost of one evaluation, quadrature included.
+    #[test]
+    #[ignore = "a cachegrind probe"]
+    fn cornell_node_cost_probe() {
+        let env = |k: &str| std::env::var(k).ok();
+        let path = env("CORNELL_FILE")
+            .map(std::path::PathBuf::from)
+            .unwrap_or_else(|| {
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("../../../shared/data/measured/cornell/cayman.brdf")
+            });
+        let Ok(b) = brdf::CornellBrdf::load(&path) else {
+            eprintln!("skipped: {} is not readable", path.display());
+            return;
+        };
+        let theta: f64 = env("NODE_THETA")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(30.5);
+        let budget: u64 = env("NODE_BUDGET")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(150_000);
+        let repeat: usize = env("NODE_REPEAT").and_then(|s| s.parse().ok()).unwrap_or(1);
+        let wo = brdf::direction_from_radians(theta.to_radians(), 0.0);
+        for _ in 0..repeat {
+            let a = reference_albedo_with_budget(&b, &wo, budget).expect("node");
+            eprintln!(
+                "{} ± {:.2e} in {} evaluations",
+                a.value, a.abs_err, a.evaluations
+            );
+        }
+    }
+
     const GGX_0_1_AT_89_5: f64 = 0.920_846_216_790;
     const GGX_0_01_AT_45: f64 = 0.999_846_808;
 

@@ -15,7 +15,7 @@
 //! `p(ωo, ωi) = (sin θi sin θo, Δφ/π, cos θi cos θo)` with `Δφ = |φi − φo|` folded into
 //! `[0, π]`: symmetric in `ωi ↔ ωo` (reciprocity), invariant under a common rotation (isotropy)
 //! and under the mirror `φ ↦ −φ`. `f` at a query is the weighted mean `Σ w_k f_k / Σ w_k` over
-//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (a k-d tree searched without allocating), with Gaussian weights
+//! the `K` = [`NEIGHBOURS`] samples nearest to `p` (candidate lists on a grid over the remapped cube, each made on its first query; a k-d tree beside it), with Gaussian weights
 //! cut at the next (`K + 1`-th) nearest sample's distance:
 //! `w_k = exp(−d_k²/(2h²)) − exp(−d_{K+1}²/(2h²))`, `h` = [`BANDWIDTH`]. A
 //! sample's weight thus falls to 0 as it leaves the neighbour set, so `f` is continuous in the
@@ -340,7 +340,7 @@ impl CornellBrdf {
     /// where every weight is 0).
     #[inline]
     fn blend<const C: usize>(&self, p: &[f64; 3], value: impl Fn(usize) -> [f64; C]) -> [f64; C] {
-        let near = self.data.tree.nearest_cached(p);
+        let near = self.data.tree.nearest_fast(p);
         let w = weights(&near);
         let (mut sum, mut total) = ([0.0; C], 0.0);
         for (w, &i) in w.iter().zip(&near.index[..near.len.min(NEIGHBOURS)]) {
@@ -600,6 +600,12 @@ mod tests {
     /// direction pairs is at most 1e-10 (rounding).
     fn assert_same_interpolant(files: Vec<(String, String)>, pairs: usize) {
         for (name, text) in files {
+            let (mean, largest) = CornellBrdf::parse(&text)
+                .unwrap()
+                .data
+                .tree
+                .grid_occupancy();
+            eprintln!("{name}: {mean:.1} candidates per grid cell, at most {largest}");
             let worst = worst_difference(&text, pairs);
             eprintln!("{name}: max relative difference on {pairs} pairs {worst:.2e}");
             assert!(worst <= 1e-10, "{name}: {worst:e}");

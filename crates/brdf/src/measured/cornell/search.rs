@@ -1,6 +1,8 @@
 //! The `K + 1` nearest samples of a remapped point without a heap allocation: a small k-d tree
 //! over the samples (built once per file; boxes per node, leaves of at most [`LEAF`] samples)
-//! and a search that keeps the best candidates sorted in a stack array.
+//! and a search that keeps the best candidates sorted in a stack array. Queries in the
+//! remapped unit cube (every pair of directions) scan the candidate list of their cell of a
+//! uniform grid instead ([`Tree::nearest_fast`]): the same samples in the same order.
 //!
 //! The result is the same set of distances as any exact nearest-neighbour search (ties
 //! between equidistant samples may pick other samples at the same distance, which leaves the
@@ -39,6 +41,8 @@ pub(super) struct Tree {
     by_index: Vec<[f64; 3]>,
     /// This tree's identity in the per-thread neighbourhood cache (unique per process).
     id: u64,
+    /// Each cell's candidate samples (see [`Grid`]).
+    grid: Grid,
 }
 
 /// The `len` (≤ `N`) nearest samples, by increasing `(squared distance, file index)`.
@@ -113,6 +117,28 @@ fn dist2(p: &[f64; 3], q: &[f64; 3]) -> f64 {
     a * a + b * b + c * c
 }
 
+/// Squared distance between the boxes `[alo, ahi]` and `[blo, bhi]` (0 when they meet).
+#[inline]
+fn box_box_d2(alo: &[f64; 3], ahi: &[f64; 3], blo: &[f64; 3], bhi: &[f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for d in 0..3 {
+        let e = (blo[d] - ahi[d]).max(alo[d] - bhi[d]).max(0.0);
+        s += e * e;
+    }
+    s
+}
+
+/// Squared distance from `p` to the farthest point of the box `[lo, hi]`.
+#[inline]
+fn farthest_d2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for d in 0..3 {
+        let e = (p[d] - lo[d]).abs().max((hi[d] - p[d]).abs());
+        s += e * e;
+    }
+    s
+}
+
 fn bounds(points: &[([f64; 3], u32)]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -176,13 +202,68 @@ impl Tree {
             nodes[node].axis = axis as u32;
             nodes[node].split = items[start + mid].0[axis];
         }
-        Self {
+        let mut tree = Self {
             points: items.iter().map(|x| x.0).collect(),
             index: items.iter().map(|x| x.1).collect(),
             nodes,
             by_index: points.to_vec(),
             id: NEXT_TREE.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            grid: Grid::default(),
+        };
+        tree.grid = Grid::new();
+        tree
+    }
+
+    /// The samples whose distance to the box `[lo, hi]` is at most `r` (file indices).
+    fn within_box(&self, lo: &[f64; 3], hi: &[f64; 3], r: f64, out: &mut Vec<u32>) {
+        let r2 = r * r;
+        let mut stack = vec![0usize];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n];
+            if box_box_d2(&node.lo, &node.hi, lo, hi) > r2 {
+                continue;
+            }
+            if node.len > 0 {
+                let (s, e) = (node.first as usize, (node.first + node.len) as usize);
+                for (p, &i) in self.points[s..e].iter().zip(&self.index[s..e]) {
+                    if box_box_d2(p, p, lo, hi) <= r2 {
+                        out.push(i);
+                    }
+                }
+            } else {
+                stack.push(node.first as usize);
+                stack.push(node.first as usize + 1);
+            }
         }
+    }
+
+    /// The grid's candidates per cell, every cell listed: `(mean, largest)`.
+    #[cfg(test)]
+    pub(super) fn grid_occupancy(&self) -> (f64, usize) {
+        let sizes: Vec<usize> = (0..self.grid.cells.len())
+            .map(|c| self.grid.list(self, c).len())
+            .collect();
+        let mean = sizes.iter().sum::<usize>() as f64 / sizes.len().max(1) as f64;
+        (mean, sizes.iter().copied().max().unwrap_or(0))
+    }
+
+    /// The [`K`] nearest samples of `q`, ties by the file's index, the same samples in the
+    /// same order (so the same interpolated value to the bit) as [`Tree::nearest`]: from
+    /// `q`'s cell of the [`Grid`] when `q` is in the remapped unit cube (every pair of
+    /// directions is), else through [`Tree::nearest_cached`].
+    #[inline]
+    pub(super) fn nearest_fast(&self, q: &[f64; 3]) -> Nearest {
+        let Some(cell) = self.grid.cell(q) else {
+            return self.nearest_cached(q);
+        };
+        let mut best = Nearest::empty();
+        for &i in self.grid.list(self, cell) {
+            let d2 = dist2(&self.by_index[i as usize], q);
+            if best.admits(d2, i) {
+                best.offer(d2, i);
+            }
+        }
+        best
     }
 
     /// Squared distance from `q` to node `n`'s box (0 inside).
@@ -288,6 +369,112 @@ impl Tree {
             }
             near
         })
+    }
+}
+
+/// Cells per axis of the [`Grid`] over the remapped unit cube (instructions per evaluation
+/// and candidates per cell: docs/benchmarks.md §23.7).
+pub(super) const GRID: usize = 32;
+
+/// How far (absolute) a cell's box is widened when its candidates are chosen: a query whose
+/// cell index was rounded across a cell face, or on the cube's faces up to this much outside,
+/// still lies in the widened box.
+const GRID_PAD: f64 = 1e-9;
+
+/// Candidate lists on a uniform grid of [`GRID`]³ cells over the remapped unit cube
+/// `[0, 1]³`, where every pair of directions maps: each cell keeps every sample that can be
+/// among the [`K`] nearest of a point of its (widened) box, nearest to the cell's centre
+/// first. A query scans its cell's list (~35 samples per cell on the shared files) with the
+/// search's own order (squared distance, ties by the file's index), so it keeps exactly the
+/// samples the tree would, in the same order.
+///
+/// A cell's list: with `R` the `K`-th smallest distance from a sample to the *farthest*
+/// point of the box, every point of the box has `K` samples within `R`, so its `K` nearest
+/// (and every sample tied with the `K`-th) are within `R` of it: every sample whose distance
+/// to the box is at most `R` (with a relative margin of 10⁻⁹ for rounding) is kept. The
+/// samples beyond `d_K(centre) + half diagonal` of the box are never needed for `R`, so
+/// only those are visited (the tree's box search).
+///
+/// The lists are made when a query first needs them (a list is a function of the samples
+/// and the cell alone, so whichever thread makes it, it is the same): a file read for a few
+/// evaluations pays for a few cells, not for all (≈ 26 000 instructions a cell).
+#[derive(Default)]
+struct Grid {
+    /// Each cell's candidates (file indices), once made.
+    cells: Vec<std::sync::OnceLock<Box<[u32]>>>,
+}
+
+impl Grid {
+    fn new() -> Self {
+        Self {
+            cells: (0..GRID * GRID * GRID)
+                .map(|_| std::sync::OnceLock::new())
+                .collect(),
+        }
+    }
+
+    /// Cell `c`'s candidates, made on first use.
+    #[inline]
+    fn list<'a>(&'a self, tree: &Tree, c: usize) -> &'a [u32] {
+        self.cells[c].get_or_init(|| Self::candidates(tree, c))
+    }
+
+    /// Cell `c`'s candidates (see the type's docs).
+    fn candidates(tree: &Tree, c: usize) -> Box<[u32]> {
+        let g = GRID;
+        let h = 1.0 / g as f64;
+        let ijk = [c % g, c / g % g, c / (g * g)];
+        let lo = ijk.map(|i| i as f64 * h - GRID_PAD);
+        let hi = ijk.map(|i| (i + 1) as f64 * h + GRID_PAD);
+        let centre = [0, 1, 2].map(|d| 0.5 * (lo[d] + hi[d]));
+        let half_diag = 0.5 * dist2(&lo, &hi).sqrt();
+        let best = tree.nearest_n::<K>(&centre);
+        let mut near = Vec::new();
+        if best.len < K {
+            near.extend(0..tree.by_index.len() as u32);
+        } else {
+            // Every point of the box has `K` samples within this (1-Lipschitz `d_K`).
+            let reach = (best.d2[K - 1].sqrt() + half_diag) * (1.0 + 1e-9);
+            tree.within_box(&lo, &hi, reach, &mut near);
+        }
+        let r2 = if near.len() < K {
+            f64::INFINITY
+        } else {
+            let mut far: Vec<f64> = near
+                .iter()
+                .map(|&i| farthest_d2(&tree.by_index[i as usize], &lo, &hi))
+                .collect();
+            far.select_nth_unstable_by(K - 1, f64::total_cmp);
+            far[K - 1] * (1.0 + 1e-9)
+        };
+        let mut keyed: Vec<(f64, u32)> = near
+            .iter()
+            .copied()
+            .filter(|&i| {
+                let p = &tree.by_index[i as usize];
+                box_box_d2(p, p, &lo, &hi) <= r2
+            })
+            .map(|i| (dist2(&tree.by_index[i as usize], &centre), i))
+            .collect();
+        keyed.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        keyed.into_iter().map(|(_, i)| i).collect()
+    }
+
+    /// The cell of `q` if `q` is in the unit cube (up to [`GRID_PAD`]), else `None`.
+    #[inline]
+    fn cell(&self, q: &[f64; 3]) -> Option<usize> {
+        if self.cells.is_empty() {
+            return None;
+        }
+        let mut c = 0;
+        for d in (0..3).rev() {
+            let x = q[d];
+            if !(-GRID_PAD..=1.0 + GRID_PAD).contains(&x) {
+                return None;
+            }
+            c = c * GRID + ((x * GRID as f64) as usize).min(GRID - 1);
+        }
+        Some(c)
     }
 }
 
@@ -435,6 +622,71 @@ mod tests {
                 seen.sort_unstable();
                 seen.dedup();
                 assert_eq!(seen.len(), n, "a sample found twice");
+            }
+        }
+    }
+
+    /// The grid's search finds the same samples in the same order (bit for bit) as the tree's
+    /// on random points, on the tie grid (the queries on its planes and on the cells' faces),
+    /// on a file smaller than `K + 1` samples and on points clustered in a corner (cells far
+    /// from every sample); on the cube's faces and corners; and queries outside the cube take
+    /// the tree.
+    #[test]
+    fn grid_search_is_the_tree_search() {
+        let mut uniform = xorshift(0x6a09_e667_f3bc_c908);
+        let random: Vec<[f64; 3]> = (0..1500)
+            .map(|_| [uniform(), uniform(), uniform()])
+            .collect();
+        let corner: Vec<[f64; 3]> = (0..300)
+            .map(|_| [0.1 * uniform(), 0.1 * uniform(), 0.1 * uniform()])
+            .collect();
+        let small: Vec<[f64; 3]> = (0..7).map(|i| [i as f64 / 6.0, 0.5, 0.25]).collect();
+        let g = GRID as f64;
+        for (name, points) in [
+            ("random", random),
+            ("grid", tie_grid()),
+            ("corner", corner),
+            ("small", small),
+        ] {
+            let tree = Tree::new(&points);
+            let (mean, largest) = tree.grid_occupancy();
+            eprintln!("{name}: {mean:.1} candidates per cell, at most {largest}");
+            for k in 0..30_000 {
+                let mut q = [uniform(), uniform(), uniform()];
+                match k % 5 {
+                    // On the tie grid's planes.
+                    0 => q = [(k % 8) as f64 / 7.0, q[1], (k / 8 % 8) as f64 / 7.0],
+                    // On a cell's face, or a rounding step beside it.
+                    1 => {
+                        let face = ((q[0] * g).floor() / g + [-1e-16, 0.0, 1e-16][k % 3]).max(0.0);
+                        q[0] = face;
+                    }
+                    // On the cube's faces and corners.
+                    2 => {
+                        q = q.map(|x| {
+                            if x < 0.3 {
+                                0.0
+                            } else if x > 0.7 {
+                                1.0
+                            } else {
+                                x
+                            }
+                        })
+                    }
+                    _ => {}
+                }
+                let (a, b) = (tree.nearest_fast(&q), tree.nearest(&q));
+                assert!(tree.grid.cell(&q).is_some(), "{q:?}");
+                assert_eq!(a.len, b.len, "{name} {q:?}");
+                for j in 0..a.len {
+                    assert_eq!(a.index[j], b.index[j], "{name} {q:?}: {j}");
+                    assert_eq!(a.d2[j].to_bits(), b.d2[j].to_bits(), "{name} {q:?}: {j}");
+                }
+            }
+            for q in [[1.5, 0.5, 0.5], [-0.1, 0.0, 0.0], [0.5, f64::NAN, 0.5]] {
+                assert!(tree.grid.cell(&q).is_none(), "{q:?}");
+                let (a, b) = (tree.nearest_fast(&q), tree.nearest(&q));
+                assert_eq!(a.index[..a.len], b.index[..b.len], "{name} {q:?}");
             }
         }
     }
