@@ -20,7 +20,8 @@ pub use colour::luminance;
 ///
 /// Contract for implementors: `eval` is finite and `≥ 0` for all unit vectors in the open upper
 /// hemisphere and returns `0` when `wo.z ≤ 0` or `wi.z ≤ 0` (or either is NaN). It must not
-/// allocate: samplers call it millions of times.
+/// allocate per call: samplers call it millions of times (a reader may build a bounded part of
+/// an acceleration structure once, on first use, as the Cornell reader's search cells do).
 pub trait Brdf: Send + Sync {
     /// Scalar BRDF value in 1/sr. For coloured models this is the luminance of
     /// [`eval_rgb`](Brdf::eval_rgb) (see [`luminance`]).
