@@ -48,6 +48,45 @@ pub struct QuadTreeSampler<D> {
     bound_scale: f64,
     /// The frame is the identity (roots `[0, 1]²`, `[−1, 1]²`, …): the hot loop skips the map.
     identity: bool,
+    /// The alias table with both candidates' rectangles and bounds, one cache line per column
+    /// ([`AliasCell`]), read by the block path; derived from `tree.leaves` at construction.
+    alias_cells: Vec<AliasCell>,
+}
+
+/// One column of the alias table laid out for the block path: the column's threshold and the
+/// stored rectangle and bound of both leaves it can return (its own, and its alias — or its
+/// own again when the alias is out of range), so that a trial's leaf pick, point and height
+/// read one cache line (the [`Leaf`] array needs a second, dependent load whenever the alias
+/// is taken).
+///
+/// **Exactness.** The fields are copies of the [`Leaf`] fields (`f32` rectangle and bound as
+/// stored, `f64` threshold): the same numbers, so the sampled law and the pdf are those the
+/// stored leaves define, and the block path returns the one-sample path's samples bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(64))]
+struct AliasCell {
+    /// The column's threshold ([`Leaf::prob`]): the column's own leaf is kept when the
+    /// fraction is below it.
+    prob: f64,
+    /// `[u0, v0, du, dv, m]` of the column's own leaf.
+    keep: [f32; 5],
+    /// `[u0, v0, du, dv, m]` of its alias (of its own leaf when the alias is out of range).
+    other: [f32; 5],
+}
+
+impl AliasCell {
+    /// The cells of `leaves`' alias table, in column order.
+    fn table(leaves: &[Leaf]) -> Vec<AliasCell> {
+        let geometry = |l: &Leaf| [l.u0, l.v0, l.du, l.dv, l.m];
+        leaves
+            .iter()
+            .map(|l| AliasCell {
+                prob: l.prob,
+                keep: geometry(l),
+                other: geometry(leaves.get(l.alias as usize).unwrap_or(l)),
+            })
+            .collect()
+    }
 }
 
 impl<D> std::fmt::Debug for QuadTreeSampler<D> {
@@ -123,7 +162,9 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         let inv_integral = 1.0 / tree.integral;
         let frame = tree.frame();
         let bound_scale = tree.bound_scale;
+        let alias_cells = AliasCell::table(&tree.leaves);
         Self {
+            alias_cells,
             tree,
             density,
             counters: Arc::new(Counters::default()),
@@ -181,11 +222,12 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// Bytes per structure.
     pub fn memory(&self) -> MemoryReport {
         let density = self.density.bytes_used();
+        let cells = self.alias_cells.capacity() * std::mem::size_of::<AliasCell>();
         MemoryReport {
-            leaves: self.tree.leaf_bytes(),
+            leaves: self.tree.leaf_bytes() + cells,
             nodes: self.tree.node_bytes(),
             density,
-            total: self.tree.bytes_used() + density + std::mem::size_of::<Self>()
+            total: self.tree.bytes_used() + cells + density + std::mem::size_of::<Self>()
                 - std::mem::size_of::<QuadTree>(),
         }
     }
@@ -456,56 +498,63 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         out: &mut [Sample2],
         a: &mut Audit,
     ) {
-        let leaves = &self.tree.leaves;
+        let cells = &self.alias_cells;
+        let n = cells.len();
+        let nf = index_to_f64(n);
         let centre = self.tree.root.center();
         let mut points = [centre; TRIAL_BLOCK];
         let mut zs = [0.0f64; TRIAL_BLOCK];
         let mut bounds = [0.0f64; TRIAL_BLOCK];
         let mut fs = [0.0f64; TRIAL_BLOCK];
-        let mut us = [[0.0f64; 4]; TRIAL_BLOCK];
-        let mut picks = [0usize; TRIAL_BLOCK];
         let mut filled = 0;
         let mut since = 0u64;
         while filled < out.len() {
             let k = (out.len() - filled).min(TRIAL_BLOCK);
-            // Three passes, each free of data-dependent branches so that the cache misses of
-            // a block overlap: the uniforms of every trial and its alias column (pick_leaf's
-            // alias branch, chosen by a select), then the picked leaf's point and height
-            // (trial's), then the densities.
+            // Candidates, free of data-dependent branches so that the cache misses of a block
+            // overlap: each trial's four uniforms, its alias column (one cache line holding
+            // both candidates, the choice a select: [`Self::alias_index`]'s arithmetic), its
+            // point and height ([`Self::trial_with`]'s); then the densities.
             for j in 0..k {
-                us[j] = u.next_uniform4();
-                picks[j] = self.alias_index(us[j][0]);
-            }
-            for j in 0..k {
-                let leaf = &leaves[picks[j]];
-                let s = f64::from(leaf.u0) + us[j][1] * f64::from(leaf.du);
-                let t = f64::from(leaf.v0) + us[j][2] * f64::from(leaf.dv);
+                let us = u.next_uniform4();
+                let s = us[0] * nf;
+                let i = floor_index(s, n - 1);
+                let cell = &cells[i];
+                let g = if s - index_to_f64(i) < cell.prob {
+                    cell.keep
+                } else {
+                    cell.other
+                };
+                let s = f64::from(g[0]) + us[1] * f64::from(g[2]);
+                let t = f64::from(g[1]) + us[2] * f64::from(g[3]);
                 points[j] = if MAP {
                     [self.frame.domain_coord(0, s), self.frame.domain_coord(1, t)]
                 } else {
                     [s, t]
                 };
-                let m = leaf.bound(self.bound_scale);
+                let m = f64::from(g[4]) * self.bound_scale;
                 bounds[j] = m;
-                zs[j] = us[j][3] * m;
+                zs[j] = us[3] * m;
             }
             self.density.eval_block(&points[..k], &mut fs[..k]);
+            // The accept pass without a data-dependent branch (its outcome is random, ≈ one
+            // trial in six rejected: a mispredicted branch each time): every trial's sample is
+            // written to `out[filled]` and `filled` advances only when it was accepted, so a
+            // rejected trial's write is overwritten by the next one. In bounds: trial `j` of
+            // the block finds `filled ≤ filled₀ + j < filled₀ + k ≤ out.len()`. The exhausted
+            // case (`since` reaching the cap) stays a branch: it is never taken in practice.
+            a.trials += k as u64;
             for j in 0..k {
-                a.trials += 1;
-                since += 1;
                 let f = fs[j];
-                if f > bounds[j] {
-                    a.violations += 1;
-                }
-                if zs[j] < f {
-                    a.samples += 1;
-                    out[filled] = Sample2 {
-                        point: points[j],
-                        pdf: f * self.inv_integral,
-                    };
-                    filled += 1;
-                    since = 0;
-                } else if since >= MAX_TRIALS_PER_SAMPLE {
+                let accept = zs[j] < f;
+                a.violations += u64::from(f > bounds[j]);
+                out[filled] = Sample2 {
+                    point: points[j],
+                    pdf: f * self.inv_integral,
+                };
+                filled += usize::from(accept);
+                a.samples += u64::from(accept);
+                since = if accept { 0 } else { since + 1 };
+                if since >= MAX_TRIALS_PER_SAMPLE {
                     out[filled] = self.exhausted(points[j], a);
                     filled += 1;
                     since = 0;
@@ -658,5 +707,103 @@ impl<const MAP: bool, D: RegionStats, U: UniformSource + ?Sized> pulp::WithSimd
         let mut a = Audit::default();
         self.sampler.fill_blocks::<MAP, U>(self.u, self.out, &mut a);
         a
+    }
+}
+
+#[cfg(test)]
+mod block_level_tests {
+    //! The block path compiled for every instruction-set level `pulp` can dispatch to on the
+    //! machine running the tests (the x86-64 baseline always; AVX2 (`V3`) and AVX-512 (`V4`)
+    //! where present), each against the one-sample path: the same samples bit for bit, the same
+    //! uniforms consumed. (`sample_into` itself runs only the best level; this runs the others.)
+    use super::*;
+    use crate::{QuadTreeBuilder, Rect, SinPiRows, TabulatedDensity};
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{Rng, SeedableRng};
+
+    fn sampler(rect: Rect) -> QuadTreeSampler<TabulatedDensity<SinPiRows>> {
+        // A sun on a sky gradient: leaves of very different weights, so columns take their
+        // aliases often.
+        let (w, h) = (96usize, 48usize);
+        let vals = (0..w * h)
+            .map(|k| {
+                let (i, j) = ((k % w) as f64, (k / w) as f64);
+                1.0 + j / 8.0 + 400.0 * (-((i - 61.0).powi(2) + (j - 17.0).powi(2)) / 6.0).exp()
+            })
+            .collect();
+        let d = TabulatedDensity::new(w, h, vals, rect)
+            .unwrap()
+            .with_row_factor(SinPiRows)
+            .unwrap();
+        QuadTreeBuilder::new().n_max(1.3).build(d).unwrap()
+    }
+
+    /// `fill_blocks` at one level (`level(op)` runs the operation), from `seed`: its samples
+    /// (as bits) and the generator's next draw after them.
+    fn run<const MAP: bool>(
+        s: &QuadTreeSampler<TabulatedDensity<SinPiRows>>,
+        len: usize,
+        seed: u64,
+        level: &dyn Fn(FillBlocks<'_, MAP, TabulatedDensity<SinPiRows>, Xoshiro256PlusPlus>),
+    ) -> (Vec<[u64; 3]>, u64) {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut out = vec![
+            Sample2 {
+                point: [f64::NAN; 2],
+                pdf: f64::NAN,
+            };
+            len
+        ];
+        level(FillBlocks {
+            sampler: s,
+            u: &mut rng,
+            out: &mut out,
+        });
+        let bits = out
+            .iter()
+            .map(|x| [x.point[0].to_bits(), x.point[1].to_bits(), x.pdf.to_bits()])
+            .collect();
+        (bits, rng.next_u64())
+    }
+
+    fn check<const MAP: bool>(rect: Rect) {
+        let s = sampler(rect);
+        assert_eq!(s.identity, !MAP);
+        for (len, seed) in [(1usize, 1u64), (63, 2), (64, 3), (65, 4), (2000, 5)] {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+            let one: Vec<[u64; 3]> = (0..len)
+                .map(|_| {
+                    let x = s.sample(&mut rng);
+                    [x.point[0].to_bits(), x.point[1].to_bits(), x.pdf.to_bits()]
+                })
+                .collect();
+            let expected = (one, rng.next_u64());
+            let baseline = run::<MAP>(&s, len, seed, &|op| {
+                let mut a = Audit::default();
+                op.sampler.fill_blocks::<MAP, _>(op.u, op.out, &mut a);
+            });
+            assert_eq!(baseline, expected, "x86-64 baseline, len {len}");
+            #[cfg(target_arch = "x86_64")]
+            {
+                if let Some(v3) = pulp::x86::V3::try_new() {
+                    let got = run::<MAP>(&s, len, seed, &|op| {
+                        pulp::Simd::vectorize(v3, op);
+                    });
+                    assert_eq!(got, expected, "AVX2 (V3), len {len}");
+                }
+                if let Some(v4) = pulp::x86::V4::try_new() {
+                    let got = run::<MAP>(&s, len, seed, &|op| {
+                        pulp::Simd::vectorize(v4, op);
+                    });
+                    assert_eq!(got, expected, "AVX-512 (V4), len {len}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_level_equals_the_one_sample_path() {
+        check::<false>(Rect::UNIT);
+        check::<true>(Rect::new(-0.3, 1.0, 2.2, 1.7));
     }
 }
