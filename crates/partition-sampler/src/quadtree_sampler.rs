@@ -48,45 +48,6 @@ pub struct QuadTreeSampler<D> {
     bound_scale: f64,
     /// The frame is the identity (roots `[0, 1]²`, `[−1, 1]²`, …): the hot loop skips the map.
     identity: bool,
-    /// The alias table with both candidates' rectangles and bounds, one cache line per column
-    /// ([`AliasCell`]), read by the block path; derived from `tree.leaves` at construction.
-    alias_cells: Vec<AliasCell>,
-}
-
-/// One column of the alias table laid out for the block path: the column's threshold and the
-/// stored rectangle and bound of both leaves it can return (its own, and its alias — or its
-/// own again when the alias is out of range), so that a trial's leaf pick, point and height
-/// read one cache line (the [`Leaf`] array needs a second, dependent load whenever the alias
-/// is taken).
-///
-/// **Exactness.** The fields are copies of the [`Leaf`] fields (`f32` rectangle and bound as
-/// stored, `f64` threshold): the same numbers, so the sampled law and the pdf are those the
-/// stored leaves define, and the block path returns the one-sample path's samples bit for bit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(64))]
-struct AliasCell {
-    /// The column's threshold ([`Leaf::prob`]): the column's own leaf is kept when the
-    /// fraction is below it.
-    prob: f64,
-    /// `[u0, v0, du, dv, m]` of the column's own leaf.
-    keep: [f32; 5],
-    /// `[u0, v0, du, dv, m]` of its alias (of its own leaf when the alias is out of range).
-    other: [f32; 5],
-}
-
-impl AliasCell {
-    /// The cells of `leaves`' alias table, in column order.
-    fn table(leaves: &[Leaf]) -> Vec<AliasCell> {
-        let geometry = |l: &Leaf| [l.u0, l.v0, l.du, l.dv, l.m];
-        leaves
-            .iter()
-            .map(|l| AliasCell {
-                prob: l.prob,
-                keep: geometry(l),
-                other: geometry(leaves.get(l.alias as usize).unwrap_or(l)),
-            })
-            .collect()
-    }
 }
 
 impl<D> std::fmt::Debug for QuadTreeSampler<D> {
@@ -162,9 +123,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         let inv_integral = 1.0 / tree.integral;
         let frame = tree.frame();
         let bound_scale = tree.bound_scale;
-        let alias_cells = AliasCell::table(&tree.leaves);
         Self {
-            alias_cells,
             tree,
             density,
             counters: Arc::new(Counters::default()),
@@ -222,12 +181,11 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// Bytes per structure.
     pub fn memory(&self) -> MemoryReport {
         let density = self.density.bytes_used();
-        let cells = self.alias_cells.capacity() * std::mem::size_of::<AliasCell>();
         MemoryReport {
-            leaves: self.tree.leaf_bytes() + cells,
+            leaves: self.tree.leaf_bytes(),
             nodes: self.tree.node_bytes(),
             density,
-            total: self.tree.bytes_used() + cells + density + std::mem::size_of::<Self>()
+            total: self.tree.bytes_used() + density + std::mem::size_of::<Self>()
                 - std::mem::size_of::<QuadTree>(),
         }
     }
@@ -498,42 +456,38 @@ impl<D: RegionStats> QuadTreeSampler<D> {
         out: &mut [Sample2],
         a: &mut Audit,
     ) {
-        let cells = &self.alias_cells;
-        let n = cells.len();
-        let nf = index_to_f64(n);
+        let leaves = &self.tree.leaves;
         let centre = self.tree.root.center();
         let mut points = [centre; TRIAL_BLOCK];
         let mut zs = [0.0f64; TRIAL_BLOCK];
         let mut bounds = [0.0f64; TRIAL_BLOCK];
         let mut fs = [0.0f64; TRIAL_BLOCK];
+        let mut us = [[0.0f64; 4]; TRIAL_BLOCK];
+        let mut picks = [0usize; TRIAL_BLOCK];
         let mut filled = 0;
         let mut since = 0u64;
         while filled < out.len() {
             let k = (out.len() - filled).min(TRIAL_BLOCK);
-            // Candidates, free of data-dependent branches so that the cache misses of a block
-            // overlap: each trial's four uniforms, its alias column (one cache line holding
-            // both candidates, the choice a select: [`Self::alias_index`]'s arithmetic), its
-            // point and height ([`Self::trial_with`]'s); then the densities.
+            // Three passes, each free of data-dependent branches so that the cache misses of
+            // a block overlap: the uniforms of every trial and its alias column (pick_leaf's
+            // alias branch, chosen by a select), then the picked leaf's point and height
+            // (trial's), then the densities.
             for j in 0..k {
-                let us = u.next_uniform4();
-                let s = us[0] * nf;
-                let i = floor_index(s, n - 1);
-                let cell = &cells[i];
-                let g = if s - index_to_f64(i) < cell.prob {
-                    cell.keep
-                } else {
-                    cell.other
-                };
-                let s = f64::from(g[0]) + us[1] * f64::from(g[2]);
-                let t = f64::from(g[1]) + us[2] * f64::from(g[3]);
+                us[j] = u.next_uniform4();
+                picks[j] = self.alias_index(us[j][0]);
+            }
+            for j in 0..k {
+                let leaf = &leaves[picks[j]];
+                let s = f64::from(leaf.u0) + us[j][1] * f64::from(leaf.du);
+                let t = f64::from(leaf.v0) + us[j][2] * f64::from(leaf.dv);
                 points[j] = if MAP {
                     [self.frame.domain_coord(0, s), self.frame.domain_coord(1, t)]
                 } else {
                     [s, t]
                 };
-                let m = f64::from(g[4]) * self.bound_scale;
+                let m = leaf.bound(self.bound_scale);
                 bounds[j] = m;
-                zs[j] = us[3] * m;
+                zs[j] = us[j][3] * m;
             }
             self.density.eval_block(&points[..k], &mut fs[..k]);
             // The accept pass without a data-dependent branch (its outcome is random, ≈ one
