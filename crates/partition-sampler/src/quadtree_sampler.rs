@@ -675,6 +675,10 @@ mod block_level_tests {
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{Rng, SeedableRng};
 
+    /// The block path's operation on the test density and generator.
+    type Op<'a, const MAP: bool> =
+        FillBlocks<'a, MAP, TabulatedDensity<SinPiRows>, Xoshiro256PlusPlus>;
+
     fn sampler(rect: Rect) -> QuadTreeSampler<TabulatedDensity<SinPiRows>> {
         // A sun on a sky gradient: leaves of very different weights, so columns take their
         // aliases often.
@@ -698,7 +702,7 @@ mod block_level_tests {
         s: &QuadTreeSampler<TabulatedDensity<SinPiRows>>,
         len: usize,
         seed: u64,
-        level: &dyn Fn(FillBlocks<'_, MAP, TabulatedDensity<SinPiRows>, Xoshiro256PlusPlus>),
+        level: &dyn Fn(Op<'_, MAP>),
     ) -> (Vec<[u64; 3]>, u64) {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let mut out = vec![
