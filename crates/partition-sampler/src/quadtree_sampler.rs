@@ -490,22 +490,25 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                 zs[j] = us[j][3] * m;
             }
             self.density.eval_block(&points[..k], &mut fs[..k]);
+            // The accept pass without a data-dependent branch (its outcome is random, ≈ one
+            // trial in six rejected: a mispredicted branch each time): every trial's sample is
+            // written to `out[filled]` and `filled` advances only when it was accepted, so a
+            // rejected trial's write is overwritten by the next one. In bounds: trial `j` of
+            // the block finds `filled ≤ filled₀ + j < filled₀ + k ≤ out.len()`. The exhausted
+            // case (`since` reaching the cap) stays a branch: it is never taken in practice.
+            a.trials += k as u64;
             for j in 0..k {
-                a.trials += 1;
-                since += 1;
                 let f = fs[j];
-                if f > bounds[j] {
-                    a.violations += 1;
-                }
-                if zs[j] < f {
-                    a.samples += 1;
-                    out[filled] = Sample2 {
-                        point: points[j],
-                        pdf: f * self.inv_integral,
-                    };
-                    filled += 1;
-                    since = 0;
-                } else if since >= MAX_TRIALS_PER_SAMPLE {
+                let accept = zs[j] < f;
+                a.violations += u64::from(f > bounds[j]);
+                out[filled] = Sample2 {
+                    point: points[j],
+                    pdf: f * self.inv_integral,
+                };
+                filled += usize::from(accept);
+                a.samples += u64::from(accept);
+                since = if accept { 0 } else { since + 1 };
+                if since >= MAX_TRIALS_PER_SAMPLE {
                     out[filled] = self.exhausted(points[j], a);
                     filled += 1;
                     since = 0;
@@ -658,5 +661,107 @@ impl<const MAP: bool, D: RegionStats, U: UniformSource + ?Sized> pulp::WithSimd
         let mut a = Audit::default();
         self.sampler.fill_blocks::<MAP, U>(self.u, self.out, &mut a);
         a
+    }
+}
+
+#[cfg(test)]
+mod block_level_tests {
+    //! The block path compiled for every instruction-set level `pulp` can dispatch to on the
+    //! machine running the tests (the x86-64 baseline always; AVX2 (`V3`) and AVX-512 (`V4`)
+    //! where present), each against the one-sample path: the same samples bit for bit, the same
+    //! uniforms consumed. (`sample_into` itself runs only the best level; this runs the others.)
+    use super::*;
+    use crate::{QuadTreeBuilder, Rect, SinPiRows, TabulatedDensity};
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{Rng, SeedableRng};
+
+    /// The block path's operation on the test density and generator.
+    type Op<'a, const MAP: bool> =
+        FillBlocks<'a, MAP, TabulatedDensity<SinPiRows>, Xoshiro256PlusPlus>;
+
+    fn sampler(rect: Rect) -> QuadTreeSampler<TabulatedDensity<SinPiRows>> {
+        // A sun on a sky gradient: leaves of very different weights, so columns take their
+        // aliases often.
+        let (w, h) = (96usize, 48usize);
+        let vals = (0..w * h)
+            .map(|k| {
+                let (i, j) = ((k % w) as f64, (k / w) as f64);
+                1.0 + j / 8.0 + 400.0 * (-((i - 61.0).powi(2) + (j - 17.0).powi(2)) / 6.0).exp()
+            })
+            .collect();
+        let d = TabulatedDensity::new(w, h, vals, rect)
+            .unwrap()
+            .with_row_factor(SinPiRows)
+            .unwrap();
+        QuadTreeBuilder::new().n_max(1.3).build(d).unwrap()
+    }
+
+    /// `fill_blocks` at one level (`level(op)` runs the operation), from `seed`: its samples
+    /// (as bits) and the generator's next draw after them.
+    fn run<const MAP: bool>(
+        s: &QuadTreeSampler<TabulatedDensity<SinPiRows>>,
+        len: usize,
+        seed: u64,
+        level: &dyn Fn(Op<'_, MAP>),
+    ) -> (Vec<[u64; 3]>, u64) {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut out = vec![
+            Sample2 {
+                point: [f64::NAN; 2],
+                pdf: f64::NAN,
+            };
+            len
+        ];
+        level(FillBlocks {
+            sampler: s,
+            u: &mut rng,
+            out: &mut out,
+        });
+        let bits = out
+            .iter()
+            .map(|x| [x.point[0].to_bits(), x.point[1].to_bits(), x.pdf.to_bits()])
+            .collect();
+        (bits, rng.next_u64())
+    }
+
+    fn check<const MAP: bool>(rect: Rect) {
+        let s = sampler(rect);
+        assert_eq!(s.identity, !MAP);
+        for (len, seed) in [(1usize, 1u64), (63, 2), (64, 3), (65, 4), (2000, 5)] {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+            let one: Vec<[u64; 3]> = (0..len)
+                .map(|_| {
+                    let x = s.sample(&mut rng);
+                    [x.point[0].to_bits(), x.point[1].to_bits(), x.pdf.to_bits()]
+                })
+                .collect();
+            let expected = (one, rng.next_u64());
+            let baseline = run::<MAP>(&s, len, seed, &|op| {
+                let mut a = Audit::default();
+                op.sampler.fill_blocks::<MAP, _>(op.u, op.out, &mut a);
+            });
+            assert_eq!(baseline, expected, "x86-64 baseline, len {len}");
+            #[cfg(target_arch = "x86_64")]
+            {
+                if let Some(v3) = pulp::x86::V3::try_new() {
+                    let got = run::<MAP>(&s, len, seed, &|op| {
+                        pulp::Simd::vectorize(v3, op);
+                    });
+                    assert_eq!(got, expected, "AVX2 (V3), len {len}");
+                }
+                if let Some(v4) = pulp::x86::V4::try_new() {
+                    let got = run::<MAP>(&s, len, seed, &|op| {
+                        pulp::Simd::vectorize(v4, op);
+                    });
+                    assert_eq!(got, expected, "AVX-512 (V4), len {len}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_level_equals_the_one_sample_path() {
+        check::<false>(Rect::UNIT);
+        check::<true>(Rect::new(-0.3, 1.0, 2.2, 1.7));
     }
 }

@@ -674,6 +674,69 @@ mod tests {
         }
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_and_avx512_levels_give_the_scalar_numbers() {
+        // `eval_block` and `sin_pi_unit_block` run only the best level `pulp` finds; this runs
+        // their operations at AVX2 (`V3`) and AVX-512 (`V4`) where the CPU has them, against
+        // the scalar functions, bit for bit.
+        let mut ts: Vec<f64> = (0..=4000).map(|k| k as f64 / 4000.0).collect();
+        ts.extend([
+            0.5f64.next_up(),
+            0.5f64.next_down(),
+            1.0f64.next_down(),
+            -0.0,
+        ]);
+        let d = TabulatedDensity::new(9, 5, (0..45).map(|k| (k % 7) as f64).collect(), Rect::UNIT)
+            .unwrap()
+            .with_row_factor(SinPiRows)
+            .unwrap();
+        let pts: Vec<Point2> = (0..1000)
+            .map(|k| [-0.05 + 0.0011 * k as f64, 1.02 - 0.00105 * k as f64])
+            .chain([
+                [1.0, 1.0],
+                [0.0, 0.0],
+                [f64::NAN, 0.5],
+                [0.5, 1.0f64.next_up()],
+            ])
+            .collect();
+        let check = |level: &str,
+                     vectorize: &dyn Fn(SinPiBlock<'_>) -> usize,
+                     eval: &dyn Fn(EvalBlock<'_, SinPiRows>)| {
+            let mut out = vec![f64::NAN; ts.len()];
+            assert_eq!(
+                vectorize(SinPiBlock {
+                    ts: &ts,
+                    out: &mut out
+                }),
+                0,
+                "{level}"
+            );
+            for (t, o) in ts.iter().zip(&out) {
+                assert_eq!(o.to_bits(), sin_pi_unit(*t).to_bits(), "{level}: t = {t:e}");
+            }
+            let mut out = vec![f64::NAN; pts.len()];
+            eval(EvalBlock {
+                density: &d,
+                points: &pts,
+                out: &mut out,
+            });
+            for (p, o) in pts.iter().zip(&out) {
+                assert_eq!(o.to_bits(), d.eval(*p).to_bits(), "{level}: {p:?}");
+            }
+        };
+        if let Some(v3) = pulp::x86::V3::try_new() {
+            check("V3", &|op| pulp::Simd::vectorize(v3, op), &|op| {
+                pulp::Simd::vectorize(v3, op)
+            });
+        }
+        if let Some(v4) = pulp::x86::V4::try_new() {
+            check("V4", &|op| pulp::Simd::vectorize(v4, op), &|op| {
+                pulp::Simd::vectorize(v4, op)
+            });
+        }
+    }
+
     #[test]
     fn exact_region_stats_with_sin_rows() {
         let (w, h) = (6usize, 5usize);
