@@ -77,6 +77,7 @@ impl DirectionSampler for ExactSet {
                 .map(|c| {
                     std::mem::size_of::<Cell>()
                         + c.upper.capacity() * 8
+                        + std::mem::size_of_val(c.iso.as_slice())
                         + c.tables
                             .iter()
                             .flatten()
