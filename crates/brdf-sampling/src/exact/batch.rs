@@ -7,8 +7,15 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{Audit, UniformSource};
 
+use super::fused::IsoQuery;
 use super::{ExactSet, Query};
 use crate::EvalSample;
+
+/// A query located by the isotropic fast path or the general one.
+enum Located {
+    Iso(IsoQuery),
+    General(Query),
+}
 
 impl ExactSet {
     /// Index of every interval of the set in one list: `offsets[cell] + interval`.
@@ -27,7 +34,8 @@ impl ExactSet {
     /// served group by group in the order of the intervals (queries of one interval in the
     /// caller's order); the uniforms are consumed in that order. Queries at or below the
     /// horizon get [`EvalSample::NONE`] and consume nothing. Each sample is drawn by the
-    /// one-query path's code ([`ExactSet::draw_located`]), so its law is the same.
+    /// one-query path's code ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so its
+    /// law is the same.
     pub(super) fn sample_eval_grouped(
         &self,
         brdf: &dyn Brdf,
@@ -39,9 +47,16 @@ impl ExactSet {
         out.resize(wos.len(), EvalSample::NONE);
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
-        let located: Vec<Option<(Query, usize)>> = wos
+        // Isotropic queries by the fast path's locate (`ExactSet::locate_iso`), the others
+        // (anisotropic, grazing) by the general one.
+        let located: Vec<Option<(Located, usize)>> = wos
             .iter()
-            .map(|wo| self.locate(wo).map(|q| (q, offsets[q.cell] + q.interval)))
+            .map(|wo| match self.locate_iso(wo) {
+                Some(q) => Some((Located::Iso(q), q.interval)),
+                None => self
+                    .locate(wo)
+                    .map(|q| (Located::General(q), offsets[q.cell] + q.interval)),
+            })
             .collect();
         // Counting sort of the located queries by interval (stable).
         let mut start = vec![0usize; groups + 1];
@@ -64,8 +79,16 @@ impl ExactSet {
                 continue;
             };
             let wo = &wos[k];
-            let (s, f) = self.draw_located(q, wo, u, &mut audit);
-            out[k] = self.finish(brdf, wo, s, f);
+            out[k] = match q {
+                Located::Iso(q) => {
+                    let (s, f) = self.draw_iso(q, wo, u, &mut audit);
+                    self.finish_iso(brdf, wo, s, f)
+                }
+                Located::General(q) => {
+                    let (s, f) = self.draw_located(q, wo, u, &mut audit);
+                    self.finish(brdf, wo, s, f)
+                }
+            };
         }
         self.counters.record(&audit);
     }

@@ -415,6 +415,22 @@ impl ChebyshevTable {
         }
     }
 
+    /// A one-variable table as `(lo, hi, centre, scale, power)` when its monomial form
+    /// ([`Self::power`]) was kept and has at most `N` coefficients (padded with zeros, which
+    /// [`Self::eval`]'s Horner loop never reads): `eval(t, _)` is then
+    /// `power[..len]` by Horner's rule at `x = ((t − centre) · scale).clamp(−1, 1)`, and
+    /// `[lo, hi]` the node range. `None` for tensor tables, Clenshaw's form or longer series.
+    pub(crate) fn inline_power<const N: usize>(&self) -> Option<([f64; 4], [f64; N], usize)> {
+        let n = self.power.len();
+        if self.delta.len() != 1 || n == 0 || n > N {
+            return None;
+        }
+        let mut power = [0.0; N];
+        power[..n].copy_from_slice(&self.power);
+        let range = [self.theta[self.theta.len() - 1], self.theta[0]];
+        Some(([range[0], range[1], self.centre, self.scale], power, n))
+    }
+
     /// The interpolant at `(θ, δ)` (arguments outside the box are clamped to it). One δ node:
     /// Horner's rule on [`Self::power`] when it was kept, else Clenshaw's recurrence; a tensor
     /// table: [`tensor_horner`] on [`Self::power`] when it was kept, else [`tensor_clenshaw`],

@@ -5,11 +5,192 @@
 //! [`DirectionSampler::sample_eval`]: crate::DirectionSampler::sample_eval
 
 use brdf::{Brdf, Vec3};
+use partition_sampler::{Audit, UniformSource};
 
 use super::ExactSet;
+use super::density::QueryDensity;
+use super::grid::TableVar;
+use super::interval::Interval;
+use crate::disc::DiscMap;
+use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
 
+/// An isotropic query located for [`ExactSet::draw_iso`] (issue 29, the per-query cost):
+/// the interval, and the served `ωo` in the interval's frame, `(r, 0, cos θo)` with
+/// `r = |(ωo.x, ωo.y)|` — the rotation of `ωo` to azimuth 0 with no division, so the trials'
+/// density can be prepared before the rotation back to the world (`(x, y)/r`) is known.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct IsoQuery {
+    pub(super) interval: usize,
+    r: f64,
+    cos: f64,
+}
+
+/// Normaliser coefficients an [`IsoRecord`] holds inline (the default table has 9 nodes).
+const ISO_TERMS: usize = 11;
+
+/// What the isotropic fast path reads of one interval besides its sampling table, in one
+/// 128-byte record on two adjacent cache lines (issue 29: a random `ωo` lands in a different
+/// interval per query, and the [`Interval`]'s own fields — node range, series, map — lie on
+/// several lines of a large struct and two heap blocks): the normaliser table's node range,
+/// affine map and monomial coefficients (copies of the table's own values, so
+/// [`IsoRecord::normaliser`] is bit for bit `Interval::normaliser`), and the disc map.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+pub(super) struct IsoRecord {
+    /// `[lo, hi, centre, scale]`: the node range of `cos θo` and `x = (v − centre) · scale`.
+    affine: [f64; 4],
+    /// Coefficients of `A cos θo` in `x`, `power[..n]`; `n = 0`: the interval's table is
+    /// evaluated instead (a longer series, or Clenshaw's form).
+    power: [f64; ISO_TERMS],
+    n: u32,
+    map: DiscMap,
+}
+
+impl IsoRecord {
+    /// The record of one interval of an isotropic (`cos θo`-table) cell.
+    pub(super) fn of(iv: &Interval) -> Self {
+        let t = &iv.table.theta;
+        let (affine, power, n) = iv.table.inline_power::<ISO_TERMS>().unwrap_or((
+            [t[t.len() - 1], t[0], 0.0, 0.0],
+            [0.0; ISO_TERMS],
+            0,
+        ));
+        Self {
+            affine,
+            power,
+            n: n as u32,
+            map: iv.map,
+        }
+    }
+
+    /// `A(θo)` at `cos θo = cos` for a `cos θo` table: the variable clamped to the nodes,
+    /// `A = (A cos θo)(v) / v`, bit for bit `Interval::normaliser` (the same operations on the
+    /// same values).
+    #[inline]
+    fn normaliser(&self, cos: f64, iv: &Interval) -> f64 {
+        let [lo, hi, centre, scale] = self.affine;
+        let v = cos.clamp(lo, hi);
+        let n = self.n as usize;
+        let p = if n > 0 && n <= ISO_TERMS {
+            let x = ((v - centre) * scale).clamp(-1.0, 1.0);
+            self.power[..n]
+                .iter()
+                .rev()
+                .fold(0.0, |acc, &a| acc * x + a)
+        } else {
+            iv.table.eval(v, 0.0)
+        };
+        p / v
+    }
+}
+
 impl ExactSet {
+    /// The isotropic query of `wo` when the fast path serves it: an isotropic set (its
+    /// normaliser tables over `cos θo`), `ωo`
+    /// above [`THETA_TOP_DEG`](super::THETA_TOP_DEG)'s cosine with finite components; `None`
+    /// otherwise (the general [`ExactSet::locate`] then serves the query, the grazing ones at
+    /// the top angle, or refuses it at and below the horizon). The interval is the one
+    /// `locate` finds: the same search key `1 − cos θo` and guide table.
+    #[inline]
+    pub(super) fn locate_iso(&self, wo: &Vec3) -> Option<IsoQuery> {
+        if !(self.isotropic
+            && self.var == TableVar::Cos
+            && wo.z >= self.top_cos
+            && wo.x.is_finite()
+            && wo.y.is_finite())
+        {
+            return None;
+        }
+        let cos = wo.z.min(1.0);
+        Some(IsoQuery {
+            interval: self.cells[0].interval_of(TableVar::Cos.key(cos), 0.0),
+            r: (wo.x * wo.x + wo.y * wo.y).sqrt(),
+            cos,
+        })
+    }
+
+    /// One direction at an isotropic query (`q = self.locate_iso(wo)`), with the accepted
+    /// trial's `f` (NaN when none was accepted or it is not finite): the law of
+    /// [`ExactSet::draw_located`] — the same interval, table, trials, normaliser and pdf — with
+    /// the trials' `ωo` at `(r, 0, cos θo)` instead of `R_{−φo} ωo` (the same direction to
+    /// rounding), the normaliser inline and no `Option` hand-offs.
+    #[inline]
+    pub(super) fn draw_iso<U: UniformSource + ?Sized>(
+        &self,
+        q: &IsoQuery,
+        wo: &Vec3,
+        u: &mut U,
+        audit: &mut Audit,
+    ) -> (DirSample, f64) {
+        let cell = &self.cells[0];
+        let iv = &cell.intervals[q.interval];
+        let rec = &cell.iso[q.interval];
+        let frame = Vec3::new(q.r, 0.0, q.cos);
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), true, &frame, Turn::IDENTITY, rec.map);
+        // The normaliser and the rotation back to the world depend on the query only: issued
+        // before the trials, their dependent chains (Horner's rule, two divisions) run in the
+        // shadow of the trials' evaluations instead of after the loop's last, mispredicted
+        // branch. Bit for bit the pdf's normaliser ([`IsoRecord::normaliser`]).
+        let a = rec.normaliser(q.cos, iv);
+        let turn = if q.r > 0.0 {
+            Turn {
+                cos: wo.x / q.r,
+                sin: wo.y / q.r,
+            }
+        } else {
+            Turn::IDENTITY
+        };
+        let drawn = match &cell.tables[q.interval] {
+            Some(table) => table.draw(&|p| g.at(p), u, audit),
+            None => {
+                use partition_sampler::diagnostics::AuditedDraws;
+                iv.tree.sample_envelope_of(&|p| g.at(p), u, audit)
+            }
+        };
+        let Some((x, gx)) = drawn else {
+            let none = DirSample {
+                wi: Vec3::new(0.0, 0.0, 1.0),
+                pdf: 0.0,
+            };
+            return (none, f64::NAN);
+        };
+        let d = rec.map.to_direction(x);
+        let s = DirSample {
+            wi: turn.apply(&d),
+            pdf: rec.map.area_to_solid_angle(gx / a, &d),
+        };
+        let f = match rec.map {
+            DiscMap::Projected => gx,
+            DiscMap::EqualArea => gx / (2.0 * d.z),
+        };
+        (s, f)
+    }
+
+    /// [`ExactSet::finish`] for an accepted trial's `f` given as a number (NaN or infinite:
+    /// none; `brdf` is then evaluated).
+    #[inline]
+    pub(super) fn finish_iso(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        s: DirSample,
+        f: f64,
+    ) -> EvalSample {
+        let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
+            0.0
+        } else if f.is_finite() && same_brdf(brdf, self.brdf.as_ref()) {
+            f
+        } else {
+            brdf.eval(wo, &s.wi)
+        };
+        EvalSample {
+            wi: s.wi,
+            pdf: s.pdf,
+            f,
+        }
+    }
+
     /// The [`EvalSample`] of a drawn sample `s` at `wo`, with `f` the accepted trial's value
     /// from [`ExactSet::draw_with_f`]: that value when `brdf` is the set's own BRDF object,
     /// otherwise one evaluation of `brdf`; 0 for a sample that contributes nothing.
@@ -87,6 +268,71 @@ mod tests {
         }
         let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
         (brdf, set)
+    }
+
+    /// The isotropic fast path (`locate_iso`, `draw_iso`) serves what the general path
+    /// (`locate`, `draw_located`) serves: the same interval for every query — also exactly at
+    /// the intervals' θ edges and their neighbouring floats — the same normaliser bits (the
+    /// inline records), and from the same uniforms the
+    /// same trials (streams in step), `ωi` and pdf to 1e-13 and the accepted trial's `f` to
+    /// 1e-13 (the trials' `ωo` is `(r, 0, cos θo)` rather than `R_{−φo} ωo`, the same
+    /// direction to rounding). Grazing queries, at and below the horizon, are left to the
+    /// general path.
+    #[test]
+    fn the_isotropic_fast_path_draws_what_the_general_path_draws() {
+        use partition_sampler::Audit;
+        for spec in ["phong:n=50", "ggx:alpha=0.2"] {
+            let (_, set) = set_of(spec);
+            let cell = &set.cells[0];
+            let mut wos: Vec<Vec3> = cell
+                .upper
+                .iter()
+                .flat_map(|&t| [t.next_down(), t, t.next_up()])
+                .filter(|t| *t < crate::exact::THETA_TOP_DEG.to_radians())
+                .map(|t| brdf::direction_from_radians(t, 1.3))
+                .collect();
+            let mut qr = Xoshiro256PlusPlus::seed_from_u64(16);
+            wos.extend((0..3000).map(|i| query(i, &mut qr)));
+            wos.push(Vec3::new(0.0, 0.0, 1.0));
+            let (mut r1, mut r2) = (
+                Xoshiro256PlusPlus::seed_from_u64(7),
+                Xoshiro256PlusPlus::seed_from_u64(7),
+            );
+            let (mut a1, mut a2) = (Audit::default(), Audit::default());
+            let mut served = 0;
+            for wo in &wos {
+                let Some(iso) = set.locate_iso(wo) else {
+                    assert!(wo.z < set.top_cos, "{spec}: {wo:?} not served");
+                    continue;
+                };
+                served += 1;
+                let q = set.locate(wo).unwrap();
+                assert_eq!((q.cell, q.interval), (0, iso.interval), "{spec}: {wo:?}");
+                let iv = set.interval(&q);
+                assert_eq!(
+                    set.cells[0].iso[q.interval]
+                        .normaliser(iso.cos, iv)
+                        .to_bits(),
+                    iv.normaliser(set.var, &q).to_bits(),
+                    "{spec}: {wo:?}"
+                );
+                let (s, f) = set.draw_located(&q, wo, &mut r1, &mut a1);
+                let (si, fi) = set.draw_iso(&iso, wo, &mut r2, &mut a2);
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * a.abs().max(b.abs());
+                let (w, wi) = (s.wi, si.wi);
+                assert!(
+                    close(s.pdf, si.pdf)
+                        && close(f.unwrap_or(f64::NAN), fi)
+                        && (w.x - wi.x).abs() < 1e-13
+                        && (w.y - wi.y).abs() < 1e-13
+                        && (w.z - wi.z).abs() < 1e-13,
+                    "{spec} {wo:?}: {s:?} {f:?} vs {si:?} {fi}"
+                );
+            }
+            assert_eq!(a1, a2, "{spec}");
+            assert_eq!(r1.next_uniform(), r2.next_uniform(), "{spec}");
+            assert!(served > 2800, "{spec}: {served}");
+        }
     }
 
     /// `sample_eval` draws the very samples of `sample` (same uniforms consumed, same `ωi` and

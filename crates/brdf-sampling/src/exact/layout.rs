@@ -48,6 +48,9 @@ pub(super) struct Cell {
     /// Per interval, the compact table its samples are drawn from ([`LeafTable`]; `None`: the
     /// tree's own walk).
     pub(super) tables: Vec<Option<LeafTable>>,
+    /// Per interval, what the isotropic fast path reads besides the table
+    /// ([`IsoRecord`](super::fused::IsoRecord); unused by anisotropic cells).
+    pub(super) iso: Vec<super::fused::IsoRecord>,
 }
 
 /// An interval with its θ and δ numerators ([`Grid`]).
@@ -99,6 +102,7 @@ impl Cell {
             .collect();
         let intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
         let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
+        let iso = intervals.iter().map(super::fused::IsoRecord::of).collect();
         Self {
             phi,
             phi_turn: Turn::from_angle(phi),
@@ -114,6 +118,7 @@ impl Cell {
             members: if plain { Vec::new() } else { entries },
             intervals,
             tables,
+            iso,
         }
     }
 

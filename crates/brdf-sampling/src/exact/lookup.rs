@@ -113,6 +113,9 @@ impl ExactSet {
         u: &mut dyn UniformSource,
         audit: &mut Audit,
     ) -> Option<DirSample> {
+        if let Some(q) = self.locate_iso(wo) {
+            return Some(self.draw_iso(&q, wo, u, audit).0);
+        }
         self.draw_with_f(wo, u, audit).map(|(s, _)| s)
     }
 

@@ -12,6 +12,11 @@ use super::set::ExactSet;
 impl DirectionSampler for ExactSet {
     fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> DirSample {
         let mut a = Audit::default();
+        if let Some(q) = self.locate_iso(wo) {
+            let (s, _) = self.draw_iso(&q, wo, u, &mut a);
+            self.counters.record(&a);
+            return s;
+        }
         match self.draw(wo, u, &mut a) {
             Some(s) => {
                 self.counters.record(&a);
@@ -28,6 +33,11 @@ impl DirectionSampler for ExactSet {
     /// served at its own `ωo` (θo ≤ [`THETA_TOP_DEG`]); otherwise one evaluation of `brdf`.
     fn sample_eval(&self, brdf: &dyn Brdf, wo: &Vec3, u: &mut dyn UniformSource) -> EvalSample {
         let mut a = Audit::default();
+        if let Some(q) = self.locate_iso(wo) {
+            let (s, f) = self.draw_iso(&q, wo, u, &mut a);
+            self.counters.record(&a);
+            return self.finish_iso(brdf, wo, s, f);
+        }
         let Some((s, f)) = self.draw_with_f(wo, u, &mut a) else {
             return EvalSample::NONE;
         };
@@ -67,6 +77,7 @@ impl DirectionSampler for ExactSet {
                 .map(|c| {
                     std::mem::size_of::<Cell>()
                         + c.upper.capacity() * 8
+                        + std::mem::size_of_val(c.iso.as_slice())
                         + c.tables
                             .iter()
                             .flatten()
