@@ -85,7 +85,7 @@ pub use plot::{
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{
-    IMAGE_KINDS, Image, Render, RenderConfig, SampleCost, TIMING_REPEATS, encode_png,
+    IMAGE_KINDS, Image, Render, RenderConfig, SampleCost, SphereError, TIMING_REPEATS, encode_png,
     equal_time_spp, relative_error, stack,
 };
 pub use report::{ReportAssets, report_markdown};

@@ -145,6 +145,9 @@ pub struct Image {
     pub seconds: f64,
 }
 
+/// One image's error on one sphere: `(sampler, samples per pixel, relative error)`.
+pub type SphereError = (String, usize, f64);
+
 /// The images of a study.
 #[derive(Debug, Clone)]
 pub struct Render {
@@ -895,7 +898,7 @@ impl Render {
 
     /// Per sphere (its BRDF, left to right): the images of `kind` as `(sampler, spp, relative
     /// error of that sphere's pixels)`, lowest error first.
-    pub fn sphere_ranking(&self, kind: &str) -> Vec<(String, Vec<(String, usize, f64)>)> {
+    pub fn sphere_ranking(&self, kind: &str) -> Vec<(String, Vec<SphereError>)> {
         let w = self.reference.width;
         let px = (w / self.brdfs.len().max(1)).max(1);
         self.brdfs
@@ -906,7 +909,7 @@ impl Render {
                     .filter(|p| p % w / px == b)
                     .collect();
                 let reference: Vec<[f64; 3]> = idx.iter().map(|&p| self.reference.rgb[p]).collect();
-                let mut rows: Vec<(String, usize, f64)> = self
+                let mut rows: Vec<SphereError> = self
                     .images
                     .iter()
                     .filter(|i| i.kind == kind)
@@ -1073,15 +1076,16 @@ impl Render {
             } else {
                 "| sphere | BRDF only |\n|---|---|\n"
             });
-            let cell = |r: &[(String, usize, f64)]| -> String {
+            let cell = |r: &[SphereError]| -> String {
                 let Some(b) = r.first() else {
                     return "—".into();
                 };
                 let mut c = format!("**{}** {:.2} %", b.0, 100.0 * b.2);
-                if !crate::is_adaptive(&b.0) {
-                    if let Some(a) = r.iter().find(|x| crate::is_adaptive(&x.0)) {
-                        let _ = write!(c, " (adaptive best: {} {:.2} %)", a.0, 100.0 * a.2);
-                    }
+                if let (false, Some(a)) = (
+                    crate::is_adaptive(&b.0),
+                    r.iter().find(|x| crate::is_adaptive(&x.0)),
+                ) {
+                    let _ = write!(c, " (adaptive best: {} {:.2} %)", a.0, 100.0 * a.2);
                 }
                 c
             };
