@@ -153,7 +153,7 @@ pub(crate) fn run(args: &StudyArgs) -> CliResult<()> {
     let staging = Staging::new(&args.out)?;
     let images = !args.no_images && shard.is_none();
     let render_steps = if images {
-        1 + 2 * plan.config().samplers.len() as u64
+        1 + study::IMAGE_KINDS.len() as u64 * plan.config().samplers.len() as u64
     } else {
         0
     };
@@ -249,7 +249,10 @@ fn merge(args: &MergeArgs) -> CliResult<()> {
             sphere_px: args.sphere_px,
             ..study::RenderConfig::default()
         };
-        let bar = progress::bar(1 + 2 * plan.config().samplers.len() as u64, "images");
+        let bar = progress::bar(
+            1 + study::IMAGE_KINDS.len() as u64 * plan.config().samplers.len() as u64,
+            "images",
+        );
         let r = render_sheet(&plan, &cfg, &|n| bar.inc(n))?;
         bar.finish_and_clear();
         Some(r)
@@ -486,7 +489,10 @@ fn write_images(dir: &Path, r: &study::Render) -> CliResult<String> {
         })?;
     }
     let mut sheets = Vec::new();
-    for kind in ["equal samples", "equal time"] {
+    for kind in study::IMAGE_KINDS {
+        if !r.images.iter().any(|i| i.kind == kind) {
+            continue;
+        }
         let rows: Vec<(String, image::RgbImage)> = std::iter::once(&r.reference)
             .chain(r.images.iter().filter(|i| i.kind == kind))
             .map(|i| {

@@ -1,6 +1,7 @@
 //! The study's sphere images alone (no variance cells): equal-samples and equal-time images of
 //! the `--quick` study's BRDFs (or those given) under one light, every registered preferred
-//! sampler, with the cost table (coherent vs random ωo). docs/benchmarks.md §21.
+//! sampler, BRDF sampling alone and with MIS (each sampler with the light's own sampler), with
+//! the cost table (coherent vs random ωo, MIS). docs/benchmarks.md §21, §23.8.
 //!
 //! ```text
 //! cargo run --release -p study --example sphere_costs -- LIGHT [PX] [SPP] [BRDF ...]
@@ -41,36 +42,27 @@ fn main() {
         reference_spp: 512,
         light: 0,
         seed: 1,
+        mis: true,
     };
     let render = plan.render(&cfg, &|_| {}).unwrap_or_else(|e| {
         eprintln!("sphere_costs: {e}");
         std::process::exit(1);
     });
     println!("{}", render.markdown(&[]));
-    // Per sphere: each sampler's relative error at equal time, best first.
-    let w = render.reference.width;
-    for (b, spec) in render.brdfs.iter().enumerate() {
-        let cols = |i: usize| i % w / px == b;
-        let mut rows: Vec<(String, usize, f64)> = render
-            .images
-            .iter()
-            .filter(|i| i.kind == "equal time")
-            .map(|i| {
-                let idx: Vec<usize> = (0..i.rgb.len()).filter(|&p| cols(p)).collect();
-                let img: Vec<[f64; 3]> = idx.iter().map(|&p| i.rgb[p]).collect();
-                let reference: Vec<[f64; 3]> =
-                    idx.iter().map(|&p| render.reference.rgb[p]).collect();
-                (
-                    i.sampler.clone(),
-                    i.spp,
-                    study::relative_error(&img, &reference),
-                )
-            })
-            .collect();
-        rows.sort_by(|a, b| a.2.total_cmp(&b.2));
-        println!("sphere `{spec}`, equal time (sampler, spp, rel. error):");
-        for (name, spp, e) in rows {
-            println!("  {name:<24} {spp:>5} {:>8.3} %", 100.0 * e);
+    // Per sphere: each sampler's relative error at equal time, best first, BRDF sampling alone
+    // and with MIS.
+    for kind in ["equal time", "MIS equal time"] {
+        for (spec, rows) in render.sphere_ranking(kind) {
+            if rows.is_empty() {
+                continue;
+            }
+            println!("sphere `{spec}`, {kind} (sampler, spp, rel. error):");
+            for (name, spp, e) in rows {
+                println!("  {name:<24} {spp:>5} {:>8.3} %", 100.0 * e);
+            }
         }
+    }
+    if let Some(v) = render.equal_time_verdict() {
+        println!("{v}");
     }
 }

@@ -2111,6 +2111,7 @@ mod shared_draw_tests {
             reference_spp: 4,
             light: 0,
             seed: 1,
+            mis: false,
         };
         let r = plan
             .render_subset(&cfg, &["phong:n=20".to_string()], &|_| {})

@@ -84,7 +84,10 @@ pub use plot::{
 };
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
-pub use render::{Image, Render, RenderConfig, encode_png, relative_error, stack};
+pub use render::{
+    IMAGE_KINDS, Image, Render, RenderConfig, SampleCost, SphereError, TIMING_REPEATS, encode_png,
+    equal_time_spp, relative_error, stack,
+};
 pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
 pub use sheet::labelled_sheet;

@@ -257,6 +257,8 @@ fn table1() -> Result<PaperTable, StudyError> {
             reference_spp: 8192,
             light: 0,
             seed: 1,
+            // Table 1 is BRDF sampling alone at equal samples: no MIS images to pay for.
+            mis: false,
         },
         &|_| {},
     )?;

@@ -27,13 +27,28 @@
 //! **Error.** The papers' relative error: the mean over pixels with non-null reference
 //! luminance of `|Y(I) − Y(I_ref)| / Y(I_ref)`.
 //!
+//! **MIS images.** Beside the BRDF-sampling images, with [`RenderConfig::mis`] (the default)
+//! every sampler is also combined with the light's own sampler (the reference's: the
+//! `envmap-adaptive` map sampler, or the area light's cone) by MIS, balance heuristic, one BRDF
+//! sample and one light sample per "spp" ([`estimators::Batch::mis`], the reference's and the
+//! study's MIS cells' estimator): kinds `MIS equal samples` and `MIS equal time`. Under a
+//! constant light there is nothing to sample and no MIS image is made.
+//!
 //! **Equal time.** Each sampler's time per pixel sample is measured on one thread on a fixed
 //! subset of row segments, on the render's own path (a row of pixels per batch call:
 //! *coherent* ωo), and also with each query at a random pixel of the same sphere (*random*
 //! ωo, same batch sizes), with the samplers' BRDF evaluations per sample (a count that does not
-//! depend on the machine's load); at equal time a sampler gets `spp × t_adaptive / t_sampler` samples per
-//! pixel (at least 1), `t_adaptive` the `adaptive` sampler's time (or the mean time when it is
-//! not in the study). Equal-time images therefore depend on timings.
+//! depend on the machine's load); with MIS images, also the time per MIS pixel sample on the
+//! coherent path (both samples, the other technique's pdf at each, the integrand at each). The
+//! clock is the timing thread's CPU clock where the platform has one (wall time elsewhere), and
+//! the [`TIMING_REPEATS`] runs of every sampler and path are interleaved (repeat `r` of every
+//! sampler before repeat `r + 1` of any), the median kept, so that a burst of load on the
+//! machine does not fall on one sampler. Every equal-time image gets the same time per pixel,
+//! `spp × t_adaptive`, `t_adaptive` the `adaptive` sampler's BRDF-sampling time per sample (or
+//! the mean of the samplers' when it is not in the study): a sampler gets
+//! `spp × t_adaptive / t_sampler` BRDF samples per pixel, and `spp × t_adaptive / t_MIS,sampler`
+//! MIS pairs (at least 1 each; [`equal_time_spp`]). Equal-time images therefore depend on
+//! timings.
 
 use std::time::Instant;
 
@@ -49,8 +64,29 @@ use serde::{Deserialize, Serialize};
 
 use crate::{Light, StudyError, StudyPlan};
 
-/// Timing runs per sampler for the equal-time budget (the median is used).
-const TIMING_REPEATS: usize = 5;
+/// Timing runs per sampler and path for the equal-time budget (interleaved; the median is used).
+pub const TIMING_REPEATS: usize = 9;
+
+/// The kinds of sphere images ([`Image::kind`]), in the report's order (the reference aside):
+/// BRDF sampling alone at equal samples and at equal time, then MIS with the light's sampler.
+pub const IMAGE_KINDS: [&str; 4] = [
+    "equal samples",
+    "equal time",
+    "MIS equal samples",
+    "MIS equal time",
+];
+
+/// Samples (or MIS pairs) per pixel at equal time: `spp × budget_ns / ns` rounded, at least 1
+/// (`budget_ns` the time per sample of the budget's sampler at `spp`, `ns` this sampler's time
+/// per sample on the same path; 1 when `ns` is not a positive number).
+pub fn equal_time_spp(spp: usize, budget_ns: f64, ns: f64) -> usize {
+    let x = spp as f64 * budget_ns / ns;
+    if x.is_finite() && x > 0.0 {
+        (x.round() as usize).max(1)
+    } else {
+        1
+    }
+}
 
 /// Settings of the sphere images.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -65,6 +101,14 @@ pub struct RenderConfig {
     pub light: usize,
     /// Seed of the images.
     pub seed: u64,
+    /// Also render the MIS images (each sampler with the light's own sampler; see the module
+    /// docs). No effect under a constant light.
+    #[serde(default = "mis_default")]
+    pub mis: bool,
+}
+
+fn mis_default() -> bool {
+    true
 }
 
 impl Default for RenderConfig {
@@ -75,6 +119,7 @@ impl Default for RenderConfig {
             reference_spp: 512,
             light: 0,
             seed: 1,
+            mis: true,
         }
     }
 }
@@ -84,9 +129,9 @@ impl Default for RenderConfig {
 pub struct Image {
     /// Sampler name (or `reference`).
     pub sampler: String,
-    /// `equal samples`, `equal time` or `reference`.
+    /// One of [`IMAGE_KINDS`], or `reference`.
     pub kind: String,
-    /// Samples per pixel (per strategy for the reference).
+    /// Samples per pixel (per strategy for the reference and the MIS images).
     pub spp: usize,
     /// Width in pixels.
     pub width: usize,
@@ -99,6 +144,9 @@ pub struct Image {
     /// Render time (s, all threads) — a timing.
     pub seconds: f64,
 }
+
+/// One image's error on one sphere: `(sampler, samples per pixel, relative error)`.
+pub type SphereError = (String, usize, f64);
 
 /// The images of a study.
 #[derive(Debug, Clone)]
@@ -113,11 +161,17 @@ pub struct Render {
     pub reference_method: String,
     /// The reference.
     pub reference: Image,
-    /// One equal-samples and one equal-time image per sampler that could be built.
+    /// One equal-samples and one equal-time image per sampler that could be built, each
+    /// followed by its two MIS images when there are MIS images.
     pub images: Vec<Image>,
     /// Measured ns per pixel sample per sampler on the render's path (coherent ωo; timings):
     /// the equal-time budget.
     pub ns_per_sample: Vec<(String, f64)>,
+    /// The equal-time budget: ns per pixel sample of the budget's sampler (`adaptive`, BRDF
+    /// sampling alone); every equal-time image gets `spp × budget_ns` per pixel.
+    pub budget_ns: f64,
+    /// The light's sampler in the MIS images (`None`: no MIS images).
+    pub mis_light: Option<String>,
     /// Time and BRDF evaluations per sample with coherent and with random ωo, per sampler.
     pub sample_costs: Vec<SampleCost>,
 }
@@ -135,6 +189,11 @@ pub struct SampleCost {
     pub coherent_evals: f64,
     /// The sampler's BRDF evaluations per sample, random queries.
     pub random_evals: f64,
+    /// ns per MIS pixel sample (one BRDF and one light sample, the other technique's pdf at
+    /// each, the integrand at each), coherent queries as rendered (median of the timing runs);
+    /// `None` without MIS images.
+    #[serde(default)]
+    pub mis_ns: Option<f64>,
 }
 
 /// The light's own sampler for the reference.
@@ -421,13 +480,31 @@ impl StudyPlan {
             seconds: start.elapsed().as_secs_f64(),
         };
         // Time per pixel sample, one thread, on every 11th row segment: median of
-        // `TIMING_REPEATS` runs, coherent (the render's path) and random ωo.
-        let costs: Vec<(usize, SampleCost)> = (0..self.entries.len())
+        // `TIMING_REPEATS` interleaved runs, coherent (the render's path) and random ωo, and
+        // MIS (coherent) when there are MIS images.
+        let mis_light = match (&light_sampler, cfg.mis) {
+            (LightSampler::None, _) | (_, false) => None,
+            (l, true) => Some(l),
+        };
+        let timed: Vec<usize> = (0..self.entries.len())
             .filter(|&s| built[s].iter().all(Option::is_some))
-            .map(|s| {
-                let samplers: Vec<&dyn DirectionSampler> =
-                    built[s].iter().flatten().map(|b| b.as_ref()).collect();
-                let cost = sample_cost(&hits, &segments, &brdfs, light, &samplers, cfg.seed);
+            .collect();
+        let timed_samplers: Vec<Vec<&dyn DirectionSampler>> = timed
+            .iter()
+            .map(|&s| built[s].iter().flatten().map(|b| b.as_ref()).collect())
+            .collect();
+        let costs: Vec<(usize, SampleCost)> = timed
+            .iter()
+            .zip(sample_costs(
+                &hits,
+                &segments,
+                &brdfs,
+                light,
+                mis_light,
+                &timed_samplers,
+                cfg.seed,
+            ))
+            .map(|(&s, cost)| {
                 (
                     s,
                     SampleCost {
@@ -447,10 +524,26 @@ impl StudyPlan {
                 ns_per_sample.iter().map(|x| x.1).sum::<f64>() / ns_per_sample.len().max(1) as f64
             });
         let mut images = Vec::new();
-        for &(s, ns) in &ns_per_sample {
+        for (s, cost) in &costs {
+            let s = *s;
             let name = self.entries[s].name;
-            let equal_time = ((cfg.spp as f64 * budget_ns / ns).round() as usize).max(1);
-            for (kind, spp) in [("equal samples", cfg.spp), ("equal time", equal_time)] {
+            let mut kinds = vec![
+                (IMAGE_KINDS[0], cfg.spp, false),
+                (
+                    IMAGE_KINDS[1],
+                    equal_time_spp(cfg.spp, budget_ns, cost.coherent_ns),
+                    false,
+                ),
+            ];
+            if let (Some(_), Some(mis_ns)) = (mis_light, cost.mis_ns) {
+                kinds.push((IMAGE_KINDS[2], cfg.spp, true));
+                kinds.push((
+                    IMAGE_KINDS[3],
+                    equal_time_spp(cfg.spp, budget_ns, mis_ns),
+                    true,
+                ));
+            }
+            for (kind, spp, mis) in kinds {
                 let start = Instant::now();
                 let rgb = render_segments(
                     &hits,
@@ -458,10 +551,13 @@ impl StudyPlan {
                     width * height,
                     |seg, rng| {
                         let sphere = seg[0].sphere;
-                        built[s][sphere].as_deref().map_or_else(
-                            || vec![[0.0; 3]; seg.len()],
-                            |smp| brdf_row(brdfs[sphere], light, seg, smp, spp, rng),
-                        )
+                        match (built[s][sphere].as_deref(), mis_light) {
+                            (None, _) => vec![[0.0; 3]; seg.len()],
+                            (Some(smp), Some(l)) if mis => {
+                                mis_row(brdfs[sphere], light, seg, smp, l, spp, rng)
+                            }
+                            (Some(smp), _) => brdf_row(brdfs[sphere], light, seg, smp, spp, rng),
+                        }
                     },
                     cfg.seed ^ name_hash(name) ^ name_hash(kind),
                 );
@@ -478,17 +574,17 @@ impl StudyPlan {
                 progress(1);
             }
         }
+        let light_method = match light_sampler {
+            LightSampler::Map(_) => "the envmap-adaptive map sampler",
+            LightSampler::Cone { .. } => "uniform sampling of the area light's cone",
+            LightSampler::None => "nothing (constant light: BRDF sampling alone)",
+        };
         Ok(Render {
             config: cfg.clone(),
             light: self.config.lights[cfg.light].clone(),
             brdfs: chosen.iter().map(|&b| self.brdfs[b].spec.clone()).collect(),
             reference_method: format!(
-                "MIS (balance heuristic) of the adaptive BRDF sampler and {}, {} samples of each per pixel",
-                match light_sampler {
-                    LightSampler::Map(_) => "the envmap-adaptive map sampler",
-                    LightSampler::Cone { .. } => "uniform sampling of the area light's cone",
-                    LightSampler::None => "nothing (constant light: BRDF sampling alone)",
-                },
+                "MIS (balance heuristic) of the adaptive BRDF sampler and {light_method}, {} samples of each per pixel",
                 cfg.reference_spp
             ),
             reference,
@@ -498,6 +594,8 @@ impl StudyPlan {
                 .map(|(s, ns)| (self.entries[*s].name.to_string(), *ns))
                 .collect(),
             sample_costs: costs.into_iter().map(|(_, c)| c).collect(),
+            budget_ns,
+            mis_light: mis_light.map(|_| light_method.to_string()),
         })
     }
 }
@@ -565,12 +663,12 @@ fn brdf_row(
 }
 
 /// The MIS (balance heuristic, `spp` samples of each technique) estimates of a row segment.
-fn mis_row(
+fn mis_row<L: LightTechnique + ?Sized>(
     brdf: &dyn Brdf,
     light: &Light,
     seg: &[Hit],
     sampler: &dyn DirectionSampler,
-    light_sampler: &LightSampler,
+    light_sampler: &L,
     spp: usize,
     rng: &mut dyn UniformSource,
 ) -> Vec<[f64; 3]> {
@@ -589,19 +687,23 @@ fn mis_row(
     )
 }
 
-/// One sampler's cost per sample (`samplers[sphere]`), one thread: every 11th row segment,
-/// 8 samples per pixel per batch call (coherent); then, with the same batch sizes, each query
-/// at a pixel of the same sphere drawn at random (random ωo, one sample each). Median ns of
-/// `TIMING_REPEATS` runs each, and the samplers' BRDF evaluations per sample (counted on this
-/// thread by the study's [`crate::CountingBrdf`]).
-fn sample_cost(
+/// Each sampler's cost per pixel sample (`samplers[i][sphere]`), one thread: every 11th row
+/// segment, 8 samples per pixel per batch call (coherent); then, with the same batch sizes,
+/// each query at a pixel of the same sphere drawn at random (random ωo, one sample each); and,
+/// with a light sampler, MIS on the coherent segments (8 pairs per pixel). Median of
+/// [`TIMING_REPEATS`] runs of each (sampler, path), the runs interleaved (repeat `r` of every
+/// sampler and path before repeat `r + 1`), timed on the thread's CPU clock where there is
+/// one; and the samplers' BRDF evaluations per sample (counted on this thread by the study's
+/// [`crate::CountingBrdf`]).
+fn sample_costs(
     hits: &[Hit],
     segments: &[std::ops::Range<usize>],
     brdfs: &[&dyn Brdf],
     light: &Light,
-    samplers: &[&dyn DirectionSampler],
+    light_sampler: Option<&LightSampler>,
+    samplers: &[Vec<&dyn DirectionSampler>],
     seed: u64,
-) -> SampleCost {
+) -> Vec<SampleCost> {
     let spp = 8;
     let subset: Vec<&[Hit]> = segments
         .iter()
@@ -610,7 +712,7 @@ fn sample_cost(
         .collect();
     // Random ωo: per subset segment, `len × spp` hits of the same sphere drawn uniformly.
     let mut pick = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, u64::MAX));
-    let by_sphere: Vec<Vec<Hit>> = (0..samplers.len())
+    let by_sphere: Vec<Vec<Hit>> = (0..brdfs.len())
         .map(|b| hits.iter().filter(|h| h.sphere == b).copied().collect())
         .collect();
     let random: Vec<Vec<Hit>> = subset
@@ -624,46 +726,67 @@ fn sample_cost(
                 .collect()
         })
         .collect();
+    let random_refs: Vec<&[Hit]> = random.iter().map(Vec::as_slice).collect();
     let samples = (subset.iter().map(|s| s.len()).sum::<usize>() * spp).max(1) as f64;
-    let run = |batches: &[&[Hit]], per_point: usize| -> (f64, f64) {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let mut times: Vec<f64> = Vec::with_capacity(TIMING_REPEATS);
-        let mut evals = 0;
-        for r in 0..TIMING_REPEATS {
-            let before = crate::thread_evaluations();
-            let t = Instant::now();
-            let mut sink = 0.0;
-            for seg in batches {
-                let sphere = seg[0].sphere;
-                let v = brdf_row(
-                    brdfs[sphere],
-                    light,
-                    seg,
-                    samplers[sphere],
-                    per_point,
-                    &mut rng,
-                );
-                sink += v.iter().map(|c| c[1]).sum::<f64>();
-            }
-            std::hint::black_box(sink);
-            times.push(t.elapsed().as_secs_f64() * 1e9 / samples);
-            if r == 0 {
-                evals = crate::thread_evaluations() - before;
+    // Paths: 0 coherent BRDF sampling, 1 random ωo, 2 coherent MIS.
+    let paths = if light_sampler.is_some() { 3 } else { 2 };
+    let mut times = vec![vec![Vec::with_capacity(TIMING_REPEATS); paths]; samplers.len()];
+    let mut evals = vec![[0.0; 2]; samplers.len()];
+    let mut rngs: Vec<Vec<Xoshiro256PlusPlus>> = (0..samplers.len())
+        .map(|i| {
+            (0..paths)
+                .map(|p| Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, (i * 3 + p) as u64)))
+                .collect()
+        })
+        .collect();
+    for r in 0..TIMING_REPEATS {
+        for (i, smp) in samplers.iter().enumerate() {
+            for (path, rng) in rngs[i].iter_mut().enumerate() {
+                let (batches, per_point) = match path {
+                    1 => (&random_refs[..], 1),
+                    _ => (&subset[..], spp),
+                };
+                let before = crate::thread_evaluations();
+                let (cpu, wall) = (crate::machine::thread_cpu_seconds(), Instant::now());
+                let mut sink = 0.0;
+                for seg in batches {
+                    let sphere = seg[0].sphere;
+                    let v = match (path, light_sampler) {
+                        (2, Some(l)) => {
+                            mis_row(brdfs[sphere], light, seg, smp[sphere], l, per_point, rng)
+                        }
+                        _ => brdf_row(brdfs[sphere], light, seg, smp[sphere], per_point, rng),
+                    };
+                    sink += v.iter().map(|c| c[1]).sum::<f64>();
+                }
+                std::hint::black_box(sink);
+                let seconds = match (cpu, crate::machine::thread_cpu_seconds()) {
+                    (Some(a), Some(b)) => b - a,
+                    _ => wall.elapsed().as_secs_f64(),
+                };
+                times[i][path].push(seconds * 1e9 / samples);
+                if r == 0 && path < 2 {
+                    evals[i][path] = (crate::thread_evaluations() - before) as f64 / samples;
+                }
             }
         }
-        times.sort_by(f64::total_cmp);
-        (times[times.len() / 2], evals as f64 / samples)
-    };
-    let (coherent_ns, coherent_evals) = run(&subset, spp);
-    let random_refs: Vec<&[Hit]> = random.iter().map(Vec::as_slice).collect();
-    let (random_ns, random_evals) = run(&random_refs, 1);
-    SampleCost {
-        sampler: String::new(),
-        coherent_ns,
-        random_ns,
-        coherent_evals,
-        random_evals,
     }
+    let median = |t: &mut Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    };
+    times
+        .iter_mut()
+        .zip(&evals)
+        .map(|(t, e)| SampleCost {
+            sampler: String::new(),
+            coherent_ns: median(&mut t[0]),
+            random_ns: median(&mut t[1]),
+            coherent_evals: e[0],
+            random_evals: e[1],
+            mis_ns: t.get_mut(2).map(median),
+        })
+        .collect()
 }
 
 /// Mean over pixels with non-null reference luminance of `|Y − Y_ref| / Y_ref`.
@@ -762,6 +885,66 @@ fn srgb(x: f64) -> f64 {
 }
 
 impl Render {
+    /// The images of `kind` (one of [`IMAGE_KINDS`]), lowest relative error first.
+    pub fn ranked(&self, kind: &str) -> Vec<&Image> {
+        let mut ranked: Vec<&Image> = self.images.iter().filter(|i| i.kind == kind).collect();
+        ranked.sort_by(|a, b| {
+            a.rel_error
+                .unwrap_or(f64::MAX)
+                .total_cmp(&b.rel_error.unwrap_or(f64::MAX))
+        });
+        ranked
+    }
+
+    /// Per sphere (its BRDF, left to right): the images of `kind` as `(sampler, spp, relative
+    /// error of that sphere's pixels)`, lowest error first.
+    pub fn sphere_ranking(&self, kind: &str) -> Vec<(String, Vec<SphereError>)> {
+        let w = self.reference.width;
+        let px = (w / self.brdfs.len().max(1)).max(1);
+        self.brdfs
+            .iter()
+            .enumerate()
+            .map(|(b, spec)| {
+                let idx: Vec<usize> = (0..self.reference.rgb.len())
+                    .filter(|p| p % w / px == b)
+                    .collect();
+                let reference: Vec<[f64; 3]> = idx.iter().map(|&p| self.reference.rgb[p]).collect();
+                let mut rows: Vec<SphereError> = self
+                    .images
+                    .iter()
+                    .filter(|i| i.kind == kind)
+                    .map(|i| {
+                        let img: Vec<[f64; 3]> = idx.iter().map(|&p| i.rgb[p]).collect();
+                        (i.sampler.clone(), i.spp, relative_error(&img, &reference))
+                    })
+                    .collect();
+                rows.sort_by(|a, b| a.2.total_cmp(&b.2));
+                (spec.clone(), rows)
+            })
+            .collect()
+    }
+
+    /// "At equal time, BRDF only: best **X** (e %); with MIS: best **Y** (e %)." over the
+    /// whole row of spheres (`None` without equal-time images; the MIS part only with MIS
+    /// images).
+    pub fn equal_time_verdict(&self) -> Option<String> {
+        let best = |kind: &str| {
+            self.ranked(kind).first().map(|i| {
+                format!(
+                    "best **{}** ({:.2} %, {} spp)",
+                    i.sampler,
+                    100.0 * i.rel_error.unwrap_or(0.0),
+                    i.spp
+                )
+            })
+        };
+        let brdf_only = best(IMAGE_KINDS[1])?;
+        Some(match best(IMAGE_KINDS[3]) {
+            Some(mis) => format!("At equal time, BRDF only: {brdf_only}; with MIS: {mis}."),
+            None => format!("At equal time, BRDF only: {brdf_only}; with MIS: no MIS images."),
+        })
+    }
+
     /// The report's section on the images: the setup, the reference, and per sampler the
     /// samples per pixel and relative error at equal samples and at equal time. `sheets` are
     /// `(caption, path)` of the images to embed.
@@ -819,28 +1002,57 @@ impl Render {
             }
             s.push('\n');
         }
-        for kind in ["equal samples", "equal time"] {
-            let mut ranked: Vec<&Image> = self.images.iter().filter(|i| i.kind == kind).collect();
-            ranked.sort_by(|a, b| {
-                a.rel_error
-                    .unwrap_or(f64::MAX)
-                    .total_cmp(&b.rel_error.unwrap_or(f64::MAX))
-            });
+        if let Some(method) = &self.mis_light {
+            let _ = writeln!(
+                s,
+                "**With MIS.** Each sampler combined with {method} by MIS (balance heuristic), one BRDF sample and one light sample per spp (the reference's estimator). ns / MIS sample † = both samples, the other technique's pdf at each and the integrand at each, on the coherent path. Equal time = the same time per pixel as the BRDF-only equal-time images ({} spp × {:.0} ns), so the two tables compare at equal time too.\n",
+                self.config.spp, self.budget_ns
+            );
+            s.push_str("| sampler | ns / MIS sample † | spp (equal samples) | rel. error | spp (equal time †) | rel. error |\n|---|---|---|---|---|---|\n");
+            for c in &self.sample_costs {
+                let find = |kind: &str| {
+                    self.images
+                        .iter()
+                        .find(|i| i.sampler == c.sampler && i.kind == kind)
+                };
+                let (Some(es), Some(et), Some(ns)) =
+                    (find(IMAGE_KINDS[2]), find(IMAGE_KINDS[3]), c.mis_ns)
+                else {
+                    continue;
+                };
+                let _ = writeln!(
+                    s,
+                    "| {} | {ns:.0} | {} | {:.2} % | {} | {:.2} % |",
+                    c.sampler,
+                    es.spp,
+                    100.0 * es.rel_error.unwrap_or(0.0),
+                    et.spp,
+                    100.0 * et.rel_error.unwrap_or(0.0)
+                );
+            }
+            s.push('\n');
+        }
+        for kind in IMAGE_KINDS {
+            let ranked = self.ranked(kind);
             let best = ranked.first();
             let best_adaptive = ranked.iter().find(|i| crate::is_adaptive(&i.sampler));
+            let at = match kind.strip_prefix("MIS ") {
+                Some(k) => format!("With MIS at {k}"),
+                None => format!("At {kind}"),
+            };
             if let (Some(b), Some(a)) = (best, best_adaptive) {
                 let (eb, ea) = (b.rel_error.unwrap_or(0.0), a.rel_error.unwrap_or(0.0));
                 if crate::is_adaptive(&b.sampler) {
                     let _ = writeln!(
                         s,
-                        "At {kind}, **{}** has the lowest image error ({:.2} %) (one image per sampler, no interval: an observation, not a ranking).",
+                        "{at}, **{}** has the lowest image error ({:.2} %) (one image per sampler, no interval: an observation, not a ranking).",
                         b.sampler,
                         100.0 * eb
                     );
                 } else {
                     let _ = writeln!(
                         s,
-                        "At {kind}, **{}** has the lowest image error ({:.2} %); the best adaptive sampler, {}, has {:.2} % ({:.2}× the error) (one image per sampler, no interval: an observation, not a ranking).",
+                        "{at}, **{}** has the lowest image error ({:.2} %); the best adaptive sampler, {}, has {:.2} % ({:.2}× the error) (one image per sampler, no interval: an observation, not a ranking).",
                         b.sampler,
                         100.0 * eb,
                         a.sampler,
@@ -848,6 +1060,41 @@ impl Render {
                         if eb > 0.0 { ea / eb } else { f64::INFINITY }
                     );
                 }
+            }
+        }
+        s.push('\n');
+        if let Some(v) = self.equal_time_verdict() {
+            let _ = writeln!(s, "{v}\n");
+        }
+        let brdf_only = self.sphere_ranking(IMAGE_KINDS[1]);
+        let mis = self.sphere_ranking(IMAGE_KINDS[3]);
+        if brdf_only.iter().any(|(_, r)| !r.is_empty()) {
+            let with_mis = mis.iter().any(|(_, r)| !r.is_empty());
+            s.push_str("Per sphere at equal time (relative error of that sphere's pixels; best sampler, and the best adaptive one when it is not the best):\n\n");
+            s.push_str(if with_mis {
+                "| sphere | BRDF only | with MIS |\n|---|---|---|\n"
+            } else {
+                "| sphere | BRDF only |\n|---|---|\n"
+            });
+            let cell = |r: &[SphereError]| -> String {
+                let Some(b) = r.first() else {
+                    return "—".into();
+                };
+                let mut c = format!("**{}** {:.2} %", b.0, 100.0 * b.2);
+                if let (false, Some(a)) = (
+                    crate::is_adaptive(&b.0),
+                    r.iter().find(|x| crate::is_adaptive(&x.0)),
+                ) {
+                    let _ = write!(c, " (adaptive best: {} {:.2} %)", a.0, 100.0 * a.2);
+                }
+                c
+            };
+            for (k, (brdf, r)) in brdf_only.iter().enumerate() {
+                let _ = write!(s, "| `{}` | {} |", crate::names::short_brdf(brdf), cell(r));
+                if with_mis {
+                    let _ = write!(s, " {} |", cell(&mis[k].1));
+                }
+                s.push('\n');
             }
         }
         s.push('\n');
@@ -1076,6 +1323,114 @@ mod tests {
             assert!(
                 x > limit,
                 "broken batch {broken} not caught: Σz² = {x:.1} (limit {limit:.1})"
+            );
+        }
+    }
+
+    /// A light technique that reports twice its density (a broken MIS: the weights and the
+    /// light term are then biased).
+    struct DoubledPdf<'a>(&'a LightSampler);
+
+    impl LightTechnique for DoubledPdf<'_> {
+        fn sample_world(&self, u: &mut dyn UniformSource) -> Option<(Vec3, f64)> {
+            self.0.sample_world(u).map(|(d, p)| (d, 2.0 * p))
+        }
+        fn pdf_world(&self, d: &Vec3) -> f64 {
+            2.0 * self.0.pdf_world(d)
+        }
+    }
+
+    /// The MIS images' law under a map, the light technique of the Grace images (the
+    /// `envmap-adaptive` sampler of a small procedural sky with a sun): the row segments'
+    /// batched MIS of `adaptive` and the map sampler, as the `MIS …` images are rendered, against
+    /// the one-query MIS (`estimators::MisPair`) per pixel, two spheres: `Σ z²` below the χ²(k)
+    /// quantile at α = 10⁻³ (fixed seeds; docs/benchmarks.md §23.8 gives the measured value). A
+    /// light technique reporting twice its density fails, and so does a batch whose outputs
+    /// reach the pixels in the wrong order.
+    #[test]
+    fn the_mis_images_under_a_map_have_the_law_of_the_per_pixel_mis_and_a_wrong_light_pdf_fails() {
+        use statrs::distribution::{ChiSquared, ContinuousCDF};
+        let light = Light::Map {
+            map: envmap::procedural_sky(64, 32).unwrap(),
+            label: "sky".into(),
+        };
+        let specs = ["lambert", "phong:n=20"];
+        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = specs
+            .iter()
+            .map(|s| std::sync::Arc::from(brdf::parse_spec(s).unwrap()))
+            .collect();
+        let options = brdf_sampling::SetOptions {
+            slices: 8,
+            ..Default::default()
+        };
+        let built: Vec<std::sync::Arc<dyn DirectionSampler>> = brdfs
+            .iter()
+            .map(|b| {
+                samplers::build_direction(
+                    "adaptive",
+                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
+                )
+                .unwrap()
+                .sampler
+            })
+            .collect();
+        let light_sampler = LightSampler::new(&light).unwrap();
+        assert!(matches!(light_sampler, LightSampler::Map(_)));
+        let doubled = DoubledPdf(&light_sampler);
+        let px = 10;
+        let hs = hits(2, px);
+        let segs = segments(&hs, 2 * px);
+        let spp = 300;
+        // 0: as rendered; 1: the doubled density; 2: outputs handed out in reverse.
+        let render = |variant: u8| -> Vec<[f64; 3]> {
+            let mut out = Vec::new();
+            for r in &segs {
+                let seg = &hs[r.clone()];
+                let b = seg[0].sphere;
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(41, r.start as u64));
+                let (brdf, smp) = (brdfs[b].as_ref(), built[b].as_ref());
+                let mut v = if variant == 1 {
+                    mis_row(brdf, &light, seg, smp, &doubled, spp, &mut rng)
+                } else {
+                    mis_row(brdf, &light, seg, smp, &light_sampler, spp, &mut rng)
+                };
+                if variant == 2 {
+                    v.reverse();
+                }
+                out.extend(v);
+            }
+            out
+        };
+        let one: Vec<Vec<[f64; 3]>> = hs
+            .iter()
+            .map(|h| {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(43, h.pixel as u64));
+                let pair = estimators::MisPair {
+                    brdf_sampler: built[h.sphere].as_ref(),
+                    light_sampler: &light_sampler,
+                    frame: h.query.frame,
+                    heuristic: MisHeuristic::Balance,
+                };
+                let g = |wi: &Vec3| integrand(brdfs[h.sphere].as_ref(), &light, h, wi);
+                (0..spp)
+                    .map(|_| pair.value(&h.query.wo, g, &mut rng))
+                    .collect()
+            })
+            .collect();
+        let (x, k) = chi2(&render(0), &one);
+        assert!(k > 100, "{k} lit pixels");
+        let limit = ChiSquared::new(k as f64).unwrap().inverse_cdf(1.0 - 1e-3);
+        eprintln!("MIS under a map: Σz² = {x:.1} over {k} pixels (limit {limit:.1})");
+        assert!(
+            x < limit,
+            "batch vs one-query: Σz² = {x:.1} over {k} pixels (limit {limit:.1})"
+        );
+        for broken in [1, 2] {
+            let (x, _) = chi2(&render(broken), &one);
+            eprintln!("broken {broken}: Σz² = {x:.1}");
+            assert!(
+                x > limit,
+                "broken MIS {broken} not caught: Σz² = {x:.1} (limit {limit:.1})"
             );
         }
     }

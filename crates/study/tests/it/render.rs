@@ -20,6 +20,7 @@ fn cfg() -> RenderConfig {
         reference_spp: 32,
         light: 0,
         seed: 5,
+        mis: true,
     }
 }
 
@@ -43,6 +44,9 @@ fn constant_light_lambert_is_exact_for_cosine_sampling() {
     for &i in &lit {
         assert!((cosine.rgb[i][1] - 1.6).abs() < 1e-9, "{:?}", cosine.rgb[i]);
     }
+    // Nothing to sample under a constant light: no MIS images.
+    assert!(r.images.iter().all(|i| !i.kind.starts_with("MIS")));
+    assert!(r.mis_light.is_none());
     // Uniform sampling is not exact.
     let uniform = equal_samples("uniform");
     assert!(lit.iter().any(|&i| (uniform.rgb[i][1] - 1.6).abs() > 1e-3));
@@ -74,10 +78,11 @@ fn images_do_not_depend_on_the_thread_count() {
     let equal_samples = |r: &study::Render| -> Vec<Vec<[f64; 3]>> {
         r.images
             .iter()
-            .filter(|i| i.kind == "equal samples")
+            .filter(|i| i.kind == "equal samples" || i.kind == "MIS equal samples")
             .map(|i| i.rgb.clone())
             .collect()
     };
+    assert_eq!(equal_samples(&one).len(), 6);
     assert_eq!(equal_samples(&one), equal_samples(&two));
     assert!(
         one.images
@@ -118,4 +123,56 @@ fn a_subset_of_the_study_renders_as_a_study_of_the_subset() {
         both.render_subset(&cfg(), &["ward".to_string()], &|_| {})
             .is_err()
     );
+}
+
+/// The MIS images under an area light: two per sampler (`MIS equal samples` at the config's
+/// spp, `MIS equal time`), and the equal-time MIS budget comes from each sampler's measured
+/// time per **MIS** pixel sample: `spp × t_adaptive / t_MIS` pairs, `t_adaptive` the budget
+/// (the `adaptive` sampler's BRDF-sampling time). Rounding the BRDF-only time instead would
+/// give another count for at least one sampler (MIS does both samplings, so its time is
+/// larger), which the test requires, so a budget taken from the wrong time fails.
+#[test]
+fn mis_images_get_their_equal_time_budget_from_the_mis_time() {
+    let p = plan("area:theta=30,phi=180,radius=10");
+    let mut c = cfg();
+    c.spp = 16;
+    let r = p.render(&c, &|_| {}).unwrap();
+    assert!(r.mis_light.as_deref().is_some_and(|m| m.contains("cone")));
+    let adaptive = r
+        .sample_costs
+        .iter()
+        .find(|c| c.sampler == "adaptive")
+        .unwrap();
+    assert_eq!(r.budget_ns, adaptive.coherent_ns);
+    let mut differs = false;
+    for cost in &r.sample_costs {
+        let mis_ns = cost.mis_ns.unwrap();
+        assert!(mis_ns > 0.0 && cost.coherent_ns > 0.0);
+        let image = |kind: &str| {
+            r.images
+                .iter()
+                .find(|i| i.sampler == cost.sampler && i.kind == kind)
+                .unwrap_or_else(|| panic!("no {kind} image of {}", cost.sampler))
+        };
+        assert_eq!(image("MIS equal samples").spp, 16);
+        let equal_time = image("MIS equal time");
+        assert_eq!(
+            equal_time.spp,
+            study::equal_time_spp(16, r.budget_ns, mis_ns),
+            "{}: {mis_ns:.0} ns per MIS sample, budget {:.0} ns",
+            cost.sampler,
+            r.budget_ns
+        );
+        assert!(equal_time.rel_error.is_some_and(f64::is_finite));
+        differs |= equal_time.spp != study::equal_time_spp(16, r.budget_ns, cost.coherent_ns);
+        assert_eq!(
+            image("equal time").spp,
+            study::equal_time_spp(16, r.budget_ns, cost.coherent_ns)
+        );
+    }
+    assert!(differs, "the MIS and BRDF-only times give the same budgets");
+    let md = r.markdown(&[]);
+    assert!(md.contains("| sampler | ns / MIS sample † |"), "{md}");
+    assert!(md.contains("At equal time, BRDF only: best **"), "{md}");
+    assert!(md.contains("; with MIS: best **"), "{md}");
 }
