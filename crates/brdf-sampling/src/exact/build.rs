@@ -42,6 +42,11 @@ pub(super) fn eval_cost_ns(brdf: &dyn Brdf) -> f64 {
     start.elapsed().as_secs_f64() * 1e9 / n as f64
 }
 
+/// Whether `brdf` is an RGL material (or a wrapper that exposes one).
+fn is_rgl(brdf: &dyn Brdf) -> bool {
+    brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>())
+}
+
 impl ExactSet {
     /// Builds the set of `brdf` (intervals in parallel with rayon; the result does not depend
     /// on the thread count). `progress` is called with `(intervals built, intervals queued)`.
@@ -124,6 +129,9 @@ pub(super) struct Plan {
     /// The largest interpolation tail an interval keeps whatever its nodes' error estimate
     /// ([`tabulated::tail_cap`]).
     pub(super) tail_cap: f64,
+    /// Intervals split for their mean trials hand their normaliser tables down
+    /// (`jobs::InheritedTable`): RGL sets, whose nodes cost ~9·10⁴ evaluations each.
+    pub(super) inherit_tables: bool,
 }
 
 impl Plan {
@@ -174,9 +182,12 @@ impl Plan {
         // BRDFs. Anisotropic intervals spend most of their evaluations on the normaliser
         // nodes: on poulin-fournier the cache cut the build's evaluations by 16 % and its CPU
         // time by 10 %, for a peak of 280 MB instead of 16 MB (it stays off by default).
+        // RGL materials always cache (issue 29): at ~300 ns per evaluation they sat next to the
+        // threshold, so a loaded host's probe could turn the cache off and multiply the
+        // envelopes' evaluations by ~2.3 (`cc_ibiza_sunset`: 13.6 M → 30.1 M).
         let cache = match cache {
             Some(forced) => forced,
-            None => isotropic && eval_cost_ns(brdf) > CACHE_ABOVE_NS,
+            None => isotropic && (is_rgl(brdf) || eval_cost_ns(brdf) > CACHE_ABOVE_NS),
         };
         Self {
             isotropic,
@@ -195,6 +206,7 @@ impl Plan {
             } else {
                 f64::INFINITY
             },
+            inherit_tables: table_nodes && is_rgl(brdf),
         }
     }
 
@@ -212,6 +224,7 @@ impl Plan {
             table_nodes: self.table_nodes,
             node_cache: Arc::clone(&self.node_cache),
             set_table: self.set_table.clone(),
+            inherit_tables: self.inherit_tables,
         }
     }
 

@@ -16,7 +16,9 @@ use super::density::{EnvelopeNode, IntervalEnvelope, NodeKey, NodeValues, QueryD
 use super::error::ExactError;
 use super::grid::{Grid, TableVar};
 use super::interval::Interval;
-use super::jobs::{Inheritance, Job, Normaliser, NormaliserKey};
+use super::jobs::{
+    INHERITED_TAIL_CAP, Inheritance, InheritedTable, Job, Normaliser, NormaliserKey,
+};
 use super::options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
 use super::phases::{Lap, PhaseCounts};
 use super::tabulated;
@@ -81,6 +83,9 @@ pub(super) struct IntervalContext {
     pub(super) node_cache: Arc<tabulated::NodeCache>,
     /// The set's table of `A(θo)` (Cornell data): the nodes are its values.
     pub(super) set_table: Option<Arc<super::set_table::SetTable>>,
+    /// An isotropic interval split for its mean trials completes its normaliser table and hands
+    /// it to its descendants when its tail is small enough ([`InheritedTable`]; RGL sets).
+    pub(super) inherit_tables: bool,
 }
 
 /// One interval's build: the interval (`None`: to be split) and what its children can reuse.
@@ -271,15 +276,19 @@ fn envelope_tree(
 enum TableOutcome {
     /// `A · cos θo` at the Chebyshev nodes and the largest quadrature error estimate.
     Table(ChebyshevTable, f64),
-    /// A node's mean trials `ΣV/A` exceed the cap (and the interval can be split).
-    Split,
+    /// A node's mean trials `ΣV/A` exceed the cap (and the interval can be split), with the
+    /// table its descendants inherit, if any.
+    Split(Option<Arc<InheritedTable>>),
 }
 
 /// The normaliser at the Chebyshev nodes, by the leaf quadrature of `tree`; the δ nodes double
 /// (Lobatto-nested) while their tail exceeds the tolerance. Every node integrated goes to
 /// `normalisers` (the children's inheritance). The ends and the middle come first: a node
 /// whose mean trials exceed the cap decides a split (when `axis` allows one), and the other
-/// nodes' quadratures are not needed.
+/// nodes' quadratures are not needed, unless the build hands tables down
+/// (`ctx.inherit_tables`): then the table is completed, and handed to the descendants when its
+/// tail is at most the tolerance or its nodes' error capped at [`INHERITED_TAIL_CAP`]. The nodes
+/// of an interval that inherited a table are that table's values.
 #[allow(clippy::too_many_arguments)]
 fn normaliser_table(
     brdf: &dyn Brdf,
@@ -312,6 +321,12 @@ fn normaliser_table(
     }
     let volume = tree.volume();
     let nt = theta_nodes.len();
+    let inherit = ctx.inherit_tables && span.isotropic;
+    let inherited = if inherit {
+        job.inherited.table.clone()
+    } else {
+        None
+    };
     let mut nd = options.phi_normaliser_nodes;
     loop {
         let delta_nodes = if span.isotropic {
@@ -338,6 +353,7 @@ fn normaliser_table(
         order.sort_by_key(|&(i, j)| known(normalisers.as_slice(), i, delta_nodes[j]).is_none());
         let mut values = vec![0.0; nt * delta_nodes.len()];
         let mut quad_err = 0.0f64;
+        let mut split = false;
         for (i, j) in order {
             let (t, cos, d) = (
                 var.theta(theta_nodes[i]),
@@ -347,7 +363,13 @@ fn normaliser_table(
             let r = match known(normalisers.as_slice(), i, d) {
                 Some(r) => r,
                 None => {
-                    let r = integrate_node(brdf, ctx, span, tree, t, d);
+                    let r = match &inherited {
+                        Some(it) => Normaliser {
+                            total: it.table.eval(theta_nodes[i], d) / cos,
+                            rel_err: it.rel_err,
+                        },
+                        None => integrate_node(brdf, ctx, span, tree, t, d),
+                    };
                     normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
                     r
                 }
@@ -360,12 +382,28 @@ fn normaliser_table(
                 });
             }
             if axis.is_some() && volume / r.total > options.max_trials {
-                return Ok(TableOutcome::Split);
+                if !inherit {
+                    return Ok(TableOutcome::Split(None));
+                }
+                split = true;
             }
             quad_err = quad_err.max(r.rel_err);
             values[i * delta_nodes.len() + j] = r.total * cos;
         }
         let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
+        if split {
+            let handed = inherited.or_else(|| {
+                let tail = table.rel_tail_theta();
+                let cap = options.normaliser_tol.max(quad_err.min(INHERITED_TAIL_CAP));
+                (tail <= cap).then(|| {
+                    Arc::new(InheritedTable {
+                        table,
+                        rel_err: quad_err + tail,
+                    })
+                })
+            });
+            return Ok(TableOutcome::Split(handed));
+        }
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
         // A θ tail the build splits for (`next_axis` in `build.rs`: the same floor) is not
@@ -479,19 +517,22 @@ pub(super) fn build_interval(
     let quad_evals = crate::disc::thread_evaluations() - before;
     phases.quadrature = lap.take();
     phases.nodes = normalisers.len() as u64;
-    let interval = match outcome {
-        TableOutcome::Split => None,
-        TableOutcome::Table(table, quad_err) => Some(finish_interval(
-            brdf,
-            job,
-            ctx,
-            &span,
-            &envelope,
-            tree,
-            table,
-            quad_err,
-            build_evals + axis_evals + quad_evals,
-        )?),
+    let (interval, table) = match outcome {
+        TableOutcome::Split(table) => (None, table),
+        TableOutcome::Table(table, quad_err) => (
+            Some(finish_interval(
+                brdf,
+                job,
+                ctx,
+                &span,
+                &envelope,
+                tree,
+                table,
+                quad_err,
+                build_evals + axis_evals + quad_evals,
+            )?),
+            None,
+        ),
     };
     phases.finish = lap.take();
     Ok(Built {
@@ -502,6 +543,7 @@ pub(super) fn build_interval(
             nodes: values_of(envelope),
             normalisers,
             tree: None,
+            table,
         },
     })
 }

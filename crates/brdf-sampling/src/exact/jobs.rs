@@ -6,6 +6,7 @@ use partition_sampler::QuadTree;
 
 use crate::disc::DiscMap;
 
+use super::chebyshev::ChebyshevTable;
 use super::density::{NodeKey, NodeValues};
 use super::grid::Grid;
 
@@ -35,7 +36,30 @@ pub(super) struct Inheritance {
     pub(super) normalisers: Vec<(NormaliserKey, Normaliser)>,
     /// The tree of an interval split for its tail, and its disc map.
     pub(super) tree: Option<(QuadTree, DiscMap)>,
+    /// An ancestor's normaliser table whose interpolation tail met the inheritance test (see
+    /// [`InheritedTable`]): the descendants take their nodes from it.
+    pub(super) table: Option<Arc<InheritedTable>>,
 }
+
+/// The normaliser table of an isotropic interval split for its mean trials, handed to its
+/// descendants (RGL sets, issue 29): its tail was at most the tolerance, or its nodes' error
+/// estimate capped at [`INHERITED_TAIL_CAP`], so within the interval the table is `A · cos θo`
+/// to `rel_err`, and a descendant's nodes are its values there (no quadrature). A
+/// descendant's table re-interpolates the same polynomial (its own tail is rounding): its
+/// declared error carries `rel_err`.
+pub(super) struct InheritedTable {
+    /// `A · cos θo` over the ancestor's interval (table variable).
+    pub(super) table: ChebyshevTable,
+    /// The ancestor's node error estimate plus its table's interpolation tail (relative).
+    pub(super) rel_err: f64,
+}
+
+/// Largest interpolation tail (relative) of a table that a split interval hands to its
+/// descendants, unless the tolerance is larger: the tail test of a kept interval stops at its
+/// nodes' own error estimate (up to ~10⁻³ for grazing RGL nodes), but an inherited table
+/// serves many narrow intervals, so it is held to this instead when that is smaller (the RGL
+/// sets' normaliser goal is 10⁻⁴, `tabulated.rs`).
+pub(super) const INHERITED_TAIL_CAP: f64 = 3e-5;
 
 /// A normaliser node: the bits of its table variable and of `δ`.
 pub(super) type NormaliserKey = (u64, u64);

@@ -288,6 +288,59 @@ mod tests {
         assert_eq!(set.bound_violations(), Some(0));
     }
 
+    /// Issue 29: an RGL interval halved for its mean trials completes its normaliser table and
+    /// hands it to its descendants when its tail is small (`jobs::InheritedTable`); they take
+    /// their nodes from it instead of integrating fresh ones (~9·10⁴ evaluations each). The
+    /// RGL fixture with a tighter trial cap (1.5) has such splits. Checked: some kept
+    /// intervals integrated no node, and at the middle of each of them the set's normaliser
+    /// is within 3·10⁻⁵ (`INHERITED_TAIL_CAP`) of the node rule at the query itself (`node_rule_at`:
+    /// the gap is the inherited interpolation's alone) and within its declared error.
+    /// `cargo test --release -p brdf-sampling --lib rgl_descendants -- --ignored`.
+    #[test]
+    #[ignore = "an RGL build and 6 cell-rule nodes on one thread (43 s of wall at a load average of 20)"]
+    fn rgl_descendants_take_their_nodes_from_an_inherited_table() {
+        use crate::direction_sampler::SamplerDiagnostics;
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let Ok(rgl) = brdf::RglBrdf::load(&path) else {
+            eprintln!("skipped: the RGL fixture {} is missing", path.display());
+            return;
+        };
+        let brdf: Arc<dyn Brdf> = Arc::new(rgl);
+        let opts = ExactOptions {
+            max_trials: 1.5,
+            ..ExactOptions::default()
+        };
+        let (set, phases) = ExactSet::build_counted(brdf, &opts).unwrap();
+        assert_eq!(phases.total(), phases.counted);
+        let inherited: Vec<&IntervalRecord> = phases
+            .log
+            .iter()
+            .filter(|r| r.split.is_none() && r.counts.quadrature == 0)
+            .collect();
+        assert!(
+            inherited.len() >= 4,
+            "{} inherited\n{phases}",
+            inherited.len()
+        );
+        let mut worst = 0.0f64;
+        for r in inherited.iter().step_by(inherited.len().div_ceil(6)) {
+            let t = (0.5 * (r.theta_deg[0] + r.theta_deg[1])).to_radians();
+            let wo = brdf::direction_from_radians(t, 0.0);
+            let a_hat = set.normaliser(&wo).unwrap();
+            let (rule, _) = set.node_rule_at(&wo).unwrap();
+            let gap = (a_hat / rule - 1.0).abs();
+            let declared = set.normaliser_rel_err(&wo).unwrap();
+            eprintln!(
+                "θo {:.3}°: gap {gap:.3e}, declared {declared:.3e}",
+                t.to_degrees()
+            );
+            assert!(gap <= declared, "θo {t}: gap {gap:e} above {declared:e}");
+            worst = worst.max(gap);
+        }
+        assert!(worst <= 3e-5, "inherited tables: max gap {worst:e}");
+    }
+
     /// An anisotropic interval halved in θ for its table's θ tail does not first double its
     /// δ nodes (they cannot cure a θ tail): poulin-fournier's `A` has a kink along the onset
     /// of masking (`|ψo| = 30°` in the cylinders' cross-section), which crosses its cells.
