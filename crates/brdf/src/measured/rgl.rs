@@ -32,14 +32,12 @@
 //! **Reciprocity** is not guaranteed by the format (the tables are sliced by `ωo` only), so
 //! [`Brdf::is_reciprocal`] is `false`.
 
-use std::cell::Cell;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::Arc;
 
 use super::tensor::TensorFile;
-use super::warp::{BilinearTable, ParamAxis, Warp2D, Warp2DSlice};
+use super::warp::{BilinearTable, ParamAxis, Warp2D};
 use crate::brdf::{Brdf, Outgoing, luminance};
 use crate::geometry::Vec3;
 
@@ -103,73 +101,6 @@ struct Tables {
     sigma_y_constant: bool,
     /// Every table is even in the relative azimuth (`u.y ↦ 1 − u.y`).
     mirror_symmetric: bool,
-    /// The slices blended at the θo of many queries ([`RglBrdf::prepare`](Brdf::prepare)).
-    slices: SliceCache,
-}
-
-/// How many θo blends an [`RglBrdf`] keeps as [`PreparedSlice`]s for its evaluations at a
-/// prepared `ωo` (each ≈ 270 KiB for the 128² `vndf` grids of the RGL database; shared by
-/// clones; never evicted: the first θo blends that qualify keep them).
-pub const PREPARED_SLICES: usize = 8;
-
-/// Consecutive [`Brdf::prepare`] calls on one thread at one θo blend (the same slice and
-/// weight bit for bit: a fixed `θo`, queries of one batch group) after which that blend is
-/// made a [`PreparedSlice`]. Blending the 128² `vndf` grid costs about as much as 10³
-/// evaluations save, so random `ωo` (a new blend per query) never pay it.
-pub const PREPARE_SLICE_AFTER: u32 = 256;
-
-/// The blended slices of one material, filled in order and never replaced (readers need no
-/// lock: a slot is read through its `OnceLock`).
-#[derive(Debug, Default)]
-struct SliceCache {
-    slots: [OnceLock<PreparedSlice>; PREPARED_SLICES],
-    /// Slots set so far.
-    filled: AtomicUsize,
-    /// Held while a slice is blended (two threads reaching the threshold together blend once).
-    build: Mutex<()>,
-}
-
-/// The `vndf` and luminance tables of one θo, blended once from the two slices around it
-/// ([`RglBrdf::prepare_slice`]): an evaluation at that θo then inverts and reads one plain
-/// slice instead of blending two at every table read. [`RglBrdf::eval_in_slice`] returns
-/// [`Brdf::eval_prepared`]'s value bit for bit (each blended entry is the one the two-slice
-/// path computes at each read, by the same expression).
-#[derive(Debug, Clone)]
-pub struct PreparedSlice {
-    /// Address of the material's tables (a slice of another material is not used).
-    owner: usize,
-    /// The slice `i` and weight `w` of θo on the `theta_i` axis.
-    slice: usize,
-    weight: f64,
-    vndf: Warp2DSlice,
-    rgb_luminance: BilinearTable,
-}
-
-impl PreparedSlice {
-    /// Heap bytes of the slice.
-    pub fn bytes_used(&self) -> usize {
-        let (nx, ny) = self.rgb_luminance.size();
-        self.vndf.bytes_used() + 8 * nx * ny
-    }
-
-    fn matches(&self, owner: usize, slice: usize, weight: f64) -> bool {
-        self.owner == owner && self.slice == slice && self.weight.to_bits() == weight.to_bits()
-    }
-}
-
-/// One thread's run of [`Brdf::prepare`] calls at one blend (see [`PREPARE_SLICE_AFTER`]).
-#[derive(Clone, Copy, Default)]
-struct PrepareRun {
-    owner: usize,
-    slice: usize,
-    weight_bits: u64,
-    count: u32,
-    /// The blend's slot + 1 once found (0: none yet).
-    slot: usize,
-}
-
-thread_local! {
-    static PREPARE_RUN: Cell<PrepareRun> = Cell::new(PrepareRun::default());
 }
 
 /// Accepted range of the NDF's normalisation `∫ D(m) cos θm dm` (1 for a microfacet
@@ -335,7 +266,6 @@ impl RglBrdf {
                 rgb_luminance,
                 jacobian,
                 clamped,
-                slices: SliceCache::default(),
             }),
         })
     }
@@ -753,8 +683,6 @@ mod prepared {
     pub(super) const WEIGHT: usize = 4;
     /// `4 σ(u_o)` (1 when the file has no Jacobian factor).
     pub(super) const FOUR_SIGMA: usize = 5;
-    /// The [`PreparedSlice`](super::PreparedSlice) slot of the blend + 1 (0: none).
-    pub(super) const SLOT: usize = 6;
 }
 
 impl RglBrdf {
@@ -773,16 +701,6 @@ impl RglBrdf {
     /// `(ωo, ωi)` for a prepared `ωo`; `None` below the horizon or for `ωi = −ωo`.
     #[inline]
     fn lookup_prepared(&self, q: &Outgoing, wi: &Vec3) -> Option<([f64; 2], usize, f64, f64)> {
-        let (u_m, factor) = self.half_prepared(q, wi)?;
-        let (i, w) = self.prepared_slice(q);
-        let (s, _) = self.tables.vndf.invert_located(u_m, i, w);
-        Some((s, i, w, factor))
-    }
-
-    /// The half vector's `u_m` and the `D/(4σ)` factor of `(ωo, ωi)` for a prepared `ωo`;
-    /// `None` below the horizon or for `ωi = −ωo`.
-    #[inline]
-    fn half_prepared(&self, q: &Outgoing, wi: &Vec3) -> Option<([f64; 2], f64)> {
         let c = q.cache();
         // A cache from another BRDF may hold anything: only positive 4σ is taken.
         if !(c[prepared::VALID] == 1.0 && wi.z > 0.0 && c[prepared::FOUR_SIGMA] > 0.0) {
@@ -800,172 +718,14 @@ impl RglBrdf {
         let rel = fast::atan2(cos_o * sum.y - sin_o * sum.x, cos_o * sum.x + sin_o * sum.y);
         let u_m = [theta_to_u(fast::elevation(&m)), fast::unit_azimuth(rel)];
         let t = &self.tables;
+        let (i, w) = self.prepared_slice(q);
+        let (s, _) = t.vndf.invert_located(u_m, i, w);
         let factor = if t.jacobian {
             t.ndf.eval(u_m, 0, 0, 0.0) / c[prepared::FOUR_SIGMA]
         } else {
             1.0
         };
-        Some((u_m, factor))
-    }
-
-    /// [`eval_prepared`](Brdf::eval_prepared) through the two-slice tables.
-    #[inline]
-    fn eval_blended(&self, q: &Outgoing, wi: &Vec3) -> f64 {
-        match self.lookup_prepared(q, wi) {
-            Some((s, i, w, factor)) => {
-                (self.tables.rgb_luminance.eval(s, i, 1, w) * factor).max(0.0) / wi.z
-            }
-            None => 0.0,
-        }
-    }
-
-    /// Address of the tables: the identity of the material (shared by clones).
-    fn owner(&self) -> usize {
-        Arc::as_ptr(&self.tables) as usize
-    }
-
-    /// The `vndf` and luminance tables blended once at the elevation of `ωo`, for many
-    /// evaluations at outgoing directions of that elevation (any azimuth) through
-    /// [`eval_in_slice`](Self::eval_in_slice). Costs about as much as 10³ evaluations save
-    /// (the `vndf` grid is read whole). [`Brdf::prepare`] makes and keeps such slices by itself
-    /// for θo blends it sees often ([`PREPARE_SLICE_AFTER`]).
-    pub fn prepare_slice(&self, wo: &Vec3) -> PreparedSlice {
-        let (i, w) = self.tables.theta.locate(fast::elevation(wo));
-        self.blend_prepared(i, w)
-    }
-
-    /// The [`PreparedSlice`] of the blend `(i, w)` (as [`prepared_slice`] sanitises it).
-    ///
-    /// [`prepared_slice`]: Self::prepared_slice
-    fn blend_prepared(&self, i: usize, w: f64) -> PreparedSlice {
-        let t = &self.tables;
-        let q = Outgoing::with_cache(Vec3::new(0.0, 0.0, 1.0), {
-            let mut c = [0.0; Outgoing::CACHE_LEN];
-            c[prepared::SLICE] = i as f64;
-            c[prepared::WEIGHT] = w;
-            c
-        });
-        let (i, w) = self.prepared_slice(&q);
-        let one = t.theta.values().len() < 2;
-        PreparedSlice {
-            owner: self.owner(),
-            slice: i,
-            weight: w,
-            vndf: t.vndf.blend_slice(i, w),
-            rgb_luminance: if one {
-                t.rgb_luminance.blend_slice(0, 0, 0.0)
-            } else {
-                t.rgb_luminance.blend_slice(i, 1, w)
-            },
-        }
-    }
-
-    /// [`Brdf::eval_prepared`] for `q` from this BRDF's [`prepare`](Brdf::prepare) through a
-    /// slice from [`prepare_slice`](Self::prepare_slice): the same value bit for bit, read
-    /// from the one blended slice when `q`'s θo has `p`'s blend, else through the two-slice
-    /// tables.
-    #[inline]
-    pub fn eval_in_slice(&self, p: &PreparedSlice, q: &Outgoing, wi: &Vec3) -> f64 {
-        let (i, w) = self.prepared_slice(q);
-        if !p.matches(self.owner(), i, w) {
-            return self.eval_blended(q, wi);
-        }
-        match self.half_prepared(q, wi) {
-            Some((u_m, factor)) => {
-                let (s, _) = p.vndf.invert(u_m);
-                (p.rgb_luminance.eval_single(s) * factor).max(0.0) / wi.z
-            }
-            None => 0.0,
-        }
-    }
-
-    /// How many θo blends are kept as [`PreparedSlice`]s (at most [`PREPARED_SLICES`]).
-    pub fn prepared_slices(&self) -> usize {
-        self.tables
-            .slices
-            .filled
-            .load(Ordering::Acquire)
-            .min(PREPARED_SLICES)
-    }
-
-    /// The kept slice of `q`'s blend, if `prepare` attached one.
-    #[inline]
-    fn kept_slice(&self, q: &Outgoing) -> Option<&PreparedSlice> {
-        let slot = q.cache()[prepared::SLOT];
-        if slot >= 1.0 {
-            self.tables
-                .slices
-                .slots
-                .get(slot as usize - 1)
-                .and_then(OnceLock::get)
-        } else {
-            None
-        }
-    }
-
-    /// The kept slot (+ 1; 0 for none) of the blend `(i, w)` met by `prepare` on this thread:
-    /// counts the thread's consecutive calls at one blend and blends the slice once they reach
-    /// [`PREPARE_SLICE_AFTER`].
-    fn slot_for(&self, i: usize, w: f64) -> usize {
-        let owner = self.owner();
-        let cache = &self.tables.slices;
-        PREPARE_RUN.with(|cell| {
-            let mut run = cell.get();
-            if run.owner == owner && run.slice == i && run.weight_bits == w.to_bits() {
-                if run.slot > 0 {
-                    // Still this material's slot (the address may have been reused).
-                    if let Some(p) = cache.slots.get(run.slot - 1).and_then(OnceLock::get)
-                        && p.matches(owner, i, w)
-                    {
-                        return run.slot;
-                    }
-                    run.slot = 0;
-                }
-                run.count = run.count.saturating_add(1);
-            } else {
-                run = PrepareRun {
-                    owner,
-                    slice: i,
-                    weight_bits: w.to_bits(),
-                    count: 1,
-                    slot: 0,
-                };
-            }
-            if run.count >= PREPARE_SLICE_AFTER {
-                run.slot = self.find_or_blend(i, w);
-                // Full: try again after as many calls.
-                run.count = 0;
-            }
-            cell.set(run);
-            run.slot
-        })
-    }
-
-    /// The slot (+ 1) of the blend `(i, w)`, blended now if no slot has it; 0 when every slot
-    /// holds another blend.
-    #[cold]
-    fn find_or_blend(&self, i: usize, w: f64) -> usize {
-        let owner = self.owner();
-        let cache = &self.tables.slices;
-        let _guard = cache.build.lock().unwrap_or_else(|e| e.into_inner());
-        let filled = cache.filled.load(Ordering::Acquire).min(PREPARED_SLICES);
-        if let Some(k) =
-            (0..filled).find(|&k| cache.slots[k].get().is_some_and(|p| p.matches(owner, i, w)))
-        {
-            return k + 1;
-        }
-        if filled == PREPARED_SLICES {
-            return 0;
-        }
-        let slice = self.blend_prepared(i, w);
-        if !slice.matches(owner, i, w) {
-            // `(i, w)` is not a sanitised blend (cannot happen from `prepare`).
-            return 0;
-        }
-        // Only this thread (holding the lock) sets slots.
-        let _ = cache.slots[filled].set(slice);
-        cache.filled.store(filled + 1, Ordering::Release);
-        filled + 1
+        Some((s, i, w, factor))
     }
 }
 
@@ -1021,18 +781,16 @@ impl Brdf for RglBrdf {
             c[prepared::SLICE] = i as f64;
             c[prepared::WEIGHT] = w;
             c[prepared::FOUR_SIGMA] = four_sigma;
-            let (i, w) = self.prepared_slice(&Outgoing::with_cache(*wo, c));
-            c[prepared::SLOT] = self.slot_for(i, w) as f64;
         }
         Outgoing::with_cache(*wo, c)
     }
 
-    /// Through the [`PreparedSlice`] `prepare` attached when `q`'s θo blend is kept (the same
-    /// value bit for bit), else through the two-slice tables.
     fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
-        match self.kept_slice(q) {
-            Some(p) => self.eval_in_slice(p, q, wi),
-            None => self.eval_blended(q, wi),
+        match self.lookup_prepared(q, wi) {
+            Some((s, i, w, factor)) => {
+                (self.tables.rgb_luminance.eval(s, i, 1, w) * factor).max(0.0) / wi.z
+            }
+            None => 0.0,
         }
     }
 
@@ -1197,124 +955,5 @@ mod tests {
             worst_grazing <= 1e-9,
             "worst relative difference beyond 85° {worst_grazing:e}"
         );
-    }
-
-    /// The prepared-slice path (one blended slice, [`RglBrdf::eval_in_slice`]) returns the
-    /// two-slice path's value bit for bit: 10⁵ pairs (fixed seed) on the fixture, 400 `ωo`
-    /// (random θo, the normal, every slice angle exactly) × 250 random `ωi`, and 10⁴ on each
-    /// file of the team's data set that is present (100 × 100).
-    #[test]
-    fn prepared_slice_evaluation_is_bit_identical_on_random_pairs() {
-        let mut files = vec![fixture()];
-        // The team's data set beside the repository, as CI has it.
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/measured/rgl");
-        match std::fs::read_dir(&dir) {
-            Ok(entries) => {
-                let mut paths: Vec<_> = entries
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "bsdf"))
-                    .collect();
-                paths.sort();
-                files.extend(paths.iter().map(|p| RglBrdf::load(p).unwrap()));
-            }
-            Err(_) => println!("skipping the shared RGL files: {} is absent", dir.display()),
-        }
-        let mut uniform = crate::test_support::splitmix_uniforms(0x05ee_d0f5_11ce_u64);
-        for (f, b) in files.iter().enumerate() {
-            let (n_wo, n_wi) = if f == 0 { (400, 250) } else { (100, 100) };
-            let slices: Vec<f64> = b.theta_slices().to_vec();
-            let (mut compared, mut positive, mut on_slice) = (0usize, 0usize, 0usize);
-            for k in 0..n_wo {
-                let wo = match k % 25 {
-                    0 => Vec3::new(0.0, 0.0, 1.0),
-                    1..=8 => {
-                        let t = slices[(k % 25 - 1) % slices.len()].min(FRAC_PI_2 - 1e-6);
-                        let phi = TAU * uniform();
-                        Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
-                    }
-                    _ => direction(uniform(), uniform(), false),
-                };
-                let q = b.prepare(&wo);
-                let p = b.prepare_slice(&wo);
-                // The slice is the blend `prepare` located.
-                assert!(p.matches(b.owner(), b.prepared_slice(&q).0, b.prepared_slice(&q).1));
-                on_slice += usize::from(p.weight == 0.0);
-                for _ in 0..n_wi {
-                    let wi = direction(uniform(), uniform(), false);
-                    let two = b.eval_blended(&q, &wi);
-                    let one = b.eval_in_slice(&p, &q, &wi);
-                    assert_eq!(one.to_bits(), two.to_bits(), "ωo {wo:?} ωi {wi:?}");
-                    assert_eq!(b.eval_prepared(&q, &wi).to_bits(), two.to_bits());
-                    compared += 1;
-                    positive += usize::from(two > 0.0);
-                }
-            }
-            assert_eq!(compared, n_wo * n_wi);
-            assert!(10 * positive > 9 * compared, "{positive} positive values");
-            assert!(on_slice * 20 >= n_wo, "{on_slice} ωo on a slice");
-        }
-    }
-
-    /// `prepare` keeps a blended slice once one thread has prepared the same θo blend
-    /// [`PREPARE_SLICE_AFTER`] times in a row, attaches it to later preparations of that
-    /// blend, never for random `ωo`, at most [`PREPARED_SLICES`] of them; values are the
-    /// two-slice path's bit for bit throughout.
-    #[test]
-    fn prepare_keeps_slices_of_repeated_blends_only() {
-        let b = fixture();
-        let mut uniform = crate::test_support::splitmix_uniforms(0x0ddb_a11d_u64);
-        // Random ωo: a new blend per call, no slice.
-        for _ in 0..5_000 {
-            let q = b.prepare(&direction(uniform(), uniform(), false));
-            assert_eq!(q.cache()[prepared::SLOT], 0.0);
-        }
-        assert_eq!(b.prepared_slices(), 0);
-        let wi: Vec<Vec3> = (0..64)
-            .map(|_| direction(uniform(), uniform(), false))
-            .collect();
-        for (n, deg) in [
-            30.0_f64, 45.0, 60.0, 5.0, 10.0, 15.0, 20.0, 25.0, 35.0, 40.0,
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let t = deg.to_radians();
-            let wo = Vec3::new(t.sin(), 0.0, t.cos());
-            for call in 1..=PREPARE_SLICE_AFTER + 10 {
-                let q = b.prepare(&wo);
-                let kept = q.cache()[prepared::SLOT] > 0.0;
-                let expected = call >= PREPARE_SLICE_AFTER && n < PREPARED_SLICES;
-                assert_eq!(kept, expected, "θo {deg}°, call {call}");
-                for wi in &wi {
-                    let v = b.eval_prepared(&q, wi);
-                    assert_eq!(v.to_bits(), b.eval_blended(&q, wi).to_bits());
-                }
-            }
-            assert_eq!(b.prepared_slices(), (n + 1).min(PREPARED_SLICES));
-            // `eval` (a `prepare` each) goes the same way, with the same values.
-            for wi in &wi {
-                let q = b.prepare(&wo);
-                assert_eq!(b.eval(&wo, wi).to_bits(), b.eval_blended(&q, wi).to_bits());
-            }
-        }
-        // A clone shares the kept slices (a run of its own finds the kept blend, none is
-        // added); another material's slot index is ignored.
-        let c = b.clone();
-        let t = 30f64.to_radians();
-        let wo = Vec3::new(t.sin(), 0.0, t.cos());
-        let slots: Vec<f64> = (0..PREPARE_SLICE_AFTER)
-            .map(|_| c.prepare(&wo).cache()[prepared::SLOT])
-            .collect();
-        assert_eq!(slots[slots.len() - 1], 1.0);
-        assert_eq!(c.prepared_slices(), PREPARED_SLICES);
-        let other = fixture();
-        let q = b.prepare(&wo);
-        assert!(other.kept_slice(&q).is_none());
-        for wi in &wi {
-            assert_eq!(
-                other.eval_prepared(&q, wi).to_bits(),
-                other.eval_blended(&q, wi).to_bits()
-            );
-        }
     }
 }
