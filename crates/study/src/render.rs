@@ -1213,6 +1213,34 @@ mod tests {
     /// the one-query samples' variance (same law under the null), green channel; pixels whose
     /// samples are all equal (no light reaches them) must agree exactly and are not counted.
     /// Returns `(statistic, pixels counted)`.
+    /// Each hit's `spp` one-query MIS values (balance heuristic), its generator seeded from
+    /// `(seed, pixel)`: the judge of the batched MIS rows.
+    fn one_query_mis(
+        hs: &[Hit],
+        brdfs: &[std::sync::Arc<dyn Brdf>],
+        built: &[std::sync::Arc<dyn DirectionSampler>],
+        light: &Light,
+        light_sampler: &LightSampler,
+        spp: usize,
+        seed: u64,
+    ) -> Vec<Vec<[f64; 3]>> {
+        hs.iter()
+            .map(|h| {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, h.pixel as u64));
+                let pair = estimators::MisPair {
+                    brdf_sampler: built[h.sphere].as_ref(),
+                    light_sampler,
+                    frame: h.query.frame,
+                    heuristic: MisHeuristic::Balance,
+                };
+                let g = |wi: &Vec3| integrand(brdfs[h.sphere].as_ref(), light, h, wi);
+                (0..spp)
+                    .map(|_| pair.value(&h.query.wo, g, &mut rng))
+                    .collect()
+            })
+            .collect()
+    }
+
     fn chi2(a: &[[f64; 3]], b: &[Vec<[f64; 3]>]) -> (f64, usize) {
         let (mut x, mut k) = (0.0, 0);
         for (a, vs) in a.iter().zip(b) {
@@ -1295,22 +1323,7 @@ mod tests {
             }
             out
         };
-        let one: Vec<Vec<[f64; 3]>> = hs
-            .iter()
-            .map(|h| {
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(29, h.pixel as u64));
-                let pair = estimators::MisPair {
-                    brdf_sampler: built[h.sphere].as_ref(),
-                    light_sampler: &light_sampler,
-                    frame: h.query.frame,
-                    heuristic: MisHeuristic::Balance,
-                };
-                let g = |wi: &Vec3| integrand(brdfs[h.sphere].as_ref(), &light, h, wi);
-                (0..spp)
-                    .map(|_| pair.value(&h.query.wo, g, &mut rng))
-                    .collect()
-            })
-            .collect();
+        let one = one_query_mis(&hs, &brdfs, &built, &light, &light_sampler, spp, 29);
         let (x, k) = chi2(&render(0), &one);
         assert!(k > 60, "{k} lit pixels");
         let limit = ChiSquared::new(k as f64).unwrap().inverse_cdf(1.0 - 1e-3);
@@ -1401,22 +1414,7 @@ mod tests {
             }
             out
         };
-        let one: Vec<Vec<[f64; 3]>> = hs
-            .iter()
-            .map(|h| {
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(43, h.pixel as u64));
-                let pair = estimators::MisPair {
-                    brdf_sampler: built[h.sphere].as_ref(),
-                    light_sampler: &light_sampler,
-                    frame: h.query.frame,
-                    heuristic: MisHeuristic::Balance,
-                };
-                let g = |wi: &Vec3| integrand(brdfs[h.sphere].as_ref(), &light, h, wi);
-                (0..spp)
-                    .map(|_| pair.value(&h.query.wo, g, &mut rng))
-                    .collect()
-            })
-            .collect();
+        let one = one_query_mis(&hs, &brdfs, &built, &light, &light_sampler, spp, 43);
         let (x, k) = chi2(&render(0), &one);
         assert!(k > 100, "{k} lit pixels");
         let limit = ChiSquared::new(k as f64).unwrap().inverse_cdf(1.0 - 1e-3);

@@ -300,10 +300,7 @@ mod tests {
     #[ignore = "an RGL build and 6 cell-rule nodes on one thread (43 s of wall at a load average of 20)"]
     fn rgl_descendants_take_their_nodes_from_an_inherited_table() {
         use crate::direction_sampler::SamplerDiagnostics;
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
-        let Ok(rgl) = brdf::RglBrdf::load(&path) else {
-            eprintln!("skipped: the RGL fixture {} is missing", path.display());
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
             return;
         };
         let brdf: Arc<dyn Brdf> = Arc::new(rgl);

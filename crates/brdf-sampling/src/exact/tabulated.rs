@@ -192,10 +192,7 @@ mod tests {
     /// a node of the 28.45–40.86° interval).
     #[test]
     fn rgl_nodes_agree_with_the_reference_rule() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
-        let Ok(rgl) = RglBrdf::load(&path) else {
-            eprintln!("skipped: the RGL fixture {} is missing", path.display());
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
             return;
         };
         assert!(table_normaliser_exists(&rgl));

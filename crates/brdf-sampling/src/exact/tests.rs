@@ -400,10 +400,7 @@ fn declared_gap(set: &ExactSet, wo: &Vec3, t: f64, a: f64) -> f64 {
 /// (2.1e-3 at 78.67°, 8.2e-4 at 39.89°, measured): the test fails with the old normaliser.
 #[test]
 fn intervals_cut_at_the_rgl_slices_normalise_to_1e4() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/measured/rgl/paper_white_rgb.bsdf");
-    let Ok(rgl) = brdf::RglBrdf::load(&path) else {
-        eprintln!("skipped: the RGL fixture {} is missing", path.display());
+    let Some(rgl) = paper_white_fixture() else {
         return;
     };
     let brdf: Arc<dyn Brdf> = Arc::new(rgl);
@@ -578,5 +575,22 @@ fn pf_node_rules() {
         }
         let ((a, ea), (b, eb)) = (big[0], big[1]);
         assert!((a - b).abs() <= ea + eb, "θo {t}: {a} vs {b}");
+    }
+}
+
+/// The repository's RGL fixture (`data/measured/rgl/paper_white_rgb.bsdf`), or `None` with the
+/// reason printed (a test then skips).
+pub(super) fn paper_white_fixture() -> Option<brdf::RglBrdf> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+    match brdf::RglBrdf::load(&path) {
+        Ok(rgl) => Some(rgl),
+        Err(e) => {
+            eprintln!(
+                "skipped: the RGL fixture {} is missing ({e})",
+                path.display()
+            );
+            None
+        }
     }
 }

@@ -123,31 +123,26 @@ pub(crate) trait GuideEntry: Copy + Default {
     fn cell(self) -> usize;
 }
 
-impl GuideEntry for u32 {
-    const MAX_CELL: usize = u32::MAX as usize;
-    #[inline(always)]
-    fn from_cell(i: usize) -> Self {
-        debug_assert!(i <= Self::MAX_CELL);
-        i as u32
-    }
-    #[inline(always)]
-    fn cell(self) -> usize {
-        self as usize
-    }
+/// `GuideEntry` for an unsigned integer type narrower than `usize`.
+macro_rules! guide_entry {
+    ($t:ty) => {
+        impl GuideEntry for $t {
+            const MAX_CELL: usize = <$t>::MAX as usize;
+            #[inline(always)]
+            fn from_cell(i: usize) -> Self {
+                debug_assert!(i <= Self::MAX_CELL);
+                i as $t
+            }
+            #[inline(always)]
+            fn cell(self) -> usize {
+                self as usize
+            }
+        }
+    };
 }
 
-impl GuideEntry for u16 {
-    const MAX_CELL: usize = u16::MAX as usize;
-    #[inline(always)]
-    fn from_cell(i: usize) -> Self {
-        debug_assert!(i <= Self::MAX_CELL);
-        i as u16
-    }
-    #[inline(always)]
-    fn cell(self) -> usize {
-        self as usize
-    }
-}
+guide_entry!(u32);
+guide_entry!(u16);
 
 /// The guide table of the normalised CDF `cdf` (as [`fill_cdf`] writes it), `guide.len() ≥ 1`
 /// entries: `guide[g]` is the cell [`find_cell`] returns for `u = g / guide.len()`. O(n + G).
