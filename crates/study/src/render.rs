@@ -1213,6 +1213,36 @@ mod tests {
     /// the one-query samples' variance (same law under the null), green channel; pixels whose
     /// samples are all equal (no light reaches them) must agree exactly and are not counted.
     /// Returns `(statistic, pixels counted)`.
+    /// `lambert` and `phong:n=20` with `sampler` built for each (8 slices where it has them).
+    #[allow(clippy::type_complexity)]
+    fn lambert_and_phong_with(
+        sampler: &str,
+    ) -> (
+        Vec<std::sync::Arc<dyn Brdf>>,
+        Vec<std::sync::Arc<dyn DirectionSampler>>,
+    ) {
+        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = ["lambert", "phong:n=20"]
+            .iter()
+            .map(|s| std::sync::Arc::from(brdf::parse_spec(s).unwrap()))
+            .collect();
+        let options = brdf_sampling::SetOptions {
+            slices: 8,
+            ..Default::default()
+        };
+        let built = brdfs
+            .iter()
+            .map(|b| {
+                samplers::build_direction(
+                    sampler,
+                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
+                )
+                .unwrap()
+                .sampler
+            })
+            .collect();
+        (brdfs, built)
+    }
+
     /// Each hit's `spp` one-query MIS values (balance heuristic), its generator seeded from
     /// `(seed, pixel)`: the judge of the batched MIS rows.
     fn one_query_mis(
@@ -1269,26 +1299,7 @@ mod tests {
     fn the_batched_mis_render_has_the_law_of_the_per_pixel_one_and_a_misordered_batch_fails() {
         use statrs::distribution::{ChiSquared, ContinuousCDF};
         let light = Light::parse("area:theta=30,phi=180,radius=10").unwrap();
-        let specs = ["lambert", "phong:n=20"];
-        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = specs
-            .iter()
-            .map(|s| std::sync::Arc::from(brdf::parse_spec(s).unwrap()))
-            .collect();
-        let options = brdf_sampling::SetOptions {
-            slices: 8,
-            ..Default::default()
-        };
-        let built: Vec<std::sync::Arc<dyn DirectionSampler>> = brdfs
-            .iter()
-            .map(|b| {
-                samplers::build_direction(
-                    "adaptive-exact",
-                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
-                )
-                .unwrap()
-                .sampler
-            })
-            .collect();
+        let (brdfs, built) = lambert_and_phong_with("adaptive-exact");
         let light_sampler = LightSampler::new(&light).unwrap();
         let px = 10;
         let hs = hits(2, px);
@@ -1367,26 +1378,7 @@ mod tests {
             map: envmap::procedural_sky(64, 32).unwrap(),
             label: "sky".into(),
         };
-        let specs = ["lambert", "phong:n=20"];
-        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = specs
-            .iter()
-            .map(|s| std::sync::Arc::from(brdf::parse_spec(s).unwrap()))
-            .collect();
-        let options = brdf_sampling::SetOptions {
-            slices: 8,
-            ..Default::default()
-        };
-        let built: Vec<std::sync::Arc<dyn DirectionSampler>> = brdfs
-            .iter()
-            .map(|b| {
-                samplers::build_direction(
-                    "adaptive",
-                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
-                )
-                .unwrap()
-                .sampler
-            })
-            .collect();
+        let (brdfs, built) = lambert_and_phong_with("adaptive");
         let light_sampler = LightSampler::new(&light).unwrap();
         assert!(matches!(light_sampler, LightSampler::Map(_)));
         let doubled = DoubledPdf(&light_sampler);

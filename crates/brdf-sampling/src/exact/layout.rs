@@ -49,8 +49,8 @@ pub(super) struct Cell {
     /// tree's own walk).
     pub(super) tables: Vec<Option<LeafTable>>,
     /// Per interval, what the isotropic fast path reads besides the table
-    /// ([`IsoRecord`](super::fused::IsoRecord); unused by anisotropic cells).
-    pub(super) iso: Vec<super::fused::IsoRecord>,
+    /// ([`IsoRecord`](super::iso_record::IsoRecord); unused by anisotropic cells).
+    pub(super) iso: Vec<super::iso_record::IsoRecord>,
 }
 
 /// An interval with its θ and δ numerators ([`Grid`]).
@@ -102,7 +102,10 @@ impl Cell {
             .collect();
         let intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
         let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
-        let iso = intervals.iter().map(super::fused::IsoRecord::of).collect();
+        let iso = intervals
+            .iter()
+            .map(super::iso_record::IsoRecord::of)
+            .collect();
         Self {
             phi,
             phi_turn: Turn::from_angle(phi),

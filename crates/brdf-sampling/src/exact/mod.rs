@@ -73,6 +73,7 @@ mod error;
 mod fused;
 mod grid;
 mod interval;
+mod iso_record;
 mod jobs;
 mod layout;
 mod lookup;
