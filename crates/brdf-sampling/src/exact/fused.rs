@@ -117,18 +117,7 @@ impl ExactSet {
         s: DirSample,
         f: f64,
     ) -> EvalSample {
-        let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
-            0.0
-        } else if f.is_finite() && same_brdf(brdf, self.brdf.as_ref()) {
-            f
-        } else {
-            brdf.eval(wo, &s.wi)
-        };
-        EvalSample {
-            wi: s.wi,
-            pdf: s.pdf,
-            f,
-        }
+        self.finish(brdf, wo, s, f.is_finite().then_some(f))
     }
 
     /// The [`EvalSample`] of a drawn sample `s` at `wo`, with `f` the accepted trial's value
