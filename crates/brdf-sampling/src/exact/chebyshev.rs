@@ -305,6 +305,15 @@ fn tensor_monomial_of(series: &[f64], nd: usize, min_abs: f64) -> Option<Vec<f64
     if !(cond <= POWER_COND * min_abs) {
         return None;
     }
+    Some(tensor_monomial(series, nd))
+}
+
+/// The monomial coefficients `a[i · nd + j]` (of `xⁱ yʲ`) of the tensor series `series`
+/// (`series[k · nd + l]` of `T_k(x) T_l(y)`), whatever the conditioning (the caller checks the
+/// result: the anisotropic records' bicubic patches, `aniso_record.rs`).
+pub(super) fn tensor_monomial(series: &[f64], nd: usize) -> Vec<f64> {
+    let nt = series.len() / nd;
+    let (tx, ty) = (chebyshev_monomials(nt), chebyshev_monomials(nd));
     // Along y for every θ coefficient k, then along x.
     let mut half = vec![0.0; nt * nd];
     for k in 0..nt {
@@ -323,7 +332,7 @@ fn tensor_monomial_of(series: &[f64], nd: usize, min_abs: f64) -> Option<Vec<f64
             }
         }
     }
-    Some(out)
+    out
 }
 
 /// `Σ_i Σ_j a[i · nd + j] xⁱ yʲ`: Horner's rule along `x` for all `j` side by side over the
@@ -369,7 +378,7 @@ fn tensor_horner_any(a: &[f64], nd: usize, x: f64, y: f64) -> f64 {
 /// The tensor Chebyshev series of `values` (`values[i · nd + k]` at the Lobatto nodes `i` of
 /// θ and `k` of δ): [`chebyshev_series`] along δ for every θ node, then along θ for every δ
 /// coefficient; `out[k · nd + l]` multiplies `T_k(x) T_l(y)`.
-fn tensor_series(values: &[f64], nd: usize) -> Vec<f64> {
+pub(super) fn tensor_series(values: &[f64], nd: usize) -> Vec<f64> {
     let nt = values.len() / nd;
     let rows: Vec<Vec<f64>> = (0..nt)
         .map(|i| chebyshev_series(&values[i * nd..(i + 1) * nd]))

@@ -52,11 +52,17 @@ pub(super) struct Query {
     /// The outgoing direction served: the query's, or above [`THETA_TOP_DEG`](super::options::THETA_TOP_DEG) the direction of
     /// the same azimuth at that angle.
     pub(super) wo: Vec3,
-    /// The table variable ([`TableVar`]) of the served direction.
+    /// The table variable ([`TableVar`]) of the served direction (NaN for an anisotropic
+    /// query located for drawing only: [`ExactSet::locate_keys`](super::ExactSet::locate_keys)).
     pub(super) var: f64,
     /// `cos θo`.
     pub(super) cos: f64,
+    /// The offset `δ` from the cell's centre (NaN as [`Query::var`]).
     pub(super) delta: f64,
+    /// Anisotropic sets: the normaliser grid's keys `w = √(1 − cos θo)` and the strip key
+    /// (`tan δ` or `δ`, [`Cell::by_tan`](super::layout::Cell::by_tan)); see
+    /// [`AnisoRecord`](super::aniso_record::AnisoRecord). Unused for isotropic sets.
+    pub(super) keys: [f64; 2],
     /// The rotation about the normal from the tree's frame to the world's.
     pub(super) turn: Turn,
 }

@@ -51,6 +51,12 @@ pub(super) struct Cell {
     /// Per interval, what the isotropic fast path reads besides the table
     /// ([`IsoRecord`](super::iso_record::IsoRecord); unused by anisotropic cells).
     pub(super) iso: Vec<super::iso_record::IsoRecord>,
+    /// Per interval of an anisotropic cell, what its queries read besides the table: the
+    /// normaliser grid over the search keys and the disc map
+    /// ([`AnisoRecord`](super::aniso_record::AnisoRecord); empty for isotropic cells).
+    pub(super) aniso: Vec<super::aniso_record::AnisoRecord>,
+    /// The normaliser patches of [`Cell::aniso`]'s records.
+    pub(super) patches: Vec<super::aniso_record::Patch>,
 }
 
 /// An interval with its θ and δ numerators ([`Grid`]).
@@ -100,7 +106,18 @@ impl Cell {
             .iter()
             .map(|&d: &f64| if by_tan { d.tan() } else { d })
             .collect();
-        let intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
+        let mut intervals: Vec<Interval> = members.into_iter().map(|(_, _, iv)| iv).collect();
+        // Anisotropic cells: the normaliser refitted over the search keys (`aniso_record.rs`);
+        // its difference from the table is part of the interval's declared error.
+        let (mut aniso, mut patches) = (Vec::new(), Vec::new());
+        if grid.half > 0.0 {
+            for iv in &mut intervals {
+                let (rec, err) = super::aniso_record::AnisoRecord::of(iv, by_tan, &mut patches);
+                iv.norm_err += err;
+
+                aniso.push(rec);
+            }
+        }
         let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
         let iso = intervals
             .iter()
@@ -122,6 +139,8 @@ impl Cell {
             intervals,
             tables,
             iso,
+            aniso,
+            patches,
         }
     }
 

@@ -20,7 +20,19 @@ impl ExactSet {
     /// (`None` below the horizon).
     pub fn normaliser(&self, wo: &Vec3) -> Option<f64> {
         let q = self.locate(wo)?;
-        Some(self.interval(&q).normaliser(self.var, &q))
+        Some(self.normaliser_of(&q))
+    }
+
+    /// The pdf's normaliser at a located query: the interval's table for isotropic sets, the
+    /// interval's record of patches over the query's keys for anisotropic ones
+    /// ([`AnisoRecord::normaliser`](super::aniso_record::AnisoRecord::normaliser)).
+    #[inline]
+    pub(super) fn normaliser_of(&self, q: &Query) -> f64 {
+        if self.isotropic {
+            return self.interval(q).normaliser(self.var, q);
+        }
+        let c = &self.cells[q.cell];
+        c.aniso[q.interval].normaliser(q.keys[0], q.keys[1], q.cos, &c.patches)
     }
 
     pub(super) fn interval(&self, q: &Query) -> &Interval {
@@ -30,6 +42,19 @@ impl ExactSet {
     /// Cell, interval, θo, δ and rotation of `wo`; `None` at or below the horizon.
     #[inline]
     pub(super) fn locate(&self, wo: &Vec3) -> Option<Query> {
+        self.locate_with::<true>(wo)
+    }
+
+    /// [`ExactSet::locate`] for drawing: the same query, but an anisotropic one without its
+    /// angles `θo` and `δ` (NaN; drawing and the normaliser need only the keys, issue 29).
+    #[inline]
+    pub(super) fn locate_keys(&self, wo: &Vec3) -> Option<Query> {
+        self.locate_with::<false>(wo)
+    }
+
+    /// [`ExactSet::locate`] (`ANGLES`) or [`ExactSet::locate_keys`].
+    #[inline]
+    fn locate_with<const ANGLES: bool>(&self, wo: &Vec3) -> Option<Query> {
         if !(wo.z > 0.0 && wo.x.is_finite() && wo.y.is_finite()) {
             return None;
         }
@@ -65,7 +90,13 @@ impl ExactSet {
             |k| self.cells[k].phi_turn,
             self.cells.len(),
         ) {
-            found
+            let (k, turn, tan) = found;
+            let delta = if ANGLES {
+                super::walk::atan_halved(tan)
+            } else {
+                f64::NAN
+            };
+            (k, turn, delta, tan)
         } else {
             let phi = wo.y.atan2(wo.x);
             let n = self.cells.len();
@@ -86,15 +117,26 @@ impl ExactSet {
         };
         let var = match self.var {
             TableVar::Cos => cos,
-            // Anisotropic sets: θo without `acos` (`walk::theta_of`; within a few ulp).
+            // Anisotropic sets: θo without `acos` (`walk::theta_of`; within a few ulp), and
+            // only when asked for (the normaliser takes `√(1 − cos θo)`).
             TableVar::Theta if !self.isotropic => {
-                super::walk::theta_of(cos, (wo.x * wo.x + wo.y * wo.y).sqrt())
+                if ANGLES {
+                    super::walk::theta_of(cos, (wo.x * wo.x + wo.y * wo.y).sqrt())
+                } else {
+                    f64::NAN
+                }
             }
             TableVar::Theta => cos.acos(),
         };
         let c = &self.cells[cell];
         let interval = c.interval_of(c.search_key(cos, var), dkey);
+        let keys = if self.isotropic {
+            [0.0; 2]
+        } else {
+            [(1.0 - cos).sqrt(), dkey]
+        };
         Some(Query {
+            keys,
             cell,
             interval,
             wo: served,
@@ -129,7 +171,7 @@ impl ExactSet {
         u: &mut dyn UniformSource,
         audit: &mut Audit,
     ) -> Option<(DirSample, Option<f64>)> {
-        let q = self.locate(wo)?;
+        let q = self.locate_keys(wo)?;
         Some(self.draw_located(&q, wo, u, audit))
     }
 
@@ -151,7 +193,7 @@ impl ExactSet {
         };
         match drawn {
             Some((x, gx)) => {
-                let a = iv.normaliser(self.var, &q);
+                let a = self.normaliser_of(&q);
                 let v = iv.map.to_direction(x);
                 let s = DirSample {
                     wi: q.turn.apply(&v),

@@ -64,6 +64,7 @@
 //! each quadrature uses the graded rule (`normalisation::Grading::Graded`: orders 5 and 3
 //! first, order 8 only on the pieces that need it).
 
+mod aniso_record;
 mod batch;
 mod build;
 mod build_interval;

@@ -65,7 +65,7 @@ impl DirectionSampler for ExactSet {
         let Some(q) = self.locate(wo) else {
             return 0.0;
         };
-        let a = self.interval(&q).normaliser(self.var, &q);
+        let a = self.normaliser_of(&q);
         self.brdf.eval(&q.wo, wi) * wi.z / a
     }
 
@@ -78,6 +78,8 @@ impl DirectionSampler for ExactSet {
                     std::mem::size_of::<Cell>()
                         + c.upper.capacity() * 8
                         + std::mem::size_of_val(c.iso.as_slice())
+                        + std::mem::size_of_val(c.aniso.as_slice())
+                        + std::mem::size_of_val(c.patches.as_slice())
                         + c.tables
                             .iter()
                             .flatten()

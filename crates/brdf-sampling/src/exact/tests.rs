@@ -260,6 +260,10 @@ fn anisotropic_cells_are_split_in_azimuth_and_searched_by_both_angles() {
         ..ExactOptions::default()
     };
     let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+    // Narrow cells (`tan δ` keys): the queries' normaliser patches are the table
+    // (`aniso_record.rs`).
+    assert!(set.cells[0].by_tan);
+    aniso_record::tests::assert_normaliser_is_the_table(&set);
     let layout = set.layout();
     let strips: Vec<usize> = layout
         .iter()

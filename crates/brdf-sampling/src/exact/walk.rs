@@ -102,12 +102,13 @@ fn coarse_angle(c: f64, s: f64) -> f64 {
 
 /// The azimuth cell of a query and its offset from the cell's centre without `atan2`
 /// (issue 29): `(k, turn, δ)` with `turn` the rotation by `φo − φ_k` ([`turn_from_cell`]) and
-/// `δ ∈ [−h, h]` (to rounding) its angle reduced modulo the `period`. The cell comes from a
-/// coarse angle ([`coarse_angle`]) and is moved to a neighbour when `|tan δ| > tan h`; `δ` is
-/// then `atan(turn.sin / turn.cos)` ([`atan_halved`]: `|tan δ| ≤ tan h` is small), which is the
-/// offset reduced modulo π, and modulo 2π too since `|δ| < π/2`; `tan δ` is returned too (the
-/// strip search of [`super::layout::Cell::interval_of`] takes it, so that the walk need not
-/// wait for the `atan`). `None` when the cells are
+/// `tan δ`, `δ ∈ [−h, h]` (to rounding) its angle reduced modulo the `period`. The cell comes
+/// from a coarse angle ([`coarse_angle`]) and is moved to a neighbour when `|tan δ| > tan h`;
+/// `δ` itself is `atan(tan δ)` ([`atan_halved`]: `|tan δ| ≤ tan h` is small), which is the
+/// offset reduced modulo π, and modulo 2π too since `|δ| < π/2` — left to the caller: the
+/// strip search of [`super::layout::Cell::interval_of`] and the normaliser grid
+/// ([`super::aniso_record::AnisoRecord`]) take `tan δ`, so a drawing query needs no `atan`
+/// (issue 29). `None` when the cells are
 /// wider than [`TAN_HALF_MAX`] allows or the coarse cell is more than one cell off (the caller
 /// then takes `atan2`). `phi_turns[k]` is cell `k`'s `(cos φ_k, sin φ_k)`, `φ_k = k · period / n`.
 #[inline]
@@ -117,7 +118,7 @@ pub(super) fn cell_offset(
     tan_half: f64,
     phi_turns: impl Fn(usize) -> Turn,
     n: usize,
-) -> Option<(usize, Turn, f64, f64)> {
+) -> Option<(usize, Turn, f64)> {
     if !(tan_half <= TAN_HALF_MAX) || n < 2 {
         return None;
     }
@@ -146,7 +147,7 @@ pub(super) fn cell_offset(
         } else if t < -tan_half {
             k = if k == 0 { n - 1 } else { k - 1 };
         } else {
-            return Some((k, turn, atan_halved(t), t));
+            return Some((k, turn, t));
         }
     }
     None
@@ -261,7 +262,8 @@ mod tests {
             let wo = brdf::direction_from_radians(theta, phi);
             let turns = |k: usize| Turn::from_angle(k as f64 * period / n as f64);
             let got = cell_offset(&wo, period, half.tan(), turns, n);
-            let (k, t, delta, tan) = got.expect("cells this narrow are always served");
+            let (k, t, tan) = got.expect("cells this narrow are always served");
+            let delta = atan_halved(tan);
             prop_assert!((tan - t.sin / t.cos).abs() <= 4.0 * f64::EPSILON, "tan δ {tan:e}");
             let (k_ref, d_ref) = reference(&wo, period, n);
             prop_assert_eq!(t, turn_from_cell(&wo, turns(k)));
