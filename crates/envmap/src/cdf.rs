@@ -1,34 +1,146 @@
 //! The marginal/conditional CDF sampler of a map on fixed-point tables: every CDF is a row of
-//! `u32` boundaries in units of 2⁻³¹ (half the bytes of `f64` tables, and no separate table of
-//! cell values: a cell's probability is the difference of its two boundaries), searched by a
-//! branch-free binary search that the block path runs for many samples side by side.
+//! `u32` boundaries in units of 2⁻³⁰ (half the bytes of `f64` tables, and no separate table of
+//! cell values: a cell's probability is the difference of its two boundaries), searched by
+//! counting: a 16-ary tree of cache lines per row (every 256th, every 16th, every boundary),
+//! where each level is one aligned 64-byte load and a count of its 16 entries `≤ x` (compares
+//! the compiler vectorises: one AVX-512 compare, two AVX2 ones), with no branch on the data.
+//! The block path runs the levels of [`BLOCK`] samples side by side, compiled for the best
+//! instruction set `pulp` finds at run time.
 //!
 //! **The law is the stored tables'.** A row is drawn with probability `m_r = (M[r+1] − M[r]) /
-//! 2³¹` and a column of that row with `c_k = (C_r[k+1] − C_r[k]) / 2³¹`, exactly: the uniform's
-//! top 31 bits pick the cell (`B[i] ≤ ⌊u·2³¹⌋ < B[i+1]`) and its remaining bits place the point
+//! 2³⁰` and a column of that row with `c_k = (C_r[k+1] − C_r[k]) / 2³⁰`, exactly: the uniform's
+//! top 30 bits pick the cell (`B[i] ≤ ⌊u·2³⁰⌋ < B[i+1]`) and its remaining bits place the point
 //! uniformly in the cell. The pdf reported is that law, `m_r · c_k · W·H` on `[0,1]²`; the
-//! quantisation only moves each cell's probability by less than 2⁻³¹ from the `f64` weights,
-//! and every cell of positive weight keeps at least one unit, so no lit pixel becomes
+//! quantisation only moves each cell's probability by about 2⁻³⁰ from the `f64` weights, and
+//! every cell of positive weight keeps at least one unit, so no lit pixel becomes
 //! unreachable.
-
-use std::hint::select_unpredictable;
 
 use distributions::{Point2, Sample2, Sampler2D, UniformSource};
 
 use crate::EnvMapError;
 
-/// log₂ of the fixed-point unit: CDF boundaries are integers in `[0, 2³¹]`.
-const BITS: i32 = 31;
+/// log₂ of the fixed-point unit: CDF boundaries are integers in `[0, 2³⁰]` (so that they
+/// compare as `i32`, the compare every x86 vector level has).
+const BITS: i32 = 30;
 
-/// `2³¹`, the fixed-point total of every CDF.
+/// `2³⁰`, the fixed-point total of every CDF.
 const ONE: u32 = 1 << BITS;
 
-/// `2³¹` as `f64`.
+/// `2³⁰` as `f64`.
 const ONE_F: f64 = ONE as f64;
 
 /// Samples walked side by side by the block path: enough independent loads in flight to
 /// overlap the cache misses of the conditional rows.
 const BLOCK: usize = 32;
+
+/// Entries per line of a counting tree.
+const FAN: usize = 16;
+
+/// One cache line of 16 boundaries.
+#[repr(align(64))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Line([u32; FAN]);
+
+/// How many entries of a line are `≤ x` (all entries and `x` are at most 2³⁰: `i32`
+/// compares), by the instruction set at hand.
+trait Count: Copy {
+    /// `#{k < 16 : line[k] ≤ x}`.
+    fn count(self, line: &Line, x: u32) -> usize;
+}
+
+/// The count in scalar code: a bit mask of the 16 compares and its population count (the
+/// one-sample path, and the block path where AVX-512 is absent).
+#[derive(Debug, Clone, Copy)]
+struct ScalarCount;
+
+impl Count for ScalarCount {
+    #[inline(always)]
+    fn count(self, line: &Line, x: u32) -> usize {
+        let x = x as i32;
+        let mut mask = 0u32;
+        for (k, &v) in line.0.iter().enumerate() {
+            mask |= u32::from((v as i32) <= x) << k;
+        }
+        mask.count_ones() as usize
+    }
+}
+
+/// The count in AVX-512 through `pulp`'s safe `V4` operations: one 16-lane compare into a
+/// mask register, and its population count. (Left to the vectoriser, the 16 compares became
+/// a chain of mask-bit extractions slower than the scalar binary search.)
+impl Count for pulp::x86::V4 {
+    #[inline(always)]
+    fn count(self, line: &Line, x: u32) -> usize {
+        let v: pulp::i32x16 = pulp::cast(line.0);
+        let mask = self.cmp_le_i32x16(v, self.splat_i32x16(x as i32));
+        mask.0.count_ones() as usize
+    }
+}
+
+/// `rows` CDFs of `n` cells each (boundaries `B[0] = 0 ≤ … ≤ B[n] = 2³⁰`) as counting trees.
+///
+/// Level `ℓ` of a row holds `T_ℓ[m] = B[m·16^ℓ]` for `m·16^ℓ < n` and 2³⁰ beyond (level 0 is
+/// the boundaries themselves, `B[n] = 2³⁰` included), in lines of 16. With `q_ℓ = ⌊i/16^ℓ⌋`
+/// for the cell `i` sought (the largest `i < n` with `B[i] ≤ x`), the top level has one line
+/// (`q_D = 0`) and `q_ℓ = 16·q_{ℓ+1} + #{k < 16 : T_ℓ[16·q_{ℓ+1} + k] ≤ x} − 1`: the `T` are
+/// monotone, `T_ℓ[16·q_{ℓ+1}] ≤ x`, and `T_ℓ[16·q_{ℓ+1} + 16] > x`.
+#[derive(Debug, Clone, PartialEq)]
+struct CountTree {
+    n: usize,
+    /// Per level, lowest first: lines per row, and the rows' lines concatenated.
+    levels: Vec<(usize, Vec<Line>)>,
+}
+
+impl CountTree {
+    /// The trees of `boundaries`, `rows` runs of `n + 1` boundaries.
+    fn new(n: usize, rows: usize, boundaries: &[u32]) -> Self {
+        let mut levels = Vec::new();
+        let mut stride = 1usize; // 16^ℓ
+        loop {
+            let per_row = n / (stride * FAN) + 1;
+            let mut lines = vec![Line([ONE; FAN]); per_row * rows];
+            for (b, out) in boundaries
+                .chunks_exact(n + 1)
+                .zip(lines.chunks_exact_mut(per_row))
+            {
+                for (m, i) in (0..n).step_by(stride).enumerate() {
+                    out[m / FAN].0[m % FAN] = b[i];
+                }
+            }
+            levels.push((per_row, lines));
+            if stride.saturating_mul(FAN) >= n {
+                break;
+            }
+            stride *= FAN;
+        }
+        Self { n, levels }
+    }
+
+    /// Boundary `i ≤ n` of row `row`.
+    #[inline(always)]
+    fn boundary(&self, row: usize, i: usize) -> u32 {
+        let (per_row, lines) = &self.levels[0];
+        lines[row * per_row + i / FAN].0[i % FAN]
+    }
+
+    /// The cell of `x < 2³⁰` in row `row`: the largest `i < n` with `B[i] ≤ x`.
+    #[inline(always)]
+    fn find(&self, row: usize, x: u32) -> usize {
+        let mut q = 0usize;
+        for (per_row, lines) in self.levels.iter().rev() {
+            q = FAN * q + ScalarCount.count(&lines[row * per_row + q], x) - 1;
+        }
+        q
+    }
+
+    /// Bytes of the lines.
+    fn bytes(&self) -> usize {
+        self.levels
+            .iter()
+            .map(|(_, l)| l.capacity() * std::mem::size_of::<Line>())
+            .sum()
+    }
+}
 
 /// Boundaries `B[0] = 0 ≤ B[1] ≤ … ≤ B[n] = 2³¹` of a CDF of `weights` (finite, ≥ 0, positive
 /// sum `total`) written to `out[..=n]`: each positive weight gets one unit, the other
@@ -57,24 +169,7 @@ fn quantise(weights: &[f64], total: f64, out: &mut [u32]) {
     }
 }
 
-/// The largest `i < n` with `b[i] ≤ x`, for a CDF row `b` of `n + 1` boundaries with `b[0] = 0`
-/// and `b[n] = 2³¹ > x`: a binary search whose step count depends on `n` only and whose steps
-/// are selects, not branches (`select_unpredictable`: a conditional move that LLVM's x86 pass
-/// would otherwise turn back into a branch, mispredicted half the time on a search).
-#[inline(always)]
-fn find(b: &[u32], n: usize, x: u32) -> usize {
-    let mut base = 0usize;
-    let mut len = n;
-    while len > 1 {
-        let half = len / 2;
-        let probe = base + half;
-        base = select_unpredictable(b[probe] <= x, probe, base);
-        len -= half;
-    }
-    base
-}
-
-/// The uniform's top 31 bits, `⌊u·2³¹⌋`, and `u·2³¹` itself (exact: a power-of-two scaling);
+/// The uniform's top 30 bits, `⌊u·2³⁰⌋`, and `u·2³⁰` itself (exact: a power-of-two scaling);
 /// NaN and negatives count as 0, values ≥ 1 as the largest number below 1.
 #[inline(always)]
 fn fixed(u: f64) -> (u32, f64) {
@@ -113,17 +208,19 @@ fn cell_of(p: f64, n: usize) -> usize {
 /// `distributions::PiecewiseConstant2D`); [`Sampler2D::sample_into`] walks [`BLOCK`] samples
 /// side by side and returns the same samples as that many [`Sampler2D::sample`] calls, bit for
 /// bit.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct QuantisedCdf2D {
     width: usize,
     height: usize,
-    /// `height` rows of `width + 1` boundaries: the conditional CDFs of the columns of each row
-    /// (a row of zero weight holds the uniform CDF; it is never drawn).
-    conditional: Vec<u32>,
-    /// `height + 1` boundaries: the marginal CDF of the rows.
-    marginal: Vec<u32>,
-    /// `width · height / 2⁶²`: a cell's pdf on `[0,1]²` is its two widths' product times this.
+    /// `height` rows: the conditional CDFs of the columns of each row (a row of zero weight
+    /// holds the uniform CDF; it is never drawn).
+    conditional: CountTree,
+    /// One row: the marginal CDF of the rows.
+    marginal: CountTree,
+    /// `width · height / 2⁶⁰`: a cell's pdf on `[0,1]²` is its two widths' product times this.
     pdf_scale: f64,
+    /// The instruction set of the block path (`pulp`'s runtime dispatch).
+    arch: pulp::Arch,
 }
 
 impl QuantisedCdf2D {
@@ -131,15 +228,14 @@ impl QuantisedCdf2D {
     /// zero).
     ///
     /// Errors: [`EnvMapError::Empty`] for a zero size, [`EnvMapError::TooLarge`] for a side of
-    /// 2³¹ − 1 cells or more,
-    /// [`EnvMapError::SizeMismatch`] when `weights.len() ≠ width · height`,
-    /// [`EnvMapError::AllBlack`] when no weight is positive or a weight or a row sum is not
-    /// finite and non-negative.
+    /// 2³⁰ − 1 cells or more, [`EnvMapError::SizeMismatch`] when `weights.len() ≠ width ·
+    /// height`, [`EnvMapError::AllBlack`] when no weight is positive or a weight or a row sum
+    /// is not finite and non-negative.
     pub fn new(width: usize, height: usize, weights: &[f64]) -> Result<Self, EnvMapError> {
-        // At most 2³¹ − 1 cells per CDF, so every positive cell can keep one unit.
         if width == 0 || height == 0 {
             return Err(EnvMapError::Empty { width, height });
         }
+        // Fewer than 2³⁰ cells per CDF, so every positive cell can keep one unit.
         let too_large = EnvMapError::TooLarge {
             width,
             height,
@@ -186,9 +282,10 @@ impl QuantisedCdf2D {
         Ok(Self {
             width,
             height,
-            conditional,
-            marginal,
+            conditional: CountTree::new(width, height, &conditional),
+            marginal: CountTree::new(height, 1, &marginal),
             pdf_scale: (width as f64 * height as f64) / (ONE_F * ONE_F),
+            arch: pulp::Arch::new(),
         })
     }
 
@@ -203,7 +300,7 @@ impl QuantisedCdf2D {
     }
 
     /// The probability of cell `(column, row)` as the sampler draws it (its two stored widths'
-    /// product over 2⁶²); 0 outside the table.
+    /// product over 2⁶⁰); 0 outside the table.
     pub fn cell_probability(&self, column: usize, row: usize) -> f64 {
         if column >= self.width || row >= self.height {
             return 0.0;
@@ -212,44 +309,32 @@ impl QuantisedCdf2D {
         m * c / (ONE_F * ONE_F)
     }
 
-    /// The stored widths (in units of 2⁻³¹) of row `row` in the marginal and of column
+    /// The stored widths (in units of 2⁻³⁰) of row `row` in the marginal and of column
     /// `column` in that row's conditional.
     #[inline(always)]
     fn widths(&self, column: usize, row: usize) -> (f64, f64) {
-        let m = self.marginal[row + 1] - self.marginal[row];
-        let b = &self.conditional[row * (self.width + 1)..];
-        (f64::from(m), f64::from(b[column + 1] - b[column]))
+        let (mg, cd) = (&self.marginal, &self.conditional);
+        let m = mg.boundary(0, row + 1) - mg.boundary(0, row);
+        let c = cd.boundary(row, column + 1) - cd.boundary(row, column);
+        (f64::from(m), f64::from(c))
     }
 
     /// The sample of the uniforms `u0` (column) and `u1` (row).
     #[inline(always)]
     fn sample_pair(&self, u0: f64, u1: f64) -> Sample2 {
-        let (w, h) = (self.width, self.height);
         let (x1, s1) = fixed(u1);
-        let row = find(&self.marginal, h, x1);
-        let (m_lo, m_hi) = (self.marginal[row], self.marginal[row + 1]);
-        let b = &self.conditional[row * (w + 1)..(row + 1) * (w + 1)];
+        let row = self.marginal.find(0, x1);
         let (x0, s0) = fixed(u0);
-        let col = find(b, w, x0);
-        let (c_lo, c_hi) = (b[col], b[col + 1]);
-        self.finish(row, s1, m_lo, m_hi, col, s0, c_lo, c_hi)
+        let col = self.conditional.find(row, x0);
+        self.finish(row, s1, col, s0)
     }
 
-    /// The point and pdf of cell `(col, row)` given the scaled uniforms and the cell's
-    /// boundaries.
-    #[allow(clippy::too_many_arguments)]
+    /// The point and pdf of cell `(col, row)` given the scaled uniforms.
     #[inline(always)]
-    fn finish(
-        &self,
-        row: usize,
-        s1: f64,
-        m_lo: u32,
-        m_hi: u32,
-        col: usize,
-        s0: f64,
-        c_lo: u32,
-        c_hi: u32,
-    ) -> Sample2 {
+    fn finish(&self, row: usize, s1: f64, col: usize, s0: f64) -> Sample2 {
+        let (mg, cd) = (&self.marginal, &self.conditional);
+        let (m_lo, m_hi) = (mg.boundary(0, row), mg.boundary(0, row + 1));
+        let (c_lo, c_hi) = (cd.boundary(row, col), cd.boundary(row, col + 1));
         let (dm, dc) = (f64::from(m_hi - m_lo), f64::from(c_hi - c_lo));
         let (w, h) = (self.width as f64, self.height as f64);
         Sample2 {
@@ -263,19 +348,23 @@ impl QuantisedCdf2D {
 
     /// Bytes of the tables and the struct.
     pub fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + (self.conditional.capacity() + self.marginal.capacity()) * std::mem::size_of::<u32>()
+        std::mem::size_of::<Self>() + self.conditional.bytes() + self.marginal.bytes()
     }
 
     /// Up to [`BLOCK`] samples side by side: the uniforms, every row search (level by level
-    /// across the lanes), every column search likewise, then the points.
+    /// across the lanes, so the lanes' loads overlap), every column search likewise, then the
+    /// points.
     // Lane loops index several per-lane arrays by the lane number.
     #[allow(clippy::needless_range_loop)]
     #[inline(always)]
-    fn sample_block<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
+    fn sample_block<U: UniformSource + ?Sized, C: Count>(
+        &self,
+        c: C,
+        u: &mut U,
+        out: &mut [Sample2],
+    ) {
         let m = out.len();
         debug_assert!(m <= BLOCK);
-        let (w, h) = (self.width, self.height);
         let mut x0 = [0u32; BLOCK];
         let mut s0 = [0.0f64; BLOCK];
         let mut x1 = [0u32; BLOCK];
@@ -284,47 +373,87 @@ impl QuantisedCdf2D {
             (x0[j], s0[j]) = fixed(u.next_uniform());
             (x1[j], s1[j]) = fixed(u.next_uniform());
         }
-        // Rows: the marginal is small (cached); level by level so the lanes' selects overlap.
-        let mg = &self.marginal[..];
         let mut row = [0usize; BLOCK];
-        let mut len = h;
-        while len > 1 {
-            let half = len / 2;
+        for (_, lines) in self.marginal.levels.iter().rev() {
             for j in 0..m {
-                let probe = row[j] + half;
-                row[j] = select_unpredictable(mg[probe] <= x1[j], probe, row[j]);
+                row[j] = FAN * row[j] + c.count(&lines[row[j]], x1[j]) - 1;
             }
-            len -= half;
         }
-        // Columns: absolute indices into the concatenated rows, so every lane's probe of a
-        // level is one independent load (the misses of the block overlap).
-        let cd = &self.conditional[..];
-        let mut at = [0usize; BLOCK];
-        for j in 0..m {
-            at[j] = row[j] * (w + 1);
-        }
-        let mut len = w;
-        while len > 1 {
-            let half = len / 2;
+        let mut col = [0usize; BLOCK];
+        for (per_row, lines) in self.conditional.levels.iter().rev() {
             for j in 0..m {
-                let probe = at[j] + half;
-                at[j] = select_unpredictable(cd[probe] <= x0[j], probe, at[j]);
+                col[j] = FAN * col[j] + c.count(&lines[row[j] * per_row + col[j]], x0[j]) - 1;
             }
-            len -= half;
         }
         for j in 0..m {
-            let r = row[j];
-            let col = at[j] - r * (w + 1);
-            out[j] = self.finish(
-                r,
-                s1[j],
-                mg[r],
-                mg[r + 1],
-                col,
-                s0[j],
-                cd[at[j]],
-                cd[at[j] + 1],
-            );
+            out[j] = self.finish(row[j], s1[j], col[j], s0[j]);
+        }
+    }
+}
+
+/// Equality of the tables (the dispatch level is not part of the sampler's law).
+impl PartialEq for QuantisedCdf2D {
+    fn eq(&self, other: &Self) -> bool {
+        (self.width, self.height, &self.conditional, &self.marginal)
+            == (
+                other.width,
+                other.height,
+                &other.conditional,
+                &other.marginal,
+            )
+    }
+}
+
+/// [`QuantisedCdf2D::sample_block`] over a slice with the count `c`, as a `pulp` operation
+/// (compiled for the instruction set it is dispatched to).
+struct Blocks<'a, U: ?Sized, C> {
+    table: &'a QuantisedCdf2D,
+    c: C,
+    u: &'a mut U,
+    out: &'a mut [Sample2],
+}
+
+impl<U: UniformSource + ?Sized, C: Count> pulp::WithSimd for Blocks<'_, U, C> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        for chunk in self.out.chunks_mut(BLOCK) {
+            self.table.sample_block(self.c, self.u, chunk);
+        }
+    }
+}
+
+impl QuantisedCdf2D {
+    /// The block path at the instruction-set level `level`: AVX-512 (`V4`) where `pulp`
+    /// finds it (and `level` allows it), else the scalar count compiled for AVX2 (`V3`) or
+    /// the x86-64 baseline. Every level gives the same samples (integer compares).
+    fn sample_into_at<U: UniformSource + ?Sized>(
+        &self,
+        level: pulp::Arch,
+        u: &mut U,
+        out: &mut [Sample2],
+    ) {
+        use pulp::WithSimd;
+        match level {
+            pulp::Arch::V4(simd) => {
+                let op = Blocks {
+                    table: self,
+                    c: simd,
+                    u,
+                    out,
+                };
+                simd.vectorize(
+                    #[inline(always)]
+                    || op.with_simd(simd),
+                )
+            }
+            other => other.dispatch(Blocks {
+                table: self,
+                c: ScalarCount,
+                u,
+                out,
+            }),
         }
     }
 }
@@ -339,15 +468,14 @@ impl Sampler2D for QuantisedCdf2D {
     }
 
     /// The samples of as many [`Sampler2D::sample`] calls (same uniforms, same samples, bit for
-    /// bit), walked [`BLOCK`] at a time side by side.
+    /// bit), walked [`BLOCK`] at a time side by side (the same numbers at every dispatch
+    /// level: integer compares and the one-sample path's floating-point operations).
     fn sample_into<U: UniformSource + ?Sized>(&self, u: &mut U, out: &mut [Sample2]) {
-        for chunk in out.chunks_mut(BLOCK) {
-            self.sample_block(u, chunk);
-        }
+        self.sample_into_at(self.arch, u, out);
     }
 
     /// The stored law's density on `[0,1]²` at `p`: the product of its cell's two stored
-    /// widths times `W·H / 2⁶²`; 0 outside the square.
+    /// widths times `W·H / 2⁶⁰`; 0 outside the square.
     fn pdf(&self, p: Point2) -> f64 {
         if !(p[0] >= 0.0 && p[0] <= 1.0 && p[1] >= 0.0 && p[1] <= 1.0) {
             return 0.0;
@@ -384,6 +512,49 @@ mod tests {
         (0..n).rev().find(|&i| b[i] <= x).unwrap_or(0)
     }
 
+    /// The `n + 1` stored boundaries of row `row` of `tree`.
+    fn bounds(tree: &CountTree, row: usize) -> Vec<u32> {
+        (0..=tree.n).map(|i| tree.boundary(row, i)).collect()
+    }
+
+    #[test]
+    fn counting_trees_find_the_linear_scans_cell() {
+        // Sizes at and around the levels' edges (1 to 4 levels), rows with runs of equal
+        // boundaries (zero-width cells), every boundary and its neighbours as `x`.
+        let mut g = Mix(11);
+        for n in [1, 2, 15, 16, 17, 255, 256, 257, 1024, 4097] {
+            let rows = 3;
+            let mut b = Vec::new();
+            for _ in 0..rows {
+                let w: Vec<f64> = (0..n)
+                    .map(|_| {
+                        let r = g.next_uniform();
+                        if r < 0.3 { 0.0 } else { r }
+                    })
+                    .collect();
+                let mut out = vec![0u32; n + 1];
+                if w.iter().any(|&x| x > 0.0) {
+                    quantise(&w, w.iter().sum(), &mut out);
+                } else {
+                    quantise(&vec![1.0; n], n as f64, &mut out);
+                }
+                b.extend(out);
+            }
+            let tree = CountTree::new(n, rows, &b);
+            for r in 0..rows {
+                let row = &b[r * (n + 1)..(r + 1) * (n + 1)];
+                assert_eq!(bounds(&tree, r), row);
+                let mut xs: Vec<u32> = (0..200).map(|_| fixed(g.next_uniform()).0).collect();
+                for &v in row {
+                    xs.extend([v.saturating_sub(1), v, v + 1]);
+                }
+                for x in xs.into_iter().filter(|&x| x < ONE) {
+                    assert_eq!(tree.find(r, x), scan(row, n, x), "n {n}, row {r}, x {x}");
+                }
+            }
+        }
+    }
+
     fn table(width: usize, height: usize, seed: u64) -> Vec<f64> {
         let mut g = Mix(seed);
         (0..width * height)
@@ -408,8 +579,10 @@ mod tests {
         for (w, h, seed) in [(1, 1, 1), (7, 5, 2), (64, 33, 3), (1000, 3, 4)] {
             let v = table(w, h, seed);
             let t = QuantisedCdf2D::new(w, h, &v).unwrap();
-            assert_eq!(*t.marginal.last().unwrap(), ONE);
-            for (r, b) in t.conditional.chunks_exact(w + 1).enumerate() {
+            let marginal = bounds(&t.marginal, 0);
+            assert_eq!(*marginal.last().unwrap(), ONE);
+            for r in 0..h {
+                let b = bounds(&t.conditional, r);
                 assert_eq!((b[0], b[w]), (0, ONE));
                 let row = &v[r * w..(r + 1) * w];
                 let row_positive = row.iter().any(|&x| x > 0.0);
@@ -420,7 +593,7 @@ mod tests {
                         assert_eq!(b[c + 1] > b[c], row[c] > 0.0, "({c}, {r})");
                     }
                 }
-                assert_eq!(t.marginal[r + 1] > t.marginal[r], row_positive);
+                assert_eq!(marginal[r + 1] > marginal[r], row_positive);
             }
             let total: f64 = (0..h)
                 .flat_map(|r| (0..w).map(move |c| (c, r)))
@@ -444,7 +617,13 @@ mod tests {
 
     #[test]
     fn block_path_equals_the_one_sample_path_and_the_plain_search() {
-        for (w, h, seed) in [(1, 1, 5), (3, 1, 6), (37, 19, 7), (1024, 8, 8)] {
+        for (w, h, seed) in [
+            (1, 1, 5),
+            (3, 1, 6),
+            (37, 19, 7),
+            (1024, 8, 8),
+            (5000, 2, 9),
+        ] {
             let v = table(w, h, seed);
             let t = QuantisedCdf2D::new(w, h, &v).unwrap();
             for len in [1, 31, 32, 33, 200] {
@@ -465,7 +644,11 @@ mod tests {
             // The searches against the linear scan, on random and boundary uniforms.
             let mut g = Mix(seed + 100);
             let mut us: Vec<f64> = (0..2000).map(|_| g.next_uniform()).collect();
-            for &x in t.conditional.iter().chain(&t.marginal) {
+            let all: Vec<u32> = (0..h)
+                .flat_map(|r| bounds(&t.conditional, r))
+                .chain(bounds(&t.marginal, 0))
+                .collect();
+            for &x in &all {
                 let y = f64::from(x) / ONE_F;
                 us.extend([y, y.next_down(), y.next_up()]);
             }
@@ -475,9 +658,8 @@ mod tests {
                 let s = t.sample_pair(u0, u1);
                 let (x1, _) = fixed(u1);
                 let (x0, _) = fixed(u0);
-                let row = scan(&t.marginal, h, x1);
-                let b = &t.conditional[row * (w + 1)..(row + 1) * (w + 1)];
-                let col = scan(b, w, x0);
+                let row = scan(&bounds(&t.marginal, 0), h, x1);
+                let col = scan(&bounds(&t.conditional, row), w, x0);
                 assert!(
                     s.point[0] >= 0.0 && s.point[0] < 1.0 && s.point[1] >= 0.0 && s.point[1] < 1.0
                 );
