@@ -507,9 +507,17 @@ mod tests {
         }
     }
 
-    /// The plain linear scan: the largest `i < n` with `b[i] ≤ x`.
+    /// The reference search (std's `partition_point`): the largest `i < n` with `b[i] ≤ x`.
     fn scan(b: &[u32], n: usize, x: u32) -> usize {
-        (0..n).rev().find(|&i| b[i] <= x).unwrap_or(0)
+        b[..n].partition_point(|&v| v <= x).max(1) - 1
+    }
+
+    /// The baseline and every `pulp` level this CPU has (AVX2, AVX-512).
+    fn levels() -> Vec<pulp::Arch> {
+        let mut l = vec![pulp::Arch::Scalar];
+        l.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
+        l.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
+        l
     }
 
     /// The `n + 1` stored boundaries of row `row` of `tree`.
@@ -518,7 +526,7 @@ mod tests {
     }
 
     #[test]
-    fn counting_trees_find_the_linear_scans_cell() {
+    fn counting_trees_find_the_reference_searchs_cell() {
         // Sizes at and around the levels' edges (1 to 4 levels), rows with runs of equal
         // boundaries (zero-width cells), every boundary and its neighbours as `x`.
         let mut g = Mix(11);
@@ -640,14 +648,23 @@ mod tests {
                 t.sample_into(&mut b, &mut blk);
                 assert_eq!(one, blk, "{w}×{h}, {len}");
                 assert_eq!(a.0, b.0, "uniforms consumed");
+                // Every dispatch level this CPU has, not only the best one.
+                for level in levels() {
+                    let mut c = Mix(seed);
+                    blk.fill(Sample2 {
+                        point: [0.0; 2],
+                        pdf: 0.0,
+                    });
+                    t.sample_into_at(level, &mut c, &mut blk);
+                    assert_eq!(one, blk, "{w}×{h}, {len}, {level:?}");
+                }
             }
             // The searches against the linear scan, on random and boundary uniforms.
             let mut g = Mix(seed + 100);
             let mut us: Vec<f64> = (0..2000).map(|_| g.next_uniform()).collect();
-            let all: Vec<u32> = (0..h)
-                .flat_map(|r| bounds(&t.conditional, r))
-                .chain(bounds(&t.marginal, 0))
-                .collect();
+            let rows: Vec<Vec<u32>> = (0..h).map(|r| bounds(&t.conditional, r)).collect();
+            let marginal = bounds(&t.marginal, 0);
+            let all: Vec<u32> = rows.iter().flatten().chain(&marginal).copied().collect();
             for &x in &all {
                 let y = f64::from(x) / ONE_F;
                 us.extend([y, y.next_down(), y.next_up()]);
@@ -658,8 +675,8 @@ mod tests {
                 let s = t.sample_pair(u0, u1);
                 let (x1, _) = fixed(u1);
                 let (x0, _) = fixed(u0);
-                let row = scan(&bounds(&t.marginal, 0), h, x1);
-                let col = scan(&bounds(&t.conditional, row), w, x0);
+                let row = scan(&marginal, h, x1);
+                let col = scan(&rows[row], w, x0);
                 assert!(
                     s.point[0] >= 0.0 && s.point[0] < 1.0 && s.point[1] >= 0.0 && s.point[1] < 1.0
                 );
