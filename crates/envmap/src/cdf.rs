@@ -15,7 +15,7 @@
 //! every cell of positive weight keeps at least one unit, so no lit pixel becomes
 //! unreachable.
 
-use distributions::{Point2, Sample2, Sampler2D, UniformSource};
+use distributions::{InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSource};
 
 use crate::EnvMapError;
 
@@ -458,6 +458,39 @@ impl QuantisedCdf2D {
     }
 }
 
+/// The warp of the unit square and its inverse (`u[0]` picks the column, `u[1]` the row).
+impl InvertibleSampler2D for QuantisedCdf2D {
+    /// Inputs outside `[0,1)` (and NaN) are clamped into it.
+    #[inline]
+    fn sample_square(&self, u: Point2) -> Sample2 {
+        self.sample_pair(u[0], u[1])
+    }
+
+    /// `None` outside the square and on cells the sampler never draws (zero stored width):
+    /// the uniforms `(C_r[c] + t_c·ΔC) / 2³⁰, (M[r] + t_r·ΔM) / 2³⁰` of the point's cell and
+    /// position `t` in it (up to rounding).
+    fn invert(&self, p: Point2) -> Option<Point2> {
+        if !(p[0] >= 0.0 && p[0] <= 1.0 && p[1] >= 0.0 && p[1] <= 1.0) {
+            return None;
+        }
+        let (col, row) = (cell_of(p[0], self.width), cell_of(p[1], self.height));
+        let (mg, cd) = (&self.marginal, &self.conditional);
+        let (m_lo, m_hi) = (mg.boundary(0, row), mg.boundary(0, row + 1));
+        let (c_lo, c_hi) = (cd.boundary(row, col), cd.boundary(row, col + 1));
+        if m_hi == m_lo || c_hi == c_lo {
+            return None;
+        }
+        let within = |x: f64, i: usize, lo: u32, hi: u32| {
+            let t = (x - i as f64).clamp(0.0, 1.0);
+            ((f64::from(lo) + t * f64::from(hi - lo)) / ONE_F).min(1.0 - f64::EPSILON / 2.0)
+        };
+        Some([
+            within(p[0] * self.width as f64, col, c_lo, c_hi),
+            within(p[1] * self.height as f64, row, m_lo, m_hi),
+        ])
+    }
+}
+
 impl Sampler2D for QuantisedCdf2D {
     /// Two uniforms: the first for the column, the second for the row.
     #[inline]
@@ -493,6 +526,7 @@ impl Sampler2D for QuantisedCdf2D {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use distributions::UniformSequence;
 
     /// SplitMix64 uniforms (53 bits), for tests independent of the crate's generators.
     struct Mix(u64);
@@ -670,8 +704,32 @@ mod tests {
                 us.extend([y, y.next_down(), y.next_up()]);
             }
             us.extend([0.0, -0.0, 1.0 - f64::EPSILON / 2.0, 1.0, f64::NAN, -1.0]);
-            for (k, &u1) in us.iter().enumerate() {
-                let u0 = us[(k * 7919) % us.len()];
+            let pairs: Vec<[f64; 2]> = (0..us.len())
+                .map(|k| [us[(k * 7919) % us.len()], us[k]])
+                .collect();
+            // The block path at every level on these uniforms (boundaries exactly hit: the
+            // compares' `≤`), against the one-sample path.
+            let flat: Vec<f64> = pairs.iter().flatten().copied().collect();
+            let one: Vec<Sample2> = pairs.iter().map(|&[a, b]| t.sample_pair(a, b)).collect();
+            for level in levels() {
+                let mut blk = vec![
+                    Sample2 {
+                        point: [0.0; 2],
+                        pdf: 0.0
+                    };
+                    pairs.len()
+                ];
+                t.sample_into_at(level, &mut UniformSequence::new(&flat), &mut blk);
+                for (a, b) in one.iter().zip(&blk) {
+                    // NaN inputs give the same sample; compare bits.
+                    assert_eq!(
+                        (a.point.map(f64::to_bits), a.pdf.to_bits()),
+                        (b.point.map(f64::to_bits), b.pdf.to_bits()),
+                        "{level:?}"
+                    );
+                }
+            }
+            for &[u0, u1] in &pairs {
                 let s = t.sample_pair(u0, u1);
                 let (x1, _) = fixed(u1);
                 let (x0, _) = fixed(u0);
@@ -689,6 +747,22 @@ mod tests {
                 assert_eq!(s.pdf, t.pdf(s.point));
             }
         }
+    }
+
+    #[test]
+    fn invert_undoes_the_warp() {
+        let (w, h) = (37, 19);
+        let t = QuantisedCdf2D::new(w, h, &table(w, h, 12)).unwrap();
+        let mut g = Mix(13);
+        for _ in 0..2000 {
+            let u = [g.next_uniform(), g.next_uniform()];
+            let s = t.sample_square(u);
+            let back = t.invert(s.point).unwrap();
+            assert!((back[0] - u[0]).abs() < 1e-12 && (back[1] - u[1]).abs() < 1e-12);
+        }
+        // Row 2 has zero weight: never drawn, not invertible; outside the square neither.
+        assert_eq!(t.invert([0.5, 2.5 / h as f64]), None);
+        assert_eq!(t.invert([1.5, 0.5]), None);
     }
 
     #[test]
