@@ -15,6 +15,8 @@
 //! every cell of positive weight keeps at least one unit, so no lit pixel becomes
 //! unreachable.
 
+use std::hint::select_unpredictable;
+
 use distributions::{InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSource};
 
 use crate::EnvMapError;
@@ -44,6 +46,10 @@ struct Line([u32; FAN]);
 /// How many entries of a line are `≤ x` (all entries and `x` are at most 2³⁰: `i32`
 /// compares), by the instruction set at hand.
 trait Count: Copy {
+    /// Whether the count beats the binary search (a vector compare); the block path walks
+    /// by binary search otherwise.
+    const FAST: bool;
+
     /// `#{k < 16 : line[k] ≤ x}`.
     fn count(self, line: &Line, x: u32) -> usize;
 }
@@ -54,6 +60,8 @@ trait Count: Copy {
 struct ScalarCount;
 
 impl Count for ScalarCount {
+    const FAST: bool = false;
+
     #[inline(always)]
     fn count(self, line: &Line, x: u32) -> usize {
         let x = x as i32;
@@ -69,6 +77,8 @@ impl Count for ScalarCount {
 /// mask register, and its population count. (Left to the vectoriser, the 16 compares became
 /// a chain of mask-bit extractions slower than the scalar binary search.)
 impl Count for pulp::x86::V4 {
+    const FAST: bool = true;
+
     #[inline(always)]
     fn count(self, line: &Line, x: u32) -> usize {
         let v: pulp::i32x16 = pulp::cast(line.0);
@@ -125,12 +135,31 @@ impl CountTree {
 
     /// The cell of `x < 2³⁰` in row `row`: the largest `i < n` with `B[i] ≤ x`.
     #[inline(always)]
-    fn find(&self, row: usize, x: u32) -> usize {
+    fn find<C: Count>(&self, c: C, row: usize, x: u32) -> usize {
         let mut q = 0usize;
         for (per_row, lines) in self.levels.iter().rev() {
-            q = FAN * q + ScalarCount.count(&lines[row * per_row + q], x) - 1;
+            q = FAN * q + c.count(&lines[row * per_row + q], x) - 1;
         }
         q
+    }
+
+    /// The same cell by a binary search of the boundaries (level 0), whose steps are
+    /// `select_unpredictable`s (conditional moves: a branch there mispredicts half the
+    /// time): the search of the levels without AVX-512, where the 16-entry count is slow.
+    #[inline(always)]
+    fn find_binary(&self, row: usize, x: u32) -> usize {
+        let (per_row, lines) = &self.levels[0];
+        let row = &lines[row * per_row..(row + 1) * per_row];
+        let mut base = 0usize;
+        let mut len = self.n;
+        while len > 1 {
+            let half = len / 2;
+            let probe = base + half;
+            let v = row[probe / FAN].0[probe % FAN];
+            base = select_unpredictable(v <= x, probe, base);
+            len -= half;
+        }
+        base
     }
 
     /// Bytes of the lines.
@@ -319,13 +348,37 @@ impl QuantisedCdf2D {
         (f64::from(m), f64::from(c))
     }
 
-    /// The sample of the uniforms `u0` (column) and `u1` (row).
+    /// The sample of the uniforms `u0` (column) and `u1` (row): the counting walk in AVX-512
+    /// where the CPU has it (one call into the `V4` build per sample), else the binary
+    /// search. The same cell either way.
     #[inline(always)]
     fn sample_pair(&self, u0: f64, u1: f64) -> Sample2 {
+        match self.arch {
+            pulp::Arch::V4(simd) => simd.vectorize(
+                #[inline(always)]
+                || self.sample_pair_counted(simd, u0, u1),
+            ),
+            _ => self.sample_pair_binary(u0, u1),
+        }
+    }
+
+    /// [`Self::sample_pair`] by the counting walk with the count `c`.
+    #[inline(always)]
+    fn sample_pair_counted<C: Count>(&self, c: C, u0: f64, u1: f64) -> Sample2 {
         let (x1, s1) = fixed(u1);
-        let row = self.marginal.find(0, x1);
+        let row = self.marginal.find(c, 0, x1);
         let (x0, s0) = fixed(u0);
-        let col = self.conditional.find(row, x0);
+        let col = self.conditional.find(c, row, x0);
+        self.finish(row, s1, col, s0)
+    }
+
+    /// [`Self::sample_pair`] by the binary search.
+    #[inline(always)]
+    fn sample_pair_binary(&self, u0: f64, u1: f64) -> Sample2 {
+        let (x1, s1) = fixed(u1);
+        let row = self.marginal.find_binary(0, x1);
+        let (x0, s0) = fixed(u0);
+        let col = self.conditional.find_binary(row, x0);
         self.finish(row, s1, col, s0)
     }
 
@@ -374,12 +427,25 @@ impl QuantisedCdf2D {
             (x1[j], s1[j]) = fixed(u.next_uniform());
         }
         let mut row = [0usize; BLOCK];
+        let mut col = [0usize; BLOCK];
+        if !C::FAST {
+            // Without AVX-512: the binary searches, lane by lane (independent chains).
+            for j in 0..m {
+                row[j] = self.marginal.find_binary(0, x1[j]);
+            }
+            for j in 0..m {
+                col[j] = self.conditional.find_binary(row[j], x0[j]);
+            }
+            for j in 0..m {
+                out[j] = self.finish(row[j], s1[j], col[j], s0[j]);
+            }
+            return;
+        }
         for (_, lines) in self.marginal.levels.iter().rev() {
             for j in 0..m {
                 row[j] = FAN * row[j] + c.count(&lines[row[j]], x1[j]) - 1;
             }
         }
-        let mut col = [0usize; BLOCK];
         for (per_row, lines) in self.conditional.levels.iter().rev() {
             for j in 0..m {
                 col[j] = FAN * col[j] + c.count(&lines[row[j] * per_row + col[j]], x0[j]) - 1;
@@ -591,7 +657,17 @@ mod tests {
                     xs.extend([v.saturating_sub(1), v, v + 1]);
                 }
                 for x in xs.into_iter().filter(|&x| x < ONE) {
-                    assert_eq!(tree.find(r, x), scan(row, n, x), "n {n}, row {r}, x {x}");
+                    let want = scan(row, n, x);
+                    assert_eq!(tree.find(ScalarCount, r, x), want, "n {n}, row {r}, x {x}");
+                    assert_eq!(
+                        tree.find_binary(r, x),
+                        want,
+                        "binary: n {n}, row {r}, x {x}"
+                    );
+                    if let Some(simd) = pulp::x86::V4::try_new() {
+                        let got = simd.vectorize(|| tree.find(simd, r, x));
+                        assert_eq!(got, want, "V4: n {n}, row {r}, x {x}");
+                    }
                 }
             }
         }
@@ -711,6 +787,18 @@ mod tests {
             // compares' `≤`), against the one-sample path.
             let flat: Vec<f64> = pairs.iter().flatten().copied().collect();
             let one: Vec<Sample2> = pairs.iter().map(|&[a, b]| t.sample_pair(a, b)).collect();
+            // The one-sample path's three walks give the same samples.
+            for (&[a, b], s) in pairs.iter().zip(&one) {
+                for other in [
+                    t.sample_pair_binary(a, b),
+                    t.sample_pair_counted(ScalarCount, a, b),
+                ] {
+                    assert_eq!(
+                        (s.point.map(f64::to_bits), s.pdf.to_bits()),
+                        (other.point.map(f64::to_bits), other.pdf.to_bits())
+                    );
+                }
+            }
             for level in levels() {
                 let mut blk = vec![
                     Sample2 {
