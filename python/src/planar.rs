@@ -24,7 +24,7 @@ use crate::threads::{install, next_seed, par_map};
 /// The uniforms that `t` maps to each point (N, 2); NaN rows where the density is zero.
 fn invert_points<'py>(
     py: Python<'py>,
-    t: &PiecewiseConstant2D,
+    t: &(impl InvertibleSampler2D + Sync),
     p: &[[f64; 2]],
 ) -> Bound<'py, PyArray2<f64>> {
     rows(

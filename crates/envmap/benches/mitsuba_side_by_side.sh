@@ -19,7 +19,9 @@ THREADS=${THREADS:-2}
 PY="$PEERS/.venv/bin/python"
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-cargo build --release -q -p brdf-lab-cli -p envmap --example export_density
+# Two builds: with an --example selection cargo builds only the examples, not brdf-lab's binary.
+cargo build --release -q -p brdf-lab-cli
+cargo build --release -q -p envmap --example export_density
 BIN=target/release/brdf-lab
 EXPORT=target/release/examples/export_density
 echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -16,8 +16,8 @@
 //! carries `pdf_uv` (w.r.t. area on `[0,1]²`) and `pdf_sa = pdf_uv / (2π² sin(πv))` (w.r.t.
 //! solid angle). [`EnvMapSampler`] offers the adaptive-partition sampler of
 //! `partition_sampler` (exact target; envelope or paper scheme; alias or descent leaf choice)
-//! and the classic piecewise-constant CDF `distributions::PiecewiseConstant2D` (midpoint
-//! approximation of the sine).
+//! and the classic piecewise-constant CDF [`QuantisedCdf2D`] (midpoint approximation of the
+//! sine; fixed-point tables whose stored law is the reported pdf).
 //!
 //! ```
 //! use envmap::{AdaptiveOptions, EnvMapSampler, SamplerKind, procedural_sky};
@@ -47,6 +47,7 @@
 // Validation is written `if !(x >= 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod cdf;
 mod error;
 mod format;
 pub mod lanes;
@@ -56,6 +57,7 @@ mod map;
 mod sampler;
 mod sky;
 
+pub use cdf::QuantisedCdf2D;
 pub use error::EnvMapError;
 pub use format::MapFormat;
 pub use lanes::LaneRng;

@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use distributions::{PiecewiseConstant2D, Point2, Rect, Sample2, Sampler2D, UniformSource};
+use distributions::{Point2, Rect, Sample2, Sampler2D, UniformSource};
 use partition_sampler::{
     LeafChoice, MemoryReport, QuadTreeBuilder, QuadTreeSampler, SamplerStats, Scheme, SinPiRows,
     TabulatedDensity, TreeParams,
@@ -10,6 +10,7 @@ use partition_sampler::{
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::cdf::QuantisedCdf2D;
 use crate::lanes::LaneRng;
 use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
 use crate::{EnvMap, EnvMapError};
@@ -100,7 +101,7 @@ impl EnvSample {
 #[derive(Debug)]
 enum Inner {
     Adaptive(Box<QuadTreeSampler<TabulatedDensity<SinPiRows>>>),
-    PiecewiseConstant(PiecewiseConstant2D),
+    PiecewiseConstant(QuantisedCdf2D),
 }
 
 /// An importance sampler of directions ∝ luminance per solid angle for one [`EnvMap`].
@@ -153,8 +154,9 @@ impl EnvMapSampler {
         })
     }
 
-    /// The piecewise-constant CDF sampler ([`PiecewiseConstant2D`]) of
-    /// `Y(pixel) · sin(π (y + ½)/H)` on `[0,1]²`. The build time includes the table.
+    /// The piecewise-constant CDF sampler ([`QuantisedCdf2D`], fixed-point CDF tables whose
+    /// stored law is the pdf) of `Y(pixel) · sin(π (y + ½)/H)` on `[0,1]²`. The build time
+    /// includes the table.
     pub fn piecewise_constant(map: &EnvMap) -> Result<Self, EnvMapError> {
         let start = Instant::now();
         let (w, h) = (map.width(), map.height());
@@ -167,7 +169,7 @@ impl EnvMapSampler {
             .enumerate()
             .map(|(i, &p)| crate::luminance(p) * row_weight[i / w])
             .collect();
-        let table = PiecewiseConstant2D::new(w, h, values, Rect::UNIT)?;
+        let table = QuantisedCdf2D::new(w, h, &values)?;
         Ok(Self {
             inner: Inner::PiecewiseConstant(table),
             kind: SamplerKind::PiecewiseConstant,
@@ -231,8 +233,8 @@ impl EnvMapSampler {
         }
     }
 
-    /// The CDF sampler itself, for callers that need its full API (e.g. inversion).
-    pub fn as_piecewise_constant(&self) -> Option<&PiecewiseConstant2D> {
+    /// The CDF sampler itself, for callers that need its full API (e.g. cell probabilities).
+    pub fn as_piecewise_constant(&self) -> Option<&QuantisedCdf2D> {
         match &self.inner {
             Inner::Adaptive(_) => None,
             Inner::PiecewiseConstant(t) => Some(t),

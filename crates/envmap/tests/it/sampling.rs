@@ -167,9 +167,12 @@ fn sample_pdfs_match_pdf_queries() {
             );
             assert_eq!(e.pdf_uv, s.pdf_uv(e.u, e.v), "{kind:?}");
             let sa = s.pdf_sa(e.direction);
+            // The round trip through the direction recovers v by acos, whose relative error
+            // near a pole grows as ε / (π·min(v, 1 − v))² (2.8e-9 at v = 1 − 4.3e-5).
+            let pole = f64::EPSILON / (PI * e.v.min(1.0 - e.v)).powi(2);
             assert!(
-                (sa - e.pdf_sa).abs() <= 1e-9 * e.pdf_sa,
-                "{kind:?}: {sa} vs {}",
+                (sa - e.pdf_sa).abs() <= (1e-9 + pole) * e.pdf_sa,
+                "{kind:?}: {sa} vs {} at {e:?}",
                 e.pdf_sa
             );
             let expected = e.pdf_uv / (2.0 * PI * PI * (PI * e.v).sin());
