@@ -1591,6 +1591,136 @@ mod tests {
         }
     }
 
+    /// Paired costs per pixel sample of the fused f and of the `eval_rgb` path (the renderer
+    /// before issue 29's item 1), every quick sampler on the quick BRDFs under the Grace probe,
+    /// on [`sample_costs`]'s subset (every 11th row segment of 80-pixel spheres, 8 samples per
+    /// pixel, θo as rendered), the two paths interleaved in each of [`TIMING_REPEATS`] rounds
+    /// (their order alternating between rounds), the same uniforms for both, medians; with the
+    /// BRDF evaluations per sample. docs/benchmarks.md §24.7:
+    /// `cargo test --release -p study --lib fused_f_costs -- --ignored --nocapture`.
+    /// `FUSED_COSTS_SAMPLERS`, `FUSED_COSTS_BRDFS` (comma-separated), `FUSED_COSTS_REPEATS`
+    /// and `FUSED_COSTS_LIGHT` (a light spec instead of the probe) narrow the run (e.g. one sampler under valgrind, whose inclusive
+    /// instruction counts of `brdf_row_fused`, `brdf_row_rgb`, `mis_row_fused` and
+    /// `mis_row_rgb` are then the four paths').
+    #[test]
+    #[ignore = "a measurement (about a minute): docs/benchmarks.md §24.7"]
+    fn fused_f_costs_under_the_grace_probe() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let map = root.join("../shared/data/envmaps/grace_probe_latlong.hdr");
+        if !map.exists() {
+            eprintln!("skipped: {} is absent", map.display());
+            return;
+        }
+        let list = |var: &str| -> Option<Vec<String>> {
+            std::env::var(var)
+                .ok()
+                .map(|v| v.split(',').map(str::to_string).collect())
+        };
+        let brdf_specs = list("FUSED_COSTS_BRDFS")
+            .unwrap_or_else(|| crate::QUICK_BRDFS.iter().map(|s| s.to_string()).collect());
+        let samplers = list("FUSED_COSTS_SAMPLERS")
+            .unwrap_or_else(|| crate::StudyConfig::quick(None).0.samplers);
+        let repeats = std::env::var("FUSED_COSTS_REPEATS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(TIMING_REPEATS);
+        let config = crate::StudyConfig::new(
+            samplers,
+            brdf_specs,
+            vec![30.0],
+            vec![
+                std::env::var("FUSED_COSTS_LIGHT")
+                    .unwrap_or_else(|_| format!("envmap:{}", map.display())),
+            ],
+        );
+        let plan = StudyPlan::new(config, Vec::new()).unwrap();
+        let nb = plan.brdfs.len();
+        let pairs: Vec<(usize, usize)> = (0..plan.entries.len())
+            .flat_map(|s| (0..nb).map(move |b| (s, b)))
+            .collect();
+        plan.build_all(&pairs, &|_| {});
+        let built: Vec<(usize, Vec<std::sync::Arc<dyn DirectionSampler>>)> =
+            (0..plan.entries.len())
+                .filter_map(|s| {
+                    let v: Option<Vec<_>> = (0..nb)
+                        .map(|b| plan.build(s, b).ok().map(|(d, _)| d.sampler))
+                        .collect();
+                    v.map(|v| (s, v))
+                })
+                .collect();
+        let light = plan.lights[0].as_ref();
+        let light_sampler = LightSampler::new(light).unwrap();
+        let brdfs: Vec<&dyn Brdf> = plan.brdfs.iter().map(|b| b.counted.as_ref()).collect();
+        let px = 80;
+        let hs = hits(nb, px);
+        let segs = segments(&hs, nb * px);
+        let subset: Vec<&[Hit]> = segs.iter().step_by(11).map(|r| &hs[r.clone()]).collect();
+        let spp = 8;
+        let samples = (subset.iter().map(|s| s.len()).sum::<usize>() * spp) as f64;
+        // [sampler][variant: 0 fused BRDF, 1 eval_rgb BRDF, 2 fused MIS, 3 eval_rgb MIS]
+        let mut ns = vec![vec![Vec::new(); 4]; built.len()];
+        let mut evals = vec![[0.0; 4]; built.len()];
+        println!("{samples} pixel samples per path and round");
+        for r in 0..repeats {
+            for (i, (_, smp)) in built.iter().enumerate() {
+                // Odd rounds run the eval_rgb path first (no position bias).
+                let order = if r % 2 == 0 {
+                    [0, 1, 2, 3]
+                } else {
+                    [1, 0, 3, 2]
+                };
+                for v in order {
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(7, r as u64));
+                    let before = crate::thread_evaluations();
+                    let t0 = crate::machine::thread_cpu_seconds().unwrap_or(0.0);
+                    let mut sink = 0.0;
+                    for seg in &subset {
+                        let b = seg[0].sphere;
+                        let (f, s) = (brdfs[b], smp[b].as_ref());
+                        let l = &light_sampler;
+                        let out = match v {
+                            0 => brdf_row(f, light, seg, s, spp, &mut rng),
+                            1 => brdf_row_rgb(f, light, seg, s, spp, &mut rng),
+                            2 => mis_row(f, light, seg, s, l, spp, &mut rng),
+                            _ => mis_row_rgb(f, light, seg, s, l, spp, &mut rng),
+                        };
+                        sink += out.iter().map(|c| c[1]).sum::<f64>();
+                    }
+                    std::hint::black_box(sink);
+                    let t1 = crate::machine::thread_cpu_seconds().unwrap_or(0.0);
+                    ns[i][v].push((t1 - t0) * 1e9 / samples);
+                    evals[i][v] = (crate::thread_evaluations() - before) as f64 / samples;
+                }
+            }
+        }
+        let median = |t: &mut Vec<f64>| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        };
+        println!(
+            "| sampler | ns fused | ns eval_rgb | ratio | evals fused | evals eval_rgb | MIS ns fused | MIS ns eval_rgb | ratio | MIS evals fused | MIS evals eval_rgb |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|");
+        for (i, (s, _)) in built.iter().enumerate() {
+            let m: Vec<f64> = ns[i].iter_mut().map(median).collect();
+            let e = evals[i];
+            println!(
+                "| {} | {:.0} | {:.0} | {:.3} | {:.2} | {:.2} | {:.0} | {:.0} | {:.3} | {:.2} | {:.2} |",
+                plan.entries[*s].name,
+                m[0],
+                m[1],
+                m[0] / m[1],
+                e[0],
+                e[1],
+                m[2],
+                m[3],
+                m[2] / m[3],
+                e[2],
+                e[3]
+            );
+        }
+    }
+
     /// A light technique that reports twice its density (a broken MIS: the weights and the
     /// light term are then biased).
     struct DoubledPdf<'a>(&'a LightSampler);
