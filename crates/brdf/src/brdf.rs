@@ -33,6 +33,16 @@ pub trait Brdf: Send + Sync {
         [y, y, y]
     }
 
+    /// `Some(c)` when the RGB value is the scalar one times a constant colour everywhere:
+    /// [`eval_rgb`](Brdf::eval_rgb)`(ωo, ωi) = c ⊙ eval(ωo, ωi)` for every pair, bit for bit
+    /// (`c = [1; 3]` for a grey model that keeps the default `eval_rgb`). A renderer holding
+    /// `f = eval(ωo, ωi)` from a fused sample-and-evaluate then needs no RGB evaluation.
+    /// Default `None` (the safe answer: the caller evaluates `eval_rgb`); a model that overrides
+    /// `eval_rgb` keeps `None` unless its colour is constant.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        None
+    }
+
     /// The values of `f_r(ωo, ·)` that depend on `ωo` alone, computed once for many
     /// evaluations at one outgoing direction (a sampler's trials at one query). The default
     /// keeps `ωo` only.
@@ -156,8 +166,8 @@ impl Outgoing {
 }
 
 /// The [`Brdf`] methods other than the three evaluations (`prepare`, the property predicates,
-/// `analytic_lobes`, `name`, `as_any`), forwarded to `$inner`: what a wrapper passes through
-/// unchanged (the pointer impls below; [`CountingBrdf`](crate::CountingBrdf), which counts
+/// `rgb_scale`, `analytic_lobes`, `name`, `as_any`), forwarded to `$inner`: what a wrapper
+/// passes through unchanged (the pointer impls below; [`CountingBrdf`](crate::CountingBrdf), which counts
 /// evaluations only). Used inside `impl Brdf for …` as `forward_brdf_queries!(self => inner)`.
 macro_rules! forward_brdf_queries {
     ($self:ident => $inner:expr) => {
@@ -168,6 +178,9 @@ macro_rules! forward_brdf_queries {
         $crate::brdf::forward_brdf_queries!(@predicates $self => $inner;
             is_isotropic, is_mirror_symmetric, is_half_turn_symmetric, is_reciprocal,
             conserves_energy, bounded_at_horizon);
+        fn rgb_scale(&$self) -> Option<[f64; 3]> {
+            $inner.rgb_scale()
+        }
         fn analytic_lobes(&$self) -> Option<$crate::AnalyticLobes> {
             $inner.analytic_lobes()
         }
@@ -209,3 +222,65 @@ macro_rules! forward_brdf {
 }
 
 forward_brdf!(Box<T>, Arc<T>, &T);
+
+#[cfg(test)]
+mod rgb_scale_tests {
+    use super::*;
+    use crate::{CountingBrdf, direction_from_angles, models, parse_spec, preset_names};
+
+    /// Every model built from its defaults, and every `sgd`/`abc` preset.
+    fn every_model() -> Vec<(String, Box<dyn Brdf>)> {
+        let mut out = Vec::new();
+        for m in models() {
+            if !m.needs_argument() {
+                out.push((m.name.to_string(), m.build(&[]).unwrap()));
+            }
+            for p in preset_names(m.name).unwrap_or_default() {
+                let spec = format!("{}:material={p}", m.name);
+                out.push((spec.clone(), parse_spec(&spec).unwrap()));
+            }
+        }
+        out
+    }
+
+    /// A model that claims a constant colour has `eval_rgb = c ⊙ eval` bit for bit on a grid
+    /// of direction pairs (both hemispheres' edges included); every model built from numeric
+    /// parameters (the analytic ones, all grey) claims it, and the coloured presets do not. A
+    /// wrapper forwards the claim. Checked against a broken claim: `abc` answering
+    /// `Some([1; 3])` fails here (its channels differ).
+    #[test]
+    fn a_claimed_constant_colour_is_the_rgb_value_and_the_analytic_models_claim_it() {
+        let (mut grey, mut coloured) = (0, 0);
+        for (name, b) in every_model() {
+            let by_values = models()
+                .iter()
+                .any(|m| m.name == name && !m.needs_argument());
+            let Some(c) = b.rgb_scale() else {
+                assert!(!by_values, "{name}: no rgb_scale");
+                coloured += 1;
+                continue;
+            };
+            grey += 1;
+            for to in [0.0, 20.0, 45.0, 70.0, 89.0] {
+                for (ti, pi) in [(0.0, 0.0), (30.0, 10.0), (60.0, 180.0), (85.0, 95.0)] {
+                    let (wo, wi) = (
+                        direction_from_angles(to, 0.0),
+                        direction_from_angles(ti, pi),
+                    );
+                    let f = b.eval(&wo, &wi);
+                    assert_eq!(
+                        b.eval_rgb(&wo, &wi),
+                        c.map(|k| k * f),
+                        "{name} at θo {to}, θi {ti}, φi {pi}"
+                    );
+                }
+            }
+            let wrapped = CountingBrdf(std::sync::Arc::from(b));
+            assert_eq!(wrapped.rgb_scale(), Some(c), "{name} through a wrapper");
+        }
+        assert!(
+            grey >= 16 && coloured > 0,
+            "{grey} grey, {coloured} coloured"
+        );
+    }
+}

@@ -191,7 +191,8 @@ impl Batch<'_> {
     /// point come first (one batch call), then the light samples, point-major. `g(k, ωi, f)`
     /// is point `k`'s integrand at the local direction `ωi`, with `f = Some(s.f)` at a BRDF
     /// sample and `None` at a light sample. The light's density is evaluated at the world
-    /// direction `frame.to_world(ωi)`, the BRDF sampler's at the local one.
+    /// direction `frame.to_world(ωi)`, the BRDF sampler's at the local one: per point, at its
+    /// light samples where `g` is positive, by one [`DirectionSampler::pdf_many`] call.
     pub fn mis<V: Radiance, L: LightTechnique + ?Sized>(
         &self,
         points: &[Query],
@@ -233,26 +234,34 @@ impl Batch<'_> {
             )
         });
         let inv = 1.0 / self.spp.max(1) as f64;
+        // Per point: its light samples, then the BRDF sampler's pdf at those that can
+        // contribute in one `pdf_many` call at the point's ωo (a sampler that locates ωo in
+        // its structure does so once per point). Zero terms are skipped: the sum is the same.
+        let mut terms: Vec<(V, f64)> = Vec::with_capacity(self.spp);
+        let mut wis: Vec<Vec3> = Vec::with_capacity(self.spp);
         for (k, p) in points.iter().enumerate() {
-            let mut sum = V::default();
+            terms.clear();
+            wis.clear();
             for _ in 0..self.spp {
                 let Some((d, pl)) = light.sample_world(u) else {
                     break;
                 };
                 let wi = p.frame.to_local(&d);
-                let gl = if wi.z > 0.0 {
-                    g(k, &wi, None)
-                } else {
-                    V::default()
-                };
-                sum = sum.plus(mis_term_with(
-                    gl,
-                    pl,
-                    1.0,
-                    1.0,
-                    || self.sampler.pdf(&p.wo, &wi),
-                    &weight,
-                ));
+                if wi.z > 0.0 && pl > 0.0 {
+                    let gl = g(k, &wi, None);
+                    if gl.any_positive() {
+                        terms.push((gl, pl));
+                        wis.push(wi);
+                    }
+                }
+            }
+            if terms.is_empty() {
+                continue;
+            }
+            let pdfs = self.sampler.pdf_many(&p.wo, &wis);
+            let mut sum = V::default();
+            for (&(gl, pl), &pb) in terms.iter().zip(&pdfs) {
+                sum = sum.plus(mis_term_with(gl, pl, 1.0, 1.0, || pb, &weight));
             }
             acc[k] = acc[k].plus(sum.scale(inv));
         }
@@ -373,6 +382,98 @@ pub(crate) mod tests {
         });
         let z = z_of(&v);
         assert!(z.abs() > 4.0, "broken weight not caught: z = {z}");
+    }
+
+    /// `CosineHemisphere` whose `pdf_many` may hand its values back in reverse (broken).
+    struct Cosine {
+        reversed: bool,
+    }
+
+    impl brdf_sampling::SamplerDiagnostics for Cosine {}
+
+    impl DirectionSampler for Cosine {
+        fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> brdf_sampling::DirSample {
+            CosineHemisphere.sample(wo, u)
+        }
+        fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            CosineHemisphere.pdf(wo, wi)
+        }
+        fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
+            let mut v: Vec<f64> = wi.iter().map(|w| self.pdf(wo, w)).collect();
+            if self.reversed {
+                v.reverse();
+            }
+            v
+        }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+    }
+
+    /// `Batch::mis` (the BRDF pdfs of a point's light samples from one `pdf_many` call) gives
+    /// bit for bit the values of the per-sample loop it replaced (`pdf` at each light sample,
+    /// in order, zero terms included); a `pdf_many` that returns its values in reverse
+    /// order does not.
+    #[test]
+    fn batch_mis_light_pdfs_from_pdf_many_equal_the_per_sample_loop_and_a_misordered_one_fails() {
+        let (map, brdf, frame, wo) = scene_parts();
+        let scene = ProductScene::new(brdf.as_ref(), &map, frame, wo).unwrap();
+        let light = EnvMapSampler::piecewise_constant(&map).unwrap();
+        let points: Vec<Query> = (0..64)
+            .map(|i| Query {
+                wo: brdf::direction_from_angles(1.0 + i as f64, 7.0 * i as f64),
+                frame,
+            })
+            .collect();
+        let g = |_: usize, wi: &Vec3, _: Option<f64>| scene.integrand(wi);
+        let spp = 6;
+        // The loop before `pdf_many`: BRDF terms as `Batch::mis`, then per point and light
+        // sample `mis_term` with the sampler's `pdf`.
+        let before = |u: &mut Xoshiro256PlusPlus| -> Vec<f64> {
+            let batch = Batch {
+                sampler: &CosineHemisphere,
+                brdf: brdf.as_ref(),
+                spp,
+            };
+            let mut out = Vec::new();
+            batch.draw(&points, u, &mut out);
+            let mut acc = batch.reduce(points.len(), &out, |k, s| {
+                let gb = if s.wi.z > 0.0 { g(k, &s.wi, None) } else { 0.0 };
+                mis_term(MisHeuristic::Balance, gb, s.pdf, 1.0, 1.0, || {
+                    light.pdf_world(&points[k].frame.to_world(&s.wi))
+                })
+            });
+            for (k, p) in points.iter().enumerate() {
+                let mut sum = 0.0;
+                for _ in 0..spp {
+                    let (d, pl) = light.sample_world(u).unwrap();
+                    let wi = p.frame.to_local(&d);
+                    let gl = if wi.z > 0.0 { g(k, &wi, None) } else { 0.0 };
+                    sum += mis_term(MisHeuristic::Balance, gl, pl, 1.0, 1.0, || {
+                        CosineHemisphere.pdf(&p.wo, &wi)
+                    });
+                }
+                acc[k] += sum * (1.0 / spp as f64);
+            }
+            acc
+        };
+        let now = |reversed: bool, u: &mut Xoshiro256PlusPlus| -> Vec<f64> {
+            Batch {
+                sampler: &Cosine { reversed },
+                brdf: brdf.as_ref(),
+                spp,
+            }
+            .mis(&points, &light, MisHeuristic::Balance, g, u)
+        };
+        let seeded = || Xoshiro256PlusPlus::seed_from_u64(31);
+        let want = before(&mut seeded());
+        assert!(want.iter().filter(|v| **v > 0.0).count() > 40);
+        assert_eq!(now(false, &mut seeded()), want);
+        assert_ne!(
+            now(true, &mut seeded()),
+            want,
+            "misordered pdf_many not caught"
+        );
     }
 
     #[test]

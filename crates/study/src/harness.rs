@@ -88,7 +88,7 @@ pub type ProgressFn<'a> = &'a (dyn Fn(u64) + Sync);
 pub(crate) struct StudyBrdf {
     pub(crate) spec: String,
     pub(crate) raw: Arc<dyn Brdf>,
-    counted: Arc<dyn Brdf>,
+    pub(crate) counted: Arc<dyn Brdf>,
 }
 
 /// A built sampler and its build time (s), or why it could not be built.

@@ -17,6 +17,15 @@
 //! reproducible for any thread count. (Before issue 29 each pixel had its own generator and
 //! called `sample` `N` times; the images' law is the same, the values per seed differ.)
 //!
+//! **The fused f.** The batch is handed the BRDF object the sampler was built with. For a BRDF
+//! of constant colour ([`Brdf::rgb_scale`]: the analytic models, grey) the RGB value is the
+//! colour times the `f` the batch returns with each sample: a rejection sampler's accepted
+//! trial (`adaptive-exact`: no further evaluation), the one evaluation of the default
+//! `sample_eval` for the others (as many evaluations as before). A coloured BRDF (measured
+//! data, fitted presets) gets one `eval_rgb` per sample, for every sampler. The values change
+//! by rounding only (the accepted trial's `f` was evaluated in the sampler's frame); the
+//! uniforms drawn are the same.
+//!
 //! **Reference.** Multiple importance sampling (balance heuristic, equal counts;
 //! [`estimators::Batch::mis`], the estimator of `product` and of the study's MIS cells) of the
 //! reference BRDF sampler (`adaptive`, checked by the validation suite) and the light's own
@@ -37,8 +46,8 @@
 //! **Equal time.** Each sampler's time per pixel sample is measured on one thread on a fixed
 //! subset of row segments, on the render's own path (a row of pixels per batch call:
 //! *coherent* ωo), and also with each query at a random pixel of the same sphere (*random*
-//! ωo, same batch sizes), with the samplers' BRDF evaluations per sample (a count that does not
-//! depend on the machine's load); with MIS images, also the time per MIS pixel sample on the
+//! ωo, same batch sizes), with the BRDF evaluations per sample, the sampler's and the
+//! estimator's (a count that does not depend on the machine's load); with MIS images, also the time per MIS pixel sample on the
 //! coherent path (both samples, the other technique's pdf at each, the integrand at each). The
 //! clock is the timing thread's CPU clock where the platform has one (wall time elsewhere), and
 //! the [`TIMING_REPEATS`] runs of every sampler and path are interleaved (repeat `r` of every
@@ -185,9 +194,10 @@ pub struct SampleCost {
     pub coherent_ns: f64,
     /// ns per sample, each query at a random pixel of the same sphere, same batch sizes.
     pub random_ns: f64,
-    /// The sampler's BRDF evaluations per sample, coherent queries.
+    /// BRDF evaluations per sample on the render's path, coherent queries: the sampler's and
+    /// the estimator's (a fused `f` is not evaluated again).
     pub coherent_evals: f64,
-    /// The sampler's BRDF evaluations per sample, random queries.
+    /// The same, random queries.
     pub random_evals: f64,
     /// ns per MIS pixel sample (one BRDF and one light sample, the other technique's pdf at
     /// each, the integrand at each), coherent queries as rendered (median of the timing runs);
@@ -253,10 +263,10 @@ impl LightTechnique for LightSampler {
     }
 }
 
-/// The BRDF handed to `sample_eval_batch`: `f = 1` everywhere. The renderer needs the RGB
-/// value `eval_rgb`, which it evaluates itself, so the batch's own (luminance) evaluation would
-/// be wasted: every sampler pays its sampling and one RGB evaluation per sample, as before the
-/// batch path.
+/// The BRDF handed to `sample_eval_batch` for a coloured BRDF ([`Brdf::rgb_scale`] `None`):
+/// `f = 1` everywhere. The renderer needs the RGB value `eval_rgb`, which it evaluates itself,
+/// so the batch's own (luminance) evaluation would be wasted: every sampler pays its sampling
+/// and one RGB evaluation per sample.
 struct NoEval;
 
 impl Brdf for NoEval {
@@ -337,9 +347,24 @@ fn integrand(brdf: &dyn Brdf, light: &Light, h: &Hit, wi: &Vec3) -> [f64; 3] {
     if !(wi.z > 0.0) {
         return [0.0; 3];
     }
-    let f = brdf.eval_rgb(&h.query.wo, wi);
+    lit(brdf.eval_rgb(&h.query.wo, wi), light, h, wi)
+}
+
+/// `f ⊙ L · cos` (RGB) for a local `wi` above the horizon and its RGB BRDF value `f`.
+#[inline]
+fn lit(f: [f64; 3], light: &Light, h: &Hit, wi: &Vec3) -> [f64; 3] {
     let l = light.radiance(&h.world_of(wi));
     [f[0] * l[0] * wi.z, f[1] * l[1] * wi.z, f[2] * l[2] * wi.z]
+}
+
+/// [`integrand`] of a BRDF whose RGB value is `c ⊙ f` ([`Brdf::rgb_scale`]), given its scalar
+/// value `f` at `wi` (the sampler's fused one, or one evaluation).
+#[inline]
+fn integrand_scaled(c: [f64; 3], f: f64, light: &Light, h: &Hit, wi: &Vec3) -> [f64; 3] {
+    if !(wi.z > 0.0) {
+        return [0.0; 3];
+    }
+    lit(c.map(|k| k * f), light, h, wi)
 }
 
 /// A stable per-name number for seeds.
@@ -404,7 +429,12 @@ impl StudyPlan {
         let px = cfg.sphere_px.max(4);
         let (width, height) = (chosen.len() * px, px);
         let hits = hits(chosen.len(), px);
-        let brdfs: Vec<&dyn Brdf> = chosen.iter().map(|&b| self.brdfs[b].raw.as_ref()).collect();
+        // The objects the samplers were built with (the study's counting wrappers), so that a
+        // sampler recognises its own BRDF and hands back its accepted trial's `f`.
+        let brdfs: Vec<&dyn Brdf> = chosen
+            .iter()
+            .map(|&b| self.brdfs[b].counted.as_ref())
+            .collect();
         // Samplers per (sampler, BRDF), built on every core first (cached: those the study's
         // statistics built are reused); the reference sampler is `adaptive`.
         let pairs: Vec<(usize, usize)> = (0..self.entries.len())
@@ -439,7 +469,7 @@ impl StudyPlan {
                     .map(|b| {
                         reference_entry
                             .build_direction(&samplers::DirectionRequest::new(
-                                std::sync::Arc::clone(&b.raw),
+                                std::sync::Arc::clone(&b.counted),
                                 &options,
                             ))
                             .map(|d| d.sampler)
@@ -645,7 +675,47 @@ fn render_segments(
 }
 
 /// The BRDF-sampling estimates of a row segment: one batch call, `spp` samples per pixel.
+/// `brdf` is the object `sampler` was built with. A BRDF of constant colour
+/// ([`Brdf::rgb_scale`]) is passed to the batch and its `f` ([`brdf_sampling::EvalSample::f`]:
+/// a rejection sampler's accepted trial, or the one evaluation of the default `sample_eval`)
+/// times the colour is the RGB value (the *fused f*); a coloured one gets [`NoEval`] and one
+/// `eval_rgb` per sample. Every sampler gets the same treatment.
 fn brdf_row(
+    brdf: &dyn Brdf,
+    light: &Light,
+    seg: &[Hit],
+    sampler: &dyn DirectionSampler,
+    spp: usize,
+    rng: &mut dyn UniformSource,
+) -> Vec<[f64; 3]> {
+    match brdf.rgb_scale() {
+        Some(c) => brdf_row_fused(brdf, c, light, seg, sampler, spp, rng),
+        None => brdf_row_rgb(brdf, light, seg, sampler, spp, rng),
+    }
+}
+
+/// [`brdf_row`] with the fused `f` of a BRDF whose RGB value is `c ⊙ f`.
+#[inline(never)]
+fn brdf_row_fused(
+    brdf: &dyn Brdf,
+    c: [f64; 3],
+    light: &Light,
+    seg: &[Hit],
+    sampler: &dyn DirectionSampler,
+    spp: usize,
+    rng: &mut dyn UniformSource,
+) -> Vec<[f64; 3]> {
+    let points: Vec<Query> = seg.iter().map(|h| h.query).collect();
+    Batch { sampler, brdf, spp }.brdf(
+        &points,
+        |k, s| integrand_scaled(c, s.f, light, &seg[k], &s.wi),
+        rng,
+    )
+}
+
+/// [`brdf_row`] with one `eval_rgb` per sample (the batch evaluates nothing).
+#[inline(never)]
+fn brdf_row_rgb(
     brdf: &dyn Brdf,
     light: &Light,
     seg: &[Hit],
@@ -662,8 +732,54 @@ fn brdf_row(
     .brdf(&points, |k, s| integrand(brdf, light, &seg[k], &s.wi), rng)
 }
 
-/// The MIS (balance heuristic, `spp` samples of each technique) estimates of a row segment.
+/// The MIS (balance heuristic, `spp` samples of each technique) estimates of a row segment;
+/// `brdf` as in [`brdf_row`] (the fused `f` at the BRDF samples of a constant-colour BRDF,
+/// one scalar evaluation times the colour at its light samples).
 fn mis_row<L: LightTechnique + ?Sized>(
+    brdf: &dyn Brdf,
+    light: &Light,
+    seg: &[Hit],
+    sampler: &dyn DirectionSampler,
+    light_sampler: &L,
+    spp: usize,
+    rng: &mut dyn UniformSource,
+) -> Vec<[f64; 3]> {
+    match brdf.rgb_scale() {
+        Some(c) => mis_row_fused(brdf, c, light, seg, sampler, light_sampler, spp, rng),
+        None => mis_row_rgb(brdf, light, seg, sampler, light_sampler, spp, rng),
+    }
+}
+
+/// [`mis_row`] with the fused `f` of a BRDF whose RGB value is `c ⊙ f`.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn mis_row_fused<L: LightTechnique + ?Sized>(
+    brdf: &dyn Brdf,
+    c: [f64; 3],
+    light: &Light,
+    seg: &[Hit],
+    sampler: &dyn DirectionSampler,
+    light_sampler: &L,
+    spp: usize,
+    rng: &mut dyn UniformSource,
+) -> Vec<[f64; 3]> {
+    let points: Vec<Query> = seg.iter().map(|h| h.query).collect();
+    Batch { sampler, brdf, spp }.mis(
+        &points,
+        light_sampler,
+        MisHeuristic::Balance,
+        |k, wi, f| {
+            let h = &seg[k];
+            let f = f.unwrap_or_else(|| brdf.eval(&h.query.wo, wi));
+            integrand_scaled(c, f, light, h, wi)
+        },
+        rng,
+    )
+}
+
+/// [`mis_row`] with one `eval_rgb` per sample (the batch evaluates nothing).
+#[inline(never)]
+fn mis_row_rgb<L: LightTechnique + ?Sized>(
     brdf: &dyn Brdf,
     light: &Light,
     seg: &[Hit],
@@ -693,8 +809,8 @@ fn mis_row<L: LightTechnique + ?Sized>(
 /// with a light sampler, MIS on the coherent segments (8 pairs per pixel). Median of
 /// [`TIMING_REPEATS`] runs of each (sampler, path), the runs interleaved (repeat `r` of every
 /// sampler and path before repeat `r + 1`), timed on the thread's CPU clock where there is
-/// one; and the samplers' BRDF evaluations per sample (counted on this thread by the study's
-/// [`crate::CountingBrdf`]).
+/// one; and the BRDF evaluations per sample, the sampler's and the estimator's (counted on this
+/// thread by the study's [`crate::CountingBrdf`], the object the samplers were built with).
 fn sample_costs(
     hits: &[Hit],
     segments: &[std::ops::Range<usize>],
@@ -987,7 +1103,7 @@ impl Render {
         }
         s.push('\n');
         if !self.sample_costs.is_empty() {
-            s.push_str("Cost per pixel sample on the batch path (one thread; every 11th row segment, 8 samples per pixel): *coherent* = one `sample_eval_batch` call per row of pixels of a sphere, as the images are rendered; *random ωo* = the same number of queries per call, each at a pixel of the same sphere drawn at random. BRDF evaluations are the sampler's own (the integrand's RGB evaluation not counted); they do not depend on the machine's load.\n\n| sampler | ns / sample, coherent † | ns / sample, random ωo † | random / coherent | BRDF evals / sample, coherent | random |\n|---|---|---|---|---|---|\n");
+            s.push_str("Cost per pixel sample on the batch path (one thread; every 11th row segment, 8 samples per pixel): *coherent* = one `sample_eval_batch` call per row of pixels of a sphere, as the images are rendered; *random ωo* = the same number of queries per call, each at a pixel of the same sphere drawn at random. BRDF evaluations per sample are all of the path's, the sampler's and the estimator's (a sampler's fused f, e.g. `adaptive-exact`'s accepted trial on a grey BRDF, is not evaluated again); they do not depend on the machine's load.\n\n| sampler | ns / sample, coherent † | ns / sample, random ωo † | random / coherent | BRDF evals / sample, coherent | random |\n|---|---|---|---|---|---|\n");
             for c in &self.sample_costs {
                 let _ = writeln!(
                     s,
@@ -1347,6 +1463,260 @@ mod tests {
             assert!(
                 x > limit,
                 "broken batch {broken} not caught: Σz² = {x:.1} (limit {limit:.1})"
+            );
+        }
+    }
+
+    /// `lambert` and `phong:n=20` wrapped in the study's evaluation counter, and `sampler`
+    /// built for each **with that wrapped object** (as the study builds them), 8 slices.
+    #[allow(clippy::type_complexity)]
+    fn counted_lambert_and_phong_with(
+        sampler: &str,
+    ) -> (
+        Vec<std::sync::Arc<dyn Brdf>>,
+        Vec<std::sync::Arc<dyn DirectionSampler>>,
+    ) {
+        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = ["lambert", "phong:n=20"]
+            .iter()
+            .map(|s| {
+                let raw: std::sync::Arc<dyn Brdf> =
+                    std::sync::Arc::from(brdf::parse_spec(s).unwrap());
+                std::sync::Arc::new(crate::CountingBrdf(raw)) as std::sync::Arc<dyn Brdf>
+            })
+            .collect();
+        let options = brdf_sampling::SetOptions {
+            slices: 8,
+            ..Default::default()
+        };
+        let built = brdfs
+            .iter()
+            .map(|b| {
+                samplers::build_direction(
+                    sampler,
+                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
+                )
+                .unwrap()
+                .sampler
+            })
+            .collect();
+        (brdfs, built)
+    }
+
+    /// The fused f (issue 29): on grey BRDFs the rows rendered with the batch's `f` equal the
+    /// rows rendered with one `eval_rgb` per sample from the same seed — bit for bit for
+    /// `cosine` (its `f` is that evaluation), to rounding for `adaptive-exact` (its accepted
+    /// trial's `f`, evaluated in its own frame) — BRDF sampling and MIS; and `adaptive-exact`
+    /// saves one evaluation per sample (`cosine` none). Shown to fail on broken versions: a
+    /// wrong colour (`c = [1, ½, 1]` for a grey BRDF) changes the values, and a BRDF object
+    /// other than the one the sampler was built with (the same model, not fused) saves no
+    /// evaluation.
+    #[test]
+    fn the_fused_f_gives_the_rgb_rows_values_and_saves_the_exact_samplers_evaluation() {
+        let light = Light::parse("area:theta=30,phi=180,radius=40").unwrap();
+        let light_sampler = LightSampler::new(&light).unwrap();
+        let hs = hits(2, 10);
+        let segs = segments(&hs, 20);
+        let spp = 16;
+        // (values, evaluations) of every 2nd segment; `variant`: 0 fused, 1 one `eval_rgb`
+        // per sample, 2 fused with a wrong colour, 3 fused with another object of the model.
+        let rows = |brdfs: &[std::sync::Arc<dyn Brdf>],
+                    built: &[std::sync::Arc<dyn DirectionSampler>],
+                    mis: bool,
+                    variant: u8| {
+            let before = crate::thread_evaluations();
+            let mut out = Vec::new();
+            for r in segs.iter().step_by(2) {
+                let seg = &hs[r.clone()];
+                let b = seg[0].sphere;
+                let (smp, own) = (built[b].as_ref(), brdfs[b].as_ref());
+                let other = crate::CountingBrdf(std::sync::Arc::from(
+                    brdf::parse_spec(own.name()).unwrap(),
+                ));
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(5, r.start as u64));
+                let (brdf, c): (&dyn Brdf, [f64; 3]) = match variant {
+                    2 => (own, [1.0, 0.5, 1.0]),
+                    3 => (&other, [1.0; 3]),
+                    _ => (own, own.rgb_scale().unwrap()),
+                };
+                out.extend(match (mis, variant) {
+                    (false, 1) => brdf_row_rgb(own, &light, seg, smp, spp, &mut rng),
+                    (false, _) => brdf_row_fused(brdf, c, &light, seg, smp, spp, &mut rng),
+                    (true, 1) => mis_row_rgb(own, &light, seg, smp, &light_sampler, spp, &mut rng),
+                    (true, _) => {
+                        mis_row_fused(brdf, c, &light, seg, smp, &light_sampler, spp, &mut rng)
+                    }
+                });
+            }
+            (out, crate::thread_evaluations() - before)
+        };
+        for sampler in ["cosine", "adaptive-exact"] {
+            let (brdfs, built) = counted_lambert_and_phong_with(sampler);
+            assert_eq!(brdfs[1].rgb_scale(), Some([1.0; 3]));
+            for mis in [false, true] {
+                let (fused, e_fused) = rows(&brdfs, &built, mis, 0);
+                let (rgb, e_rgb) = rows(&brdfs, &built, mis, 1);
+                let lit = rgb.iter().filter(|c| c[1] > 0.0).count();
+                assert!(lit > 30, "{sampler}: {lit} lit pixels");
+                if sampler == "cosine" {
+                    assert_eq!(fused, rgb, "cosine, MIS {mis}");
+                }
+                for (a, b) in fused.iter().zip(&rgb) {
+                    for ch in 0..3 {
+                        approx::assert_relative_eq!(a[ch], b[ch], max_relative = 1e-9);
+                    }
+                }
+                let samples = (lit * spp) as u64;
+                if sampler == "cosine" {
+                    assert_eq!(e_fused, e_rgb, "cosine, MIS {mis}");
+                } else {
+                    assert!(
+                        e_rgb >= e_fused + samples,
+                        "{sampler}, MIS {mis}: {e_fused} evaluations fused, {e_rgb} unfused"
+                    );
+                    let (_, e_other) = rows(&brdfs, &built, mis, 3);
+                    assert!(
+                        e_other >= e_rgb,
+                        "a foreign object fused: {e_other} vs {e_rgb}"
+                    );
+                }
+                let (wrong, _) = rows(&brdfs, &built, mis, 2);
+                assert!(
+                    wrong
+                        .iter()
+                        .zip(&rgb)
+                        .any(|(a, b)| (a[1] - b[1]).abs() > 1e-6 * b[1]),
+                    "a wrong colour not caught"
+                );
+            }
+        }
+    }
+
+    /// Paired costs per pixel sample of the fused f and of the `eval_rgb` path (the renderer
+    /// before issue 29's item 1), every quick sampler on the quick BRDFs under the Grace probe,
+    /// on [`sample_costs`]'s subset (every 11th row segment of 80-pixel spheres, 8 samples per
+    /// pixel, θo as rendered), the two paths interleaved in each of [`TIMING_REPEATS`] rounds
+    /// (their order alternating between rounds), the same uniforms for both, medians; with the
+    /// BRDF evaluations per sample. docs/benchmarks.md §24.7:
+    /// `cargo test --release -p study --lib fused_f_costs -- --ignored --nocapture`.
+    /// `FUSED_COSTS_SAMPLERS`, `FUSED_COSTS_BRDFS` (comma-separated), `FUSED_COSTS_REPEATS`
+    /// and `FUSED_COSTS_LIGHT` (a light spec instead of the probe) narrow the run (e.g. one sampler under valgrind, whose inclusive
+    /// instruction counts of `brdf_row_fused`, `brdf_row_rgb`, `mis_row_fused` and
+    /// `mis_row_rgb` are then the four paths').
+    #[test]
+    #[ignore = "a measurement (about a minute): docs/benchmarks.md §24.7"]
+    fn fused_f_costs_under_the_grace_probe() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let map = root.join("../shared/data/envmaps/grace_probe_latlong.hdr");
+        if !map.exists() {
+            eprintln!("skipped: {} is absent", map.display());
+            return;
+        }
+        let list = |var: &str| -> Option<Vec<String>> {
+            std::env::var(var)
+                .ok()
+                .map(|v| v.split(',').map(str::to_string).collect())
+        };
+        let brdf_specs = list("FUSED_COSTS_BRDFS")
+            .unwrap_or_else(|| crate::QUICK_BRDFS.iter().map(|s| s.to_string()).collect());
+        let samplers = list("FUSED_COSTS_SAMPLERS")
+            .unwrap_or_else(|| crate::StudyConfig::quick(None).0.samplers);
+        let repeats = std::env::var("FUSED_COSTS_REPEATS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(TIMING_REPEATS);
+        let config = crate::StudyConfig::new(
+            samplers,
+            brdf_specs,
+            vec![30.0],
+            vec![
+                std::env::var("FUSED_COSTS_LIGHT")
+                    .unwrap_or_else(|_| format!("envmap:{}", map.display())),
+            ],
+        );
+        let plan = StudyPlan::new(config, Vec::new()).unwrap();
+        let nb = plan.brdfs.len();
+        let pairs: Vec<(usize, usize)> = (0..plan.entries.len())
+            .flat_map(|s| (0..nb).map(move |b| (s, b)))
+            .collect();
+        plan.build_all(&pairs, &|_| {});
+        let built: Vec<(usize, Vec<std::sync::Arc<dyn DirectionSampler>>)> =
+            (0..plan.entries.len())
+                .filter_map(|s| {
+                    let v: Option<Vec<_>> = (0..nb)
+                        .map(|b| plan.build(s, b).ok().map(|(d, _)| d.sampler))
+                        .collect();
+                    v.map(|v| (s, v))
+                })
+                .collect();
+        let light = plan.lights[0].as_ref();
+        let light_sampler = LightSampler::new(light).unwrap();
+        let brdfs: Vec<&dyn Brdf> = plan.brdfs.iter().map(|b| b.counted.as_ref()).collect();
+        let px = 80;
+        let hs = hits(nb, px);
+        let segs = segments(&hs, nb * px);
+        let subset: Vec<&[Hit]> = segs.iter().step_by(11).map(|r| &hs[r.clone()]).collect();
+        let spp = 8;
+        let samples = (subset.iter().map(|s| s.len()).sum::<usize>() * spp) as f64;
+        // [sampler][variant: 0 fused BRDF, 1 eval_rgb BRDF, 2 fused MIS, 3 eval_rgb MIS]
+        let mut ns = vec![vec![Vec::new(); 4]; built.len()];
+        let mut evals = vec![[0.0; 4]; built.len()];
+        println!("{samples} pixel samples per path and round");
+        for r in 0..repeats {
+            for (i, (_, smp)) in built.iter().enumerate() {
+                // Odd rounds run the eval_rgb path first (no position bias).
+                let order = if r % 2 == 0 {
+                    [0, 1, 2, 3]
+                } else {
+                    [1, 0, 3, 2]
+                };
+                for v in order {
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(7, r as u64));
+                    let before = crate::thread_evaluations();
+                    let t0 = crate::machine::thread_cpu_seconds().unwrap_or(0.0);
+                    let mut sink = 0.0;
+                    for seg in &subset {
+                        let b = seg[0].sphere;
+                        let (f, s) = (brdfs[b], smp[b].as_ref());
+                        let l = &light_sampler;
+                        let out = match v {
+                            0 => brdf_row(f, light, seg, s, spp, &mut rng),
+                            1 => brdf_row_rgb(f, light, seg, s, spp, &mut rng),
+                            2 => mis_row(f, light, seg, s, l, spp, &mut rng),
+                            _ => mis_row_rgb(f, light, seg, s, l, spp, &mut rng),
+                        };
+                        sink += out.iter().map(|c| c[1]).sum::<f64>();
+                    }
+                    std::hint::black_box(sink);
+                    let t1 = crate::machine::thread_cpu_seconds().unwrap_or(0.0);
+                    ns[i][v].push((t1 - t0) * 1e9 / samples);
+                    evals[i][v] = (crate::thread_evaluations() - before) as f64 / samples;
+                }
+            }
+        }
+        let median = |t: &mut Vec<f64>| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        };
+        println!(
+            "| sampler | ns fused | ns eval_rgb | ratio | evals fused | evals eval_rgb | MIS ns fused | MIS ns eval_rgb | ratio | MIS evals fused | MIS evals eval_rgb |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|");
+        for (i, (s, _)) in built.iter().enumerate() {
+            let m: Vec<f64> = ns[i].iter_mut().map(median).collect();
+            let e = evals[i];
+            println!(
+                "| {} | {:.0} | {:.0} | {:.3} | {:.2} | {:.2} | {:.0} | {:.0} | {:.3} | {:.2} | {:.2} |",
+                plan.entries[*s].name,
+                m[0],
+                m[1],
+                m[0] / m[1],
+                e[0],
+                e[1],
+                m[2],
+                m[3],
+                m[2] / m[3],
+                e[2],
+                e[3]
             );
         }
     }

@@ -96,4 +96,8 @@ impl Brdf for BeardMaxwell {
         first + vol
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }

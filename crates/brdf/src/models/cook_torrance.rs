@@ -65,6 +65,10 @@ impl Brdf for CookTorrance {
         self.diffuse + self.params.ks * f * d * g / (4.0 * ci * co)
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.kd,

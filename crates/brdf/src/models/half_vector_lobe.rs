@@ -92,6 +92,10 @@ macro_rules! half_vector_model {
                 self.lobe.eval(wo, wi)
             }
             $crate::models::brdf_properties!($name);
+            /// Grey: the default `eval_rgb`, `[eval; 3]`.
+            fn rgb_scale(&self) -> Option<[f64; 3]> {
+                Some([1.0; 3])
+            }
             fn analytic_lobes(&self) -> Option<$crate::AnalyticLobes> {
                 Some($crate::AnalyticLobes {
                     diffuse: self.params.kd,

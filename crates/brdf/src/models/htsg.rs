@@ -462,6 +462,10 @@ impl Brdf for Htsg {
         fres * geo * shadow * d / (PI * ci * co) + self.params.kd * FRAC_1_PI
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }
 
 #[cfg(test)]

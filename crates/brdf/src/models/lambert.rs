@@ -35,6 +35,10 @@ impl Brdf for Lambert {
         if both_above(wo, wi) { self.value } else { 0.0 }
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: 1.0,

@@ -166,6 +166,10 @@ impl Brdf for Microfacet {
         f * d * g / (4.0 * wi.z * wo.z)
     }
     brdf_properties!();
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: 0.0,

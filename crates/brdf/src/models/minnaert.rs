@@ -49,4 +49,8 @@ impl Brdf for Minnaert {
         self.scale * c.powf(self.params.k - 1.0)
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }

@@ -58,4 +58,8 @@ impl Brdf for OrenNayar {
         }
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }

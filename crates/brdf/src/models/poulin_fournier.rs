@@ -437,6 +437,10 @@ impl Brdf for PoulinFournier {
         ((diffuse + spec) / (self.params.d * wi.z * wo.z)).max(0.0)
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }
 
 #[cfg(test)]

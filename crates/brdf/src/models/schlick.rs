@@ -206,6 +206,10 @@ impl Brdf for Schlick {
         }
     }
     brdf_properties!();
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
     fn name(&self) -> &str {
         if self.params.d.is_some() {
             NAME_DIFFUSE

@@ -88,4 +88,8 @@ impl Brdf for Strauss {
         self.diffuse + spec.max(0.0)
     }
     brdf_properties!(NAME);
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
 }

@@ -129,6 +129,10 @@ impl Brdf for Ward {
         self.diffuse + spec
     }
     brdf_properties!();
+    /// Grey: the default `eval_rgb`, `[eval; 3]`.
+    fn rgb_scale(&self) -> Option<[f64; 3]> {
+        Some([1.0; 3])
+    }
     fn analytic_lobes(&self) -> Option<crate::AnalyticLobes> {
         Some(crate::AnalyticLobes {
             diffuse: self.params.rho_d,
