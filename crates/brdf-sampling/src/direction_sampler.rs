@@ -140,6 +140,15 @@ pub trait DirectionSampler: SamplerDiagnostics + Send + Sync {
         false
     }
 
+    /// True when [`Self::sample_eval`] returns an `f` the sampler computed while drawing (a
+    /// rejection sampler's accepted trial) for the BRDF object it was built with, so a caller
+    /// that needs `f_r(ωo, ωi)` saves an evaluation by taking it from the sample. `false` by
+    /// default (`sample_eval` then evaluates `f` once after the draw, which costs a caller no
+    /// less than evaluating it itself).
+    fn fuses_eval(&self) -> bool {
+        false
+    }
+
     /// Bytes of the precomputed structures this sampler needs.
     fn bytes_used(&self) -> usize;
 }

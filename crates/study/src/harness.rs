@@ -184,6 +184,9 @@ impl DirectionSampler for SharedSet {
     fn prefers_batches(&self) -> bool {
         self.set.prefers_batches()
     }
+    fn fuses_eval(&self) -> bool {
+        self.set.fuses_eval()
+    }
     fn bytes_used(&self) -> usize {
         self.bytes
     }

@@ -18,13 +18,14 @@
 //! called `sample` `N` times; the images' law is the same, the values per seed differ.)
 //!
 //! **The fused f.** The batch is handed the BRDF object the sampler was built with. For a BRDF
-//! of constant colour ([`Brdf::rgb_scale`]: the analytic models, grey) the RGB value is the
-//! colour times the `f` the batch returns with each sample: a rejection sampler's accepted
-//! trial (`adaptive-exact`: no further evaluation), the one evaluation of the default
-//! `sample_eval` for the others (as many evaluations as before). A coloured BRDF (measured
-//! data, fitted presets) gets one `eval_rgb` per sample, for every sampler. The values change
-//! by rounding only (the accepted trial's `f` was evaluated in the sampler's frame); the
-//! uniforms drawn are the same.
+//! of constant colour ([`Brdf::rgb_scale`]: the analytic models, grey) and a sampler whose
+//! `sample_eval` returns an `f` it computed while drawing
+//! ([`DirectionSampler::fuses_eval`]: `adaptive-exact`'s accepted trial), the RGB value is the
+//! colour times that `f`: no further evaluation. Every other pair gets one `eval_rgb` per
+//! sample, as before (for a sampler that would evaluate `f` once after its draw anyway, the
+//! fused loop measured slower — docs/benchmarks.md §24.7 — so each sampler keeps its faster
+//! path). The values change by rounding only (the accepted trial's `f` was evaluated in the
+//! sampler's frame); the uniforms drawn are the same.
 //!
 //! **Reference.** Multiple importance sampling (balance heuristic, equal counts;
 //! [`estimators::Batch::mis`], the estimator of `product` and of the study's MIS cells) of the
@@ -677,9 +678,9 @@ fn render_segments(
 /// The BRDF-sampling estimates of a row segment: one batch call, `spp` samples per pixel.
 /// `brdf` is the object `sampler` was built with. A BRDF of constant colour
 /// ([`Brdf::rgb_scale`]) is passed to the batch and its `f` ([`brdf_sampling::EvalSample::f`]:
-/// a rejection sampler's accepted trial, or the one evaluation of the default `sample_eval`)
-/// times the colour is the RGB value (the *fused f*); a coloured one gets [`NoEval`] and one
-/// `eval_rgb` per sample. Every sampler gets the same treatment.
+/// a rejection sampler's accepted trial) times the colour is the RGB value (the *fused f*) when
+/// the sampler fuses ([`DirectionSampler::fuses_eval`]); otherwise [`NoEval`] and one
+/// `eval_rgb` per sample.
 fn brdf_row(
     brdf: &dyn Brdf,
     light: &Light,
@@ -689,8 +690,8 @@ fn brdf_row(
     rng: &mut dyn UniformSource,
 ) -> Vec<[f64; 3]> {
     match brdf.rgb_scale() {
-        Some(c) => brdf_row_fused(brdf, c, light, seg, sampler, spp, rng),
-        None => brdf_row_rgb(brdf, light, seg, sampler, spp, rng),
+        Some(c) if sampler.fuses_eval() => brdf_row_fused(brdf, c, light, seg, sampler, spp, rng),
+        _ => brdf_row_rgb(brdf, light, seg, sampler, spp, rng),
     }
 }
 
@@ -745,8 +746,10 @@ fn mis_row<L: LightTechnique + ?Sized>(
     rng: &mut dyn UniformSource,
 ) -> Vec<[f64; 3]> {
     match brdf.rgb_scale() {
-        Some(c) => mis_row_fused(brdf, c, light, seg, sampler, light_sampler, spp, rng),
-        None => mis_row_rgb(brdf, light, seg, sampler, light_sampler, spp, rng),
+        Some(c) if sampler.fuses_eval() => {
+            mis_row_fused(brdf, c, light, seg, sampler, light_sampler, spp, rng)
+        }
+        _ => mis_row_rgb(brdf, light, seg, sampler, light_sampler, spp, rng),
     }
 }
 
@@ -1552,6 +1555,8 @@ mod tests {
         for sampler in ["cosine", "adaptive-exact"] {
             let (brdfs, built) = counted_lambert_and_phong_with(sampler);
             assert_eq!(brdfs[1].rgb_scale(), Some([1.0; 3]));
+            // Only a sampler whose `f` is free takes the fused path in the render.
+            assert_eq!(built[1].fuses_eval(), sampler == "adaptive-exact");
             for mis in [false, true] {
                 let (fused, e_fused) = rows(&brdfs, &built, mis, 0);
                 let (rgb, e_rgb) = rows(&brdfs, &built, mis, 1);

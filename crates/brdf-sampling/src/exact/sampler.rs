@@ -45,6 +45,11 @@ impl DirectionSampler for ExactSet {
         self.finish(brdf, wo, s, f)
     }
 
+    /// `true`: the accepted trial evaluated `f` (see [`Self::sample_eval`]).
+    fn fuses_eval(&self) -> bool {
+        true
+    }
+
     /// Queries grouped by interval (a counting sort), each group drawn while its tree is
     /// hot; see [`ExactSet::sample_eval_grouped`].
     fn sample_eval_batch(
