@@ -390,20 +390,51 @@ fn normaliser_table(
             quad_err = quad_err.max(r.rel_err);
             values[i * delta_nodes.len() + j] = r.total * cos;
         }
-        let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         if split {
-            let handed = inherited.or_else(|| {
-                let tail = table.rel_tail_theta();
-                let cap = options.normaliser_tol.max(quad_err.min(INHERITED_TAIL_CAP));
-                (tail <= cap).then(|| {
-                    Arc::new(InheritedTable {
-                        table,
-                        rel_err: quad_err + tail,
-                    })
-                })
-            });
+            if inherited.is_some() {
+                return Ok(TableOutcome::Split(inherited));
+            }
+            let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values.clone());
+            if let Some(handed) = handed_down(options, table, quad_err) {
+                return Ok(TableOutcome::Split(Some(handed)));
+            }
+            // The table's tail is above the cap: its halves would integrate 3 fresh nodes each
+            // (and their halves again, near grazing). The nested Lobatto nodes of order
+            // `2 nt − 1` cost `nt − 1` fresh nodes and resolve the same interval far better.
+            let handed = if span.isotropic && 2 * nt - 1 <= EXTENDED_TABLE_NODES {
+                let (lo, hi) = (theta_nodes[nt - 1], theta_nodes[0]);
+                let mut fine = lobatto_nodes(lo, hi, 2 * nt - 1);
+                let mut fine_values = vec![0.0; fine.len()];
+                let mut fine_err = quad_err;
+                for (k, v) in values.iter().enumerate() {
+                    fine[2 * k] = theta_nodes[k];
+                    fine_values[2 * k] = *v;
+                }
+                for i in (1..fine.len()).step_by(2) {
+                    let (t, cos) = (var.theta(fine[i]), var.cos(fine[i]));
+                    let r = integrate_node(brdf, ctx, span, tree, t, 0.0);
+                    if !(r.total.is_finite() && r.total > 0.0) {
+                        return Err(ExactError::Normaliser {
+                            value: r.total,
+                            theta_deg: t.to_degrees(),
+                            phi_deg: ctx.phi_k.to_degrees(),
+                        });
+                    }
+                    normalisers.push(((fine[i].to_bits(), 0.0f64.to_bits()), r));
+                    fine_err = fine_err.max(r.rel_err);
+                    fine_values[i] = r.total * cos;
+                }
+                handed_down(
+                    options,
+                    ChebyshevTable::new(fine, vec![0.0], fine_values),
+                    fine_err,
+                )
+            } else {
+                None
+            };
             return Ok(TableOutcome::Split(handed));
         }
+        let table = ChebyshevTable::new(theta_nodes.clone(), delta_nodes, values);
         // Interpolation below the quadrature's own error is noise: no refinement past it.
         let floor = options.normaliser_tol.max(quad_err);
         // A θ tail the build splits for (`next_axis` in `build.rs`: the same floor) is not
@@ -418,6 +449,28 @@ fn normaliser_table(
         }
         nd = 2 * nd - 1;
     }
+}
+
+/// Most θ nodes of a table handed down by an interval split for its mean trials: a 5-node
+/// table whose tail misses the cap is extended once to the 9 nested Lobatto nodes (issue 29).
+const EXTENDED_TABLE_NODES: usize = 9;
+
+/// `table` (isotropic, nodes' error estimate `quad_err`) as the table an interval split for
+/// its mean trials hands to its descendants, if its tail is at most the tolerance or
+/// `quad_err` capped at [`INHERITED_TAIL_CAP`].
+fn handed_down(
+    options: &ExactOptions,
+    table: ChebyshevTable,
+    quad_err: f64,
+) -> Option<Arc<InheritedTable>> {
+    let tail = table.rel_tail_theta();
+    let cap = options.normaliser_tol.max(quad_err.min(INHERITED_TAIL_CAP));
+    (tail <= cap).then(|| {
+        Arc::new(InheritedTable {
+            table,
+            rel_err: quad_err + tail,
+        })
+    })
 }
 
 /// `A` at the outgoing direction `(t, φ_k + d)`: over the BRDF's own bins for the MERL layout,
