@@ -14,7 +14,7 @@ use super::build_interval::{Built, IntervalContext, build_interval};
 use super::error::ExactError;
 use super::grid::{EDGE_BITS, Grid, MAX_BREAKS, TableVar, initial_breaks, table_var, theta_kinks};
 use super::interval::Interval;
-use super::jobs::{Inheritance, Job};
+use super::jobs::{INHERITED_TAIL_CAP, Inheritance, Job};
 use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
 use super::phases::{BuildPhases, Lap};
@@ -377,15 +377,18 @@ fn next_axis(
 /// `|c_{n−1}| + |c_{n−2}|` (what `chebyshev::tail_estimate` measures) of node errors
 /// within that bound. A tail below it cannot be told from the nodes' noise, and halving the
 /// interval would integrate fresh nodes with the same noise (`satin_rosaline`: tails of
-/// 1–2·10⁻⁵ at 39.7–42.4° over node errors of 6–8·10⁻⁶, docs/benchmarks.md §23.6).
+/// 1–2·10⁻⁵ at 39.7–42.4° over node errors of 6–8·10⁻⁶, docs/benchmarks.md §23.6). That
+/// allowance is capped at [`INHERITED_TAIL_CAP`] (the level below which RGL tails were
+/// measured to be noise): the RGL estimate is pessimistic where it is large (grazing), and
+/// a tail of 1.4 × an estimate of 2·10⁻⁴ there is more likely the interpolation's own.
 fn tail_floor(options: &ExactOptions, plan: &Plan, quad_err: f64, n: usize) -> f64 {
-    let noise = quad_err.min(plan.tail_cap);
-    let factor = if plan.tail_noise {
-        noise_tail_bound(n)
+    let estimate = quad_err.min(plan.tail_cap);
+    let noise = if plan.tail_noise {
+        (noise_tail_bound(n) * quad_err).min(INHERITED_TAIL_CAP)
     } else {
-        1.0
+        0.0
     };
-    options.normaliser_tol.max(factor * noise)
+    options.normaliser_tol.max(estimate).max(noise)
 }
 
 /// The largest `|c_{n−1}| + |c_{n−2}|` (the tail `chebyshev::tail_estimate` measures) of
@@ -516,5 +519,9 @@ mod tests {
             theta.iter().map(|&t| quartic(t)).collect(),
         );
         assert!(real.rel_tail_theta() > tail_floor(&opts, &plan, e, 5));
+        // Where the estimate is large (grazing), the allowance stops at `INHERITED_TAIL_CAP`:
+        // the floor is the estimate itself, as before.
+        assert_eq!(tail_floor(&opts, &plan, 2e-4, 5), 2e-4);
+        assert_eq!(tail_floor(&opts, &plan, 2.5e-5, 5), INHERITED_TAIL_CAP);
     }
 }
