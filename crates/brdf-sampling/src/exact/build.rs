@@ -14,7 +14,7 @@ use super::build_interval::{Built, IntervalContext, build_interval};
 use super::error::ExactError;
 use super::grid::{EDGE_BITS, Grid, MAX_BREAKS, TableVar, initial_breaks, table_var, theta_kinks};
 use super::interval::Interval;
-use super::jobs::{Inheritance, Job};
+use super::jobs::{INHERITED_TAIL_CAP, Inheritance, Job};
 use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
 use super::phases::{BuildPhases, Lap};
@@ -132,6 +132,10 @@ pub(super) struct Plan {
     /// Intervals split for their mean trials hand their normaliser tables down
     /// (`jobs::InheritedTable`): RGL sets, whose nodes cost ~9·10⁴ evaluations each.
     pub(super) inherit_tables: bool,
+    /// An interval is halved for its interpolation tail only when the tail exceeds the largest
+    /// one its nodes' own errors can make ([`noise_tail_bound`] × their error estimate), not
+    /// the estimate itself (RGL sets, issue 29): below it the tail may be the nodes' noise.
+    pub(super) tail_noise: bool,
 }
 
 impl Plan {
@@ -207,6 +211,7 @@ impl Plan {
                 f64::INFINITY
             },
             inherit_tables: table_nodes && is_rgl(brdf),
+            tail_noise: table_nodes && is_rgl(brdf),
         }
     }
 
@@ -334,8 +339,8 @@ fn run_jobs(
 
 /// The axis to halve (`Some(true)`: δ), if any: too many trials (either axis, `trials_axis`
 /// from the build; `iv` is `None` only for an interval that can be split), or an
-/// interpolation tail above the tolerance (or the quadrature's own error, if larger: below it
-/// the tail is quadrature noise; at most the plan's `tail_cap`) along θ or δ.
+/// interpolation tail above the tolerance (or [`tail_floor`], if larger: below it the tail is
+/// quadrature noise) along θ or δ.
 fn next_axis(
     options: &ExactOptions,
     plan: &Plan,
@@ -344,22 +349,69 @@ fn next_axis(
     trials_axis: Option<bool>,
 ) -> Option<bool> {
     let (grid, min_width) = (&plan.grid, plan.min_width);
-    let floor = |iv: &Interval| options.normaliser_tol.max(iv.quad_err.min(plan.tail_cap));
+    let floor = |iv: &Interval, n: usize| tail_floor(options, plan, iv.quad_err, n);
     match iv {
         None => trials_axis,
         Some(iv) if iv.worst_trials > options.max_trials && trials_axis.is_some() => trials_axis,
         Some(iv)
-            if iv.table.rel_tail_theta() > floor(iv) && job.can_split_theta(grid, min_width) =>
+            if iv.table.rel_tail_theta() > floor(iv, iv.table.theta.len())
+                && job.can_split_theta(grid, min_width) =>
         {
             Some(false)
         }
         Some(iv)
-            if iv.table.rel_tail_delta() > floor(iv) && job.can_split_delta(grid, min_width) =>
+            if iv.table.rel_tail_delta() > floor(iv, iv.table.delta.len())
+                && job.can_split_delta(grid, min_width) =>
         {
             Some(true)
         }
         Some(_) => None,
     }
+}
+
+/// The interpolation tail (relative, along an axis of `n` nodes) below which an interval is
+/// not halved: the tolerance, or the tail its nodes' errors alone can make if larger. Nodes
+/// with relative errors up to `quad_err` (capped at the plan's `tail_cap`) make a tail up to
+/// `quad_err` itself (the rule before issue 29's RGL work, kept for every other BRDF), or,
+/// with the plan's `tail_noise`, up to [`noise_tail_bound`]`(n) · quad_err`: the largest
+/// `|c_{n−1}| + |c_{n−2}|` (what `chebyshev::tail_estimate` measures) of node errors
+/// within that bound. A tail below it cannot be told from the nodes' noise, and halving the
+/// interval would integrate fresh nodes with the same noise (`satin_rosaline`: tails of
+/// 1–2·10⁻⁵ at 39.7–42.4° over node errors of 6–8·10⁻⁶, docs/benchmarks.md §23.6). That
+/// allowance is capped at [`INHERITED_TAIL_CAP`] (the level below which RGL tails were
+/// measured to be noise): the RGL estimate is pessimistic where it is large (grazing), and
+/// a tail of 1.4 × an estimate of 2·10⁻⁴ there is more likely the interpolation's own.
+fn tail_floor(options: &ExactOptions, plan: &Plan, quad_err: f64, n: usize) -> f64 {
+    let estimate = quad_err.min(plan.tail_cap);
+    let noise = if plan.tail_noise {
+        (noise_tail_bound(n) * quad_err).min(INHERITED_TAIL_CAP)
+    } else {
+        0.0
+    };
+    options.normaliser_tol.max(estimate).max(noise)
+}
+
+/// The largest `|c_{n−1}| + |c_{n−2}|` (the tail `chebyshev::tail_estimate` measures) of
+/// values at `n` Chebyshev–Lobatto nodes each at most 1 in magnitude: with `a_j` and `b_j`
+/// the weights of value `j` in the two coefficients, `max(Σ_j |a_j + b_j|, Σ_j |a_j − b_j|)`
+/// (attained at the signs of `a_j ± b_j`). 0 below 3 nodes (no tail); 1.457 for 5 nodes.
+pub(super) fn noise_tail_bound(n: usize) -> f64 {
+    if n < 3 {
+        return 0.0;
+    }
+    let m = (n - 1) as f64;
+    // The weight of value `j` in coefficient `k` (as `tail_estimate` computes it).
+    let weight = |j: usize, k: usize| {
+        let w = if j == 0 || j == n - 1 { 0.5 } else { 1.0 };
+        let c = 2.0 * w * (std::f64::consts::PI * (j * k) as f64 / m).cos() / m;
+        if k == n - 1 { 0.5 * c } else { c }
+    };
+    let sum = |sign: f64| -> f64 {
+        (0..n)
+            .map(|j| (weight(j, n - 1) + sign * weight(j, n - 2)).abs())
+            .sum()
+    };
+    sum(1.0).max(sum(-1.0))
 }
 
 /// The cells of the kept intervals (sorted by cell, θ and δ: the same set whatever the
@@ -375,4 +427,101 @@ fn assemble_cells(mut done: Vec<(usize, Placed)>, plan: &Plan) -> Vec<Cell> {
         .zip(&plan.phis)
         .map(|(members, &phi)| Cell::new(phi, members, &plan.grid, plan.var))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::chebyshev::{ChebyshevTable, lobatto_nodes, tail_estimate};
+    use super::*;
+
+    /// [`noise_tail_bound`] is the largest tail that node errors of magnitude at most 1 make:
+    /// the tail is convex in the values, so its maximum over the box is at a vertex, and every
+    /// vertex (sign pattern) is tried. Attained, not only an upper bound.
+    #[test]
+    fn noise_tail_bound_is_the_largest_tail_of_bounded_node_errors() {
+        for n in 3..=9usize {
+            let worst = (0u32..1 << n)
+                .map(|signs| {
+                    let e: Vec<f64> = (0..n)
+                        .map(|j| if signs >> j & 1 == 1 { 1.0 } else { -1.0 })
+                        .collect();
+                    tail_estimate(&e)
+                })
+                .fold(0.0f64, f64::max);
+            let bound = noise_tail_bound(n);
+            assert!((worst - bound).abs() <= 1e-12, "n {n}: {worst} vs {bound}");
+        }
+        assert!((noise_tail_bound(5) - 1.457).abs() < 1e-3);
+        assert_eq!(noise_tail_bound(2), 0.0);
+    }
+
+    /// The tail test of RGL sets (issue 29): a 5-node table of a smooth `A · cos θo` whose
+    /// nodes carry their largest errors (relative `e`, the signs that maximise the tail) is not
+    /// halved, while a table with a real quartic term twice the noise's largest tail is; other
+    /// BRDFs keep the test against the error estimate itself. The rule before (the estimate
+    /// alone) halves the noisy table: this test fails with it.
+    #[test]
+    fn rgl_tail_test_does_not_split_on_the_nodes_noise() {
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
+            return;
+        };
+        let opts = ExactOptions::default();
+        let plan = Plan::new(&rgl, &opts, Some(true), true);
+        assert!(plan.tail_noise && plan.table_nodes);
+        let phong = brdf::parse_spec("phong:n=20").unwrap();
+        let plain = Plan::new(phong.as_ref(), &opts, Some(false), true);
+        assert!(!plain.tail_noise);
+        let (a, b) = (0.69f64, 0.74f64); // θo 39.5°–42.4° (radians)
+        let theta = lobatto_nodes(a, b, 5);
+        let smooth = |t: f64| (0.8 + 0.05 * t - 0.02 * t * t) * t.cos();
+        let e = 8e-6;
+        // The signs of `a_j + b_j`: the worst errors (see `noise_tail_bound`).
+        let worst_signs = (0u32..32)
+            .max_by(|&s, &r| {
+                let tail = |s: u32| {
+                    tail_estimate(
+                        &(0..5)
+                            .map(|j| if s >> j & 1 == 1 { 1.0 } else { -1.0 })
+                            .collect::<Vec<f64>>(),
+                    )
+                };
+                tail(s).total_cmp(&tail(r))
+            })
+            .unwrap();
+        let noisy: Vec<f64> = theta
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| {
+                let s = if worst_signs >> j & 1 == 1 { 1.0 } else { -1.0 };
+                smooth(t) * (1.0 + s * e * 0.999)
+            })
+            .collect();
+        let table = ChebyshevTable::new(theta.clone(), vec![0.0], noisy);
+        let tail = table.rel_tail_theta();
+        assert!(
+            tail > e,
+            "the noise's tail {tail:e} is above the estimate {e:e}"
+        );
+        assert!(
+            tail <= tail_floor(&opts, &plan, e, 5),
+            "RGL: {tail:e} halved for noise"
+        );
+        assert!(tail > tail_floor(&opts, &plain, e, 5));
+        // A quartic term twice the noise's largest tail is halved for.
+        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        let quartic = |t: f64| {
+            let x = (t - mid) / half;
+            smooth(t) + 2.0 * noise_tail_bound(5) * e * 0.8 * (8.0 * x.powi(4) - 8.0 * x * x + 1.0)
+        };
+        let real = ChebyshevTable::new(
+            theta.clone(),
+            vec![0.0],
+            theta.iter().map(|&t| quartic(t)).collect(),
+        );
+        assert!(real.rel_tail_theta() > tail_floor(&opts, &plan, e, 5));
+        // Where the estimate is large (grazing), the allowance stops at `INHERITED_TAIL_CAP`:
+        // the floor is the estimate itself, as before.
+        assert_eq!(tail_floor(&opts, &plan, 2e-4, 5), 2e-4);
+        assert_eq!(tail_floor(&opts, &plan, 2.5e-5, 5), INHERITED_TAIL_CAP);
+    }
 }
