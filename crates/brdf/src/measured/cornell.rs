@@ -121,7 +121,10 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
+mod line;
 mod search;
+
+pub use line::{LINE_ORDER, LineIntegral, SEGMENT_REL_TOL};
 
 // The search keeps the blended samples and the one their weights are cut at.
 const _: () = assert!(search::K == NEIGHBOURS + 1);
