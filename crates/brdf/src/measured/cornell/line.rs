@@ -14,7 +14,7 @@
 //!
 //! The candidates of each stretch of the line come from the search's grid cells (every sample
 //! that can be among the `K + 1` nearest of a point of the cell), so the sets are those of
-//! [`CornellBrdf::luminance_at`] at every point (ties, of measure zero, aside).
+//! [`CornellBrdf::knn_luminance_at`] at every point (ties, of measure zero, aside).
 
 use super::{BANDWIDTH, CornellBrdf, NEIGHBOURS, search};
 
@@ -91,7 +91,8 @@ fn overtakes(near: &Cand, far: &Cand, t: f64) -> Option<f64> {
 }
 
 impl CornellBrdf {
-    /// `∫₀¹ L(x, t, z) dt`: the luminance interpolant ([`CornellBrdf::luminance_at`]) along
+    /// `∫₀¹ L(x, t, z) dt`: the kNN luminance interpolant ([`CornellBrdf::knn_luminance_at`],
+    /// whatever this material's [`super::Interpolation`]) along
     /// the line of the remapped cube at `x`, `z` (both in `[0, 1]`), integrated exactly piece
     /// by piece (see the [module docs](self)). `None` when `x` or `z` is outside `[0, 1]`.
     ///
@@ -243,7 +244,7 @@ mod tests {
         (0..n)
             .map(|k| {
                 gl.integrate(k as f64 / n as f64, (k + 1) as f64 / n as f64, |t| {
-                    b.luminance_at(&[x, t, z])
+                    b.knn_luminance_at(&[x, t, z])
                 })
             })
             .sum()
