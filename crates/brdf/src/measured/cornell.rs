@@ -839,4 +839,25 @@ mod tests {
             );
         }
     }
+
+    /// `cornell:PATH,interp=knn|grid` picks the interpolation (kNN without the key); any other
+    /// value is a typed error.
+    #[test]
+    fn spec_key_picks_the_interpolation() {
+        let path = std::env::temp_dir().join(format!("cornell-spec-{}.brdf", std::process::id()));
+        std::fs::write(&path, synthetic()).unwrap();
+        let interp = |suffix: &str| {
+            let b = crate::parse_spec(&format!("cornell:{}{suffix}", path.display()))?;
+            let c = b
+                .as_any()
+                .and_then(|a| a.downcast_ref::<CornellBrdf>())
+                .map(|c| c.interpolation());
+            Ok::<_, crate::SpecError>(c)
+        };
+        assert_eq!(interp("").unwrap(), Some(Interpolation::Knn));
+        assert_eq!(interp(",interp=knn").unwrap(), Some(Interpolation::Knn));
+        assert_eq!(interp(",interp=grid").unwrap(), Some(Interpolation::Grid));
+        assert!(interp(",interp=cubic").is_err());
+        let _ = std::fs::remove_file(&path);
+    }
 }
