@@ -560,7 +560,7 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 /// Parse a BRDF spec and build the model.
 ///
 /// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` | `cornell:PATH` |
-/// `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
+/// `cornell:PATH,interp=knn|grid` | `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
 /// keys), malformed item, bad number, out-of-range value (stating the range), duplicate key,

@@ -132,11 +132,35 @@ mod grid;
 mod line;
 mod search;
 
-pub use grid::{GRID_CELLS, Interpolation};
 pub use line::{LINE_ORDER, LineIntegral, SEGMENT_REL_TOL};
 
 // The search keeps the blended samples and the one their weights are cut at.
 const _: () = assert!(search::K == NEIGHBOURS + 1);
+
+/// Cells per axis of the grid of [`Interpolation::Grid`].
+pub const GRID_CELLS: usize = 64;
+
+/// How a [`CornellBrdf`] interpolates its samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Interpolation {
+    /// The k nearest samples with cut Gaussian weights at every query (the module docs);
+    /// spec key `interp=knn`, the default.
+    #[default]
+    Knn,
+    /// That interpolant at the vertices of a regular [`GRID_CELLS`]³ grid of the remapped cube,
+    /// trilinear in between (see the module docs and [`CornellBrdf::grid_albedo`]); spec key
+    /// `interp=grid`.
+    Grid,
+}
+
+/// The vertex values of [`Interpolation::Grid`], by blocks of 8³ made on first use (in
+/// `grid.rs`).
+struct VertexGrid {
+    /// Each block's vertices: luminance and RGB.
+    blocks: Vec<std::sync::OnceLock<Box<[[f64; 4]]>>>,
+    /// Each vertex column's `∫₀¹ L dy`, made on first use.
+    columns: Vec<std::sync::OnceLock<f64>>,
+}
 
 struct Data {
     tree: search::Tree,
@@ -147,7 +171,7 @@ struct Data {
     wavelengths: Vec<f64>,
     clamped: Option<NegativeValues>,
     /// The kNN interpolant at the vertices of [`Interpolation::Grid`], made by blocks.
-    vertices: grid::VertexGrid,
+    vertices: VertexGrid,
 }
 
 /// A Cornell measured material (see the [module docs](self)). Cheap to clone.
@@ -320,7 +344,7 @@ impl CornellBrdf {
                 lum,
                 wavelengths,
                 clamped,
-                vertices: grid::VertexGrid::new(),
+                vertices: VertexGrid::new(),
             }),
             interp: Interpolation::default(),
         })

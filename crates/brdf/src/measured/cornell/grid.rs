@@ -1,7 +1,7 @@
 //! The tabulated Cornell interpolant (issue 29): the k-nearest-neighbour interpolant sampled
 //! once on a regular grid of the remapped cube and interpolated multilinearly.
 //!
-//! [`Interpolation::Grid`] defines `f` at a remapped point `p ∈ [0, 1]³` as the trilinear
+//! [`super::Interpolation::Grid`] defines `f` at a remapped point `p ∈ [0, 1]³` as the trilinear
 //! interpolant of the kNN interpolant's values at the vertices `(i, j, k)/N`,
 //! `N` = [`GRID_CELLS`]. Its kinks lie on the grid's planes only (the kNN interpolant has them
 //! on the bisector planes of sample pairs, everywhere), so the albedo at `θo` is an exact sum:
@@ -13,22 +13,7 @@
 
 use std::sync::OnceLock;
 
-use super::CornellBrdf;
-
-/// Cells per axis of the grid of [`Interpolation::Grid`].
-pub const GRID_CELLS: usize = 64;
-
-/// How a [`CornellBrdf`] interpolates its samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Interpolation {
-    /// The k nearest samples with cut Gaussian weights at every query (the module docs of
-    /// [`super`]); spec key `interp=knn`, the default.
-    #[default]
-    Knn,
-    /// That interpolant at the vertices of a regular [`GRID_CELLS`]³ grid of the remapped cube,
-    /// trilinear in between (the module docs of this module); spec key `interp=grid`.
-    Grid,
-}
+use super::{CornellBrdf, GRID_CELLS, VertexGrid};
 
 /// Vertices per axis.
 const V: usize = GRID_CELLS + 1;
@@ -40,14 +25,8 @@ const NB: usize = V.div_ceil(B);
 /// One vertex: luminance and RGB.
 type Vertex = [f64; 4];
 
-/// The vertex values, by blocks made on first use.
-pub(super) struct VertexGrid {
-    blocks: Vec<OnceLock<Box<[Vertex]>>>,
-    /// Each vertex column's `∫₀¹ L dy` ([`CornellBrdf::column_integral`]), made on first use.
-    columns: Vec<OnceLock<f64>>,
-}
-
 impl VertexGrid {
+    /// No vertex made yet.
     pub(super) fn new() -> Self {
         Self {
             blocks: (0..NB * NB * NB).map(|_| OnceLock::new()).collect(),
@@ -121,7 +100,7 @@ impl CornellBrdf {
         })
     }
 
-    /// The directional albedo `∫ f cos θi dωi` of the luminance of [`Interpolation::Grid`]
+    /// The directional albedo `∫ f cos θi dωi` of the luminance of [`super::Interpolation::Grid`]
     /// at the polar angle `theta_o` (radians, in `[0, π/2]`) whatever this material's own
     /// interpolation, with an error estimate: `(value, abs_err)`; `None` outside that range.
     ///
