@@ -117,7 +117,10 @@ pub use reference::{
     AlbedoEstimate, REFERENCE_BUDGET, ReferenceError, reference_albedo, reference_albedo_rgb,
     reference_albedo_with_budget,
 };
-pub use reference::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
+pub use reference::{
+    CORNELL_REFERENCE_REL_TOL, RGL_CELL_ORDER, cornell_reference_albedo, rgl_albedo_in_cells,
+    rgl_reference_albedo,
+};
 pub use report::{CostMeasurement, SetReport};
 pub use sampler_checks::{
     SampledAlbedo, equal_area_hemisphere_integral, sampled_albedo, upper_hemisphere_integral,

@@ -27,7 +27,9 @@
 use brdf::{Brdf, Vec3};
 use partition_sampler::{LeafInfo, Rect};
 
+mod cornell;
 mod rgl;
+pub use cornell::{CORNELL_REFERENCE_REL_TOL, cornell_reference_albedo};
 pub(crate) use rgl::albedo_in_cells_of;
 #[cfg(test)]
 pub(crate) use rgl::tests::ibiza as rgl_tests_ibiza;

@@ -1,7 +1,7 @@
 //! Model registry and the `SPEC` parser (`name` or `name:key=value,...`, or `merl:PATH`).
 
 use crate::brdf::Brdf;
-use crate::measured::cornell::{CornellBrdf, CornellError};
+use crate::measured::cornell::{CornellBrdf, CornellError, Interpolation};
 use crate::measured::rgl::{RglBrdf, RglError};
 use crate::merl::{MerlBrdf, MerlError};
 use crate::models::*;
@@ -460,7 +460,7 @@ static MODELS: &[ModelInfo] = &[
     ModelInfo::argument(
         "cornell",
         Build::File,
-        "measured spectral material of Cornell PCG, spec `cornell:PATH` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space)",
+        "measured spectral material of Cornell PCG, spec `cornell:PATH[,interp=knn|grid]` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space; `interp=grid` tabulates it on a 64³ grid)",
     ),
     ModelInfo::argument(
         "sgd",
@@ -560,7 +560,7 @@ pub fn find_model(name: &str) -> Option<&'static ModelInfo> {
 /// Parse a BRDF spec and build the model.
 ///
 /// Grammar: `name` | `name:key=value(,key=value)*` | `merl:PATH` | `rgl:PATH` | `cornell:PATH` |
-/// `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
+/// `cornell:PATH,interp=knn|grid` | `sgd:material=NAME` | `abc:material=NAME`. Whitespace around names,
 /// keys and values is ignored; model names are case-insensitive; omitted keys take their
 /// defaults. Errors are typed ([`SpecError`]): unknown model, unknown key (listing the valid
 /// keys), malformed item, bad number, out-of-range value (stating the range), duplicate key,
@@ -587,10 +587,26 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
     }
     if name.eq_ignore_ascii_case("cornell") {
         let path = file_path(rest, SpecError::MissingFile { model: "cornell" })?;
-        return boxed(CornellBrdf::load(Path::new(path))).map_err(|source| SpecError::Cornell {
+        // `cornell:PATH,interp=knn|grid` (the kNN interpolant by default).
+        let (path, interp) = match path.rsplit_once(",interp=") {
+            Some((p, "knn")) => (p, Some(Interpolation::Knn)),
+            Some((p, "grid")) => (p, Some(Interpolation::Grid)),
+            Some((_, other)) => {
+                return Err(SpecError::Malformed {
+                    model: "cornell".to_string(),
+                    item: format!("interp={other} (knn or grid)"),
+                });
+            }
+            None => (path, None),
+        };
+        let b = CornellBrdf::load(Path::new(path)).map_err(|source| SpecError::Cornell {
             path: path.to_string(),
             source,
-        });
+        })?;
+        return Ok(Box::new(match interp {
+            Some(i) => b.with_interpolation(i),
+            None => b,
+        }));
     }
     if name.eq_ignore_ascii_case("sgd") {
         return parse_preset("sgd", rest);

@@ -29,6 +29,7 @@
 use std::collections::HashMap;
 use std::sync::Mutex;
 
+use brdf::measured::cornell::Interpolation;
 use brdf::{Brdf, CornellBrdf, MerlBrdf, RglBrdf, direction_from_radians};
 use partition_sampler::{Density, LeafInfo};
 
@@ -117,6 +118,13 @@ pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)
             Ok(a) => (a.value, a.abs_err, a.evaluations),
             Err(_) => (f64::NAN, f64::INFINITY, 0),
         }
+    } else if let Some((value, abs_err)) = any
+        .downcast_ref::<CornellBrdf>()
+        .filter(|c| c.interpolation() == Interpolation::Grid)
+        .and_then(|c| c.grid_albedo(theta))
+    {
+        // The tabulated interpolant's albedo, exact up to rounding (docs/benchmarks.md §24.6).
+        (value, abs_err, 0)
     } else if any.is::<CornellBrdf>() {
         let wo = direction_from_radians(theta, 0.0);
         match crate::reference::reference_albedo_with_budget(brdf, &wo, CORNELL_NODE_BUDGET) {

@@ -25,6 +25,13 @@
 //! equidistant the plain Gaussian mean is used), so `f` is defined, finite and non-negative on
 //! the whole hemisphere (also far from every sample, where it tends to the nearest samples'
 //! values). The declared symmetries hold exactly by construction.
+//!
+//! **Tabulated interpolant** (opt-in, spec `cornell:PATH,interp=grid`;
+//! [`Interpolation::Grid`]): the kNN interpolant at the vertices of a regular
+//! [`GRID_CELLS`]³ grid of the remapped cube, trilinear in between. Its albedo is an exact
+//! sum ([`CornellBrdf::grid_albedo`]), so an `adaptive-exact` build spends no quadrature on its
+//! normaliser; it is another material than the kNN one (measured differences:
+//! docs/benchmarks.md §24.6).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -121,10 +128,39 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
+mod grid;
+mod line;
 mod search;
+
+pub use line::{LINE_ORDER, LineIntegral, SEGMENT_REL_TOL};
 
 // The search keeps the blended samples and the one their weights are cut at.
 const _: () = assert!(search::K == NEIGHBOURS + 1);
+
+/// Cells per axis of the grid of [`Interpolation::Grid`].
+pub const GRID_CELLS: usize = 64;
+
+/// How a [`CornellBrdf`] interpolates its samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Interpolation {
+    /// The k nearest samples with cut Gaussian weights at every query (the module docs);
+    /// spec key `interp=knn`, the default.
+    #[default]
+    Knn,
+    /// That interpolant at the vertices of a regular [`GRID_CELLS`]³ grid of the remapped cube,
+    /// trilinear in between (see the module docs and [`CornellBrdf::grid_albedo`]); spec key
+    /// `interp=grid`.
+    Grid,
+}
+
+/// The vertex values of [`Interpolation::Grid`], by blocks of 8³ made on first use (in
+/// `grid.rs`).
+struct VertexGrid {
+    /// Each block's vertices: luminance and RGB.
+    blocks: Vec<std::sync::OnceLock<Box<[[f64; 4]]>>>,
+    /// Each vertex column's `∫₀¹ L dy`, made on first use.
+    columns: Vec<std::sync::OnceLock<f64>>,
+}
 
 struct Data {
     tree: search::Tree,
@@ -134,12 +170,15 @@ struct Data {
     lum: Vec<f64>,
     wavelengths: Vec<f64>,
     clamped: Option<NegativeValues>,
+    /// The kNN interpolant at the vertices of [`Interpolation::Grid`], made by blocks.
+    vertices: VertexGrid,
 }
 
 /// A Cornell measured material (see the [module docs](self)). Cheap to clone.
 #[derive(Clone)]
 pub struct CornellBrdf {
     data: Arc<Data>,
+    interp: Interpolation,
 }
 
 impl std::fmt::Debug for CornellBrdf {
@@ -148,6 +187,7 @@ impl std::fmt::Debug for CornellBrdf {
             .field("samples", &self.data.rgb.len())
             .field("wavelengths", &self.data.wavelengths.len())
             .field("clamped", &self.data.clamped)
+            .field("interp", &self.interp)
             .finish()
     }
 }
@@ -304,7 +344,9 @@ impl CornellBrdf {
                 lum,
                 wavelengths,
                 clamped,
+                vertices: VertexGrid::new(),
             }),
+            interp: Interpolation::default(),
         })
     }
 
@@ -323,15 +365,45 @@ impl CornellBrdf {
         self.data.clamped
     }
 
-    /// The interpolated RGB at a remapped point (see the module docs: the [`NEIGHBOURS`]
-    /// nearest samples with Gaussian weights cut at the next sample's distance).
+    /// This material with another interpolation (the samples and the grid's vertices
+    /// shared).
+    pub fn with_interpolation(&self, interp: Interpolation) -> Self {
+        Self {
+            data: Arc::clone(&self.data),
+            interp,
+        }
+    }
+
+    /// How this material interpolates its samples.
+    pub fn interpolation(&self) -> Interpolation {
+        self.interp
+    }
+
+    /// The interpolated RGB at a remapped point, by this material's [`Interpolation`].
     pub fn rgb_at(&self, p: &[f64; 3]) -> [f64; 3] {
+        match self.interp {
+            Interpolation::Knn => self.knn_rgb_at(p),
+            Interpolation::Grid => self.grid_at::<3>(p, 1),
+        }
+    }
+
+    /// The luminance of [`rgb_at`](Self::rgb_at) (up to rounding).
+    pub fn luminance_at(&self, p: &[f64; 3]) -> f64 {
+        match self.interp {
+            Interpolation::Knn => self.knn_luminance_at(p),
+            Interpolation::Grid => self.grid_at::<1>(p, 0)[0],
+        }
+    }
+
+    /// The kNN interpolant's RGB at a remapped point (see the module docs: the
+    /// [`NEIGHBOURS`] nearest samples with Gaussian weights cut at the next sample's distance).
+    pub fn knn_rgb_at(&self, p: &[f64; 3]) -> [f64; 3] {
         self.blend(p, |i| self.data.rgb[i])
     }
 
-    /// The luminance of [`rgb_at`](Self::rgb_at) (up to rounding), blended from the samples'
-    /// own luminances.
-    pub fn luminance_at(&self, p: &[f64; 3]) -> f64 {
+    /// The luminance of [`knn_rgb_at`](Self::knn_rgb_at) (up to rounding), blended from the
+    /// samples' own luminances.
+    pub fn knn_luminance_at(&self, p: &[f64; 3]) -> f64 {
         let [l] = self.blend(p, |i| [self.data.lum[i]]);
         l
     }
@@ -575,7 +647,10 @@ mod tests {
     /// Largest relative difference of the new `eval` and `eval_rgb` to the old interpolant
     /// (each RGB channel relative to itself or, if smaller, to the largest channel).
     fn worst_difference(text: &str, n: usize) -> f64 {
-        let (new, old) = (CornellBrdf::parse(text).unwrap(), Before::new(text));
+        let new = CornellBrdf::parse(text)
+            .unwrap()
+            .with_interpolation(Interpolation::Knn);
+        let old = Before::new(text);
         let mut worst = 0.0f64;
         for (wo, wi) in pairs(n, 0x2545_f491_4f6c_dd1d) {
             let o = old.eval_rgb(&wo, &wi);
@@ -628,7 +703,7 @@ mod tests {
     }
 
     /// Instructions per evaluation, for cachegrind (docs/benchmarks.md §19.6):
-    /// `CORNELL_EVALS=N CORNELL_IMPL=old|new|loop valgrind --tool=cachegrind TEST_BINARY
+    /// `CORNELL_EVALS=N CORNELL_IMPL=old|new|grid|loop valgrind --tool=cachegrind TEST_BINARY
     /// eval_cost_probe --ignored --exact`, at two N, the difference divided by the difference of N.
     #[test]
     #[ignore = "a cachegrind probe"]
@@ -641,17 +716,172 @@ mod tests {
         let Some((_, text)) = shared_files().into_iter().nth(1) else {
             return;
         };
-        let (new_b, old_b) = (CornellBrdf::parse(&text).unwrap(), Before::new(&text));
+        let new_b = CornellBrdf::parse(&text)
+            .unwrap()
+            .with_interpolation(Interpolation::Knn);
+        let grid_b = new_b.with_interpolation(Interpolation::Grid);
+        let old_b = Before::new(&text);
         let ps = pairs(n, 7);
         let mut sum = 0.0;
         for (wo, wi) in &ps {
             sum += match which.as_str() {
                 "old" => luminance(old_b.eval_rgb(wo, wi)),
                 "new" => new_b.eval(wo, wi),
+                "grid" => grid_b.eval(wo, wi),
                 // The loop alone (pairs and sum), to subtract.
                 _ => wo.z * wi.z,
             };
         }
         eprintln!("sum {sum}");
+    }
+
+    /// Issue 29, the tabulated interpolant: at the grid's vertices it is the kNN interpolant
+    /// (bit for bit, every block's indexing), in between trilinear, and its albedo
+    /// ([`CornellBrdf::grid_albedo`]) is the integral of its own `eval`: within 10⁻⁶ relative
+    /// of a brute-force iterated rule (θi: 4 Gauss points on 1 000 panels; Δφ: 2 Gauss points
+    /// on each grid cell, exact for the piecewise linear interpolant) and within its estimate
+    /// plus that rule's error. Fails with the column sums as plain sums (no trapezoid ends).
+    #[test]
+    fn grid_interpolant_and_its_albedo() {
+        let knn = CornellBrdf::parse(&synthetic()).unwrap();
+        assert_eq!(knn.interpolation(), Interpolation::Knn);
+        let b = knn.with_interpolation(Interpolation::Grid);
+        let n = GRID_CELLS;
+        for (i, j, k) in [(0, 0, 0), (n, n, n), (7, 8, 9), (63, 1, 32), (17, 40, 64)] {
+            let p = [i, j, k].map(|v| v as f64 / n as f64);
+            assert_eq!(b.luminance_at(&p), knn.knn_luminance_at(&p), "{p:?}");
+            assert_eq!(b.rgb_at(&p), knn.knn_rgb_at(&p), "{p:?}");
+        }
+        // Midway along an edge: the mean of its two vertices.
+        let (p, q) = ([10.0 / 64.0, 0.5, 0.25], [11.0 / 64.0, 0.5, 0.25]);
+        let mid = [10.5 / 64.0, 0.5, 0.25];
+        let want = 0.5 * (knn.knn_luminance_at(&p) + knn.knn_luminance_at(&q));
+        assert!((b.luminance_at(&mid) - want).abs() <= 1e-14 * want.abs());
+        let gl4 = crate::quadrature::GaussLegendre::new(4);
+        let gl2 = crate::quadrature::GaussLegendre::new(2);
+        for deg in [0.0f64, 23.0, 61.3, 88.0] {
+            let to = deg.to_radians();
+            let (value, err) = b.grid_albedo(to).unwrap();
+            let wo = crate::direction_from_radians(to, 0.0);
+            let panels = 1_000;
+            let h = std::f64::consts::FRAC_PI_2 / panels as f64;
+            let brute: f64 = (0..panels)
+                .map(|m| {
+                    gl4.integrate(m as f64 * h, (m + 1) as f64 * h, |ti| {
+                        let (si, ci) = ti.sin_cos();
+                        let ring: f64 = (0..n)
+                            .map(|c| {
+                                let (a, z) = (c as f64 / n as f64, (c + 1) as f64 / n as f64);
+                                gl2.integrate(a, z, |t| {
+                                    let phi = std::f64::consts::PI * t;
+                                    let wi = Vec3::new(si * phi.cos(), si * phi.sin(), ci);
+                                    b.eval(&wo, &wi)
+                                })
+                            })
+                            .sum();
+                        std::f64::consts::TAU * si * ci * ring
+                    })
+                })
+                .sum();
+            let gap = (value - brute).abs();
+            eprintln!("θo {deg}°: grid albedo {value} ± {err:.1e}, brute force {brute}: {gap:.1e}");
+            assert!(gap <= 1e-6 * brute, "θo {deg}°: {value} vs {brute}");
+            assert!(err <= 1e-9 * value, "θo {deg}°: estimate {err:e}");
+        }
+        assert!(b.grid_albedo(f64::NAN).is_none() && b.grid_albedo(2.0).is_none());
+    }
+
+    /// The tabulated interpolant against the kNN one, for the record (docs/benchmarks.md
+    /// §24.6): at every measured sample's remapped point and at 10⁵ random direction pairs
+    /// per shared file, the relative difference of the luminance (largest, mean, 99th
+    /// percentile, and relative to the file's largest value), and the CPU time of making every
+    /// vertex. `cargo test --release -p brdf --lib grid_against_knn -- --ignored --nocapture`
+    #[test]
+    #[ignore = "a survey for the record"]
+    fn grid_against_knn_survey() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/measured/cornell");
+        for (name, text) in shared_files() {
+            let knn = CornellBrdf::parse(&text).unwrap();
+            let grid = knn.with_interpolation(Interpolation::Grid);
+            let t = std::time::Instant::now();
+            let n = GRID_CELLS + 1;
+            let mut peak = 0.0f64;
+            for k in 0..n {
+                for j in 0..n {
+                    for i in 0..n {
+                        let p = [i, j, k].map(|v| v as f64 / GRID_CELLS as f64);
+                        peak = peak.max(grid.luminance_at(&p));
+                    }
+                }
+            }
+            let fill = t.elapsed().as_secs_f64();
+            let stats = |pts: &[[f64; 3]]| {
+                let mut rel: Vec<f64> = Vec::with_capacity(pts.len());
+                let mut worst_abs = 0.0f64;
+                for p in pts {
+                    let (g, k) = (grid.luminance_at(p), knn.knn_luminance_at(p));
+                    rel.push(if k > 0.0 {
+                        (g - k).abs() / k
+                    } else {
+                        (g - k).abs()
+                    });
+                    worst_abs = worst_abs.max((g - k).abs());
+                }
+                rel.sort_by(f64::total_cmp);
+                let mean = rel.iter().sum::<f64>() / rel.len() as f64;
+                format!(
+                    "relative difference mean {:.2e}, median {:.2e}, 99th percentile {:.2e}, max {:.2e}; max absolute / file peak {:.2e}",
+                    mean,
+                    rel[rel.len() / 2],
+                    rel[rel.len() * 99 / 100],
+                    rel[rel.len() - 1],
+                    worst_abs / peak
+                )
+            };
+            let samples: Vec<[f64; 3]> = (0..knn.samples() as u32)
+                .map(|i| knn.data.tree.point(i))
+                .collect();
+            let random: Vec<[f64; 3]> = pairs(100_000, 0x9e37_79b9_7f4a_7c15)
+                .iter()
+                .filter(|(o, i)| o.z > 0.0 && i.z > 0.0)
+                .map(|(o, i)| remap_dirs(o, i))
+                .collect();
+            eprintln!(
+                "{name} ({}): every vertex made in {fill:.2} s (one thread)",
+                dir.display()
+            );
+            eprintln!(
+                "{name}: at the {} measured samples: {}",
+                samples.len(),
+                stats(&samples)
+            );
+            eprintln!(
+                "{name}: at {} random pairs: {}",
+                random.len(),
+                stats(&random)
+            );
+        }
+    }
+
+    /// `cornell:PATH,interp=knn|grid` picks the interpolation (kNN without the key); any other
+    /// value is a typed error.
+    #[test]
+    fn spec_key_picks_the_interpolation() {
+        let path = std::env::temp_dir().join(format!("cornell-spec-{}.brdf", std::process::id()));
+        std::fs::write(&path, synthetic()).unwrap();
+        let interp = |suffix: &str| {
+            let b = crate::parse_spec(&format!("cornell:{}{suffix}", path.display()))?;
+            let c = b
+                .as_any()
+                .and_then(|a| a.downcast_ref::<CornellBrdf>())
+                .map(|c| c.interpolation());
+            Ok::<_, crate::SpecError>(c)
+        };
+        assert_eq!(interp("").unwrap(), Some(Interpolation::Knn));
+        assert_eq!(interp(",interp=knn").unwrap(), Some(Interpolation::Knn));
+        assert_eq!(interp(",interp=grid").unwrap(), Some(Interpolation::Grid));
+        assert!(interp(",interp=cubic").is_err());
+        let _ = std::fs::remove_file(&path);
     }
 }

@@ -266,6 +266,22 @@ impl Tree {
         best
     }
 
+    /// The candidate list of grid cell `(ix, iy, iz)` (each index below [`GRID`]): every sample
+    /// that can be among the [`K`] nearest of a point of the cell's (widened) box; `None` when
+    /// the tree has no grid.
+    pub(super) fn cell_candidates(&self, ix: usize, iy: usize, iz: usize) -> Option<&[u32]> {
+        if self.grid.cells.is_empty() || ix >= GRID || iy >= GRID || iz >= GRID {
+            return None;
+        }
+        Some(self.grid.list(self, ix + GRID * (iy + GRID * iz)))
+    }
+
+    /// Sample `i`'s remapped point (the file's index).
+    #[inline]
+    pub(super) fn point(&self, i: u32) -> [f64; 3] {
+        self.by_index[i as usize]
+    }
+
     /// Squared distance from `q` to node `n`'s box (0 inside).
     #[inline]
     fn box_d2(&self, n: usize, q: &[f64; 3]) -> f64 {

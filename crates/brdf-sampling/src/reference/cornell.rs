@@ -1,0 +1,253 @@
+//! The albedo of a Cornell material integrated where its interpolant is smooth (issue 29:
+//! the set table's normaliser nodes; docs/benchmarks.md §24.6).
+//!
+//! The Cornell interpolant ([`brdf::measured::cornell`]) is a function of the remapped point
+//! `p = (sin θi sin θo, Δφ/π, cos θi cos θo)`, so for an isotropic material
+//!
+//! `A(θo) = ∫ f cos θi dωi = 2π ∫₀^{π/2} sin θi cos θi J(θi) dθi`,
+//! `J(θi) = ∫₀¹ L(sin θi sin θo, t, cos θi cos θo) dt`.
+//!
+//! The inner integral runs along a line of the remapped cube on which the neighbour sets
+//! change at times found exactly ([`CornellBrdf::luminance_line_integral`]: every kink is a
+//! segment end, Gauss rules of 4 and 3 points on each segment). `J` is then far smoother in
+//! `θi` than `f` is in `ωi` (the kinks' surfaces are integrated across), and the outer integral
+//! is an adaptive Gauss–Legendre rule: each piece `[a, b]` is integrated by
+//! [`OUTER_ORDER`] points on each half, its error estimated by the difference from the same
+//! rule on the whole piece (conservative: that is the whole-piece rule's error), the piece of
+//! the largest difference halved until the summed estimate, inner estimates included, is at
+//! most `rel_tol` of the value. The reference rule over the disc
+//! ([`crate::reference_albedo_with_budget`]) needed 1.5·10⁵ evaluations for ≈ 3.7·10⁻⁵ here
+//! (its error falls like `1/evaluations`: the kinks cross every piece).
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+use brdf::quadrature::GaussLegendre;
+use brdf::{Brdf, CornellBrdf};
+
+use super::{AlbedoEstimate, ReferenceError};
+
+/// Gauss–Legendre points on each half of an outer piece.
+pub(crate) const OUTER_ORDER: usize = 6;
+
+/// Equal outer pieces the rule starts from.
+const INITIAL_PIECES: usize = 8;
+
+/// Most lines (inner integrals) one albedo may take; the rule stops there with its estimate.
+const MAX_LINES: u64 = 40_000;
+
+/// Relative error target of [`cornell_reference_albedo`].
+pub const CORNELL_REFERENCE_REL_TOL: f64 = 1e-7;
+
+/// One Gauss rule over an outer piece.
+#[derive(Clone, Copy)]
+struct Rule {
+    value: f64,
+    /// Summed inner estimates, weighted like the values.
+    inner_err: f64,
+    evaluations: u64,
+}
+
+/// `2π sin θi cos θi J(θi)` integrated by `gl` over `[a, b]`.
+fn rule(b: &CornellBrdf, gl: &GaussLegendre, theta_o: f64, a: f64, c: f64) -> Option<Rule> {
+    let (so, co) = theta_o.sin_cos();
+    let (mid, half) = (0.5 * (a + c), 0.5 * (c - a));
+    let mut out = Rule {
+        value: 0.0,
+        inner_err: 0.0,
+        evaluations: 0,
+    };
+    for (x, w) in gl.nodes().iter().zip(gl.weights()) {
+        let t = mid + half * x;
+        let (si, ci) = t.sin_cos();
+        let line =
+            b.luminance_line_integral((si * so).clamp(0.0, 1.0), (ci * co).clamp(0.0, 1.0))?;
+        let jac = TAU * si * ci * w * half;
+        out.value += jac * line.value;
+        out.inner_err += jac.abs() * line.abs_err;
+        out.evaluations += line.evaluations;
+    }
+    Some(out)
+}
+
+/// One outer piece: the rule on the whole and on each half.
+struct Piece {
+    a: f64,
+    b: f64,
+    whole: Rule,
+    left: Rule,
+    right: Rule,
+}
+
+impl Piece {
+    fn new(
+        brdf: &CornellBrdf,
+        gl: &GaussLegendre,
+        theta_o: f64,
+        a: f64,
+        b: f64,
+        whole: Rule,
+    ) -> Option<Self> {
+        let m = 0.5 * (a + b);
+        Some(Self {
+            a,
+            b,
+            whole,
+            left: rule(brdf, gl, theta_o, a, m)?,
+            right: rule(brdf, gl, theta_o, m, b)?,
+        })
+    }
+
+    fn value(&self) -> f64 {
+        self.left.value + self.right.value
+    }
+
+    fn err(&self) -> f64 {
+        (self.whole.value - self.value()).abs()
+    }
+
+    fn inner_err(&self) -> f64 {
+        self.left.inner_err + self.right.inner_err
+    }
+}
+
+/// The directional albedo of `brdf` at the polar angle `theta_o` (radians, in `[0, π/2)`),
+/// to [`CORNELL_REFERENCE_REL_TOL`] (see the module docs). `evaluations` counts the blends of
+/// the inner rules (7 per segment).
+pub fn cornell_reference_albedo(
+    brdf: &CornellBrdf,
+    theta_o: f64,
+) -> Result<AlbedoEstimate, ReferenceError> {
+    cornell_albedo(brdf, theta_o, CORNELL_REFERENCE_REL_TOL)
+}
+
+/// [`cornell_reference_albedo`] to the relative error target `rel_tol`.
+pub(crate) fn cornell_albedo(
+    brdf: &CornellBrdf,
+    theta_o: f64,
+    rel_tol: f64,
+) -> Result<AlbedoEstimate, ReferenceError> {
+    let invalid = || {
+        let (s, c) = theta_o.sin_cos();
+        ReferenceError::InvalidDirection { x: s, y: 0.0, z: c }
+    };
+    if !(theta_o.is_finite() && (0.0..FRAC_PI_2).contains(&theta_o)) {
+        return Err(invalid());
+    }
+    let not_finite = || ReferenceError::NotFinite(brdf.name().to_string());
+    let gl = GaussLegendre::new(OUTER_ORDER);
+    let step = FRAC_PI_2 / INITIAL_PIECES as f64;
+    let mut pieces = Vec::with_capacity(4 * INITIAL_PIECES);
+    let mut lines = 0u64;
+    let mut evaluations = 0u64;
+    for k in 0..INITIAL_PIECES {
+        let a = step * k as f64;
+        let b = if k + 1 == INITIAL_PIECES {
+            FRAC_PI_2
+        } else {
+            step * (k + 1) as f64
+        };
+        let whole = rule(brdf, &gl, theta_o, a, b).ok_or_else(not_finite)?;
+        let p = Piece::new(brdf, &gl, theta_o, a, b, whole).ok_or_else(not_finite)?;
+        evaluations += whole.evaluations + p.left.evaluations + p.right.evaluations;
+        pieces.push(p);
+        lines += 3 * OUTER_ORDER as u64;
+    }
+    loop {
+        let total: f64 = pieces.iter().map(Piece::value).sum();
+        let err: f64 = pieces.iter().map(|p| p.err() + p.inner_err()).sum();
+        if !(total.is_finite() && err.is_finite()) {
+            return Err(not_finite());
+        }
+        if err <= rel_tol * total.abs() || lines >= MAX_LINES {
+            return Ok(AlbedoEstimate {
+                value: total,
+                abs_err: err,
+                evaluations,
+            });
+        }
+        // The piece of the largest outer difference (the first of equals: deterministic).
+        let worst = (0..pieces.len()).fold(0, |w, i| {
+            if pieces[i].err() > pieces[w].err() {
+                i
+            } else {
+                w
+            }
+        });
+        let p = pieces.swap_remove(worst);
+        let m = 0.5 * (p.a + p.b);
+        let (l, r) = (
+            Piece::new(brdf, &gl, theta_o, p.a, m, p.left).ok_or_else(not_finite)?,
+            Piece::new(brdf, &gl, theta_o, m, p.b, p.right).ok_or_else(not_finite)?,
+        );
+        lines += 4 * OUTER_ORDER as u64;
+        evaluations += [&l, &r]
+            .iter()
+            .map(|q| q.left.evaluations + q.right.evaluations)
+            .sum::<u64>();
+        pieces.push(l);
+        pieces.push(r);
+        // A fixed summation order whatever the splits: by position.
+        pieces.sort_by(|x, y| x.a.total_cmp(&y.a));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The team's Cornell file `name` when the data repository sits beside this one.
+    fn shared(name: &str) -> Option<CornellBrdf> {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
+        match CornellBrdf::load(&path) {
+            Ok(b) => Some(b),
+            Err(e) => {
+                eprintln!("skipped {name}: {e}");
+                None
+            }
+        }
+    }
+
+    /// The node rule against the reference rule over the disc, for the record
+    /// (docs/benchmarks.md §24.6): `CORNELL_FILES` (default the three shared files),
+    /// `NODE_ANGLES` (degrees), `NODE_TOL` (default the nodes' target), `REF_BUDGET` (the disc
+    /// rule's budget, default 0: not run).
+    /// `cargo test --release -p brdf-sampling --lib cornell_node_survey -- --ignored --nocapture`
+    #[test]
+    #[ignore = "a survey for the record"]
+    fn cornell_node_survey() {
+        let env = |k: &str| std::env::var(k).ok();
+        let files = env("CORNELL_FILES").unwrap_or("acryl_blue,cayman,krylon_blue".into());
+        let angles: Vec<f64> = env("NODE_ANGLES")
+            .unwrap_or("2.8,30.5,55.2,62.4,77.0,89.5".into())
+            .split(',')
+            .filter_map(|s| s.parse().ok())
+            .collect();
+        let tol: f64 = env("NODE_TOL").and_then(|s| s.parse().ok()).unwrap_or(2e-6);
+        let budget: u64 = env("REF_BUDGET").and_then(|s| s.parse().ok()).unwrap_or(0);
+        for name in files.split(',') {
+            let Some(b) = shared(name) else { continue };
+            for &deg in &angles {
+                let a = cornell_albedo(&b, deg.to_radians(), tol).unwrap();
+                let mut line = format!(
+                    "{name} {deg}°: A {:.9} ± {:.1e} (rel {:.1e}), {} evaluations",
+                    a.value,
+                    a.abs_err,
+                    a.abs_err / a.value,
+                    a.evaluations
+                );
+                if budget > 0 {
+                    let wo = brdf::direction_from_radians(deg.to_radians(), 0.0);
+                    let r = crate::reference_albedo_with_budget(&b, &wo, budget).unwrap();
+                    line += &format!(
+                        "; disc rule {:.9} ± {:.1e}: A/ref − 1 = {:+.2e}",
+                        r.value,
+                        r.abs_err,
+                        a.value / r.value - 1.0
+                    );
+                }
+                eprintln!("{line}");
+            }
+        }
+    }
+}
