@@ -19,10 +19,10 @@ use crate::{DirSample, EvalSample};
 /// isotropic fast path draw their trials through the BRDF's caller-held
 /// [`Brdf::prepare_run`] (for RGL files a blended `θo` slice, ≈ 3.4·10⁴ table entries read
 /// once); shorter runs, and BRDFs without one, evaluate through
-/// [`Brdf::prepare`]/[`Brdf::eval_prepared`], prepared once per run. At ≈ 1.5 evaluations per
-/// sample, 256 queries are ≈ 390 evaluations, around the RGL slice's measured break-even
-/// (docs/benchmarks.md §24.3).
-pub(super) const PREPARED_RUN_MIN: usize = 256;
+/// [`Brdf::prepare`]/[`Brdf::eval_prepared`], prepared once per run. The RGL slice's measured
+/// break-even (docs/benchmarks.md §24.3): its blend costs ≈ 2.1·10⁵ instructions and saves
+/// ≈ 270 per evaluation, ≈ 760 evaluations, ≈ 500 queries at ≈ 1.5 evaluations per sample.
+pub(super) const PREPARED_RUN_MIN: usize = 512;
 
 /// A query located by the isotropic fast path or the general one.
 #[derive(Clone, Copy)]
@@ -460,7 +460,7 @@ mod tests {
             let mut random =
                 || brdf::direction_from_angles(89.0 * qr.next_uniform(), 360.0 * qr.next_uniform());
             let mut wos = Vec::new();
-            for len in [1, 2, 5, 64, 300, 1, 700, 3, 255, 256] {
+            for len in [1, 2, 5, 64, 600, 1, 700, 3, 511, 512] {
                 let wo = random();
                 wos.extend(std::iter::repeat_n(wo, len));
             }
@@ -475,7 +475,7 @@ mod tests {
                 4,
             ));
             // The same ωo again after another: a run of its own.
-            wos.extend(std::iter::repeat_n(a, 280));
+            wos.extend(std::iter::repeat_n(a, 530));
 
             let before = phong.run_evals.load(Relaxed);
             let mut r1 = Xoshiro256PlusPlus::seed_from_u64(3);
@@ -503,12 +503,14 @@ mod tests {
             assert_eq!(r1.next_uniform(), r2.next_uniform(), "{}", brdf.name());
             assert!(order.len() == wos.len() - 4);
             if brdf.is_isotropic() {
-                // The runs of ≥ PREPARED_RUN_MIN queries at θo ≤ 89.99° (300, 700, 256, 280
+                // The runs of ≥ PREPARED_RUN_MIN queries at θo ≤ 89.99° (600, 700, 512, 530
                 // queries at ≈ 1.5 evaluations each) went through the run; no other did.
-                assert!(PREPARED_RUN_MIN <= 256);
-                assert!(through_runs > 1536, "{through_runs}");
+                assert_eq!(PREPARED_RUN_MIN, 512);
+                assert!(through_runs > 2342, "{through_runs}");
                 let again = phong.run_evals.load(Relaxed);
-                let short: Vec<Vec3> = wos.iter().copied().take(72).collect();
+                // The runs of 1 to 64 and the run of 511 (PREPARED_RUN_MIN − 1) queries.
+                let short: Vec<Vec3> = wos[..72].iter().chain(&wos[1376..1887]).copied().collect();
+                assert_eq!(short[72..].iter().filter(|w| **w == short[72]).count(), 511);
                 set.sample_eval_batch(brdf.as_ref(), &short, &mut r1, &mut out);
                 assert_eq!(phong.run_evals.load(Relaxed), again);
             } else {

@@ -146,11 +146,18 @@ impl BilinearTable {
     /// caller passes slices that exist.
     pub(crate) fn blend_slice(&self, s: usize, stride: usize, w: f64) -> BilinearTable {
         let n = self.slice_len();
-        BilinearTable::new(
-            self.nx,
-            self.ny,
-            (0..n).map(|k| self.blend(s, stride, w, k)).collect(),
-        )
+        let a = &self.data[s * n..(s + 1) * n];
+        let data = if w == 0.0 {
+            a.to_vec()
+        } else {
+            let b = &self.data[(s + stride) * n..(s + stride + 1) * n];
+            // `blend`'s expression over whole slices (no per-entry index checks: vectorised).
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| (1.0 - w) * a + w * b)
+                .collect()
+        };
+        BilinearTable::new(self.nx, self.ny, data)
     }
 
     /// [`eval`](Self::eval) of a one-slice table (slice 0, no blend).
@@ -395,8 +402,8 @@ impl Warp2D {
             nx: self.nx,
             ny,
             area_scale: self.area_scale(),
-            cells: (0..n).map(|k| self.cell_at(s, w, k)).collect(),
-            rows: (0..ny).map(|y| self.row_at(s, w, y)).collect(),
+            cells: blend_slices(&self.cells, n, s, w),
+            rows: blend_slices(&self.rows, ny, s, w),
         }
     }
 }
@@ -464,6 +471,21 @@ fn invert_on(
     };
     let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
     ([ux, uy], pdf)
+}
+
+/// Every entry of the blend of slices `s` (weight `1 − w`) and `s + 1` (weight `w`) of `data`,
+/// slices of `n` entries: [`blend_pair`]'s values over whole slices (no per-entry index
+/// checks, so the loop is vectorised).
+fn blend_slices(data: &[[f64; 2]], n: usize, s: usize, w: f64) -> Vec<[f64; 2]> {
+    let a = &data[s * n..(s + 1) * n];
+    if w == 0.0 {
+        return a.to_vec();
+    }
+    let b = &data[(s + 1) * n..(s + 2) * n];
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| [(1.0 - w) * a[0] + w * b[0], (1.0 - w) * a[1] + w * b[1]])
+        .collect()
 }
 
 /// Entry `k` of the blend of slices `s` (weight `1 − w`) and `s + 1` (weight `w`) of `data`,
