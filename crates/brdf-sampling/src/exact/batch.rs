@@ -438,7 +438,7 @@ mod tests {
     /// one-query path (`sample_eval`) returns when called in the batch's serving order (by
     /// interval, the caller's order within one) from the same seed — `ωi`, pdf and `f` — and
     /// leaves the stream in the same state. Runs of 1 to 700 queries, alternating `ωo` (runs
-    /// of 1), grazing and below-horizon runs; on Phong with a caller-held run (used by the
+    /// of 1), two runs at one θo and two azimuths, grazing and below-horizon runs; on Phong with a caller-held run (used by the
     /// runs of at least [`PREPARED_RUN_MIN`] only) and on anisotropic Ward (the general path).
     #[test]
     fn runs_of_one_wo_draw_the_one_query_paths_bits() {
@@ -473,6 +473,15 @@ mod tests {
             wos.extend(std::iter::repeat_n(
                 brdf::direction_from_angles(95.0, 10.0),
                 4,
+            ));
+            // Runs at one θo and two azimuths (the same cos θo bits).
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(40.0, 10.0),
+                5,
+            ));
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(40.0, 200.0),
+                5,
             ));
             // The same ωo again after another: a run of its own.
             wos.extend(std::iter::repeat_n(a, 530));
