@@ -448,10 +448,12 @@ mod tests {
             run_evals: AtomicU64::new(0),
         });
         let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
-        let mut small = ExactOptions::default();
-        small.max_trials = 8.0;
-        small.normaliser_tol = 1e-3;
-        small.initial_phi_cells = 4;
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
         let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
             [(phong.clone(), ExactOptions::default()), (ward, small)];
         for (brdf, opts) in cases {
