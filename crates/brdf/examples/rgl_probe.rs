@@ -1,9 +1,69 @@
 //! Prints a few values and albedos of an RGL file (development probe).
-use brdf::{Brdf, RglBrdf, direction_from_angles, directional_albedo};
+//!
+//! `rgl_probe FILE evals N THETA_DEG slice|blended`: only `N` evaluations at one prepared `ωo`
+//! of elevation `THETA_DEG` and random `ωi` (fixed seed), through a [`brdf::measured::rgl::PreparedSlice`]
+//! of that θo or through the two-slice tables; prints their sum (for instruction counts:
+//! `valgrind --tool=cachegrind --cache-sim=no` at two `N`, the difference over the extra `N`).
+//! `rgl_probe FILE blends N THETA_DEG`: only `N` caller-held runs ([`Brdf::prepare_run`]) at
+//! that θo, one evaluation each (the cost of blending a slice, by the same difference).
+use brdf::{Brdf, RglBrdf, Vec3, direction_from_angles, directional_albedo};
+
+/// `N` evaluations at one θo (see the module docs).
+fn evals(b: &RglBrdf, n: usize, theta: f64, slice: bool) {
+    let wo = direction_from_angles(theta, 0.0);
+    let q = b.prepare(&wo);
+    // A slice of another θo is never used: the two-slice path.
+    let p = b.prepare_slice(&if slice {
+        wo
+    } else {
+        direction_from_angles(theta + 7.0, 0.0)
+    });
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut acc = 0.0;
+    for _ in 0..n {
+        let z = 1.0 - uniform();
+        let phi = std::f64::consts::TAU * uniform();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        acc += b.eval_in_slice(&p, &q, &Vec3::new(r * phi.cos(), r * phi.sin(), z));
+    }
+    println!(
+        "{n} evaluations at θo {theta}° ({}): sum {acc}",
+        if slice { "slice" } else { "blended" }
+    );
+}
+
 fn main() {
     let path = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "data/measured/rgl/paper_white_rgb.bsdf".into());
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(2).map(String::as_str) == Some("blends") {
+        let b = RglBrdf::load(std::path::Path::new(&path)).unwrap();
+        let n: usize = args[3].parse().unwrap();
+        let theta: f64 = args[4].parse().unwrap();
+        let wi = direction_from_angles(20.0, 40.0);
+        let mut acc = 0.0;
+        for k in 0..n {
+            // A new θo bit pattern per run (the blend is made again every time).
+            let wo = direction_from_angles(theta + 1e-9 * k as f64, 0.0);
+            acc += b.prepare_run(&wo).map_or(0.0, |r| r.eval(&wi));
+        }
+        println!("{n} runs at θo {theta}°: sum {acc}");
+        return;
+    }
+    if args.get(2).map(String::as_str) == Some("evals") {
+        let b = RglBrdf::load(std::path::Path::new(&path)).unwrap();
+        let n = args[3].parse().unwrap();
+        let theta = args[4].parse().unwrap();
+        evals(&b, n, theta, args[5] == "slice");
+        return;
+    }
     let t = std::time::Instant::now();
     let b = RglBrdf::load(std::path::Path::new(&path)).unwrap();
     println!(

@@ -58,6 +58,18 @@ pub trait Brdf: Send + Sync {
         self.eval(q.wo(), wi)
     }
 
+    /// `f_r(ωo, ·)` prepared for a **run** of many evaluations at one outgoing direction (a
+    /// batch of queries that share `ωo`: a pixel's samples, a fixed-`ωo` benchmark), held by
+    /// the caller for the run: its [`PreparedRun::eval`]`(wi)` equals
+    /// [`eval`](Brdf::eval)`(wo, wi)` bit for bit. Worth asking only when the run is long
+    /// enough to repay the preparation (a BRDF may precompute a whole slice of its tables).
+    /// The default is `None`: callers then use [`prepare`](Brdf::prepare) and
+    /// [`eval_prepared`](Brdf::eval_prepared).
+    fn prepare_run(&self, wo: &Vec3) -> Option<Box<dyn PreparedRun + '_>> {
+        let _ = wo;
+        None
+    }
+
     /// True when `f_r` is invariant under a common rotation of `wo` and `wi` about the normal.
     /// Default `false` (the safe answer for samplers).
     fn is_isotropic(&self) -> bool {
@@ -127,6 +139,13 @@ pub trait Brdf: Send + Sync {
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         None
     }
+}
+
+/// `f_r(ωo, ·)` at one outgoing direction, prepared by [`Brdf::prepare_run`] for a run of
+/// evaluations there and held by the caller (no thread-local or shared state).
+pub trait PreparedRun: Send + Sync {
+    /// `f_r(ωo, ωi)` at the run's `ωo`: [`Brdf::eval`]`(wo, wi)` bit for bit.
+    fn eval(&self, wi: &Vec3) -> f64;
 }
 
 /// An outgoing direction `ωo` with up to [`Outgoing::CACHE_LEN`] values a BRDF derived from it
@@ -215,6 +234,9 @@ macro_rules! forward_brdf {
             #[inline]
             fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
                 (**self).eval_prepared(q, wi)
+            }
+            fn prepare_run(&self, wo: &Vec3) -> Option<Box<dyn PreparedRun + '_>> {
+                (**self).prepare_run(wo)
             }
             forward_brdf_queries!(self => (**self));
         }

@@ -49,9 +49,27 @@ impl Brdf for CountingBrdf {
         EVALUATIONS.with(|c| c.set(c.get() + 1));
         self.0.eval_prepared(q, wi)
     }
+    /// The wrapped model's run, each of its evaluations counted.
+    fn prepare_run(&self, wo: &Vec3) -> Option<Box<dyn crate::PreparedRun + '_>> {
+        self.0
+            .prepare_run(wo)
+            .map(|run| Box::new(CountedRun(run)) as Box<dyn crate::PreparedRun + '_>)
+    }
     // `prepare` is forwarded too (no evaluation, not counted), so a sampler keeps the wrapped
     // model's prepared fast path.
     crate::brdf::forward_brdf_queries!(self => self.0);
+}
+
+/// A [`PreparedRun`](crate::PreparedRun) whose evaluations are counted like
+/// [`CountingBrdf`]'s.
+struct CountedRun<'a>(Box<dyn crate::PreparedRun + 'a>);
+
+impl crate::PreparedRun for CountedRun<'_> {
+    #[inline]
+    fn eval(&self, wi: &Vec3) -> f64 {
+        EVALUATIONS.with(|c| c.set(c.get() + 1));
+        self.0.eval(wi)
+    }
 }
 
 #[cfg(test)]

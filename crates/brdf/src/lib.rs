@@ -53,7 +53,7 @@ pub mod special;
 #[cfg(test)]
 mod test_support;
 
-pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, Outgoing, luminance};
+pub use crate::brdf::{Brdf, LUMINANCE_WEIGHTS, Outgoing, PreparedRun, luminance};
 pub use analytic::{AnalyticLobes, SpecularLobe};
 pub use counting::{CountingBrdf, thread_evaluations};
 pub use geometry::{

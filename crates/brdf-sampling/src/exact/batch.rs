@@ -4,17 +4,64 @@
 //! turn, so an interval's tree, alias table and normaliser stay in cache for its group instead
 //! of being fetched again for every query when ωo changes from pixel to pixel.
 
-use brdf::{Brdf, Vec3};
-use partition_sampler::{Audit, UniformSource};
+use brdf::{Brdf, PreparedRun, Vec3};
+use partition_sampler::diagnostics::AuditedDraws;
+use partition_sampler::{Audit, Point2, UniformSource};
 
+use super::density::QueryDensity;
 use super::fused::IsoQuery;
 use super::{ExactSet, Query};
-use crate::EvalSample;
+use crate::disc::{DiscMap, count_evaluations};
+use crate::layout::Turn;
+use crate::{DirSample, EvalSample};
+
+/// Runs of at least this many consecutive queries at one `ωo` (the same bits) on the
+/// isotropic fast path draw their trials through the BRDF's caller-held
+/// [`Brdf::prepare_run`] (for RGL files a blended `θo` slice, ≈ 3.4·10⁴ table entries read
+/// once); shorter runs, and BRDFs without one, evaluate through
+/// [`Brdf::prepare`]/[`Brdf::eval_prepared`], prepared once per run. The RGL slice's measured
+/// break-even (docs/benchmarks.md §24.3): its blend costs ≈ 2.1·10⁵ instructions and saves
+/// ≈ 270 per evaluation, ≈ 760 evaluations, ≈ 500 queries at ≈ 1.5 evaluations per sample.
+pub(super) const PREPARED_RUN_MIN: usize = 512;
 
 /// A query located by the isotropic fast path or the general one.
+#[derive(Clone, Copy)]
 enum Located {
     Iso(IsoQuery),
     General(Query),
+}
+
+/// The bits of a direction: queries of one run share them.
+#[inline]
+fn bits(wo: &Vec3) -> [u64; 3] {
+    [wo.x.to_bits(), wo.y.to_bits(), wo.z.to_bits()]
+}
+
+/// One trial point's density at a run's prepared `ωo`: [`QueryDensity::at`] (no rotation: the
+/// isotropic frame) with the evaluation through the run, the same value bit for bit.
+#[inline]
+fn run_density(run: &dyn PreparedRun, map: DiscMap, p: Point2) -> f64 {
+    let r2 = p[0] * p[0] + p[1] * p[1];
+    if !(r2 < 1.0) {
+        return 0.0;
+    }
+    count_evaluations(1);
+    let v = map.to_direction(p);
+    let f = run.eval(&v);
+    match map {
+        DiscMap::Projected => f,
+        DiscMap::EqualArea => 2.0 * v.z * f,
+    }
+}
+
+/// The per-run part of an isotropic query ([`ExactSet::draw_iso`]'s, made once).
+struct IsoRun<'a> {
+    q: &'a IsoQuery,
+    wo: &'a Vec3,
+    /// The normaliser at the query's `cos θo`.
+    a: f64,
+    /// The rotation from the interval's frame back to the world.
+    turn: Turn,
 }
 
 impl ExactSet {
@@ -30,12 +77,29 @@ impl ExactSet {
         offsets
     }
 
+    /// The located query of `wo` and its group (the interval's index in the set's list).
+    #[inline]
+    fn locate_grouped(&self, wo: &Vec3, offsets: &[usize]) -> Option<(Located, usize)> {
+        match self.locate_iso(wo) {
+            Some(q) => Some((Located::Iso(q), q.interval)),
+            None => self
+                .locate(wo)
+                .map(|q| (Located::General(q), offsets[q.cell] + q.interval)),
+        }
+    }
+
     /// The batch path: `out[k]` for `wos[k]`. Queries are located, counted per interval and
     /// served group by group in the order of the intervals (queries of one interval in the
     /// caller's order); the uniforms are consumed in that order. Queries at or below the
     /// horizon get [`EvalSample::NONE`] and consume nothing. Each sample is drawn by the
-    /// one-query path's code ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so its
-    /// law is the same.
+    /// one-query path's arithmetic ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so
+    /// its law is the same, and from the same uniforms the same bits.
+    ///
+    /// **Runs of one `ωo`** (consecutive queries with the same bits: a pixel's samples, a
+    /// fixed-`ωo` benchmark) are located once, and their per-query work — the BRDF's
+    /// preparation, the normaliser, the rotation back to the world — is done once per run;
+    /// runs of at least [`PREPARED_RUN_MIN`] queries on the isotropic fast path evaluate
+    /// their trials through the BRDF's [`Brdf::prepare_run`] when it has one.
     pub(super) fn sample_eval_grouped(
         &self,
         brdf: &dyn Brdf,
@@ -48,16 +112,16 @@ impl ExactSet {
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
         // Isotropic queries by the fast path's locate (`ExactSet::locate_iso`), the others
-        // (anisotropic, grazing) by the general one.
-        let located: Vec<Option<(Located, usize)>> = wos
-            .iter()
-            .map(|wo| match self.locate_iso(wo) {
-                Some(q) => Some((Located::Iso(q), q.interval)),
-                None => self
-                    .locate(wo)
-                    .map(|q| (Located::General(q), offsets[q.cell] + q.interval)),
-            })
-            .collect();
+        // (anisotropic, grazing) by the general one; a query with its predecessor's bits takes
+        // its location.
+        let mut located: Vec<Option<(Located, usize)>> = Vec::with_capacity(wos.len());
+        for (k, wo) in wos.iter().enumerate() {
+            let l = match k.checked_sub(1) {
+                Some(j) if bits(&wos[j]) == bits(wo) => located[j],
+                _ => self.locate_grouped(wo, &offsets),
+            };
+            located.push(l);
+        }
         // Counting sort of the located queries by interval (stable).
         let mut start = vec![0usize; groups + 1];
         for (_, g) in located.iter().flatten() {
@@ -74,23 +138,176 @@ impl ExactSet {
             }
         }
         let mut audit = Audit::default();
-        for &k in &order {
-            let Some((q, _)) = &located[k] else {
-                continue;
+        // Runs in the serving order: queries of one `ωo` share their interval, so a run of
+        // the caller's order stays one run here.
+        let mut a = 0;
+        while a < order.len() {
+            let key = bits(&wos[order[a]]);
+            let mut b = a + 1;
+            while b < order.len() && bits(&wos[order[b]]) == key {
+                b += 1;
+            }
+            let run = &order[a..b];
+            let Some((q, _)) = located[run[0]] else {
+                unreachable!("only located queries are ordered")
             };
-            let wo = &wos[k];
-            out[k] = match q {
-                Located::Iso(q) => {
-                    let (s, f) = self.draw_iso(q, wo, u, &mut audit);
-                    self.finish_iso(brdf, wo, s, f)
-                }
+            let wo = &wos[run[0]];
+            match q {
+                Located::Iso(q) => self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out),
                 Located::General(q) => {
-                    let (s, f) = self.draw_located(q, wo, u, &mut audit);
-                    self.finish(brdf, wo, s, f)
+                    self.serve_general_run(brdf, &q, wo, run, u, &mut audit, out)
                 }
-            };
+            }
+            a = b;
         }
         self.counters.record(&audit);
+    }
+
+    /// The queries `run` (indices into `out`) of one isotropic query `q` at `wo`:
+    /// [`ExactSet::draw_iso`]'s arithmetic with its per-query part done once.
+    #[allow(clippy::too_many_arguments)]
+    fn serve_iso_run(
+        &self,
+        brdf: &dyn Brdf,
+        q: &IsoQuery,
+        wo: &Vec3,
+        run: &[usize],
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
+        let cell = &self.cells[0];
+        let iv = &cell.intervals[q.interval];
+        let rec = &cell.iso[q.interval];
+        let frame = Vec3::new(q.r, 0.0, q.cos);
+        let a = rec.normaliser(q.cos, iv);
+        let turn = if q.r > 0.0 {
+            Turn {
+                cos: wo.x / q.r,
+                sin: wo.y / q.r,
+            }
+        } else {
+            Turn::IDENTITY
+        };
+        let prepared = if run.len() >= PREPARED_RUN_MIN {
+            self.brdf.prepare_run(&frame)
+        } else {
+            None
+        };
+        let at = IsoRun { q, wo, a, turn };
+        match prepared {
+            Some(p) => {
+                let g = |x| run_density(p.as_ref(), rec.map, x);
+                self.serve_iso_with(brdf, &at, &g, run, u, audit, out);
+            }
+            None => {
+                let g = QueryDensity::in_frame(
+                    self.brdf.as_ref(),
+                    true,
+                    &frame,
+                    Turn::IDENTITY,
+                    rec.map,
+                );
+                self.serve_iso_with(brdf, &at, &|x| g.at(x), run, u, audit, out);
+            }
+        }
+    }
+
+    /// [`ExactSet::serve_iso_run`]'s draws with the trials' density `g`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn serve_iso_with<G: Fn(Point2) -> f64>(
+        &self,
+        brdf: &dyn Brdf,
+        at: &IsoRun<'_>,
+        g: &G,
+        run: &[usize],
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
+        let cell = &self.cells[0];
+        let iv = &cell.intervals[at.q.interval];
+        let rec = &cell.iso[at.q.interval];
+        let table = cell.tables[at.q.interval].as_ref();
+        for &k in run {
+            let drawn = match table {
+                Some(table) => table.draw(g, u, audit),
+                None => iv.tree.sample_envelope_of(g, u, audit),
+            };
+            let (s, f) = match drawn {
+                Some((x, gx)) => {
+                    let d = rec.map.to_direction(x);
+                    let s = DirSample {
+                        wi: at.turn.apply(&d),
+                        pdf: rec.map.area_to_solid_angle(gx / at.a, &d),
+                    };
+                    let f = match rec.map {
+                        DiscMap::Projected => gx,
+                        DiscMap::EqualArea => gx / (2.0 * d.z),
+                    };
+                    (s, f)
+                }
+                None => (
+                    DirSample {
+                        wi: Vec3::new(0.0, 0.0, 1.0),
+                        pdf: 0.0,
+                    },
+                    f64::NAN,
+                ),
+            };
+            out[k] = self.finish_iso(brdf, at.wo, s, f);
+        }
+    }
+
+    /// The queries `run` of one general query `q` at `wo`: [`ExactSet::draw_located`]'s
+    /// arithmetic with the query density and the normaliser made once.
+    #[allow(clippy::too_many_arguments)]
+    fn serve_general_run(
+        &self,
+        brdf: &dyn Brdf,
+        q: &Query,
+        wo: &Vec3,
+        run: &[usize],
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
+        let iv = self.interval(q);
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
+        let g = |p| g.at(p);
+        let a = iv.normaliser(self.var, q);
+        let served = q.wo == *wo;
+        let table = self.cells[q.cell].tables[q.interval].as_ref();
+        for &k in run {
+            let drawn = match table {
+                Some(table) => table.draw(&g, u, audit),
+                None => iv.tree.sample_envelope_of(&g, u, audit),
+            };
+            out[k] = match drawn {
+                Some((x, gx)) => {
+                    let v = iv.map.to_direction(x);
+                    let s = DirSample {
+                        wi: q.turn.apply(&v),
+                        pdf: iv.map.area_to_solid_angle(gx / a, &v),
+                    };
+                    let f = match iv.map {
+                        DiscMap::Projected => gx,
+                        DiscMap::EqualArea => gx / (2.0 * v.z),
+                    };
+                    self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
+                }
+                None => self.finish(
+                    brdf,
+                    wo,
+                    DirSample {
+                        wi: Vec3::new(0.0, 0.0, 1.0),
+                        pdf: 0.0,
+                    },
+                    None,
+                ),
+            };
+        }
     }
 }
 
@@ -98,7 +315,9 @@ impl ExactSet {
 mod tests {
     use std::sync::Arc;
 
-    use brdf::{Brdf, Vec3, parse_spec};
+    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+    use brdf::{Brdf, Outgoing, PreparedRun, Vec3, parse_spec};
     use partition_sampler::UniformSource;
     use rand::SeedableRng;
     use rand::rngs::Xoshiro256PlusPlus;
@@ -165,6 +384,149 @@ mod tests {
             let a = crate::reference_albedo(brdf.as_ref(), wo).unwrap().value;
             let z = (mean - cos2 / a) / (var / n).sqrt();
             assert!(z.abs() < 5.0, "θo {}: mean {mean}, z = {z}", angles[j]);
+        }
+    }
+
+    /// Phong with a caller-held run ([`Brdf::prepare_run`]) that counts its evaluations: the
+    /// run's values are `eval`'s by construction, so what is tested is the batch path's use of
+    /// it.
+    struct WithRun {
+        inner: Arc<dyn Brdf>,
+        run_evals: AtomicU64,
+    }
+
+    struct Run<'a> {
+        brdf: &'a WithRun,
+        wo: Vec3,
+    }
+
+    impl PreparedRun for Run<'_> {
+        fn eval(&self, wi: &Vec3) -> f64 {
+            self.brdf.run_evals.fetch_add(1, Relaxed);
+            self.brdf.inner.eval(&self.wo, wi)
+        }
+    }
+
+    impl Brdf for WithRun {
+        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            self.inner.eval(wo, wi)
+        }
+        fn prepare(&self, wo: &Vec3) -> Outgoing {
+            self.inner.prepare(wo)
+        }
+        fn eval_prepared(&self, q: &Outgoing, wi: &Vec3) -> f64 {
+            self.inner.eval_prepared(q, wi)
+        }
+        fn prepare_run(&self, wo: &Vec3) -> Option<Box<dyn PreparedRun + '_>> {
+            Some(Box::new(Run {
+                brdf: self,
+                wo: *wo,
+            }))
+        }
+        fn is_isotropic(&self) -> bool {
+            self.inner.is_isotropic()
+        }
+        fn is_mirror_symmetric(&self) -> bool {
+            self.inner.is_mirror_symmetric()
+        }
+        fn is_half_turn_symmetric(&self) -> bool {
+            self.inner.is_half_turn_symmetric()
+        }
+    }
+
+    /// Runs of one `ωo` (the same bits) in the batch: the batch returns, bit for bit, what the
+    /// one-query path (`sample_eval`) returns when called in the batch's serving order (by
+    /// interval, the caller's order within one) from the same seed — `ωi`, pdf and `f` — and
+    /// leaves the stream in the same state. Runs of 1 to 700 queries, alternating `ωo` (runs
+    /// of 1), two runs at one θo and two azimuths, grazing and below-horizon runs; on Phong with a caller-held run (used by the
+    /// runs of at least [`PREPARED_RUN_MIN`] only) and on anisotropic Ward (the general path).
+    #[test]
+    fn runs_of_one_wo_draw_the_one_query_paths_bits() {
+        use super::PREPARED_RUN_MIN;
+        let phong = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+        });
+        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
+        let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
+            [(phong.clone(), ExactOptions::default()), (ward, small)];
+        for (brdf, opts) in cases {
+            let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+            let mut qr = Xoshiro256PlusPlus::seed_from_u64(21);
+            let mut random =
+                || brdf::direction_from_angles(89.0 * qr.next_uniform(), 360.0 * qr.next_uniform());
+            let mut wos = Vec::new();
+            for len in [1, 2, 5, 64, 600, 1, 700, 3, 511, 512] {
+                let wo = random();
+                wos.extend(std::iter::repeat_n(wo, len));
+            }
+            let (a, b) = (random(), random());
+            wos.extend((0..40).map(|k| if k % 2 == 0 { a } else { b }));
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(89.995, 10.0),
+                300,
+            ));
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(95.0, 10.0),
+                4,
+            ));
+            // Runs at one θo and two azimuths (the same cos θo bits).
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(40.0, 10.0),
+                5,
+            ));
+            wos.extend(std::iter::repeat_n(
+                brdf::direction_from_angles(40.0, 200.0),
+                5,
+            ));
+            // The same ωo again after another: a run of its own.
+            wos.extend(std::iter::repeat_n(a, 530));
+
+            let before = phong.run_evals.load(Relaxed);
+            let mut r1 = Xoshiro256PlusPlus::seed_from_u64(3);
+            let mut out = Vec::new();
+            set.sample_eval_batch(brdf.as_ref(), &wos, &mut r1, &mut out);
+            let through_runs = phong.run_evals.load(Relaxed) - before;
+
+            // The serving order: by interval (the set's list), the caller's order within one.
+            let offsets = set.interval_offsets();
+            let mut order: Vec<(usize, usize)> = wos
+                .iter()
+                .enumerate()
+                .filter_map(|(k, wo)| set.locate_grouped(wo, &offsets).map(|(_, g)| (g, k)))
+                .collect();
+            order.sort_by_key(|&(g, _)| g);
+            let mut r2 = Xoshiro256PlusPlus::seed_from_u64(3);
+            let mut expected = vec![EvalSample::NONE; wos.len()];
+            for &(_, k) in &order {
+                expected[k] = set.sample_eval(brdf.as_ref(), &wos[k], &mut r2);
+            }
+            let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
+            for (k, (o, e)) in out.iter().zip(&expected).enumerate() {
+                assert_eq!(key(o), key(e), "{} query {k}: {o:?} vs {e:?}", brdf.name());
+            }
+            assert_eq!(r1.next_uniform(), r2.next_uniform(), "{}", brdf.name());
+            assert!(order.len() == wos.len() - 4);
+            if brdf.is_isotropic() {
+                // The runs of ≥ PREPARED_RUN_MIN queries at θo ≤ 89.99° (600, 700, 512, 530
+                // queries at ≈ 1.5 evaluations each) went through the run; no other did.
+                assert_eq!(PREPARED_RUN_MIN, 512);
+                assert!(through_runs > 2342, "{through_runs}");
+                let again = phong.run_evals.load(Relaxed);
+                // The runs of 1 to 64 and the run of 511 (PREPARED_RUN_MIN − 1) queries.
+                let short: Vec<Vec3> = wos[..72].iter().chain(&wos[1376..1887]).copied().collect();
+                assert_eq!(short[72..].iter().filter(|w| **w == short[72]).count(), 511);
+                set.sample_eval_batch(brdf.as_ref(), &short, &mut r1, &mut out);
+                assert_eq!(phong.run_evals.load(Relaxed), again);
+            } else {
+                assert_eq!(through_runs, 0);
+            }
         }
     }
 }

@@ -21,8 +21,8 @@ use crate::{DirSample, EvalSample};
 #[derive(Debug, Clone, Copy)]
 pub(super) struct IsoQuery {
     pub(super) interval: usize,
-    r: f64,
-    cos: f64,
+    pub(super) r: f64,
+    pub(super) cos: f64,
 }
 
 impl ExactSet {

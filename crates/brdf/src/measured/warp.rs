@@ -140,6 +140,36 @@ impl BilinearTable {
 }
 
 impl BilinearTable {
+    /// The blend of slice `s` (weight `1 − w`) and slice `s + stride` (weight `w`) as a
+    /// one-slice table: each grid value is the one [`eval`](Self::eval) blends at every read,
+    /// so `blended.eval(pos, 0, 0, 0.0)` equals `eval(pos, s, stride, w)` bit for bit. The
+    /// caller passes slices that exist.
+    pub(crate) fn blend_slice(&self, s: usize, stride: usize, w: f64) -> BilinearTable {
+        let n = self.slice_len();
+        let a = &self.data[s * n..(s + 1) * n];
+        let data = if w == 0.0 {
+            a.to_vec()
+        } else {
+            let b = &self.data[(s + stride) * n..(s + stride + 1) * n];
+            // `blend`'s expression over whole slices (no per-entry index checks: vectorised).
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| (1.0 - w) * a + w * b)
+                .collect()
+        };
+        BilinearTable::new(self.nx, self.ny, data)
+    }
+
+    /// [`eval`](Self::eval) of a one-slice table (slice 0, no blend).
+    #[inline]
+    pub(crate) fn eval_single(&self, pos: [f64; 2]) -> f64 {
+        let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
+        let k = cy * self.nx + cx;
+        let d = &self.data;
+        let [v00, v10, v01, v11] = [d[k], d[k + 1], d[k + self.nx], d[k + self.nx + 1]];
+        (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
+    }
+
     /// [`eval`](Self::eval) of `N` consecutive slices `s, s + 1, …` (e.g. the channels of an
     /// RGB table), each blended with the slice `stride` further on: the cell of `pos` is found
     /// once.
@@ -345,6 +375,8 @@ impl Warp2D {
     /// [`invert`](Self::invert) for a parameter already located on the axis (`(s, w)` from
     /// [`ParamAxis::locate`] of this warp's axis).
     pub(crate) fn invert_located(&self, pos: [f64; 2], s: usize, w: f64) -> ([f64; 2], f64) {
+        // Main's code, not `invert_on`: the shared closure form measured ≈ 10 % slower on
+        // random-ωo evaluations (docs/benchmarks.md §24.3); the same arithmetic.
         let (cx, cy, fx, fy) = grid_cell(pos, self.nx, self.ny);
         let ([v00, v10, v01, v11], [along0, along1]) = self.corners(s, w, cx, cy);
         let [m0, r0] = self.row_at(s, w, cy);
@@ -362,6 +394,108 @@ impl Warp2D {
         let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
         ([ux, uy], pdf)
     }
+
+    /// The blend of slices `s` and `s + 1` with weight `w` (`(s, w)` from [`ParamAxis::locate`]
+    /// of this warp's axis, `s` clamped to the last pair) as one plain slice: every grid
+    /// point's value and row CDF, every row's marginal CDF and total, blended once by the very
+    /// expression [`invert_located`](Self::invert_located) evaluates at each read, so
+    /// [`Warp2DSlice::invert`] returns its values bit for bit.
+    pub(crate) fn blend_slice(&self, s: usize, w: f64) -> Warp2DSlice {
+        let (n, ny) = (self.nx * self.ny, self.ny);
+        let slices = self.cells.len() / n;
+        let (s, w) = if slices < 2 {
+            (0, 0.0)
+        } else {
+            (s.min(slices - 2), w)
+        };
+        Warp2DSlice {
+            nx: self.nx,
+            ny,
+            area_scale: self.area_scale(),
+            cells: blend_slices(&self.cells, n, s, w),
+            rows: blend_slices(&self.rows, ny, s, w),
+        }
+    }
+}
+
+/// One slice of a [`Warp2D`] blended at a fixed parameter ([`Warp2D::blend_slice`]): its
+/// inversion reads one plain slice instead of blending two at every read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Warp2DSlice {
+    nx: usize,
+    ny: usize,
+    area_scale: f64,
+    cells: Vec<[f64; 2]>,
+    rows: Vec<[f64; 2]>,
+}
+
+impl Warp2DSlice {
+    /// [`Warp2D::invert_located`] at the slice's parameter, bit for bit.
+    #[inline]
+    pub(crate) fn invert(&self, pos: [f64; 2]) -> ([f64; 2], f64) {
+        invert_on(
+            pos,
+            self.nx,
+            self.ny,
+            self.area_scale,
+            |k| self.cells[k],
+            |y| self.rows[y],
+        )
+    }
+
+    /// Heap bytes of the slice.
+    pub fn bytes_used(&self) -> usize {
+        16 * (self.cells.len() + self.rows.len())
+    }
+}
+
+/// The inversion `pos ↦ (F_{X|Y}(x | y), F_Y(y))` and the density at `pos`, on a slice whose
+/// grid point `k` is `cell(k)` (value, row CDF) and row `y` is `row(y)` (marginal CDF, row
+/// total): one arithmetic for the blended and the prepared slices.
+#[inline(always)]
+fn invert_on(
+    pos: [f64; 2],
+    nx: usize,
+    ny: usize,
+    area_scale: f64,
+    cell: impl Fn(usize) -> [f64; 2],
+    row: impl Fn(usize) -> [f64; 2],
+) -> ([f64; 2], f64) {
+    let (cx, cy, fx, fy) = grid_cell(pos, nx, ny);
+    let k = cy * nx + cx;
+    let [v00, along0] = cell(k);
+    let [v10, _] = cell(k + 1);
+    let [v01, along1] = cell(k + nx);
+    let [v11, _] = cell(k + nx + 1);
+    let [m0, r0] = row(cy);
+    let [_, r1] = row(cy + 1);
+    let c0 = (1.0 - fy) * v00 + fy * v01;
+    let c1 = (1.0 - fy) * v10 + fy * v11;
+    let pdf = ((1.0 - fx) * c0 + fx * c1) * area_scale;
+    let row_total = (1.0 - fy) * r0 + fy * r1;
+    let along = fx * (c0 + 0.5 * fx * (c1 - c0)) + (1.0 - fy) * along0 + fy * along1;
+    let ux = if row_total > 0.0 {
+        along / row_total
+    } else {
+        0.0
+    };
+    let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
+    ([ux, uy], pdf)
+}
+
+/// Every entry of the blend of slices `s` (weight `1 − w`) and `s + 1` (weight `w`) of `data`,
+/// slices of `n` entries: [`blend_pair`]'s values over whole slices (no per-entry index
+/// checks, so the loop is vectorised).
+fn blend_slices(data: &[[f64; 2]], n: usize, s: usize, w: f64) -> Vec<[f64; 2]> {
+    let a = &data[s * n..(s + 1) * n];
+    if w == 0.0 {
+        return a.to_vec();
+    }
+    let b = &data[(s + 1) * n..(s + 2) * n];
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| [(1.0 - w) * a[0] + w * b[0], (1.0 - w) * a[1] + w * b[1]])
+        .collect()
 }
 
 /// Entry `k` of the blend of slices `s` (weight `1 − w`) and `s + 1` (weight `w`) of `data`,
