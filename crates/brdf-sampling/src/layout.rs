@@ -42,6 +42,20 @@ impl Turn {
     /// No rotation (`Δ = 0`).
     pub const IDENTITY: Turn = Turn { cos: 1.0, sin: 0.0 };
 
+    /// The rotation by `wo`'s azimuth without trigonometry: `(cos φo, sin φo) = (x, y) / r`
+    /// for `r = |(wo.x, wo.y)|` (given), the identity at `r = 0` (the normal).
+    #[inline]
+    pub fn of_azimuth(wo: &Vec3, r: f64) -> Turn {
+        if r > 0.0 {
+            Turn {
+                cos: wo.x / r,
+                sin: wo.y / r,
+            }
+        } else {
+            Turn::IDENTITY
+        }
+    }
+
     /// The rotation by `angle` radians (counter-clockwise seen from +z).
     pub fn from_angle(angle: f64) -> Turn {
         let (sin, cos) = angle.sin_cos();

@@ -1327,22 +1327,28 @@ mod tests {
         assert!(lit > 20, "{lit} lit pixels");
     }
 
-    /// `Σ_p z_p²` of per-pixel differences between batch estimates `a` and one-query
-    /// estimates `b` (`spp` samples each), `z_p = (a_p − b_p) / √(2 s²_p / spp)` with `s²_p`
-    /// the one-query samples' variance (same law under the null), green channel; pixels whose
-    /// samples are all equal (no light reaches them) must agree exactly and are not counted.
-    /// Returns `(statistic, pixels counted)`.
-    /// `lambert` and `phong:n=20` with `sampler` built for each (8 slices where it has them).
+    /// `lambert` and `phong:n=20` with `sampler` built for each (8 slices where it has them);
+    /// with `counted`, each BRDF wrapped in the study's evaluation counter and the sampler built
+    /// **with that wrapped object** (as the study builds them).
     #[allow(clippy::type_complexity)]
-    fn lambert_and_phong_with(
+    fn lambert_and_phong_built(
         sampler: &str,
+        counted: bool,
     ) -> (
         Vec<std::sync::Arc<dyn Brdf>>,
         Vec<std::sync::Arc<dyn DirectionSampler>>,
     ) {
         let brdfs: Vec<std::sync::Arc<dyn Brdf>> = ["lambert", "phong:n=20"]
             .iter()
-            .map(|s| std::sync::Arc::from(brdf::parse_spec(s).unwrap()))
+            .map(|s| {
+                let raw: std::sync::Arc<dyn Brdf> =
+                    std::sync::Arc::from(brdf::parse_spec(s).unwrap());
+                if counted {
+                    std::sync::Arc::new(crate::CountingBrdf(raw)) as std::sync::Arc<dyn Brdf>
+                } else {
+                    raw
+                }
+            })
             .collect();
         let options = brdf_sampling::SetOptions {
             slices: 8,
@@ -1418,7 +1424,7 @@ mod tests {
     fn the_batched_mis_render_has_the_law_of_the_per_pixel_one_and_a_misordered_batch_fails() {
         use statrs::distribution::{ChiSquared, ContinuousCDF};
         let light = Light::parse("area:theta=30,phi=180,radius=10").unwrap();
-        let (brdfs, built) = lambert_and_phong_with("adaptive-exact");
+        let (brdfs, built) = lambert_and_phong_built("adaptive-exact", false);
         let light_sampler = LightSampler::new(&light).unwrap();
         let px = 10;
         let hs = hits(2, px);
@@ -1470,41 +1476,6 @@ mod tests {
         }
     }
 
-    /// `lambert` and `phong:n=20` wrapped in the study's evaluation counter, and `sampler`
-    /// built for each **with that wrapped object** (as the study builds them), 8 slices.
-    #[allow(clippy::type_complexity)]
-    fn counted_lambert_and_phong_with(
-        sampler: &str,
-    ) -> (
-        Vec<std::sync::Arc<dyn Brdf>>,
-        Vec<std::sync::Arc<dyn DirectionSampler>>,
-    ) {
-        let brdfs: Vec<std::sync::Arc<dyn Brdf>> = ["lambert", "phong:n=20"]
-            .iter()
-            .map(|s| {
-                let raw: std::sync::Arc<dyn Brdf> =
-                    std::sync::Arc::from(brdf::parse_spec(s).unwrap());
-                std::sync::Arc::new(crate::CountingBrdf(raw)) as std::sync::Arc<dyn Brdf>
-            })
-            .collect();
-        let options = brdf_sampling::SetOptions {
-            slices: 8,
-            ..Default::default()
-        };
-        let built = brdfs
-            .iter()
-            .map(|b| {
-                samplers::build_direction(
-                    sampler,
-                    &samplers::DirectionRequest::new(std::sync::Arc::clone(b), &options),
-                )
-                .unwrap()
-                .sampler
-            })
-            .collect();
-        (brdfs, built)
-    }
-
     /// The fused f (issue 29): on grey BRDFs the rows rendered with the batch's `f` equal the
     /// rows rendered with one `eval_rgb` per sample from the same seed — bit for bit for
     /// `cosine` (its `f` is that evaluation), to rounding for `adaptive-exact` (its accepted
@@ -1553,7 +1524,7 @@ mod tests {
             (out, crate::thread_evaluations() - before)
         };
         for sampler in ["cosine", "adaptive-exact"] {
-            let (brdfs, built) = counted_lambert_and_phong_with(sampler);
+            let (brdfs, built) = lambert_and_phong_built(sampler, true);
             assert_eq!(brdfs[1].rgb_scale(), Some([1.0; 3]));
             // Only a sampler whose `f` is free takes the fused path in the render.
             assert_eq!(built[1].fuses_eval(), sampler == "adaptive-exact");
@@ -1753,7 +1724,7 @@ mod tests {
             map: envmap::procedural_sky(64, 32).unwrap(),
             label: "sky".into(),
         };
-        let (brdfs, built) = lambert_and_phong_with("adaptive");
+        let (brdfs, built) = lambert_and_phong_built("adaptive", false);
         let light_sampler = LightSampler::new(&light).unwrap();
         assert!(matches!(light_sampler, LightSampler::Map(_)));
         let doubled = DoubledPdf(&light_sampler);

@@ -9,7 +9,7 @@ use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, Point2, UniformSource};
 
 use super::density::QueryDensity;
-use super::fused::IsoQuery;
+use super::fused::{IsoQuery, accepted};
 use super::{ExactSet, Query};
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
@@ -83,7 +83,7 @@ impl ExactSet {
         match self.locate_iso(wo) {
             Some(q) => Some((Located::Iso(q), q.interval)),
             None => self
-                .locate(wo)
+                .locate_keys(wo)
                 .map(|q| (Located::General(q), offsets[q.cell] + q.interval)),
         }
     }
@@ -181,14 +181,7 @@ impl ExactSet {
         let rec = &cell.iso[q.interval];
         let frame = Vec3::new(q.r, 0.0, q.cos);
         let a = rec.normaliser(q.cos, iv);
-        let turn = if q.r > 0.0 {
-            Turn {
-                cos: wo.x / q.r,
-                sin: wo.y / q.r,
-            }
-        } else {
-            Turn::IDENTITY
-        };
+        let turn = Turn::of_azimuth(wo, q.r);
         let prepared = if run.len() >= PREPARED_RUN_MIN {
             self.brdf.prepare_run(&frame)
         } else {
@@ -236,18 +229,7 @@ impl ExactSet {
                 None => iv.tree.sample_envelope_of(g, u, audit),
             };
             let (s, f) = match drawn {
-                Some((x, gx)) => {
-                    let d = rec.map.to_direction(x);
-                    let s = DirSample {
-                        wi: at.turn.apply(&d),
-                        pdf: rec.map.area_to_solid_angle(gx / at.a, &d),
-                    };
-                    let f = match rec.map {
-                        DiscMap::Projected => gx,
-                        DiscMap::EqualArea => gx / (2.0 * d.z),
-                    };
-                    (s, f)
-                }
+                Some((x, gx)) => accepted(rec.map, &at.turn, x, gx, at.a),
                 None => (
                     DirSample {
                         wi: Vec3::new(0.0, 0.0, 1.0),
@@ -276,7 +258,8 @@ impl ExactSet {
         let iv = self.interval(q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
         let g = |p| g.at(p);
-        let a = iv.normaliser(self.var, q);
+        // The one-query path's normaliser (the anisotropic records' patches, §24.2), bit for bit.
+        let a = self.normaliser_of(q);
         let served = q.wo == *wo;
         let table = self.cells[q.cell].tables[q.interval].as_ref();
         for &k in run {
@@ -286,15 +269,7 @@ impl ExactSet {
             };
             out[k] = match drawn {
                 Some((x, gx)) => {
-                    let v = iv.map.to_direction(x);
-                    let s = DirSample {
-                        wi: q.turn.apply(&v),
-                        pdf: iv.map.area_to_solid_angle(gx / a, &v),
-                    };
-                    let f = match iv.map {
-                        DiscMap::Projected => gx,
-                        DiscMap::EqualArea => gx / (2.0 * v.z),
-                    };
+                    let (s, f) = accepted(iv.map, &q.turn, x, gx, a);
                     self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
                 }
                 None => self.finish(

@@ -5,7 +5,7 @@
 //! [`DirectionSampler::sample_eval`]: crate::DirectionSampler::sample_eval
 
 use brdf::{Brdf, Vec3};
-use partition_sampler::{Audit, UniformSource};
+use partition_sampler::{Audit, Point2, UniformSource};
 
 use super::ExactSet;
 use super::density::QueryDensity;
@@ -73,14 +73,7 @@ impl ExactSet {
         // shadow of the trials' evaluations instead of after the loop's last, mispredicted
         // branch. Bit for bit the pdf's normaliser ([`IsoRecord::normaliser`]).
         let a = rec.normaliser(q.cos, iv);
-        let turn = if q.r > 0.0 {
-            Turn {
-                cos: wo.x / q.r,
-                sin: wo.y / q.r,
-            }
-        } else {
-            Turn::IDENTITY
-        };
+        let turn = Turn::of_azimuth(wo, q.r);
         let drawn = match &cell.tables[q.interval] {
             Some(table) => table.draw(&|p| g.at(p), u, audit),
             None => {
@@ -95,16 +88,7 @@ impl ExactSet {
             };
             return (none, f64::NAN);
         };
-        let d = rec.map.to_direction(x);
-        let s = DirSample {
-            wi: turn.apply(&d),
-            pdf: rec.map.area_to_solid_angle(gx / a, &d),
-        };
-        let f = match rec.map {
-            DiscMap::Projected => gx,
-            DiscMap::EqualArea => gx / (2.0 * d.z),
-        };
-        (s, f)
+        accepted(rec.map, &turn, x, gx, a)
     }
 
     /// [`ExactSet::finish`] for an accepted trial's `f` given as a number (NaN or infinite:
@@ -145,6 +129,24 @@ impl ExactSet {
             f,
         }
     }
+}
+
+/// The sample of an accepted trial at the disc point `x` with `g(x) = gx` and normaliser `a`:
+/// the direction `turn · map(x)`, its pdf `gx / a` in solid angle, and `f_r` there — `g` is
+/// `f_r` on the projected map and `2 f_r cos θi` on the equal-area one (`cos θi > 0` where a
+/// trial is accepted: `g > 0`).
+#[inline]
+pub(super) fn accepted(map: DiscMap, turn: &Turn, x: Point2, gx: f64, a: f64) -> (DirSample, f64) {
+    let d = map.to_direction(x);
+    let s = DirSample {
+        wi: turn.apply(&d),
+        pdf: map.area_to_solid_angle(gx / a, &d),
+    };
+    let f = match map {
+        DiscMap::Projected => gx,
+        DiscMap::EqualArea => gx / (2.0 * d.z),
+    };
+    (s, f)
 }
 
 /// True when `a` and `b` are the same BRDF object: same address **and** same vtable (a

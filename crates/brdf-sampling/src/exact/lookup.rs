@@ -5,7 +5,6 @@ use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, UniformSource};
 
 use crate::direction_sampler::DirSample;
-use crate::disc::DiscMap;
 use crate::layout::Turn;
 
 use super::density::QueryDensity;
@@ -74,14 +73,7 @@ impl ExactSet {
             // The rotation that takes the frame's ωo (at φ = 0) to the query's, without
             // trigonometry: (cos φo, sin φo) = (x, y)/r.
             let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
-            let turn = if r > 0.0 {
-                Turn {
-                    cos: wo.x / r,
-                    sin: wo.y / r,
-                }
-            } else {
-                Turn::IDENTITY
-            };
+            let turn = Turn::of_azimuth(wo, r);
             (0, turn, 0.0, 0.0)
         } else if let Some(found) = super::walk::cell_offset(
             wo,
@@ -194,17 +186,7 @@ impl ExactSet {
         match drawn {
             Some((x, gx)) => {
                 let a = self.normaliser_of(&q);
-                let v = iv.map.to_direction(x);
-                let s = DirSample {
-                    wi: q.turn.apply(&v),
-                    pdf: iv.map.area_to_solid_angle(gx / a, &v),
-                };
-                // `g` is `f` (projected map) or `2 f cos θi` (equal-area map, `v.z > 0` where
-                // a trial is accepted: `g > 0`).
-                let f = match iv.map {
-                    DiscMap::Projected => gx,
-                    DiscMap::EqualArea => gx / (2.0 * v.z),
-                };
+                let (s, f) = super::fused::accepted(iv.map, &q.turn, x, gx, a);
                 let served = q.wo == *wo;
                 (s, (served && f.is_finite()).then_some(f))
             }
