@@ -130,6 +130,10 @@ pub enum EnvMapError {
     /// The adaptive sampler's quadtree could not be built.
     #[error("cannot build the adaptive sampler's quadtree: {0}")]
     Build(#[from] partition_sampler::BuildError),
+    /// A tree of the adaptive sampler's tightening ladder did not re-attach to its density
+    /// (not expected: the tree was built from that density).
+    #[error("cannot attach the adaptive sampler's quadtree to its density: {0}")]
+    Attach(#[from] partition_sampler::AttachError),
     /// The piecewise-constant sampler rejected the luminance table.
     #[error("cannot build the piecewise-constant sampler: {0}")]
     PiecewiseConstant(#[from] distributions::PiecewiseConstantError),

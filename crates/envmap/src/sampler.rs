@@ -16,23 +16,50 @@ use crate::latlong::{direction_to_uv, pdf_uv_to_solid_angle, uv_to_direction};
 use crate::{EnvMap, EnvMapError};
 
 /// Parameters of the adaptive-partition sampler of a map: the partition sampler's own
-/// [`TreeParams`], with the environment-map default [`AdaptiveOptions::DEFAULT_N_MAX`].
+/// [`TreeParams`], with the environment-map default [`AdaptiveOptions::DEFAULT_N_MAX`], and the
+/// leaf budget of the tightening ladder ([`AdaptiveOptions::leaf_budget`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AdaptiveOptions {
     /// Split threshold, depth, scheme ([`Scheme::Envelope`] by default, exact) and leaf choice
-    /// ([`LeafChoice::Alias`] by default, O(1)).
+    /// ([`LeafChoice::Alias`] by default, O(1)). With a [`AdaptiveOptions::leaf_budget`],
+    /// `tree.n_max` is the loosest threshold of the ladder.
     pub tree: TreeParams,
+    /// The tightening ladder's leaf budget `B` (`None`: build at `tree.n_max` exactly).
+    ///
+    /// With `Some(B)` the sampler is built at the thresholds
+    /// `n_k = 1 + (n_max − 1) / 2^k`, `k = 0, 1, …, `[`AdaptiveOptions::LADDER_STEPS`], in turn,
+    /// and keeps the tree of the largest `k` whose leaves number at most `B` (the tree of
+    /// `k = 0` is kept whatever its size). Every tree samples the same exact density
+    /// `Y · sin(πv) / Î`; a tighter threshold only lowers the expected trials per sample
+    /// `E = Σ V_i / Σ I_i ≤ n_k` at the price of more leaf records (32 bytes each), which is
+    /// what the budget bounds. Other trees give other samples for the same seed (same law).
+    #[serde(default = "AdaptiveOptions::default_leaf_budget")]
+    pub leaf_budget: Option<usize>,
 }
 
 impl AdaptiveOptions {
     /// Default split threshold for environment maps: 1.6 rather than the generic
-    /// [`TreeParams::DEFAULT_N_MAX`] = 2.
+    /// [`TreeParams::DEFAULT_N_MAX`] = 2, the loosest rung of the tightening ladder.
     ///
     /// A map is tabulated, so its bounds are exact and deeper trees cost little: on the
     /// 1024×512 maps of `docs/benchmarks.md`, `n_max = 1.6` lowers the mean trials per sample
     /// from 1.33–1.78 to 1.19–1.35 and raises 2-thread throughput above 30 M samples/s on every
     /// map, while the build stays under 8 ms.
     pub const DEFAULT_N_MAX: f64 = 1.6;
+
+    /// Default leaf budget of the tightening ladder: 2¹⁶ leaves, i.e. 2 MiB of 32-byte leaf
+    /// records (one core's L2 on the host of `docs/benchmarks.md` §25.6, where the budget was
+    /// chosen from four 1024 × 512 maps: on the two whose tighter trees stay under it the
+    /// thread CPU per sample fell, on the one whose next rung has 82 171 leaves it rose).
+    pub const DEFAULT_LEAF_BUDGET: usize = 1 << 16;
+
+    /// Rungs of the ladder after the first: thresholds down to `1 + (n_max − 1) / 8`
+    /// (1.075 from the default 1.6).
+    pub const LADDER_STEPS: u32 = 3;
+
+    fn default_leaf_budget() -> Option<usize> {
+        Some(Self::DEFAULT_LEAF_BUDGET)
+    }
 
     /// The default options with another scheme and leaf choice.
     pub fn with_scheme(scheme: Scheme, leaf_choice: LeafChoice) -> Self {
@@ -41,16 +68,24 @@ impl AdaptiveOptions {
         o.tree.leaf_choice = leaf_choice;
         o
     }
+
+    /// The threshold of rung `k` of the ladder, `1 + (n_max − 1) / 2^k` (`n_max` itself for
+    /// `k = 0`).
+    pub fn ladder_threshold(&self, k: u32) -> f64 {
+        1.0 + (self.tree.n_max - 1.0) * 0.5f64.powi(k as i32)
+    }
 }
 
 impl Default for AdaptiveOptions {
-    /// [`TreeParams::default`] with `n_max = `[`AdaptiveOptions::DEFAULT_N_MAX`].
+    /// [`TreeParams::default`] with `n_max = `[`AdaptiveOptions::DEFAULT_N_MAX`] and the leaf
+    /// budget [`AdaptiveOptions::DEFAULT_LEAF_BUDGET`].
     fn default() -> Self {
         Self {
             tree: TreeParams {
                 n_max: Self::DEFAULT_N_MAX,
                 ..TreeParams::default()
             },
+            leaf_budget: Self::default_leaf_budget(),
         }
     }
 }
@@ -137,14 +172,15 @@ impl EnvMapSampler {
     }
 
     /// The adaptive-partition sampler: a [`TabulatedDensity`] of the pixel luminances times
-    /// [`SinPiRows`] on `[0,1]²`, partitioned by a [`QuadTreeBuilder`] with `options`.
-    /// The build time includes computing the luminance table.
+    /// [`SinPiRows`] on `[0,1]²`, partitioned by a [`QuadTreeBuilder`] with `options` (the
+    /// tightening ladder of [`AdaptiveOptions::leaf_budget`] when it is set). The build time
+    /// includes computing the luminance table and every rung built.
     pub fn adaptive(map: &EnvMap, options: AdaptiveOptions) -> Result<Self, EnvMapError> {
         let start = Instant::now();
         let density =
             TabulatedDensity::new(map.width(), map.height(), map.luminance(), Rect::UNIT)?
                 .with_row_factor(SinPiRows)?;
-        let sampler = QuadTreeBuilder::from_params(options.tree).build(density)?;
+        let sampler = Self::ladder(density, options)?;
         Ok(Self {
             inner: Inner::Adaptive(Box::new(sampler)),
             kind: SamplerKind::Adaptive(options),
@@ -152,6 +188,34 @@ impl EnvMapSampler {
             height: map.height(),
             build_time: start.elapsed(),
         })
+    }
+
+    /// The tree of [`AdaptiveOptions::leaf_budget`]'s ladder on `density`: rung `k` built at
+    /// [`AdaptiveOptions::ladder_threshold`]`(k)` while the previous rung kept at most `B`
+    /// leaves; the last rung within the budget is kept (rung 0 always). All rungs borrow the
+    /// one density, whose region pyramids are built once.
+    fn ladder(
+        density: TabulatedDensity<SinPiRows>,
+        options: AdaptiveOptions,
+    ) -> Result<QuadTreeSampler<TabulatedDensity<SinPiRows>>, EnvMapError> {
+        let Some(budget) = options.leaf_budget else {
+            return Ok(QuadTreeBuilder::from_params(options.tree).build(density)?);
+        };
+        let mut params = options.tree;
+        let mut kept = QuadTreeBuilder::from_params(params).build_tree(&density)?;
+        for k in 1..=AdaptiveOptions::LADDER_STEPS {
+            let n = options.ladder_threshold(k);
+            if !(n < params.n_max) || kept.counts().leaves > budget {
+                break;
+            }
+            params.n_max = n;
+            let tree = QuadTreeBuilder::from_params(params).build_tree(&density)?;
+            if tree.counts().leaves > budget {
+                break;
+            }
+            kept = tree;
+        }
+        Ok(QuadTreeSampler::from_parts(kept, density)?)
     }
 
     /// The piecewise-constant CDF sampler ([`QuantisedCdf2D`], fixed-point CDF tables whose
@@ -332,5 +396,67 @@ impl Sampler2D for EnvMapSampler {
 
     fn bytes_used(&self) -> usize {
         EnvMapSampler::bytes_used(self)
+    }
+}
+
+#[cfg(test)]
+mod ladder_tests {
+    use super::*;
+    use crate::procedural_sky;
+
+    /// Leaves and expected trials of the adaptive sampler built with `options`.
+    fn shape(map: &EnvMap, options: AdaptiveOptions) -> (usize, u64) {
+        let s = EnvMapSampler::adaptive(map, options).unwrap();
+        let stats = s.stats().unwrap();
+        (stats.leaves, stats.expected_mean_trials.to_bits())
+    }
+
+    #[test]
+    fn the_ladder_keeps_the_last_rung_within_the_budget() {
+        // Each rung built alone (no budget) against the ladder with budgets at and just below
+        // each rung's leaf count: the ladder must keep exactly the last rung that fits.
+        let map = procedural_sky(256, 128).unwrap();
+        let fixed = AdaptiveOptions {
+            leaf_budget: None,
+            ..AdaptiveOptions::default()
+        };
+        let rungs: Vec<(usize, u64)> = (0..=AdaptiveOptions::LADDER_STEPS)
+            .map(|k| {
+                let mut o = fixed;
+                o.tree.n_max = fixed.ladder_threshold(k);
+                shape(&map, o)
+            })
+            .collect();
+        // The rungs really differ (more leaves, fewer trials), else the test proves nothing.
+        for w in rungs.windows(2) {
+            assert!(w[1].0 > w[0].0, "{rungs:?}");
+            assert!(f64::from_bits(w[1].1) < f64::from_bits(w[0].1), "{rungs:?}");
+        }
+        assert_eq!(shape(&map, fixed), rungs[0]);
+        for (k, &(leaves, _)) in rungs.iter().enumerate() {
+            let at = AdaptiveOptions {
+                leaf_budget: Some(leaves),
+                ..fixed
+            };
+            assert_eq!(shape(&map, at), rungs[k], "budget = rung {k}'s leaves");
+            let below = AdaptiveOptions {
+                leaf_budget: Some(leaves - 1),
+                ..fixed
+            };
+            // Rung 0 is kept whatever its size.
+            assert_eq!(
+                shape(&map, below),
+                rungs[k.saturating_sub(1)],
+                "budget below rung {k}"
+            );
+        }
+        // The default budget on this small map: the tightest rung.
+        assert_eq!(
+            shape(&map, AdaptiveOptions::default()),
+            rungs[AdaptiveOptions::LADDER_STEPS as usize]
+        );
+        // Rung thresholds: n_max, then halving the excess over 1.
+        assert_eq!(fixed.ladder_threshold(0), AdaptiveOptions::DEFAULT_N_MAX);
+        assert_eq!(fixed.ladder_threshold(3), 1.075);
     }
 }
