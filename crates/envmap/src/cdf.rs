@@ -94,11 +94,25 @@ impl Count for pulp::x86::V4 {
 /// for the cell `i` sought (the largest `i < n` with `B[i] ≤ x`), the top level has one line
 /// (`q_D = 0`) and `q_ℓ = 16·q_{ℓ+1} + #{k < 16 : T_ℓ[16·q_{ℓ+1} + k] ≤ x} − 1`: the `T` are
 /// monotone, `T_ℓ[16·q_{ℓ+1}] ≤ x`, and `T_ℓ[16·q_{ℓ+1} + 16] > x`.
+///
+/// **Guides** (the one-sample path): per row `G = 2^g` buckets of the fixed-point range
+/// (`g = ⌈log₂ ⌈n/4⌉⌉`, so about one bucket per 4 cells), bucket `j` holding the level-0 line
+/// `⌊i_j / 16⌋` of the cell `i_j` of `x_j = j · 2³⁰ / G`. For `x` in bucket `j = ⌊x·G/2³⁰⌋`
+/// the cell `i` of `x` has `i ≥ i_j`, so its line is found by counting from line `⌊i_j/16⌋`
+/// forward (`B[16·⌊i_j/16⌋] ≤ B[i_j] ≤ x`); each bucket holds `1/G` of the row's probability
+/// and the lines it spans sum to at most `lines + G`, so a draw counts at most
+/// `1 + lines/G` lines on average (≤ 1.26 for 1024 cells) against one per level of the tree,
+/// in a chain of two dependent loads (guide, line) instead of one per level.
 #[derive(Debug, Clone, PartialEq)]
 struct CountTree {
     n: usize,
     /// Per level, lowest first: lines per row, and the rows' lines concatenated.
     levels: Vec<(usize, Vec<Line>)>,
+    /// `G` guide entries per row (level-0 line indices), rows concatenated; empty when a row
+    /// has more than `u16::MAX` lines (the one-sample path then walks the levels).
+    guide: Vec<u16>,
+    /// `30 − g`: the bucket of `x` is `x >> guide_shift`.
+    guide_shift: u32,
 }
 
 impl CountTree {
@@ -123,7 +137,65 @@ impl CountTree {
             }
             stride *= FAN;
         }
-        Self { n, levels }
+        let (guide, guide_shift) = Self::guides(n, rows, boundaries);
+        Self {
+            n,
+            levels,
+            guide,
+            guide_shift,
+        }
+    }
+
+    /// The guides of `rows` runs of `n + 1` boundaries (see the type docs) and their shift.
+    fn guides(n: usize, rows: usize, boundaries: &[u32]) -> (Vec<u16>, u32) {
+        let g = n
+            .div_ceil(4)
+            .max(1)
+            .next_power_of_two()
+            .trailing_zeros()
+            .min(BITS as u32);
+        let shift = BITS as u32 - g;
+        let buckets = 1usize << g;
+        if n / FAN >= usize::from(u16::MAX) {
+            return (Vec::new(), shift);
+        }
+        let mut guide = Vec::with_capacity(buckets * rows);
+        for b in boundaries.chunks_exact(n + 1) {
+            // Merge walk: `i` is the cell of `x_j` (largest `i < n` with `B[i] ≤ x_j`).
+            let mut i = 0usize;
+            for j in 0..buckets {
+                let x = (j as u32) << shift;
+                while i + 1 < n && b[i + 1] <= x {
+                    i += 1;
+                }
+                guide.push((i / FAN) as u16);
+            }
+        }
+        (guide, shift)
+    }
+
+    /// The cell of `x < 2³⁰` in row `row` (as [`Self::find`]) from the row's guide: count the
+    /// guide's line, then the following lines while the previous count was full and the next
+    /// line's first boundary is `≤ x`. Falls back to [`Self::find`] without guides.
+    #[inline(always)]
+    fn find_guided<C: Count>(&self, c: C, row: usize, x: u32) -> usize {
+        if self.guide.is_empty() {
+            return self.find(c, row, x);
+        }
+        let (per_row, lines) = &self.levels[0];
+        let line = &lines[row * per_row..(row + 1) * per_row];
+        let buckets = 1usize << (BITS as u32 - self.guide_shift);
+        let mut q = usize::from(self.guide[row * buckets + (x >> self.guide_shift) as usize]);
+        let mut k = c.count(&line[q], x);
+        while k == FAN && q + 1 < line.len() {
+            let next = c.count(&line[q + 1], x);
+            if next == 0 {
+                break;
+            }
+            q += 1;
+            k = next;
+        }
+        FAN * q + k - 1
     }
 
     /// Boundary `i ≤ n` of row `row`.
@@ -167,7 +239,8 @@ impl CountTree {
         self.levels
             .iter()
             .map(|(_, l)| l.capacity() * std::mem::size_of::<Line>())
-            .sum()
+            .sum::<usize>()
+            + 2 * self.guide.capacity()
     }
 }
 
@@ -348,22 +421,33 @@ impl QuantisedCdf2D {
         (f64::from(m), f64::from(c))
     }
 
-    /// The sample of the uniforms `u0` (column) and `u1` (row): the counting walk in AVX-512
-    /// where the CPU has it (one call into the `V4` build per sample), else the binary
-    /// search. The same cell either way.
+    /// The sample of the uniforms `u0` (column) and `u1` (row): the guided count
+    /// ([`CountTree::find_guided`]) in AVX-512 where the CPU has it (one call into the `V4`
+    /// build per sample), else the binary search. The same cell either way.
     #[inline(always)]
     fn sample_pair(&self, u0: f64, u1: f64) -> Sample2 {
         match self.arch {
             pulp::Arch::V4(simd) => simd.vectorize(
                 #[inline(always)]
-                || self.sample_pair_counted(simd, u0, u1),
+                || self.sample_pair_guided(simd, u0, u1),
             ),
             _ => self.sample_pair_binary(u0, u1),
         }
     }
 
-    /// [`Self::sample_pair`] by the counting walk with the count `c`.
+    /// [`Self::sample_pair`] by the guided count with the count `c`.
     #[inline(always)]
+    fn sample_pair_guided<C: Count>(&self, c: C, u0: f64, u1: f64) -> Sample2 {
+        let (x1, s1) = fixed(u1);
+        let row = self.marginal.find_guided(c, 0, x1);
+        let (x0, s0) = fixed(u0);
+        let col = self.conditional.find_guided(c, row, x0);
+        self.finish(row, s1, col, s0)
+    }
+
+    /// The sample of `u0`, `u1` by the counting walk of the levels with the count `c` (the
+    /// block path's search; the tests' reference for the one-sample path).
+    #[cfg(test)]
     fn sample_pair_counted<C: Count>(&self, c: C, u0: f64, u1: f64) -> Sample2 {
         let (x1, s1) = fixed(u1);
         let row = self.marginal.find(c, 0, x1);
@@ -633,11 +717,18 @@ mod tests {
         for n in [1, 2, 15, 16, 17, 255, 256, 257, 1024, 4097] {
             let rows = 3;
             let mut b = Vec::new();
-            for _ in 0..rows {
+            for r in 0..rows {
+                // Row 2: a spike over a dim rest, so that guide buckets span many lines.
+                let spike = (g.next_uniform() * n as f64) as usize;
                 let w: Vec<f64> = (0..n)
-                    .map(|_| {
-                        let r = g.next_uniform();
-                        if r < 0.3 { 0.0 } else { r }
+                    .map(|i| {
+                        let u = g.next_uniform();
+                        match r {
+                            2 if i == spike => 1e6,
+                            2 => 1e-3 * u,
+                            _ if u < 0.3 => 0.0,
+                            _ => u,
+                        }
                     })
                     .collect();
                 let mut out = vec![0u32; n + 1];
@@ -664,9 +755,16 @@ mod tests {
                         want,
                         "binary: n {n}, row {r}, x {x}"
                     );
+                    assert_eq!(
+                        tree.find_guided(ScalarCount, r, x),
+                        want,
+                        "guided: n {n}, row {r}, x {x}"
+                    );
                     if let Some(simd) = pulp::x86::V4::try_new() {
                         let got = simd.vectorize(|| tree.find(simd, r, x));
                         assert_eq!(got, want, "V4: n {n}, row {r}, x {x}");
+                        let got = simd.vectorize(|| tree.find_guided(simd, r, x));
+                        assert_eq!(got, want, "V4 guided: n {n}, row {r}, x {x}");
                     }
                 }
             }
@@ -792,6 +890,7 @@ mod tests {
                 for other in [
                     t.sample_pair_binary(a, b),
                     t.sample_pair_counted(ScalarCount, a, b),
+                    t.sample_pair_guided(ScalarCount, a, b),
                 ] {
                     assert_eq!(
                         (s.point.map(f64::to_bits), s.pdf.to_bits()),
