@@ -5,7 +5,9 @@
 #
 # Environment: PEERS = directory of the peer scripts (mitsuba_warp_bench.py and its .venv,
 # required), N = samples (default 4000000), THREADS = threads for both sides
-# (default 2). Without maps: the built-in procedural sky only. For each map it exports the
+# (default 2), BIN = the brdf-lab binary to time (default: target/release/brdf-lab, built
+# here; another binary, e.g. a copy of a "before" build for interleaved A/B rounds, is
+# timed as given and not built). Without maps: the built-in procedural sky only. For each map it exports the
 # density Mitsuba's envmap emitter warps (luminance x sin(pi v_centre), float32 .npy), times
 # Mitsuba's Hierarchical2D and DiscreteDistribution2D (--fair: uniforms drawn in the kernel,
 # pdf kept; median of 5), then `brdf-lab envmap --compare` (same N, same threads), and prints
@@ -20,9 +22,11 @@ PY="$PEERS/.venv/bin/python"
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 # Two builds: with an --example selection cargo builds only the examples, not brdf-lab's binary.
-cargo build --release -q -p brdf-lab-cli
+if [ -z "${BIN:-}" ]; then
+    cargo build --release -q -p brdf-lab-cli
+    BIN=target/release/brdf-lab
+fi
 cargo build --release -q -p envmap --example export_density
-BIN=target/release/brdf-lab
 EXPORT=target/release/examples/export_density
 echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '| map | Mitsuba H2D M/s | Mitsuba D2D M/s | adaptive M/s (1 thr one / blk / lane, %s thr one / blk / lane) | envmap-cdf M/s (same) | adaptive / H2D (blk, lane) | cdf / D2D (blk, lane) | adaptive build ms | Mitsuba H2D build ms | adaptive 1->%s scaling (lane) |\n' "$THREADS" "$THREADS"
