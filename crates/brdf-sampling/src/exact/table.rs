@@ -116,15 +116,11 @@ impl LeafTable {
             let s = us[0] * self.n;
             let i = floor_index(s, last);
             let first = &self.entries[i];
-            // Branch-free alias pick (issue 29: the comparison is a coin flip for the
-            // predictor on leaves with an alias): the index is selected by a mask, then one
-            // load; the same entry as `if s − i < prob { first } else { alias }`.
-            let keep = usize::from(s - index_to_f64(i) < first.prob).wrapping_neg();
-            let alias = first.alias as usize;
-            let e = self
-                .entries
-                .get(alias ^ ((alias ^ i) & keep))
-                .unwrap_or(first);
+            let e = if s - index_to_f64(i) < first.prob {
+                first
+            } else {
+                self.entries.get(first.alias as usize).unwrap_or(first)
+            };
             let x = f64::from(e.x0) + us[1] * f64::from(e.dx);
             let y = f64::from(e.y0) + us[2] * f64::from(e.dy);
             let m = f64::from(e.m);
