@@ -19,8 +19,9 @@ const ISO_TERMS: usize = 11;
 pub(super) struct IsoRecord {
     /// `[lo, hi, centre, scale]`: the node range of `cos θo` and `x = (v − centre) · scale`.
     affine: [f64; 4],
-    /// Coefficients of `A cos θo` in `x`, `power[..n]`; `n = 0`: the interval's table is
-    /// evaluated instead (a longer series, or Clenshaw's form).
+    /// Coefficients of `A cos θo` in `x`, `power[..n]`, the rest zero ([`IsoRecord::normaliser`]
+    /// runs all `ISO_TERMS` steps); `n = 0`: the interval's table is evaluated instead (a
+    /// longer series, or Clenshaw's form).
     power: [f64; ISO_TERMS],
     n: u32,
     pub(super) map: DiscMap,
@@ -53,10 +54,11 @@ impl IsoRecord {
         let n = self.n as usize;
         let p = if n > 0 && n <= ISO_TERMS {
             let x = ((v - centre) * scale).clamp(-1.0, 1.0);
-            self.power[..n]
-                .iter()
-                .rev()
-                .fold(0.0, |acc, &a| acc * x + a)
+            // All `ISO_TERMS` steps, a fixed trip count (no loop branch): the coefficients
+            // past `n` are zero, and from `acc = +0` a step `acc · x + 0` gives `+0` again
+            // (`±0 + 0 = +0`), so the first real step and all after it are the `n`-term
+            // rule's, bit for bit.
+            self.power.iter().rev().fold(0.0, |acc, &a| acc * x + a)
         } else {
             iv.table.eval(v, 0.0)
         };
