@@ -191,6 +191,89 @@ pub(crate) fn cornell_albedo(
     }
 }
 
+/// Settings of the control-variate node rule ([`cornell_cv_albedo`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CvRule {
+    /// Most points of the disc rule on the difference (each one kNN and one grid
+    /// evaluation); it stops earlier when its estimate is below 10⁻⁹ (absolute).
+    pub(crate) budget: u64,
+    /// Depth of the disc rule's uniform first partition (`2^depth` cells per axis).
+    pub(crate) initial_depth: u32,
+    /// Depth to which the cells near the mirror direction are cut at first.
+    pub(crate) mirror_depth: u32,
+}
+
+/// The control-variate node rule of `adaptive-exact`'s Cornell set tables
+/// (docs/benchmarks.md §25.5).
+pub(crate) const CV_NODE_RULE: CvRule = CvRule {
+    budget: 30_000,
+    initial_depth: 4,
+    mirror_depth: 9,
+};
+
+/// One control-variate node: `A_knn(θo) = A_grid(θo) + D(θo)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CvNode {
+    /// `A_grid(θo)`, the tabulated interpolant's albedo ([`CornellBrdf::grid_albedo`]).
+    pub(crate) grid: f64,
+    /// Its error estimate (absolute; ≤ 10⁻¹³ relative).
+    pub(crate) grid_err: f64,
+    /// `D(θo) = ∫ (f_knn − f_grid) cos θi dωi` by the disc rule, with the rule's estimate
+    /// `Σ |I₈ − I₅|` and its points.
+    pub(crate) diff: AlbedoEstimate,
+}
+
+impl CvNode {
+    /// `A_knn(θo)`: the grid albedo plus the difference.
+    pub(crate) fn value(&self) -> f64 {
+        self.grid + self.diff.value
+    }
+
+    /// The declared absolute error: the difference's estimate plus the grid albedo's.
+    pub(crate) fn abs_err(&self) -> f64 {
+        self.diff.abs_err + self.grid_err
+    }
+}
+
+/// The kNN interpolant's albedo at `theta_o` (radians, in `[0, π/2)`) by a control variate:
+/// `A_knn = A_grid + ∫ (f_knn − f_grid) cos θi dωi`, the first term exact
+/// ([`CornellBrdf::grid_albedo`], no evaluation), the second by the reference rule over the
+/// equal-area disc ([`crate::reference_albedo_with_budget`]'s leaf quadrature) on the
+/// difference [`CornellBrdf::knn_minus_grid`], from `rule`'s first partition within its
+/// budget. The difference is small (the two interpolants agree at the grid's vertices), so the
+/// same absolute error takes fewer points than the rule on `f_knn` itself; the declared error
+/// is the rule's own estimate on the difference (plus the grid albedo's).
+pub(crate) fn cornell_cv_albedo(
+    brdf: &CornellBrdf,
+    theta_o: f64,
+    rule: CvRule,
+) -> Result<CvNode, ReferenceError> {
+    let (s, c) = theta_o.sin_cos();
+    if !(theta_o.is_finite() && (0.0..FRAC_PI_2).contains(&theta_o)) {
+        return Err(ReferenceError::InvalidDirection { x: s, y: 0.0, z: c });
+    }
+    let (grid, grid_err) = brdf
+        .grid_albedo(theta_o)
+        .ok_or_else(|| ReferenceError::NotFinite(brdf.name().to_string()))?;
+    let wo = brdf::Vec3::new(s, 0.0, c);
+    let diff = super::albedo_of_from(
+        |wo, wi| brdf.knn_minus_grid(wo, wi),
+        brdf,
+        &wo,
+        rule.budget,
+        rule.initial_depth,
+        rule.mirror_depth,
+    )?;
+    if !(grid.is_finite() && grid_err.is_finite()) {
+        return Err(ReferenceError::NotFinite(brdf.name().to_string()));
+    }
+    Ok(CvNode {
+        grid,
+        grid_err,
+        diff,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -247,6 +330,125 @@ mod tests {
                     );
                 }
                 eprintln!("{line}");
+            }
+        }
+    }
+
+    /// The control-variate node against the plain node (the disc rule on `f_knn` at
+    /// 1.5·10⁵ evaluations) and the line rule at `JUDGE_TOL` (0: not run), for the record
+    /// (docs/benchmarks.md §25.5): `CORNELL_FILES`, `NODE_ANGLES` (degrees), `CV_BUDGETS`,
+    /// `CV_DEPTHS` (`initial:mirror` pairs), `PLAIN` (1: run the plain node).
+    /// `cargo test --release -p brdf-sampling --lib cornell_cv_survey -- --ignored --nocapture`
+    #[test]
+    #[ignore = "a survey for the record"]
+    fn cornell_cv_survey() {
+        let env = |k: &str| std::env::var(k).ok();
+        let files = env("CORNELL_FILES").unwrap_or("acryl_blue,cayman,krylon_blue".into());
+        let list = |k: &str, d: &str| -> Vec<String> {
+            env(k)
+                .unwrap_or(d.into())
+                .split(',')
+                .map(str::to_string)
+                .collect()
+        };
+        let angles: Vec<f64> = list("NODE_ANGLES", "2.8,30.5,62.4,89.5")
+            .iter()
+            .filter_map(|s| s.parse().ok())
+            .collect();
+        let budgets: Vec<u64> = list("CV_BUDGETS", "5000,10000,20000,40000")
+            .iter()
+            .filter_map(|s| s.parse().ok())
+            .collect();
+        let depths: Vec<(u32, u32)> = list("CV_DEPTHS", "4:9")
+            .iter()
+            .filter_map(|s| {
+                let (a, b) = s.split_once(':')?;
+                Some((a.parse().ok()?, b.parse().ok()?))
+            })
+            .collect();
+        let judge_tol: f64 = env("JUDGE_TOL").and_then(|s| s.parse().ok()).unwrap_or(0.0);
+        let plain = env("PLAIN").is_some_and(|s| s == "1");
+        for name in files.split(',') {
+            let Some(b) = shared(name) else { continue };
+            for &deg in &angles {
+                let t = deg.to_radians();
+                let judge = (judge_tol > 0.0).then(|| cornell_albedo(&b, t, judge_tol).unwrap());
+                if let Some(j) = judge {
+                    eprintln!(
+                        "{name} {deg}°: judge {:.9} ± {:.1e} (rel {:.1e})",
+                        j.value,
+                        j.abs_err,
+                        j.abs_err / j.value
+                    );
+                }
+                let gap = |v: f64| {
+                    judge.map_or(String::new(), |j| {
+                        format!(", v/judge − 1 = {:+.2e}", v / j.value - 1.0)
+                    })
+                };
+                if plain {
+                    let wo = brdf::direction_from_radians(t, 0.0);
+                    let r = crate::reference_albedo_with_budget(&b, &wo, 150_000).unwrap();
+                    eprintln!(
+                        "{name} {deg}°: plain {:.9} ± rel {:.1e}, {} evaluations{}",
+                        r.value,
+                        r.abs_err / r.value,
+                        r.evaluations,
+                        gap(r.value)
+                    );
+                }
+                // The plain rule (on f_knn) from other first partitions: `PLAIN_DEPTHS`,
+                // `PLAIN_BUDGETS`.
+                let plain_depths: Vec<(u32, u32)> = list("PLAIN_DEPTHS", "")
+                    .iter()
+                    .filter_map(|s| {
+                        let (a, b) = s.split_once(':')?;
+                        Some((a.parse().ok()?, b.parse().ok()?))
+                    })
+                    .collect();
+                let plain_budgets: Vec<u64> = list("PLAIN_BUDGETS", "")
+                    .iter()
+                    .filter_map(|s| s.parse().ok())
+                    .collect();
+                for &(d0, d1) in &plain_depths {
+                    for &budget in &plain_budgets {
+                        let wo = brdf::Vec3::new(t.sin(), 0.0, t.cos());
+                        let r = crate::reference::albedo_of_from(
+                            |wo, wi| b.eval(wo, wi),
+                            &b,
+                            &wo,
+                            budget,
+                            d0,
+                            d1,
+                        )
+                        .unwrap();
+                        eprintln!(
+                            "{name} {deg}°: plain {d0}:{d1} budget {budget}: {:.9} ± rel {:.1e}, {} evaluations{}",
+                            r.value,
+                            r.abs_err / r.value,
+                            r.evaluations,
+                            gap(r.value)
+                        );
+                    }
+                }
+                for &(d0, d1) in &depths {
+                    for &budget in &budgets {
+                        let rule = CvRule {
+                            budget,
+                            initial_depth: d0,
+                            mirror_depth: d1,
+                        };
+                        let n = cornell_cv_albedo(&b, t, rule).unwrap();
+                        eprintln!(
+                            "{name} {deg}°: cv {d0}:{d1} budget {budget}: {:.9} ± rel {:.1e} (D/A {:+.1e}), {} points{}",
+                            n.value(),
+                            n.abs_err() / n.value(),
+                            n.diff.value / n.value(),
+                            n.diff.evaluations,
+                            gap(n.value())
+                        );
+                    }
+                }
             }
         }
     }
