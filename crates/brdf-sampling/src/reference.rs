@@ -119,20 +119,6 @@ pub(crate) fn albedo_of(
     wo: &Vec3,
     budget: u64,
 ) -> Result<AlbedoEstimate, ReferenceError> {
-    albedo_of_from(f, brdf, wo, budget, INITIAL_DEPTH, MIRROR_DEPTH)
-}
-
-/// [`albedo_of`] from a uniform `2^initial_depth` grid whose cells near the mirror direction
-/// are refined down to `mirror_depth` (the module docs' initial partition; `albedo_of` uses
-/// 5 and 11). `∫ f(ωo, ωi) cos θi dσ(ωi)` for any integrand `f` with `brdf`'s symmetries.
-pub(crate) fn albedo_of_from(
-    f: impl Fn(&Vec3, &Vec3) -> f64 + Sync,
-    brdf: &dyn Brdf,
-    wo: &Vec3,
-    budget: u64,
-    initial_depth: u32,
-    mirror_depth: u32,
-) -> Result<AlbedoEstimate, ReferenceError> {
     let unit = wo.iter().all(|c| c.is_finite()) && (wo.norm() - 1.0).abs() <= 1e-9;
     if !(unit && wo.z > 0.0) {
         return Err(ReferenceError::InvalidDirection {
@@ -162,7 +148,7 @@ pub(crate) fn albedo_of_from(
     let mut leaves = Vec::new();
     initial_partition(
         Rect::new(-1.0, -1.0, 1.0, 1.0),
-        [0, initial_depth, mirror_depth],
+        0,
         peak,
         mirror,
         &mut leaves,
@@ -187,15 +173,7 @@ pub(crate) fn albedo_of_from(
 
 /// The uniform `2^INITIAL_DEPTH` grid, with the cells near `peak` (within one cell size)
 /// split down to `MIRROR_DEPTH`; cells outside the disc (or in `y > 0` with `mirror`) dropped.
-/// `depths` = `[depth of r, uniform depth, depth near the mirror direction]`.
-fn initial_partition(
-    r: Rect,
-    depths: [u32; 3],
-    peak: [f64; 2],
-    mirror: bool,
-    out: &mut Vec<LeafInfo>,
-) {
-    let [depth, initial_depth, mirror_depth] = depths;
+fn initial_partition(r: Rect, depth: u32, peak: [f64; 2], mirror: bool, out: &mut Vec<LeafInfo>) {
     let outside_disc = {
         let dx = 0f64.clamp(r.x0, r.x1);
         let dy = 0f64.clamp(r.y0, r.y1);
@@ -209,7 +187,7 @@ fn initial_partition(
         && peak[0] < r.x1 + size
         && peak[1] > r.y0 - size
         && peak[1] < r.y1 + size;
-    if depth < initial_depth || (depth < mirror_depth && near) {
+    if depth < INITIAL_DEPTH || (depth < MIRROR_DEPTH && near) {
         let c = r.center();
         for q in [
             Rect::new(r.x0, r.y0, c[0], c[1]),
@@ -217,13 +195,7 @@ fn initial_partition(
             Rect::new(r.x0, c[1], c[0], r.y1),
             Rect::new(c[0], c[1], r.x1, r.y1),
         ] {
-            initial_partition(
-                q,
-                [depth + 1, initial_depth, mirror_depth],
-                peak,
-                mirror,
-                out,
-            );
+            initial_partition(q, depth + 1, peak, mirror, out);
         }
     } else {
         out.push(LeafInfo {

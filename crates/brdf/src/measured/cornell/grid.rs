@@ -93,22 +93,6 @@ impl CornellBrdf {
         out
     }
 
-    /// `f_knn(ωo, ωi) − f_grid(ωo, ωi)`: the luminance of the kNN interpolant
-    /// ([`super::Interpolation::Knn`]) minus that of the tabulated one
-    /// ([`super::Interpolation::Grid`]) at the same remapped point `p(ωo, ωi)` (remapped once),
-    /// whatever this material's own interpolation; 0 unless both directions are above the
-    /// horizon. Its integral `∫ (f_knn − f_grid) cos θi dωi` is `A_knn(θo) − A_grid(θo)`, the
-    /// second term exact by [`CornellBrdf::grid_albedo`]: the integrand of the control-variate
-    /// normaliser nodes of `adaptive-exact` (docs/benchmarks.md §25.5). It vanishes at the
-    /// grid's vertices.
-    pub fn knn_minus_grid(&self, wo: &crate::Vec3, wi: &crate::Vec3) -> f64 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        let p = super::remap_dirs(wo, wi);
-        self.knn_luminance_at(&p) - self.grid_at::<1>(&p, 0)[0]
-    }
-
     /// `∫₀¹ L dy` of the grid interpolant on the vertex column `(i, k)`: the trapezoid sum of
     /// its luminances (exact: the interpolant is linear in `y` between vertices).
     fn column_integral(&self, i: usize, k: usize) -> f64 {
