@@ -53,8 +53,11 @@ impl CornellBrdf {
                         }
                         let h = 1.0 / GRID_CELLS as f64;
                         let p = [vi as f64 * h, vj as f64 * h, vk as f64 * h];
-                        let [r, g, b] = self.knn_rgb_at(&p);
-                        out.push([self.knn_luminance_at(&p), r, g, b]);
+                        // One search for the four channels: each channel's sum is the one
+                        // `knn_luminance_at` / `knn_rgb_at` make (same weights, same order),
+                        // so the same bits as two blends.
+                        let (lum, rgb) = (&self.data.lum, &self.data.rgb);
+                        out.push(self.blend(&p, |i| [lum[i], rgb[i][0], rgb[i][1], rgb[i][2]]));
                     }
                 }
             }
