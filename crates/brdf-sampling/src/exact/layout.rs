@@ -238,6 +238,13 @@ impl Cell {
         self.interval_of(key, dkey)
     }
 
+    /// Bytes of this cell's [`DirectIndex`] table (0 without one).
+    pub(super) fn direct_bytes(&self) -> usize {
+        self.direct
+            .as_ref()
+            .map_or(0, |t| std::mem::size_of_val(t.entries.as_ref()))
+    }
+
     /// Share of this cell's [`DirectIndex`] buckets that hold one interval (0 without one).
     #[cfg(test)]
     pub(super) fn direct_share(&self) -> f64 {
@@ -369,6 +376,7 @@ pub(super) mod tests {
         let mut checked = 0;
         for (k, c) in cells.iter().enumerate() {
             let t = c.direct.as_ref().expect("anisotropic cells have an index");
+            assert_eq!(c.direct_bytes(), DIRECT_THETA * DIRECT_DELTA);
             let share = c.direct_share();
             assert!(share > 0.5, "cell {k}: {share} of the buckets served");
             let h = -t.d_lo;
