@@ -327,6 +327,9 @@ pub(super) mod tests {
             refined += c.aniso.iter().filter(|r| r.size() != [1, 1]).count();
         }
         assert!(refined > 0, "some grids refined");
+        // The intervals of the queries below come from the direct index
+        // (`Cell::interval_direct`): the search's, exactly.
+        assert!(crate::exact::layout::tests::assert_direct_is_the_search(&set.cells, 11) > 0);
         // Each interval's refit difference (the build's, again): below the target unless the
         // grid is at its largest size.
         let errs: Vec<Vec<f64>> = set

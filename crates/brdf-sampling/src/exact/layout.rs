@@ -57,6 +57,34 @@ pub(super) struct Cell {
     pub(super) aniso: Vec<super::aniso_record::AnisoRecord>,
     /// The normaliser patches of [`Cell::aniso`]'s records.
     pub(super) patches: Vec<super::aniso_record::Patch>,
+    /// Anisotropic cells: the interval of a query straight from its keys where one interval
+    /// covers a whole bucket ([`DirectIndex`]; `None` for isotropic cells).
+    pub(super) direct: Option<DirectIndex>,
+}
+
+/// Buckets of a [`DirectIndex`] along the θ search key `1 − cos θo`.
+pub(super) const DIRECT_THETA: usize = 256;
+/// Buckets of a [`DirectIndex`] along the strip key (`tan δ` or `δ`).
+pub(super) const DIRECT_DELTA: usize = 8;
+/// A [`DirectIndex`] entry whose bucket meets more than one interval.
+const DIRECT_NONE: u8 = u8::MAX;
+
+/// The interval of an anisotropic query by one table read instead of the guided θ search and
+/// the strip's δ scan (issue 29: `locate_keys`'s cost on anisotropic Ward). A uniform grid of
+/// [`DIRECT_THETA`] × [`DIRECT_DELTA`] buckets over the search key `k = 1 − cos θo ∈ [0,
+/// range]` and the strip key `d ∈ [−h_d, h_d]` (`h_d = tan h` or `h`); bucket `(g, e)` holds
+/// the keys with `⌊k · s_k⌋ = g` and `⌊(d + h_d) · s_d⌋ = e` (`s_k = DIRECT_THETA / range`,
+/// `s_d = DIRECT_DELTA / (2 h_d)`; the first and last buckets of each axis extend to `∓∞`).
+/// [`Cell::interval_of`] is non-decreasing in `k` (its strip) and, within a strip, in `d`
+/// (the entry), so a bucket whose two extreme corners — widened by a margin of 10⁻⁶ of a
+/// bucket for the rounding of `k · s_k` and `(d + h_d) · s_d` — give the same strip and entry
+/// has that interval at every key inside: the entry stores it (as `u8`); otherwise
+/// [`DIRECT_NONE`], and the query takes the search. The result is the search's, exactly.
+pub(super) struct DirectIndex {
+    k_scale: f64,
+    d_lo: f64,
+    d_scale: f64,
+    entries: Box<[u8; DIRECT_THETA * DIRECT_DELTA]>,
 }
 
 /// An interval with its θ and δ numerators ([`Grid`]).
@@ -119,11 +147,12 @@ impl Cell {
             }
         }
         let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
+        let half_key = if by_tan { tan_half } else { grid.half };
         let iso = intervals
             .iter()
             .map(super::iso_record::IsoRecord::of)
             .collect();
-        Self {
+        let mut cell = Self {
             phi,
             phi_turn: Turn::from_angle(phi),
             tan_half,
@@ -141,6 +170,109 @@ impl Cell {
             iso,
             aniso,
             patches,
+            direct: None,
+        };
+        if grid.half > 0.0 && cell.intervals.len() < usize::from(DIRECT_NONE) {
+            cell.direct = Some(cell.direct_index(half_key));
+        }
+        cell
+    }
+
+    /// The [`DirectIndex`] of this cell's search (strip keys in `[−half_key, half_key]`).
+    fn direct_index(&self, half_key: f64) -> DirectIndex {
+        let k_scale = DIRECT_THETA as f64 / self.range;
+        let (d_lo, d_scale) = (-half_key, DIRECT_DELTA as f64 / (2.0 * half_key));
+        // Bucket `b` of `n` over `[lo, lo + n/scale]`: its keys, widened for rounding; the
+        // end buckets reach to infinity (keys past the grid are clamped into them).
+        let ends = |b: usize, n: usize, lo: f64, scale: f64| {
+            let margin = 1e-6 / scale;
+            let a = if b == 0 {
+                f64::NEG_INFINITY
+            } else {
+                lo + b as f64 / scale - margin
+            };
+            let z = if b + 1 == n {
+                f64::INFINITY
+            } else {
+                lo + (b + 1) as f64 / scale + margin
+            };
+            [a, z]
+        };
+        let mut entries = Box::new([DIRECT_NONE; DIRECT_THETA * DIRECT_DELTA]);
+        for g in 0..DIRECT_THETA {
+            let [k0, k1] = ends(g, DIRECT_THETA, 0.0, k_scale);
+            for e in 0..DIRECT_DELTA {
+                let [d0, d1] = ends(e, DIRECT_DELTA, d_lo, d_scale);
+                let (a, z) = (self.strip_entry(k0, d0), self.strip_entry(k1, d1));
+                if a == z {
+                    let iv = self.entry_interval(a.1);
+                    if iv < usize::from(DIRECT_NONE) {
+                        entries[g * DIRECT_DELTA + e] = iv as u8;
+                    }
+                }
+            }
+        }
+        DirectIndex {
+            k_scale,
+            d_lo,
+            d_scale,
+            entries,
+        }
+    }
+
+    /// The interval of an anisotropic query: [`Cell::interval_of`]'s, from the
+    /// [`DirectIndex`] when its bucket holds one interval (the search otherwise, and for
+    /// cells without an index).
+    #[inline]
+    pub(super) fn interval_direct(&self, key: f64, dkey: f64) -> usize {
+        if let Some(t) = &self.direct {
+            // `as usize` saturates: negative keys (and NaN) go to bucket 0, past-the-end
+            // keys are clamped into the last bucket.
+            let g = ((key * t.k_scale) as usize).min(DIRECT_THETA - 1);
+            let e = (((dkey - t.d_lo) * t.d_scale) as usize).min(DIRECT_DELTA - 1);
+            let iv = t.entries[g * DIRECT_DELTA + e];
+            if iv != DIRECT_NONE {
+                return usize::from(iv);
+            }
+        }
+        self.interval_of(key, dkey)
+    }
+
+    /// Bytes of this cell's [`DirectIndex`] table (0 without one).
+    pub(super) fn direct_bytes(&self) -> usize {
+        self.direct
+            .as_ref()
+            .map_or(0, |t| std::mem::size_of_val(t.entries.as_ref()))
+    }
+
+    /// Share of this cell's [`DirectIndex`] buckets that hold one interval (0 without one).
+    #[cfg(test)]
+    pub(super) fn direct_share(&self) -> f64 {
+        self.direct.as_ref().map_or(0.0, |t| {
+            t.entries.iter().filter(|&&e| e != DIRECT_NONE).count() as f64 / t.entries.len() as f64
+        })
+    }
+
+    /// The strip of `key` and the strip entry of `dkey` in it ([`Cell::interval_of`] in two
+    /// steps; the entry is the strip itself in cells without azimuth splits).
+    fn strip_entry(&self, key: f64, dkey: f64) -> (usize, usize) {
+        let s = guided_interval(&self.keys, &self.guide, self.range, key);
+        if self.strips.is_empty() {
+            return (s, s);
+        }
+        let (mut j, last) = (self.strips[s] as usize, self.strips[s + 1] as usize - 1);
+        while j < last && self.delta_keys[j] < dkey {
+            j += 1;
+        }
+        (s, j)
+    }
+
+    /// The interval of a strip entry ([`Cell::strip_entry`]).
+    fn entry_interval(&self, j: usize) -> usize {
+        if self.strips.is_empty() {
+            j
+        } else {
+            self.members[j] as usize
         }
     }
 
@@ -226,4 +358,56 @@ pub(super) fn guided_interval(upper: &[f64], guide: &[u32], range: f64, x: f64) 
         i += 1;
     }
     i
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// Test support: the [`DirectIndex`] of every anisotropic cell of `cells` gives
+    /// [`Cell::interval_of`]'s interval — at random keys (also past both ends of each axis),
+    /// at every strip edge and δ edge and their neighbouring floats, and at every bucket
+    /// corner and its neighbouring floats — and serves most buckets. Returns the number of
+    /// keys compared.
+    pub(in crate::exact) fn assert_direct_is_the_search(cells: &[Cell], seed: u64) -> usize {
+        use partition_sampler::UniformSource;
+        use rand::SeedableRng;
+        let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut checked = 0;
+        for (k, c) in cells.iter().enumerate() {
+            let t = c.direct.as_ref().expect("anisotropic cells have an index");
+            assert_eq!(c.direct_bytes(), DIRECT_THETA * DIRECT_DELTA);
+            let share = c.direct_share();
+            assert!(share > 0.5, "cell {k}: {share} of the buckets served");
+            let h = -t.d_lo;
+            let near = |x: f64| [x.next_down(), x, x.next_up()];
+            let mut ks: Vec<f64> = c.keys.iter().flat_map(|&x| near(x)).collect();
+            ks.extend((0..=DIRECT_THETA).flat_map(|g| near(g as f64 / t.k_scale)));
+            let mut ds: Vec<f64> = c.delta_keys.iter().flat_map(|&x| near(x)).collect();
+            ds.extend((0..=DIRECT_DELTA).flat_map(|e| near(t.d_lo + e as f64 / t.d_scale)));
+            let mut pairs: Vec<(f64, f64)> = Vec::new();
+            for &x in &ks {
+                pairs.push((x, h * (2.4 * rng.next_uniform() - 1.2)));
+                for &d in &ds {
+                    pairs.push((x, d));
+                }
+            }
+            for &d in &ds {
+                pairs.push((c.range * (1.02 * rng.next_uniform() - 0.01), d));
+            }
+            for _ in 0..20_000 {
+                let x = c.range * (1.02 * rng.next_uniform() - 0.01);
+                pairs.push((x, h * (2.4 * rng.next_uniform() - 1.2)));
+            }
+            for (x, d) in pairs {
+                assert_eq!(
+                    c.interval_direct(x, d),
+                    c.interval_of(x, d),
+                    "cell {k}: key {x:e}, strip key {d:e}"
+                );
+                checked += 1;
+            }
+        }
+        checked
+    }
 }

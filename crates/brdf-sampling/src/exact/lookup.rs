@@ -121,7 +121,11 @@ impl ExactSet {
             TableVar::Theta => cos.acos(),
         };
         let c = &self.cells[cell];
-        let interval = c.interval_of(c.search_key(cos, var), dkey);
+        let interval = if self.isotropic {
+            c.interval_of(c.search_key(cos, var), dkey)
+        } else {
+            c.interval_direct(c.search_key(cos, var), dkey)
+        };
         let keys = if self.isotropic {
             [0.0; 2]
         } else {

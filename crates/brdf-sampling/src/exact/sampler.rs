@@ -85,6 +85,7 @@ impl DirectionSampler for ExactSet {
                         + std::mem::size_of_val(c.iso.as_slice())
                         + std::mem::size_of_val(c.aniso.as_slice())
                         + std::mem::size_of_val(c.patches.as_slice())
+                        + c.direct_bytes()
                         + c.tables
                             .iter()
                             .flatten()

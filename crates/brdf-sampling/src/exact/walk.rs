@@ -132,9 +132,15 @@ pub(super) fn cell_offset(
     } else {
         (1.0, 0.0)
     };
-    let step = period / n as f64;
+    // The coarse cell: `φ / step` by a multiplication (the reciprocal does not wait for the
+    // angle) and `mod n` by a comparison (`φ < period`, so the index is at most `n`); a cell
+    // one off is corrected below.
+    let per_step = n as f64 / period;
     let phi = rem_period(coarse_angle(x, y), period);
-    let mut k = round_index(phi / step) % n;
+    let mut k = round_index(phi * per_step);
+    if k >= n {
+        k = 0;
+    }
     for _ in 0..2 {
         let cell = phi_turns(k);
         let turn = Turn {
