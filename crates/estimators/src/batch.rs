@@ -572,14 +572,14 @@ pub(crate) mod tests {
     fn batch_mis_given_f_equals_mis_and_hands_the_sampler_the_light_samples_f() {
         let (map, brdf, frame, _) = scene_parts();
         let light = EnvMapSampler::piecewise_constant(&map).unwrap();
-        let points: Vec<Query> = (0..64)
-            .map(|i| Query {
-                wo: brdf::direction_from_angles(1.0 + i as f64, 7.0 * i as f64),
-                frame,
+        // The scenes' ωo (normalised by `ProductScene::new`) are the points' ωo.
+        let scenes: Vec<ProductScene> = (0..64)
+            .map(|i| {
+                let wo = brdf::direction_from_angles(1.0 + i as f64, 7.0 * i as f64);
+                ProductScene::new(brdf.as_ref(), &map, frame, wo).unwrap()
             })
             .collect();
-        let scene_of = |k: usize| ProductScene::new(brdf.as_ref(), &map, frame, points[k].wo);
-        let scenes: Vec<ProductScene> = (0..points.len()).map(|k| scene_of(k).unwrap()).collect();
+        let points: Vec<Query> = scenes.iter().map(|s| Query { wo: s.wo, frame }).collect();
         let spp = 6;
         let sampler = |scale: f64| GivenF {
             brdf: brdf::parse_spec("phong:n=20,ks=0.6,kd=0.3").unwrap(),
