@@ -56,7 +56,8 @@ impl EvalSample {
 ///
 /// The methods here are the sampling ones: draw ([`Self::sample`], [`Self::sample_eval`] and
 /// their batched forms [`Self::sample_eval_batch`], [`Self::sample_batch`],
-/// [`Self::sample_many`]), evaluate ([`Self::pdf`], [`Self::pdf_many`]) and the cost of the
+/// [`Self::sample_many`]), evaluate ([`Self::pdf`], [`Self::pdf_many`], and given a known
+/// `f`: [`Self::pdf_given_f`], [`Self::pdf_many_given_f`]) and the cost of the
 /// structure ([`Self::bytes_used`], [`Self::prefers_batches`]). Validation and report hooks
 /// are the supertrait [`SamplerDiagnostics`].
 pub trait DirectionSampler: SamplerDiagnostics + Send + Sync {
@@ -131,6 +132,27 @@ pub trait DirectionSampler: SamplerDiagnostics + Send + Sync {
     /// work; the validation suite's pdf-consistency check calls it.
     fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
         wi.iter().map(|w| self.pdf(wo, w)).collect()
+    }
+
+    /// [`Self::pdf`] at `(wo, wi)` for a caller that has already evaluated
+    /// `f = f_r(ωo, ωi)` of `brdf` there (an MIS estimator's light sample: the integrand needs
+    /// `f`, the weight needs the BRDF sampler's pdf). A sampler whose pdf is `f_r cos θi / A(ωo)`
+    /// for the BRDF object it was built with (`adaptive-exact`) returns `f cos θi / A(ωo)`
+    /// without evaluating `f_r` again when `brdf` is that object — the same value as `pdf`,
+    /// provided `f` is `brdf.eval(wo, wi)` bit for bit. The default ignores `brdf` and `f` and
+    /// calls [`Self::pdf`], so a caller may always pass them.
+    fn pdf_given_f(&self, brdf: &dyn Brdf, wo: &Vec3, wi: &Vec3, f: f64) -> f64 {
+        let _ = (brdf, f);
+        self.pdf(wo, wi)
+    }
+
+    /// [`Self::pdf_given_f`] at `wo` for every direction of `wi`, in order, `f[k]` the value
+    /// `brdf.eval(wo, wi[k])` (`f.len() == wi.len()`; otherwise the values are those of
+    /// [`Self::pdf_many`]). The default ignores `brdf` and `f` and calls [`Self::pdf_many`] (so a
+    /// sampler that batches `pdf_many` keeps batching).
+    fn pdf_many_given_f(&self, brdf: &dyn Brdf, wo: &Vec3, wi: &[Vec3], f: &[f64]) -> Vec<f64> {
+        let _ = (brdf, f);
+        self.pdf_many(wo, wi)
     }
 
     /// Whether callers should batch pdf queries through [`Self::pdf_many`] wherever they can

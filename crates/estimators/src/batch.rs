@@ -206,6 +206,33 @@ impl Batch<'_> {
         })
     }
 
+    /// [`Self::mis`] for an integrand whose BRDF is the batch's (`self.brdf`, e.g. the luminance
+    /// or a grey BRDF's colour times `f`): `g(k, ωi, f)` receives `f = f_r(ωo, ωi)` of
+    /// `self.brdf` at every sample — the sampler's at a BRDF sample ([`EvalSample::f`]), one
+    /// evaluation by the batch at a light sample above the horizon — and the BRDF sampler's pdf
+    /// at a point's light samples is one [`DirectionSampler::pdf_many_given_f`] call with those
+    /// `f`, so a sampler whose pdf is `f cos θi / A(ωo)` (`adaptive-exact`, built with
+    /// `self.brdf`) evaluates nothing more. The same uniforms, samples and values as
+    /// [`Self::mis`] with an integrand that evaluates `f` itself (bit for bit where
+    /// `pdf_many_given_f` equals `pdf_many`, as its contract requires).
+    pub fn mis_given_f<V: Radiance, L: LightTechnique + ?Sized>(
+        &self,
+        points: &[Query],
+        light: &L,
+        heuristic: MisHeuristic,
+        g: impl Fn(usize, &Vec3, f64) -> V,
+        u: &mut dyn UniformSource,
+    ) -> Vec<V> {
+        self.mis_core(
+            points,
+            light,
+            |k, wi, f| g(k, wi, f.unwrap_or(0.0)),
+            u,
+            |own, other| heuristic.weight(own, other),
+            true,
+        )
+    }
+
     /// [`Self::mis`] with the weight `weight(own, other)` (the tests give it broken ones).
     pub(crate) fn mis_with<V: Radiance, L: LightTechnique + ?Sized>(
         &self,
@@ -214,6 +241,20 @@ impl Batch<'_> {
         g: impl Fn(usize, &Vec3, Option<f64>) -> V,
         u: &mut dyn UniformSource,
         weight: impl Fn(f64, f64) -> f64,
+    ) -> Vec<V> {
+        self.mis_core(points, light, g, u, weight, false)
+    }
+
+    /// [`Self::mis_with`]; with `known_f`, [`Self::mis_given_f`]'s light samples (`f` of
+    /// `self.brdf` evaluated here and handed to `g` and to `pdf_many_given_f`).
+    fn mis_core<V: Radiance, L: LightTechnique + ?Sized>(
+        &self,
+        points: &[Query],
+        light: &L,
+        g: impl Fn(usize, &Vec3, Option<f64>) -> V,
+        u: &mut dyn UniformSource,
+        weight: impl Fn(f64, f64) -> f64,
+        known_f: bool,
     ) -> Vec<V> {
         let mut out = Vec::new();
         self.draw(points, u, &mut out);
@@ -239,26 +280,36 @@ impl Batch<'_> {
         // its structure does so once per point). Zero terms are skipped: the sum is the same.
         let mut terms: Vec<(V, f64)> = Vec::with_capacity(self.spp);
         let mut wis: Vec<Vec3> = Vec::with_capacity(self.spp);
+        let mut fs: Vec<f64> = Vec::with_capacity(if known_f { self.spp } else { 0 });
         for (k, p) in points.iter().enumerate() {
             terms.clear();
             wis.clear();
+            fs.clear();
             for _ in 0..self.spp {
                 let Some((d, pl)) = light.sample_world(u) else {
                     break;
                 };
                 let wi = p.frame.to_local(&d);
                 if wi.z > 0.0 && pl > 0.0 {
-                    let gl = g(k, &wi, None);
+                    let f = known_f.then(|| self.brdf.eval(&p.wo, &wi));
+                    let gl = g(k, &wi, f);
                     if gl.any_positive() {
                         terms.push((gl, pl));
                         wis.push(wi);
+                        if let Some(f) = f {
+                            fs.push(f);
+                        }
                     }
                 }
             }
             if terms.is_empty() {
                 continue;
             }
-            let pdfs = self.sampler.pdf_many(&p.wo, &wis);
+            let pdfs = if known_f {
+                self.sampler.pdf_many_given_f(self.brdf, &p.wo, &wis, &fs)
+            } else {
+                self.sampler.pdf_many(&p.wo, &wis)
+            };
             let mut sum = V::default();
             for (&(gl, pl), &pb) in terms.iter().zip(&pdfs) {
                 sum = sum.plus(mis_term_with(gl, pl, 1.0, 1.0, || pb, &weight));
@@ -474,6 +525,115 @@ pub(crate) mod tests {
             want,
             "misordered pdf_many not caught"
         );
+    }
+
+    /// Cosine sampling whose `pdf_many_given_f` checks the `f` it is handed against
+    /// `brdf.eval(ωo, ωi)` (counting mismatches) and may scale its pdf (broken).
+    struct GivenF {
+        brdf: Box<dyn Brdf>,
+        mismatches: std::sync::atomic::AtomicUsize,
+        calls: std::sync::atomic::AtomicUsize,
+        scale: f64,
+    }
+
+    impl brdf_sampling::SamplerDiagnostics for GivenF {}
+
+    impl DirectionSampler for GivenF {
+        fn sample(&self, wo: &Vec3, u: &mut dyn UniformSource) -> brdf_sampling::DirSample {
+            CosineHemisphere.sample(wo, u)
+        }
+        fn pdf(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            CosineHemisphere.pdf(wo, wi)
+        }
+        fn pdf_many_given_f(&self, _: &dyn Brdf, wo: &Vec3, wi: &[Vec3], f: &[f64]) -> Vec<f64> {
+            use std::sync::atomic::Ordering::Relaxed;
+            self.calls.fetch_add(1, Relaxed);
+            if f.len() != wi.len() {
+                self.mismatches.fetch_add(1, Relaxed);
+            }
+            for (w, &f) in wi.iter().zip(f) {
+                if self.brdf.eval(wo, w).to_bits() != f.to_bits() {
+                    self.mismatches.fetch_add(1, Relaxed);
+                }
+            }
+            wi.iter().map(|w| self.scale * self.pdf(wo, w)).collect()
+        }
+        fn bytes_used(&self) -> usize {
+            0
+        }
+    }
+
+    /// `Batch::mis_given_f` (the integrand handed `f` at every sample, the BRDF pdf at the
+    /// light samples from `pdf_many_given_f` with those `f`) gives bit for bit the values of
+    /// `Batch::mis` with an integrand that evaluates `f` itself, handing the sampler each light
+    /// sample's `f = brdf.eval(ωo, ωi)` in order; a `pdf_many_given_f` that departs from the
+    /// pdf (× 1.5) changes the values (the path is used).
+    #[test]
+    fn batch_mis_given_f_equals_mis_and_hands_the_sampler_the_light_samples_f() {
+        let (map, brdf, frame, _) = scene_parts();
+        let light = EnvMapSampler::piecewise_constant(&map).unwrap();
+        // The scenes' ωo (normalised by `ProductScene::new`) are the points' ωo.
+        let scenes: Vec<ProductScene> = (0..64)
+            .map(|i| {
+                let wo = brdf::direction_from_angles(1.0 + i as f64, 7.0 * i as f64);
+                ProductScene::new(brdf.as_ref(), &map, frame, wo).unwrap()
+            })
+            .collect();
+        let points: Vec<Query> = scenes.iter().map(|s| Query { wo: s.wo, frame }).collect();
+        let spp = 6;
+        let sampler = |scale: f64| GivenF {
+            brdf: brdf::parse_spec("phong:n=20,ks=0.6,kd=0.3").unwrap(),
+            mismatches: 0.into(),
+            calls: 0.into(),
+            scale,
+        };
+        let seeded = || Xoshiro256PlusPlus::seed_from_u64(37);
+        let s = sampler(1.0);
+        let batch = Batch {
+            sampler: &s,
+            brdf: brdf.as_ref(),
+            spp,
+        };
+        let want = batch.mis(
+            &points,
+            &light,
+            MisHeuristic::Balance,
+            |k, wi, f| match f {
+                Some(f) => scenes[k].integrand_with_f(wi, f),
+                None => scenes[k].integrand(wi),
+            },
+            &mut seeded(),
+        );
+        let got = batch.mis_given_f(
+            &points,
+            &light,
+            MisHeuristic::Balance,
+            |k, wi, f| scenes[k].integrand_with_f(wi, f),
+            &mut seeded(),
+        );
+        assert!(want.iter().filter(|v| **v > 0.0).count() > 40);
+        assert_eq!(got, want);
+        use std::sync::atomic::Ordering::Relaxed;
+        assert!(
+            s.calls.load(Relaxed) > 40,
+            "{} calls",
+            s.calls.load(Relaxed)
+        );
+        assert_eq!(s.mismatches.load(Relaxed), 0);
+        let broken = sampler(1.5);
+        let got = Batch {
+            sampler: &broken,
+            brdf: brdf.as_ref(),
+            spp,
+        }
+        .mis_given_f(
+            &points,
+            &light,
+            MisHeuristic::Balance,
+            |k, wi, f| scenes[k].integrand_with_f(wi, f),
+            &mut seeded(),
+        );
+        assert_ne!(got, want, "pdf_many_given_f not used");
     }
 
     #[test]

@@ -56,9 +56,21 @@ fn main() {
             if rows.is_empty() {
                 continue;
             }
-            println!("sphere `{spec}`, {kind} (sampler, spp, rel. error):");
-            for (name, spp, e) in rows {
-                println!("  {name:<24} {spp:>5} {:>8.3} %", 100.0 * e);
+            println!(
+                "sphere `{spec}`, {kind} (sampler, spp, rel. error ± 95 %, above the best ± Šidák 95 %, tied with the best): adaptive {}",
+                study::AdaptiveVerdict::of(&rows).word()
+            );
+            for r in rows {
+                println!(
+                    "  {:<24} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
+                    r.sampler,
+                    r.spp,
+                    100.0 * r.error,
+                    100.0 * r.ci95,
+                    100.0 * r.above_best,
+                    100.0 * r.above_best_hw,
+                    if r.tied_with_best { "tied" } else { "worse" }
+                );
             }
         }
     }

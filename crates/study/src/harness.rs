@@ -181,6 +181,12 @@ impl DirectionSampler for SharedSet {
     fn pdf_many(&self, wo: &Vec3, wi: &[Vec3]) -> Vec<f64> {
         self.set.pdf_many(wo, wi)
     }
+    fn pdf_given_f(&self, brdf: &dyn Brdf, wo: &Vec3, wi: &Vec3, f: f64) -> f64 {
+        self.set.pdf_given_f(brdf, wo, wi, f)
+    }
+    fn pdf_many_given_f(&self, brdf: &dyn Brdf, wo: &Vec3, wi: &[Vec3], f: &[f64]) -> Vec<f64> {
+        self.set.pdf_many_given_f(brdf, wo, wi, f)
+    }
     fn prefers_batches(&self) -> bool {
         self.set.prefers_batches()
     }
