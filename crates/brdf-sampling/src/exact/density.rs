@@ -326,7 +326,7 @@ mod tests {
         let count = AtomicU64::new(0);
         let mut positive = 0;
         for k in 0..2000u32 {
-            let t = 1.5707 * ((k as f64 + 0.5) / 2000.0).sqrt();
+            let t = (std::f64::consts::FRAC_PI_2 - 1e-4) * ((k as f64 + 0.5) / 2000.0).sqrt();
             let wi = direction_from_radians(t, 2.399_963 * k as f64);
             for (a, b) in fast.nodes.iter().zip(&slow.nodes) {
                 let (va, vb) = (
