@@ -532,11 +532,7 @@ pub(super) fn build_interval(
     let n_delta = delta_node_count(options, ctx.delta);
     let nodes = bound_nodes(brdf, job, ctx, &span, n_delta);
     let n_nodes = nodes.len() as u64;
-    let envelope = Arc::new(IntervalEnvelope {
-        brdf: Arc::clone(brdf),
-        nodes,
-        evaluations: Default::default(),
-    });
+    let envelope = Arc::new(IntervalEnvelope::new(Arc::clone(brdf), nodes, true));
     let centre = span.centre(ctx.phi_k);
     let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, span.map);
     let track = delta_nodes(
@@ -665,14 +661,14 @@ fn sampler_density(
     span: &Span,
     nodes: &[EnvelopeNode],
 ) -> DiscBrdf {
-    let plain = Arc::new(IntervalEnvelope {
-        brdf: Arc::clone(brdf),
-        nodes: nodes
+    let plain = Arc::new(IntervalEnvelope::new(
+        Arc::clone(brdf),
+        nodes
             .iter()
             .map(|n| EnvelopeNode::new(n.key, n.wo, n.delta, None, false))
             .collect(),
-        evaluations: Default::default(),
-    });
+        false,
+    ));
     DiscBrdf::with_map(plain, span.centre(ctx.phi_k), span.map)
 }
 

@@ -5,7 +5,8 @@
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex};
 
-use brdf::{Brdf, Outgoing, Vec3, rotate_z};
+use brdf::measured::rgl::PreparedSlice;
+use brdf::{Brdf, Outgoing, RglBrdf, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
 use rustc_hash::FxHashMap;
 
@@ -126,6 +127,9 @@ pub(crate) struct EnvelopeNode {
     pub(crate) delta: f64,
     /// Values this node already had in the interval's parent (same node, same lattice).
     inherited: Option<Arc<NodeValues>>,
+    /// The RGL material's θo slice blended at this node ([`RglBrdf::prepare_slice`]), for an
+    /// envelope that evaluates through it ([`IntervalEnvelope::new`]).
+    slice: Option<PreparedSlice>,
     /// Values evaluated by this build, kept for the children when caching is on: one buffer
     /// per worker thread and one for callers outside the pool.
     fresh: Option<Vec<FreshBuffer>>,
@@ -145,6 +149,7 @@ impl EnvelopeNode {
             wo,
             delta,
             inherited,
+            slice: None,
             fresh: cache.then(|| {
                 (0..=rayon::current_num_threads())
                     .map(|_| FreshBuffer::default())
@@ -153,7 +158,13 @@ impl EnvelopeNode {
         }
     }
 
-    fn value(&self, brdf: &dyn Brdf, wi: &Vec3, evaluations: &AtomicU64) -> f64 {
+    fn value(
+        &self,
+        brdf: &dyn Brdf,
+        rgl: Option<&RglBrdf>,
+        wi: &Vec3,
+        evaluations: &AtomicU64,
+    ) -> f64 {
         let key = [wi.x.to_bits(), wi.y.to_bits(), wi.z.to_bits()];
         if let Some(v) = self.inherited.as_ref().and_then(|m| m.get(&key)) {
             return v;
@@ -163,7 +174,11 @@ impl EnvelopeNode {
         } else {
             rotate_z(wi, self.delta)
         };
-        let v = brdf.eval_prepared(&self.wo, &w);
+        let v = match (rgl, &self.slice) {
+            // `eval_prepared`'s value bit for bit, read from the one blended slice.
+            (Some(rgl), Some(slice)) => rgl.eval_in_slice(slice, &self.wo, &w),
+            _ => brdf.eval_prepared(&self.wo, &w),
+        };
         if let Some(buffers) = &self.fresh {
             evaluations.fetch_add(1, Relaxed);
             let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
@@ -211,16 +226,50 @@ impl EnvelopeNode {
 /// are looked up instead of evaluated again (bit-identical: same node, same `ωi`).
 pub(crate) struct IntervalEnvelope {
     pub(crate) brdf: Arc<dyn Brdf>,
+    /// `brdf` itself when it is an RGL material whose nodes carry their blended slices: the
+    /// nodes are evaluated through [`RglBrdf::eval_in_slice`] (the same values).
+    rgl: Option<RglBrdf>,
     pub(crate) nodes: Vec<EnvelopeNode>,
     /// BRDF evaluations made by nodes that cache (their misses); the others are counted by
     /// the image map's counter.
     pub(crate) evaluations: AtomicU64,
 }
 
+impl IntervalEnvelope {
+    /// The envelope `max_n f_r(ωo_n, R_{δ_n} ·)` of `brdf` over `nodes`. With `slices`, an RGL
+    /// material (`brdf` itself, see [`rgl_itself`]) blends each node's θo slice once
+    /// ([`RglBrdf::prepare_slice`], ≈ 3.4·10⁴ table entries) and evaluates the node there:
+    /// `eval_prepared`'s values bit for bit (the format's contract, tested in `brdf`), at
+    /// ≈ 3/4 of its cost, so the envelope and the tree built on it do not change.
+    pub(crate) fn new(brdf: Arc<dyn Brdf>, mut nodes: Vec<EnvelopeNode>, slices: bool) -> Self {
+        let rgl = if slices { rgl_itself(&brdf) } else { None };
+        if let Some(rgl) = &rgl {
+            for node in &mut nodes {
+                node.slice = Some(rgl.prepare_slice(node.wo.wo()));
+            }
+        }
+        Self {
+            brdf,
+            rgl,
+            nodes,
+            evaluations: AtomicU64::new(0),
+        }
+    }
+}
+
+/// The RGL material `brdf` is, when it is one itself: not a wrapper that forwards `as_any`
+/// (such as [`brdf::CountingBrdf`], whose evaluations must go through it to be counted; a
+/// wrapped material keeps the two-slice path, with the same values).
+pub(crate) fn rgl_itself(brdf: &Arc<dyn Brdf>) -> Option<RglBrdf> {
+    let rgl = brdf.as_any()?.downcast_ref::<RglBrdf>()?;
+    let same = std::ptr::addr_eq(Arc::as_ptr(brdf), rgl as *const RglBrdf);
+    same.then(|| rgl.clone())
+}
+
 impl Brdf for IntervalEnvelope {
     fn eval(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
         self.nodes.iter().fold(0.0f64, |m, node| {
-            m.max(node.value(self.brdf.as_ref(), wi, &self.evaluations))
+            m.max(node.value(self.brdf.as_ref(), self.rgl.as_ref(), wi, &self.evaluations))
         })
     }
     fn is_mirror_symmetric(&self) -> bool {
@@ -237,5 +286,59 @@ impl Brdf for IntervalEnvelope {
     }
     fn name(&self) -> &str {
         "interval-envelope"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use brdf::{CountingBrdf, direction_from_radians};
+
+    /// Issue 29 (docs/benchmarks.md §25.4): an envelope whose RGL nodes carry their blended
+    /// slices gives every node's value of the two-slice path bit for bit (and so the same
+    /// tree), at 2 000 incident directions over the hemisphere; a wrapped material (the
+    /// counting wrapper of the counted builds) keeps the two-slice path.
+    #[test]
+    fn envelope_slices_change_nothing_but_the_cost() {
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
+            return;
+        };
+        let brdf: Arc<dyn Brdf> = Arc::new(rgl);
+        let counted: Arc<dyn Brdf> = Arc::new(CountingBrdf(Arc::clone(&brdf)));
+        assert!(rgl_itself(&brdf).is_some());
+        assert!(rgl_itself(&counted).is_none());
+        let nodes = || -> Vec<EnvelopeNode> {
+            [20.0f64, 21.5, 23.0, 24.5, 26.0, 88.9]
+                .iter()
+                .enumerate()
+                .map(|(k, deg)| {
+                    let wo = direction_from_radians(deg.to_radians(), 0.0);
+                    EnvelopeNode::new((k as u64, 0), brdf.prepare(&wo), 0.0, None, false)
+                })
+                .collect()
+        };
+        let fast = IntervalEnvelope::new(Arc::clone(&brdf), nodes(), true);
+        let slow = IntervalEnvelope::new(Arc::clone(&brdf), nodes(), false);
+        assert!(fast.nodes.iter().all(|n| n.slice.is_some()));
+        assert!(fast.rgl.is_some() && slow.rgl.is_none());
+        let wrapped = IntervalEnvelope::new(counted, nodes(), true);
+        assert!(wrapped.rgl.is_none() && wrapped.nodes.iter().all(|n| n.slice.is_none()));
+        let count = AtomicU64::new(0);
+        let mut positive = 0;
+        for k in 0..2000u32 {
+            let t = (std::f64::consts::FRAC_PI_2 - 1e-4) * ((k as f64 + 0.5) / 2000.0).sqrt();
+            let wi = direction_from_radians(t, 2.399_963 * k as f64);
+            for (a, b) in fast.nodes.iter().zip(&slow.nodes) {
+                let (va, vb) = (
+                    a.value(brdf.as_ref(), fast.rgl.as_ref(), &wi, &count),
+                    b.value(brdf.as_ref(), None, &wi, &count),
+                );
+                assert_eq!(va.to_bits(), vb.to_bits(), "θi {t}: {va} vs {vb}");
+                positive += usize::from(va > 0.0);
+            }
+            let wo = Vec3::new(0.0, 0.0, 1.0);
+            assert_eq!(fast.eval(&wo, &wi).to_bits(), slow.eval(&wo, &wi).to_bits());
+        }
+        assert!(positive > 6000, "{positive} positive values");
     }
 }

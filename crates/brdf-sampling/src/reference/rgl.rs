@@ -18,7 +18,9 @@
 //! (and the horizon), the outer over `u_m.y` with the same rule on each piece between the
 //! grids' rows (`vndf`, `ndf` and the `rgb` rows' images), graded towards `φ = ±π/2`, where at
 //! grazing `θo` the horizon's `θmax` swings from ~0 to ~π/2 over `Δφ ≈ cot θo`. The integrand
-//! is the material's own [`Brdf::eval_prepared`] (the tables, not a re-implementation).
+//! is the material's own evaluation (the tables, not a re-implementation): its
+//! [`Brdf::prepare_run`] at `ωo` when it has one (RGL: the blended θo slice, the same values
+//! as [`Brdf::eval_prepared`] bit for bit at ~3/4 of the cost), else `eval_prepared`.
 //! Its error is estimated by the same rule at half the order: the difference is returned.
 //! The whole azimuth range is integrated (the four shared files are not mirror-symmetric
 //! within the reader's tolerance).
@@ -26,7 +28,7 @@
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 use brdf::quadrature::GaussLegendre;
-use brdf::{Brdf, RglBrdf, Vec3};
+use brdf::{Brdf, PreparedRun, RglBrdf, Vec3};
 use rayon::prelude::*;
 
 use super::{AlbedoEstimate, ReferenceError};
@@ -69,8 +71,12 @@ pub(crate) fn albedo_in_cells_of(
     order: usize,
 ) -> Result<AlbedoEstimate, ReferenceError> {
     let order = order.max(2);
-    let fine = CellRule::new(brdf, rgl, theta_o, order);
-    let coarse = CellRule::new(brdf, rgl, theta_o, (order / 2).max(1));
+    // One run at `ωo` for both rules: its evaluations are `eval`'s bit for bit, read from the
+    // blended θo slice (RGL's `prepare_run`) at ~3/4 of the two-slice path's cost.
+    let wo = brdf::direction_from_radians(theta_o, 0.0);
+    let run = brdf.prepare_run(&wo);
+    let fine = CellRule::new(brdf, rgl, theta_o, order, run.as_deref());
+    let coarse = CellRule::new(brdf, rgl, theta_o, (order / 2).max(1), run.as_deref());
     let (value, e1) = fine.integrate();
     let (low, e2) = coarse.integrate();
     if !(value.is_finite() && low.is_finite()) {
@@ -96,6 +102,9 @@ struct CellRule<'a> {
     theta_o: f64,
     wo: Vec3,
     q: brdf::Outgoing,
+    /// `brdf` prepared for the run of evaluations at `ωo` ([`Brdf::prepare_run`]), if it
+    /// offers one: the same values as `eval_prepared(q, ·)`, bit for bit.
+    run: Option<&'a dyn PreparedRun>,
     gl: GaussLegendre,
     /// `u_m.x` of the `vndf` and `ndf` columns (fixed on every line).
     x_nodes: Vec<f64>,
@@ -104,7 +113,13 @@ struct CellRule<'a> {
 }
 
 impl<'a> CellRule<'a> {
-    fn new(brdf: &'a dyn Brdf, rgl: &'a RglBrdf, theta_o: f64, order: usize) -> Self {
+    fn new(
+        brdf: &'a dyn Brdf,
+        rgl: &'a RglBrdf,
+        theta_o: f64,
+        order: usize,
+        run: Option<&'a dyn PreparedRun>,
+    ) -> Self {
         let wo = brdf::direction_from_radians(theta_o, 0.0);
         let g = rgl.grids();
         let mut x_nodes = grid_nodes(g.vndf.0);
@@ -116,6 +131,7 @@ impl<'a> CellRule<'a> {
             theta_o,
             wo,
             q: brdf.prepare(&wo),
+            run,
             gl: GaussLegendre::new(order),
             x_nodes,
             s_nodes: grid_nodes(g.rgb.0),
@@ -210,7 +226,11 @@ impl<'a> CellRule<'a> {
             if !(wi.z > 0.0 && dot > 0.0) {
                 return 0.0;
             }
-            let fc = self.brdf.eval_prepared(&self.q, &wi) * wi.z;
+            let f = match self.run {
+                Some(run) => run.eval(&wi),
+                None => self.brdf.eval_prepared(&self.q, &wi),
+            };
+            let fc = f * wi.z;
             fc * 8.0 * PI * PI * x * st * dot
         };
         let mut total = 0.0;
@@ -296,6 +316,41 @@ pub(crate) mod tests {
             }
             let c = rgl_reference_albedo(rgl, 89.5f64.to_radians()).expect("cells");
             assert!(c.abs_err <= 1e-6 * c.value, "{name} 89.5°: {c:?}");
+        }
+    }
+
+    /// The material without its `prepare_run` (the two-slice path of `eval_prepared`).
+    struct NoRun<'a>(&'a RglBrdf);
+
+    impl Brdf for NoRun<'_> {
+        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            self.0.eval(wo, wi)
+        }
+        fn prepare(&self, wo: &Vec3) -> brdf::Outgoing {
+            self.0.prepare(wo)
+        }
+        fn eval_prepared(&self, q: &brdf::Outgoing, wi: &Vec3) -> f64 {
+            self.0.eval_prepared(q, wi)
+        }
+    }
+
+    /// Issue 29 (docs/benchmarks.md §25.4): the cell rule evaluated through the material's
+    /// prepared run at `ωo` gives the two-slice path's value, error estimate and evaluation
+    /// count bit for bit, from normal incidence to grazing (the run exists at every angle).
+    #[test]
+    fn the_prepared_run_changes_nothing_but_the_cost() {
+        let Some(rgl) = fixture() else { return };
+        for deg in [0.0f64, 17.3, 45.0, 80.0, 89.5] {
+            let t = deg.to_radians();
+            assert!(
+                rgl.prepare_run(&brdf::direction_from_radians(t, 0.0))
+                    .is_some()
+            );
+            let fast = albedo_in_cells_of(&rgl, &rgl, t, 2).expect("cells");
+            let slow = albedo_in_cells_of(&NoRun(&rgl), &rgl, t, 2).expect("cells");
+            assert_eq!(fast.value.to_bits(), slow.value.to_bits(), "{deg}°");
+            assert_eq!(fast.abs_err.to_bits(), slow.abs_err.to_bits(), "{deg}°");
+            assert_eq!(fast.evaluations, slow.evaluations, "{deg}°");
         }
     }
 
