@@ -160,6 +160,13 @@ impl BilinearTable {
         BilinearTable::new(self.nx, self.ny, data)
     }
 
+    /// `(nx, ny, values)`: the grid and its values, slice after slice, for the block
+    /// evaluation of `measured::rgl` (slice 0 read as [`eval_single`](Self::eval_single)).
+    #[inline]
+    pub(crate) fn parts(&self) -> (usize, usize, &[f64]) {
+        (self.nx, self.ny, &self.data)
+    }
+
     /// [`eval`](Self::eval) of a one-slice table (slice 0, no blend).
     #[inline]
     pub(crate) fn eval_single(&self, pos: [f64; 2]) -> f64 {
@@ -446,6 +453,13 @@ impl Warp2DSlice {
     /// Heap bytes of the slice.
     pub fn bytes_used(&self) -> usize {
         16 * (self.cells.len() + self.rows.len())
+    }
+
+    /// `(nx, ny, area_scale, cells, rows)`: what [`invert`](Self::invert) reads, for the
+    /// block evaluation of `measured::rgl` (the same arithmetic over many points in lanes).
+    #[inline]
+    pub(crate) fn parts(&self) -> (usize, usize, f64, &[[f64; 2]], &[[f64; 2]]) {
+        (self.nx, self.ny, self.area_scale, &self.cells, &self.rows)
     }
 }
 
