@@ -219,7 +219,11 @@ impl ExactSet {
     /// fixed-`ωo` benchmark) are located once, and their per-query work — the BRDF's
     /// preparation, the normaliser, the rotation back to the world — is done once per run;
     /// runs of at least [`PREPARED_RUN_MIN`] queries on the isotropic fast path evaluate
-    /// their trials through the BRDF's [`Brdf::prepare_run`] when it has one.
+    /// their trials through the BRDF's [`Brdf::prepare_run`] when it has one. When that run
+    /// [`prefers_blocks`](PreparedRun::prefers_blocks) (RGL files: evaluations in vector
+    /// lanes) and the interval has a compact table, such a run of an isotropic set (fast or
+    /// general path) is drawn by [`wavefront`] instead: other samples than the one-query
+    /// path's (each from its own stream), the same law.
     pub(super) fn sample_eval_grouped(
         &self,
         brdf: &dyn Brdf,
