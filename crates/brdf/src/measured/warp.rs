@@ -425,6 +425,9 @@ impl Warp2D {
     }
 }
 
+/// `(nx, ny, area_scale, cells, rows)` of a [`Warp2DSlice`] ([`Warp2DSlice::parts`]).
+pub(crate) type SliceParts<'a> = (usize, usize, f64, &'a [[f64; 2]], &'a [[f64; 2]]);
+
 /// One slice of a [`Warp2D`] blended at a fixed parameter ([`Warp2D::blend_slice`]): its
 /// inversion reads one plain slice instead of blending two at every read.
 #[derive(Debug, Clone, PartialEq)]
@@ -458,7 +461,7 @@ impl Warp2DSlice {
     /// `(nx, ny, area_scale, cells, rows)`: what [`invert`](Self::invert) reads, for the
     /// block evaluation of `measured::rgl` (the same arithmetic over many points in lanes).
     #[inline]
-    pub(crate) fn parts(&self) -> (usize, usize, f64, &[[f64; 2]], &[[f64; 2]]) {
+    pub(crate) fn parts(&self) -> SliceParts<'_> {
         (self.nx, self.ny, self.area_scale, &self.cells, &self.rows)
     }
 }

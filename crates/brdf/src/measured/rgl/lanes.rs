@@ -23,6 +23,10 @@
 //! `partition-sampler` and `envmap` do: the workspace forbids `unsafe`) to copies compiled for
 //! AVX-512 or AVX2 + FMA when the host has them, else the baseline build.
 
+// msun's constants as FreeBSD publishes them (decimal with their hex in libm's source); the
+// bit-identity test against `libm` checks every one.
+#![allow(clippy::excessive_precision, clippy::approx_constant)]
+
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::fast;
