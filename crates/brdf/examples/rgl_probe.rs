@@ -4,9 +4,40 @@
 //! of elevation `THETA_DEG` and random `ωi` (fixed seed), through a [`brdf::measured::rgl::PreparedSlice`]
 //! of that θo or through the two-slice tables; prints their sum (for instruction counts:
 //! `valgrind --tool=cachegrind --cache-sim=no` at two `N`, the difference over the extra `N`).
+//! `rgl_probe FILE evals N THETA_DEG block`: the same `N` directions through a caller-held run's
+//! [`brdf::PreparedRun::eval_block`] (the RGL block in vector lanes), 64 per call.
 //! `rgl_probe FILE blends N THETA_DEG`: only `N` caller-held runs ([`Brdf::prepare_run`]) at
 //! that θo, one evaluation each (the cost of blending a slice, by the same difference).
 use brdf::{Brdf, RglBrdf, Vec3, direction_from_angles, directional_albedo};
+
+/// `N` evaluations at one θo through a run's block evaluation, 64 per call.
+fn evals_block(b: &RglBrdf, n: usize, theta: f64) {
+    let wo = direction_from_angles(theta, 0.0);
+    let run = b.prepare_run(&wo).expect("a run above the horizon");
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut wis, mut out) = (Vec::with_capacity(64), vec![0.0; 64]);
+    let mut acc = 0.0;
+    let mut done = 0;
+    while done < n {
+        wis.clear();
+        for _ in 0..64.min(n - done) {
+            let z = 1.0 - uniform();
+            let phi = std::f64::consts::TAU * uniform();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            wis.push(Vec3::new(r * phi.cos(), r * phi.sin(), z));
+        }
+        run.eval_block(&wis, &mut out);
+        acc += out[..wis.len()].iter().sum::<f64>();
+        done += wis.len();
+    }
+    println!("{n} evaluations at θo {theta}° (block): sum {acc}");
+}
 
 /// `N` evaluations at one θo (see the module docs).
 fn evals(b: &RglBrdf, n: usize, theta: f64, slice: bool) {
@@ -61,7 +92,11 @@ fn main() {
         let b = RglBrdf::load(std::path::Path::new(&path)).unwrap();
         let n = args[3].parse().unwrap();
         let theta = args[4].parse().unwrap();
-        evals(&b, n, theta, args[5] == "slice");
+        if args[5] == "block" {
+            evals_block(&b, n, theta);
+        } else {
+            evals(&b, n, theta, args[5] == "slice");
+        }
         return;
     }
     let t = std::time::Instant::now();

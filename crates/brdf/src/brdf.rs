@@ -146,6 +146,22 @@ pub trait Brdf: Send + Sync {
 pub trait PreparedRun: Send + Sync {
     /// `f_r(ωo, ωi)` at the run's `ωo`: [`Brdf::eval`]`(wo, wi)` bit for bit.
     fn eval(&self, wi: &Vec3) -> f64;
+
+    /// `out[k] = f_r(ωo, wi[k])` for `k < min(wi.len(), out.len())`: [`eval`](Self::eval)
+    /// of each direction, bit for bit (`out`'s other entries are left alone). A run may
+    /// evaluate the block in vector lanes (RGL files do); default: one `eval` per direction.
+    fn eval_block(&self, wi: &[Vec3], out: &mut [f64]) {
+        for (w, o) in wi.iter().zip(out.iter_mut()) {
+            *o = self.eval(w);
+        }
+    }
+
+    /// Whether [`eval_block`](Self::eval_block) is cheaper per direction than
+    /// [`eval`](Self::eval) (vector lanes), so a sampler should gather its evaluations into
+    /// blocks. Default `false`.
+    fn prefers_blocks(&self) -> bool {
+        false
+    }
 }
 
 /// An outgoing direction `ωo` with up to [`Outgoing::CACHE_LEN`] values a BRDF derived from it

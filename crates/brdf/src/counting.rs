@@ -70,6 +70,17 @@ impl crate::PreparedRun for CountedRun<'_> {
         EVALUATIONS.with(|c| c.set(c.get() + 1));
         self.0.eval(wi)
     }
+    /// The wrapped run's block (its lanes kept), each direction counted.
+    #[inline]
+    fn eval_block(&self, wi: &[Vec3], out: &mut [f64]) {
+        let n = wi.len().min(out.len()) as u64;
+        EVALUATIONS.with(|c| c.set(c.get() + n));
+        self.0.eval_block(wi, out);
+    }
+    #[inline]
+    fn prefers_blocks(&self) -> bool {
+        self.0.prefers_blocks()
+    }
 }
 
 #[cfg(test)]

@@ -141,6 +141,28 @@ impl LeafTable {
     }
 }
 
+impl LeafTable {
+    /// One trial of [`LeafTable::draw`] from its four uniforms `us` (leaf pick, the point's two
+    /// coordinates; `us[3]`, the acceptance test, is the caller's): the point and its leaf's
+    /// bound `M_i`, or `None` when the point lies outside the unit circle (a trial that
+    /// evaluates nothing). The same arithmetic as `draw`'s, for the batch path's wavefront.
+    #[inline]
+    pub(super) fn propose(&self, us: [f64; 4]) -> Option<(Point2, f64)> {
+        let last = self.entries.len() - 1;
+        let s = us[0] * self.n;
+        let i = floor_index(s, last);
+        let first = &self.entries[i];
+        let e = if s - index_to_f64(i) < first.prob {
+            first
+        } else {
+            self.entries.get(first.alias as usize).unwrap_or(first)
+        };
+        let x = f64::from(e.x0) + us[1] * f64::from(e.dx);
+        let y = f64::from(e.y0) + us[2] * f64::from(e.dy);
+        (x * x + y * y < 1.0).then_some(([x, y], f64::from(e.m)))
+    }
+}
+
 /// The test-only check that every interval's table draws what its tree draws.
 #[cfg(test)]
 pub(super) mod walks {

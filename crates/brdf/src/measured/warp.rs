@@ -160,6 +160,13 @@ impl BilinearTable {
         BilinearTable::new(self.nx, self.ny, data)
     }
 
+    /// `(nx, ny, values)`: the grid and its values, slice after slice, for the block
+    /// evaluation of `measured::rgl` (slice 0 read as [`eval_single`](Self::eval_single)).
+    #[inline]
+    pub(crate) fn parts(&self) -> (usize, usize, &[f64]) {
+        (self.nx, self.ny, &self.data)
+    }
+
     /// [`eval`](Self::eval) of a one-slice table (slice 0, no blend).
     #[inline]
     pub(crate) fn eval_single(&self, pos: [f64; 2]) -> f64 {
@@ -418,6 +425,9 @@ impl Warp2D {
     }
 }
 
+/// `(nx, ny, area_scale, cells, rows)` of a [`Warp2DSlice`] ([`Warp2DSlice::parts`]).
+pub(crate) type SliceParts<'a> = (usize, usize, f64, &'a [[f64; 2]], &'a [[f64; 2]]);
+
 /// One slice of a [`Warp2D`] blended at a fixed parameter ([`Warp2D::blend_slice`]): its
 /// inversion reads one plain slice instead of blending two at every read.
 #[derive(Debug, Clone, PartialEq)]
@@ -446,6 +456,13 @@ impl Warp2DSlice {
     /// Heap bytes of the slice.
     pub fn bytes_used(&self) -> usize {
         16 * (self.cells.len() + self.rows.len())
+    }
+
+    /// `(nx, ny, area_scale, cells, rows)`: what [`invert`](Self::invert) reads, for the
+    /// block evaluation of `measured::rgl` (the same arithmetic over many points in lanes).
+    #[inline]
+    pub(crate) fn parts(&self) -> SliceParts<'_> {
+        (self.nx, self.ny, self.area_scale, &self.cells, &self.rows)
     }
 }
 
