@@ -787,6 +787,81 @@ mod tests {
         }
     }
 
+    /// The wavefront's law by χ² (α = 10⁻⁴, 16 × 32 `(cos θ, φ)` bins, 4·10⁴ samples, seeds
+    /// fixed): its samples at θo = 35° and 70° pass against the set's pdf, and two broken
+    /// wavefronts are rejected — one whose run misreports `f` by a factor `0.6 + 0.8 cos θi`
+    /// (samples of another density under the honest pdf), and one that accepts every
+    /// candidate (the envelope's law).
+    #[test]
+    fn wavefront_samples_pass_chi_square_and_broken_ones_fail() {
+        use super::wavefront;
+        use partition_sampler::Audit;
+        struct Skewed<'a>(&'a dyn PreparedRun, f64);
+        impl PreparedRun for Skewed<'_> {
+            fn eval(&self, wi: &Vec3) -> f64 {
+                // factor 0 accepts everything: a value above every bound.
+                if self.1 == 0.0 {
+                    return f64::MAX;
+                }
+                self.0.eval(wi) * (1.0 - self.1 + 2.0 * self.1 * wi.z)
+            }
+        }
+        let brdf: Arc<dyn Brdf> = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks: true,
+        });
+        let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
+        let quad = stats::QuadratureOptions {
+            min_depth: 2,
+            ..stats::QuadratureOptions::default()
+        };
+        let p_value = |theta: f64, skew: Option<f64>| {
+            let wo = brdf::direction_from_angles(theta, 0.0);
+            let q = set.locate_iso(&wo).expect("the isotropic path");
+            let table = set.cells[0].tables[q.interval].as_ref().unwrap();
+            let map = set.cells[0].iso[q.interval].map;
+            let frame = Vec3::new(q.r, 0.0, q.cos);
+            let run = brdf.prepare_run(&frame).unwrap();
+            let skewed;
+            let run: &dyn PreparedRun = match skew {
+                None => run.as_ref(),
+                Some(k) => {
+                    skewed = Skewed(run.as_ref(), k);
+                    &skewed
+                }
+            };
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
+            let mut audit = Audit::default();
+            let pts: Vec<[f64; 3]> = wavefront(run, table, map, 40_000, 256, &mut rng, &mut audit)
+                .into_iter()
+                .map(|d| {
+                    let v = map.to_direction(d.expect("accepted").0);
+                    [v.x, v.y, v.z]
+                })
+                .collect();
+            let pdf = |d: [f64; 3]| set.pdf(&frame, &Vec3::new(d[0], d[1], d[2]));
+            stats::chi_square_test(&bins, &pdf, &pts, &quad)
+                .unwrap()
+                .p_value
+        };
+        for theta in [35.0, 70.0] {
+            let p = p_value(theta, None);
+            assert!(
+                p >= 1e-4,
+                "honest wavefront rejected at θo {theta}: p = {p}"
+            );
+            for skew in [0.4, 0.0] {
+                let p = p_value(theta, Some(skew));
+                assert!(
+                    p < 1e-4,
+                    "broken wavefront ({skew}) passed at θo {theta}: p = {p}"
+                );
+            }
+        }
+    }
+
     /// The RGL fixture through the batch (its run's block evaluation in lanes and the
     /// wavefront): every output's pdf is the set's and `f` the BRDF's, and the mean `cos θi`
     /// of 4·10⁴ samples at θo = 30° lies within 5 standard errors of its exact value.
