@@ -32,7 +32,7 @@
 //! **Reciprocity** is not guaranteed by the format (the tables are sliced by `ωo` only), so
 //! [`Brdf::is_reciprocal`] is `false`.
 
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -43,7 +43,11 @@ use crate::geometry::Vec3;
 
 pub use super::rgl_error::RglError;
 
+mod angles;
 mod lanes;
+
+use angles::fast;
+pub use angles::{elevation, phi_to_u, theta_to_u, u_to_phi, u_to_theta};
 
 /// How many negative `rgb` entries were clamped to zero when reading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,33 +56,6 @@ pub struct NegativeClamp {
     pub count: usize,
     /// The most negative value.
     pub min: f64,
-}
-
-/// Elevation of a unit vector, `acos z`, computed as `2 asin(|d − n|/2)` (accurate near the
-/// normal).
-pub fn elevation(d: &Vec3) -> f64 {
-    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
-    2.0 * (0.5 * dist).clamp(-1.0, 1.0).asin()
-}
-
-/// `θ ↦ u = √(2θ/π)`.
-pub fn theta_to_u(theta: f64) -> f64 {
-    (theta.max(0.0) / FRAC_PI_2).sqrt()
-}
-
-/// `u ↦ θ = u² π/2`.
-pub fn u_to_theta(u: f64) -> f64 {
-    u * u * FRAC_PI_2
-}
-
-/// `φ ↦ u = (φ + π)/(2π)`.
-pub fn phi_to_u(phi: f64) -> f64 {
-    (phi + PI) / TAU
-}
-
-/// `u ↦ φ = (2u − 1)π`.
-pub fn u_to_phi(u: f64) -> f64 {
-    (2.0 * u - 1.0) * PI
 }
 
 /// The tables of one material (shared by clones).
@@ -651,54 +628,6 @@ fn sampling_table(
     })
 }
 
-/// The angles of the evaluation path ([`Brdf::prepare`] and [`Brdf::eval_prepared`]) with the
-/// `libm` crate's `atan2` and `asin` (FreeBSD's msun: errors below 1 ulp, as glibc's, for
-/// fewer instructions: per call `asin` 33 against 54, `atan2` 100 against 112, cachegrind,
-/// docs/benchmarks.md §20.8). The results differ from `std`'s by an ulp or two: the
-/// interpolant is the same to 1e-12 relative up to 85° from the normal, and to the
-/// interpolant's own 1-ulp conditioning beyond (tested against the `std` path on 10⁵ pairs).
-mod fast {
-    use super::phi_to_u;
-    use crate::geometry::Vec3;
-
-    /// `atan2(y, x)`.
-    #[inline]
-    pub(super) fn atan2(y: f64, x: f64) -> f64 {
-        libm::atan2(y, x)
-    }
-
-    /// [`super::elevation`] with `libm`'s `asin`.
-    #[inline]
-    pub(super) fn elevation(d: &Vec3) -> f64 {
-        let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
-        2.0 * libm::asin((0.5 * dist).clamp(-1.0, 1.0))
-    }
-
-    /// `√(x² + y²)`, through `hypot` only when the plain sum would overflow or lose precision
-    /// to underflow.
-    #[inline]
-    pub(super) fn hypot(x: f64, y: f64) -> f64 {
-        let s = x * x + y * y;
-        if s.is_finite() && s >= f64::MIN_POSITIVE {
-            s.sqrt()
-        } else {
-            x.hypot(y)
-        }
-    }
-
-    /// `frac(phi_to_u(φ))` without the `floor` call for `φ ∈ [−π, π)` (the range of `atan2`),
-    /// where the fraction is the value itself.
-    #[inline]
-    pub(super) fn unit_azimuth(phi: f64) -> f64 {
-        let u = phi_to_u(phi);
-        if (0.0..1.0).contains(&u) {
-            u
-        } else {
-            u - u.floor()
-        }
-    }
-}
-
 /// What [`RglBrdf::prepare`](Brdf::prepare) keeps of `ωo` (indices into [`Outgoing::cache`]).
 mod prepared {
     /// 1 when `ωo` is above the horizon, else 0.
@@ -1031,6 +960,7 @@ impl Brdf for RglBrdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::TAU;
 
     /// The repository's fixture (`data/measured/rgl/paper_white_rgb.bsdf`).
     fn fixture() -> RglBrdf {

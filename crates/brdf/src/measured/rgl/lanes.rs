@@ -29,8 +29,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use super::fast;
-use super::theta_to_u;
+use super::angles::{fast, theta_to_u};
 use crate::geometry::Vec3;
 use crate::measured::warp::{BilinearTable, Warp2DSlice};
 
