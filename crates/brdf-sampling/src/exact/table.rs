@@ -105,7 +105,6 @@ impl LeafTable {
         G: Fn(Point2) -> f64,
         U: UniformSource + ?Sized,
     {
-        let last = self.entries.len() - 1;
         let (mut trials, mut violations) = (0u64, 0u64);
         let found = loop {
             if trials >= MAX_TRIALS_PER_SAMPLE {
@@ -113,21 +112,10 @@ impl LeafTable {
                 break None;
             }
             let us = u.next_uniform4();
-            let s = us[0] * self.n;
-            let i = floor_index(s, last);
-            let first = &self.entries[i];
-            let e = if s - index_to_f64(i) < first.prob {
-                first
-            } else {
-                self.entries.get(first.alias as usize).unwrap_or(first)
-            };
-            let x = f64::from(e.x0) + us[1] * f64::from(e.dx);
-            let y = f64::from(e.y0) + us[2] * f64::from(e.dy);
-            let m = f64::from(e.m);
             trials += 1;
-            if x * x + y * y >= 1.0 {
+            let Some(([x, y], m)) = self.propose(us) else {
                 continue;
-            }
+            };
             let f = g([x, y]);
             violations += u64::from(f > m);
             if us[3] * m < f {
@@ -145,8 +133,8 @@ impl LeafTable {
     /// One trial of [`LeafTable::draw`] from its four uniforms `us` (leaf pick, the point's two
     /// coordinates; `us[3]`, the acceptance test, is the caller's): the point and its leaf's
     /// bound `M_i`, or `None` when the point lies outside the unit circle (a trial that
-    /// evaluates nothing). The same arithmetic as `draw`'s, for the batch path's wavefront.
-    #[inline]
+    /// evaluates nothing). `draw`'s trial, shared with the batch path's wavefront.
+    #[inline(always)]
     pub(super) fn propose(&self, us: [f64; 4]) -> Option<(Point2, f64)> {
         let last = self.entries.len() - 1;
         let s = us[0] * self.n;
