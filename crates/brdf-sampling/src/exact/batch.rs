@@ -9,7 +9,7 @@ use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
-use super::fused::{IsoQuery, accepted};
+use super::fused::{IsoQuery, accepted, accepted_at};
 use super::table::LeafTable;
 use super::{ExactSet, Query};
 use crate::disc::{DiscMap, count_evaluations};
@@ -45,21 +45,86 @@ const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 #[derive(Clone, Copy)]
 struct Stream(u64);
 
+/// A SplitMix64 output as a uniform on `[0, 1)`: its top 53 bits times `2⁻⁵³` (as
+/// `UniformSource` for a generator). The bits fit in an `i64`, so the signed conversion (one
+/// instruction) gives the value of the unsigned one.
+#[inline(always)]
+fn unit(z: u64) -> f64 {
+    ((z >> 11) as i64) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
 impl Stream {
     #[inline(always)]
     fn of(seed: u64, i: usize) -> Self {
         Self(mix64(seed ^ mix64(i as u64)))
     }
+}
 
-    /// The next four uniforms on `[0, 1)` (53 bits each, as `UniformSource` for a generator).
-    #[inline(always)]
-    fn next4(&mut self) -> [f64; 4] {
-        std::array::from_fn(|_| {
-            self.0 = self.0.wrapping_add(GOLDEN_GAMMA);
-            (mix64(self.0) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-        })
+/// The four uniforms of one trial for every pending sample of a block, in structure-of-arrays
+/// form: `u[k][j]` is the `k`-th of the next four uniforms of the stream whose state is
+/// `state[j]` (SplitMix64: state `+ γ`, output [`unit`]`(mix64(state))`), which advances by four
+/// steps. One pass over independent lanes, so the compiler keeps it in
+/// vector registers (the instruction set of `pulp`'s dispatch, [`uniforms`]).
+#[inline(always)]
+fn uniforms_soa(state: &mut [u64], u: &mut [Vec<f64>; 4]) {
+    let [u0, u1, u2, u3] = u;
+    let n = state.len();
+    let (u0, u1, u2, u3) = (&mut u0[..n], &mut u1[..n], &mut u2[..n], &mut u3[..n]);
+    for (j, s) in state.iter_mut().enumerate() {
+        let s1 = s.wrapping_add(GOLDEN_GAMMA);
+        let s2 = s1.wrapping_add(GOLDEN_GAMMA);
+        let s3 = s2.wrapping_add(GOLDEN_GAMMA);
+        let s4 = s3.wrapping_add(GOLDEN_GAMMA);
+        u0[j] = unit(mix64(s1));
+        u1[j] = unit(mix64(s2));
+        u2[j] = unit(mix64(s3));
+        u3[j] = unit(mix64(s4));
+        *s = s4;
     }
 }
+
+/// [`uniforms_soa`] as a `pulp` operation, compiled for the instruction set the host offers.
+struct Uniforms<'a> {
+    state: &'a mut [u64],
+    u: &'a mut [Vec<f64>; 4],
+}
+
+impl pulp::WithSimd for Uniforms<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        uniforms_soa(self.state, self.u);
+    }
+}
+
+/// [`uniforms_soa`] dispatched at run time (`pulp`: AVX-512 as `V4`, AVX2 + FMA as `V3`, else
+/// the baseline); the same bits on every level (integer arithmetic and one exact conversion).
+fn uniforms(arch: pulp::Arch, state: &mut [u64], u: &mut [Vec<f64>; 4]) {
+    arch.dispatch(Uniforms { state, u });
+}
+
+/// The key of a wavefront's streams: one 64-bit word made of two uniforms of `u` (their 53-bit
+/// integers, the second shifted by 11).
+fn wave_seed(u: &mut dyn UniformSource) -> u64 {
+    let [a, b] = [u.next_uniform(), u.next_uniform()];
+    let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
+    bits(a) ^ (bits(b) << 11)
+}
+
+/// A sample's stream as a caller's uniform source (test support: [`LeafTable::draw`] from it
+/// is the wavefront's sample).
+///
+/// [`LeafTable::draw`]: super::table::LeafTable::draw
+#[cfg(test)]
+impl UniformSource for Stream {
+    fn next_uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(GOLDEN_GAMMA);
+        unit(mix64(self.0))
+    }
+}
+
+/// An accepted trial of [`wavefront`]: the disc point, its direction on the map and `g` there.
+pub(super) type Drawn = (Point2, Vec3, f64);
 
 /// `n` points of `g / ∫ g` on the disc by envelope rejection under `table`'s bounds, with
 /// `g` the run's density on `map` ([`run_density`]'s: `f` on the projected map, `2 f cos θi`
@@ -72,10 +137,109 @@ impl Stream {
 /// only where its uniforms come from differs): sample `i`'s uniforms are its own SplitMix64
 /// stream keyed by `(seed, i)`, `seed` one 64-bit word made of two uniforms of `u`, so the
 /// result is a function of `u`'s state and `i` only — not of `wave`, the pass a trial falls
-/// in, nor the thread.
+/// in, nor the thread. Sample `i` is handed to `emit(i, drawn)` once, when it is decided (in
+/// no particular order of `i`).
+///
+/// The pending samples are kept in structure-of-arrays form (index, stream state, trials), a
+/// pass generating a block's uniforms in vector lanes ([`uniforms`]), proposing its trials,
+/// evaluating those inside the disc in one call and testing them.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`MAX_TRIALS_PER_SAMPLE`]: partition_sampler::MAX_TRIALS_PER_SAMPLE
+#[allow(clippy::too_many_arguments)]
+fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
+    run: &dyn PreparedRun,
+    table: &LeafTable,
+    map: DiscMap,
+    n: usize,
+    wave: usize,
+    u: &mut dyn UniformSource,
+    audit: &mut Audit,
+    mut emit: E,
+) {
+    let seed = wave_seed(u);
+    let wave = wave.max(1).min(n.max(1));
+    let arch = pulp::Arch::new();
+    // The pending samples: index, stream state, trials so far (and the next pass's).
+    let mut idx: Vec<usize> = (0..n).collect();
+    let mut state: Vec<u64> = (0..n).map(|i| Stream::of(seed, i).0).collect();
+    let mut tried: Vec<u64> = vec![0; n];
+    let (mut idx2, mut state2, mut tried2) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    // One block's uniforms, and its candidates: lane, bound, direction, value.
+    let mut us: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; wave]);
+    let mut lane: Vec<usize> = vec![0; wave];
+    let mut bound: Vec<f64> = vec![0.0; wave];
+    let mut point: Vec<Point2> = vec![[0.0; 2]; wave];
+    let mut dirs: Vec<Vec3> = vec![Vec3::zeros(); wave];
+    let mut f = vec![0.0; wave];
+    let (mut trials, mut violations) = (0u64, 0u64);
+    while !idx.is_empty() {
+        idx2.clear();
+        state2.clear();
+        tried2.clear();
+        let mut start = 0;
+        while start < idx.len() {
+            let end = (start + wave).min(idx.len());
+            uniforms(arch, &mut state[start..end], &mut us);
+            let mut c = 0;
+            for j in start..end {
+                let k = j - start;
+                if tried[j] >= MAX_TRIALS_PER_SAMPLE {
+                    audit.exhausted += 1;
+                    emit(idx[j], None);
+                    continue;
+                }
+                tried[j] += 1;
+                trials += 1;
+                match table.propose([us[0][k], us[1][k], us[2][k], us[3][k]]) {
+                    Some((p, m)) => {
+                        lane[c] = j;
+                        bound[c] = m;
+                        point[c] = p;
+                        dirs[c] = map.to_direction(p);
+                        c += 1;
+                    }
+                    None => {
+                        idx2.push(idx[j]);
+                        state2.push(state[j]);
+                        tried2.push(tried[j]);
+                    }
+                }
+            }
+            count_evaluations(c as u64);
+            run.eval_block(&dirs[..c], &mut f[..c]);
+            for k in 0..c {
+                let (j, m, v, fv) = (lane[k], bound[k], dirs[k], f[k]);
+                let g = match map {
+                    DiscMap::Projected => fv,
+                    DiscMap::EqualArea => 2.0 * v.z * fv,
+                };
+                violations += u64::from(g > m);
+                if us[3][j - start] * m < g {
+                    emit(idx[j], Some((point[k], v, g)));
+                } else {
+                    idx2.push(idx[j]);
+                    state2.push(state[j]);
+                    tried2.push(tried[j]);
+                }
+            }
+            start = end;
+        }
+        std::mem::swap(&mut idx, &mut idx2);
+        std::mem::swap(&mut state, &mut state2);
+        std::mem::swap(&mut tried, &mut tried2);
+    }
+    audit.trials += trials;
+    audit.violations += violations;
+    audit.samples += n as u64;
+}
+
+/// [`wavefront_with`]'s samples in index order (test support).
+#[cfg(test)]
 fn wavefront(
     run: &dyn PreparedRun,
     table: &LeafTable,
@@ -85,62 +249,10 @@ fn wavefront(
     u: &mut dyn UniformSource,
     audit: &mut Audit,
 ) -> Vec<Option<(Point2, f64)>> {
-    let seed = {
-        let [a, b] = [u.next_uniform(), u.next_uniform()];
-        let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
-        bits(a) ^ (bits(b) << 11)
-    };
-    let wave = wave.max(1);
-    let mut streams: Vec<Stream> = (0..n).map(|i| Stream::of(seed, i)).collect();
-    let mut trials = vec![0u64; n];
-    let mut drawn: Vec<Option<(Point2, f64)>> = vec![None; n];
-    let mut pending: Vec<usize> = (0..n).collect();
-    let mut next = Vec::with_capacity(n);
-    // The candidates of one block: sample, point, bound, acceptance uniform, direction.
-    let mut cand: Vec<(usize, Point2, f64, f64)> = Vec::with_capacity(wave);
-    let mut dirs: Vec<Vec3> = Vec::with_capacity(wave);
-    let mut f = vec![0.0; wave];
-    let mut violations = 0u64;
-    while !pending.is_empty() {
-        next.clear();
-        for chunk in pending.chunks(wave) {
-            cand.clear();
-            dirs.clear();
-            for &i in chunk {
-                if trials[i] >= MAX_TRIALS_PER_SAMPLE {
-                    audit.exhausted += 1;
-                    continue;
-                }
-                trials[i] += 1;
-                let us = streams[i].next4();
-                match table.propose(us) {
-                    Some((p, m)) => {
-                        cand.push((i, p, m, us[3]));
-                        dirs.push(map.to_direction(p));
-                    }
-                    None => next.push(i),
-                }
-            }
-            count_evaluations(cand.len() as u64);
-            run.eval_block(&dirs, &mut f);
-            for ((&(i, p, m, u3), v), &fv) in cand.iter().zip(&dirs).zip(&f) {
-                let g = match map {
-                    DiscMap::Projected => fv,
-                    DiscMap::EqualArea => 2.0 * v.z * fv,
-                };
-                violations += u64::from(g > m);
-                if u3 * m < g {
-                    drawn[i] = Some((p, g));
-                } else {
-                    next.push(i);
-                }
-            }
-        }
-        std::mem::swap(&mut pending, &mut next);
-    }
-    audit.trials += trials.iter().sum::<u64>();
-    audit.violations += violations;
-    audit.samples += n as u64;
+    let mut drawn = vec![None; n];
+    wavefront_with(run, table, map, n, wave, u, audit, |i, d| {
+        drawn[i] = d.map(|(p, _, g)| (p, g));
+    });
     drawn
 }
 
@@ -315,10 +427,9 @@ impl ExactSet {
         match prepared {
             Some(p) if p.prefers_blocks() && cell.tables[q.interval].is_some() => {
                 let table = cell.tables[q.interval].as_ref().expect("checked");
-                let drawn = wavefront(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit);
-                for (&k, d) in run.iter().zip(drawn) {
+                let emit = |i: usize, d: Option<Drawn>| {
                     let (s, f) = match d {
-                        Some((x, gx)) => accepted(rec.map, &at.turn, x, gx, at.a),
+                        Some((_, v, gx)) => accepted_at(rec.map, &at.turn, v, gx, at.a),
                         None => (
                             DirSample {
                                 wi: Vec3::new(0.0, 0.0, 1.0),
@@ -327,8 +438,9 @@ impl ExactSet {
                             f64::NAN,
                         ),
                     };
-                    out[k] = self.finish_iso(brdf, at.wo, s, f);
-                }
+                    out[run[i]] = self.finish_iso(brdf, at.wo, s, f);
+                };
+                wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
             }
             Some(p) => {
                 let g = |x| run_density(p.as_ref(), rec.map, x);
@@ -409,11 +521,10 @@ impl ExactSet {
             if let Some(p) = self.brdf.prepare_run(&frame).filter(|p| p.prefers_blocks()) {
                 let a = self.normaliser_of(q);
                 let served = q.wo == *wo;
-                let drawn = wavefront(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit);
-                for (&k, d) in run.iter().zip(drawn) {
-                    out[k] = match d {
-                        Some((x, gx)) => {
-                            let (s, f) = accepted(iv.map, &q.turn, x, gx, a);
+                let emit = |i: usize, d: Option<Drawn>| {
+                    out[run[i]] = match d {
+                        Some((_, v, gx)) => {
+                            let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
                             self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
                         }
                         None => self.finish(
@@ -426,7 +537,8 @@ impl ExactSet {
                             None,
                         ),
                     };
-                }
+                };
+                wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
                 return;
             }
         }
@@ -880,5 +992,62 @@ mod tests {
             approx::assert_relative_eq!(s.f, rgl.eval(&wo, &s.wi), max_relative = 1e-12);
         }
         assert_mean_cos(rgl.as_ref(), &wo, &out, "rgl θo 30");
+    }
+
+    /// The wavefront's sample `i` is, bit for bit, [`LeafTable::draw`]'s (the one-sample
+    /// rejection loop) with the run's density and sample `i`'s own stream as the uniform
+    /// source — the same point, `g`, and in total the same trial, violation and sample counts —
+    /// on Phong through a block-preferring run at θo = 35° (projected map) and 85° (equal-area
+    /// map), and on the RGL fixture at 30° and 75° (the general path's frame), 3000 samples each
+    /// in blocks of 256. So the wavefront's law is `draw`'s, whatever its lanes, passes and
+    /// blocks do.
+    ///
+    /// [`LeafTable::draw`]: super::table::LeafTable::draw
+    #[test]
+    fn wavefront_samples_are_draws_from_their_own_streams() {
+        use super::{Stream, run_density, wave_seed, wavefront};
+        use partition_sampler::Audit;
+        let phong: Arc<dyn Brdf> = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks: true,
+        });
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let mut compared = 0;
+        for (brdf, angles) in [(phong, [35.0, 85.0]), (rgl, [30.0, 75.0])] {
+            let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+            for t in angles {
+                let wo = brdf::direction_from_angles(t, 0.0);
+                let q = set.locate(&wo).expect("served");
+                let frame = if q.turn == crate::layout::Turn::IDENTITY {
+                    q.wo
+                } else {
+                    q.turn.undo(&q.wo)
+                };
+                let table = set.cells[q.cell].tables[q.interval].as_ref().unwrap();
+                let map = set.interval(&q).map;
+                let run = brdf.prepare_run(&frame).unwrap();
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(31);
+                let seed = wave_seed(&mut rng.clone());
+                let mut audit = Audit::default();
+                let drawn = wavefront(run.as_ref(), table, map, 3000, 256, &mut rng, &mut audit);
+                let g = |p| run_density(run.as_ref(), map, p);
+                let mut want_audit = Audit::default();
+                for (i, d) in drawn.iter().enumerate() {
+                    let mut s = Stream::of(seed, i);
+                    let want = table.draw(&g, &mut s, &mut want_audit);
+                    let key = |d: Option<([f64; 2], f64)>| {
+                        d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits))
+                    };
+                    assert_eq!(key(*d), key(want), "{} θo {t} sample {i}", brdf.name());
+                    compared += 1;
+                }
+                assert_eq!(audit, want_audit, "{} θo {t}", brdf.name());
+                assert!(audit.trials > audit.samples, "some trials rejected");
+            }
+        }
+        assert_eq!(compared, 12_000);
     }
 }

@@ -137,7 +137,13 @@ impl ExactSet {
 /// trial is accepted: `g > 0`).
 #[inline]
 pub(super) fn accepted(map: DiscMap, turn: &Turn, x: Point2, gx: f64, a: f64) -> (DirSample, f64) {
-    let d = map.to_direction(x);
+    accepted_at(map, turn, map.to_direction(x), gx, a)
+}
+
+/// [`accepted`] with the trial's direction `d = map.to_direction(x)` already made (the batch
+/// path's wavefront keeps it from the evaluation).
+#[inline]
+pub(super) fn accepted_at(map: DiscMap, turn: &Turn, d: Vec3, gx: f64, a: f64) -> (DirSample, f64) {
     let s = DirSample {
         wi: turn.apply(&d),
         pdf: map.area_to_solid_angle(gx / a, &d),
