@@ -1013,6 +1013,25 @@ mod tests {
         (y, rgb.map(|v| (v * factor).max(0.0) / wi.z))
     }
 
+    /// The fixture, then every `.bsdf` file of the team's data set beside the repository (as
+    /// CI has it; sorted by path), or the fixture alone when that directory is absent.
+    fn fixture_and_shared_files() -> Vec<RglBrdf> {
+        let mut files = vec![fixture()];
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/measured/rgl");
+        match std::fs::read_dir(&dir) {
+            Ok(entries) => {
+                let mut paths: Vec<_> = entries
+                    .filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| p.extension().is_some_and(|x| x == "bsdf"))
+                    .collect();
+                paths.sort();
+                files.extend(paths.iter().map(|p| RglBrdf::load(p).unwrap()));
+            }
+            Err(_) => println!("skipping the shared RGL files: {} is absent", dir.display()),
+        }
+        files
+    }
+
     /// A direction of the upper hemisphere from two uniforms, cosine-weighted towards the
     /// horizon as often as the normal (`z = u`), with 1 in 64 within 1e-9 of the normal.
     fn direction(u: f64, v: f64, near_normal: bool) -> Vec3 {
@@ -1130,19 +1149,7 @@ mod tests {
         ] {
             assert!(lanes::atan2_lane(y, x).1, "({y}, {x}) is flagged");
         }
-        let mut files = vec![fixture()];
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/measured/rgl");
-        match std::fs::read_dir(&dir) {
-            Ok(entries) => {
-                let mut paths: Vec<_> = entries
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "bsdf"))
-                    .collect();
-                paths.sort();
-                files.extend(paths.iter().map(|p| RglBrdf::load(p).unwrap()));
-            }
-            Err(_) => println!("skipping the shared RGL files: {} is absent", dir.display()),
-        }
+        let files = fixture_and_shared_files();
         let levels = lanes::levels();
         println!("levels {levels:?}");
         let (mut compared, mut positive) = (0usize, 0usize);
@@ -1218,20 +1225,7 @@ mod tests {
     /// file of the team's data set that is present (100 × 100).
     #[test]
     fn prepared_slice_evaluation_is_bit_identical_on_random_pairs() {
-        let mut files = vec![fixture()];
-        // The team's data set beside the repository, as CI has it.
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/measured/rgl");
-        match std::fs::read_dir(&dir) {
-            Ok(entries) => {
-                let mut paths: Vec<_> = entries
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "bsdf"))
-                    .collect();
-                paths.sort();
-                files.extend(paths.iter().map(|p| RglBrdf::load(p).unwrap()));
-            }
-            Err(_) => println!("skipping the shared RGL files: {} is absent", dir.display()),
-        }
+        let files = fixture_and_shared_files();
         let mut uniform = crate::test_support::splitmix_uniforms(0x05ee_d0f5_11ce_u64);
         for (f, b) in files.iter().enumerate() {
             let (n_wo, n_wi) = if f == 0 { (400, 250) } else { (100, 100) };
