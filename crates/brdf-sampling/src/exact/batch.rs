@@ -140,9 +140,10 @@ pub(super) type Drawn = (Point2, Vec3, f64);
 /// in, nor the thread. Sample `i` is handed to `emit(i, drawn)` once, when it is decided (in
 /// no particular order of `i`).
 ///
-/// The pending samples are kept in structure-of-arrays form (index, stream state, trials), a
-/// pass generating a block's uniforms in vector lanes ([`uniforms`]), proposing its trials,
-/// evaluating those inside the disc in one call and testing them.
+/// The pending samples are kept in structure-of-arrays form (index, stream state), a pass
+/// generating a block's uniforms in vector lanes ([`uniforms`]), proposing its trials,
+/// evaluating those inside the disc in one call and testing them; every pending sample makes
+/// one trial per pass, so a pass count stands for every sample's trial count.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`MAX_TRIALS_PER_SAMPLE`]: partition_sampler::MAX_TRIALS_PER_SAMPLE
@@ -160,78 +161,74 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     let seed = wave_seed(u);
     let wave = wave.max(1).min(n.max(1));
     let arch = pulp::Arch::new();
-    // The pending samples: index, stream state, trials so far (and the next pass's).
+    // The pending samples: index and stream state (and the next pass's). Every pending sample
+    // makes one trial per pass, so after `pass` passes each has made `pass` trials.
     let mut idx: Vec<usize> = (0..n).collect();
     let mut state: Vec<u64> = (0..n).map(|i| Stream::of(seed, i).0).collect();
-    let mut tried: Vec<u64> = vec![0; n];
-    let (mut idx2, mut state2, mut tried2) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    // One block's uniforms, and its candidates: lane, bound, direction, value.
+    let (mut idx2, mut state2) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    // One block's uniforms, and its candidates: lane, acceptance threshold `u₃·M_i`, bound,
+    // point, direction, value.
     let mut us: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; wave]);
     let mut lane: Vec<usize> = vec![0; wave];
+    let mut threshold: Vec<f64> = vec![0.0; wave];
     let mut bound: Vec<f64> = vec![0.0; wave];
     let mut point: Vec<Point2> = vec![[0.0; 2]; wave];
     let mut dirs: Vec<Vec3> = vec![Vec3::zeros(); wave];
     let mut f = vec![0.0; wave];
-    let (mut trials, mut violations) = (0u64, 0u64);
+    let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
     while !idx.is_empty() {
+        if pass >= MAX_TRIALS_PER_SAMPLE {
+            for &i in &idx {
+                audit.exhausted += 1;
+                emit(i, None);
+            }
+            break;
+        }
+        pass += 1;
+        trials += idx.len() as u64;
         idx2.clear();
         state2.clear();
-        tried2.clear();
-        let mut start = 0;
-        while start < idx.len() {
-            let end = (start + wave).min(idx.len());
-            uniforms(arch, &mut state[start..end], &mut us);
+        for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
+            let len = ib.len();
+            uniforms(arch, sb, &mut us);
+            let [u0, u1, u2, u3] = &us;
+            let (u0, u1, u2, u3) = (&u0[..len], &u1[..len], &u2[..len], &u3[..len]);
             let mut c = 0;
-            for j in start..end {
-                let k = j - start;
-                if tried[j] >= MAX_TRIALS_PER_SAMPLE {
-                    audit.exhausted += 1;
-                    emit(idx[j], None);
-                    continue;
-                }
-                tried[j] += 1;
-                trials += 1;
-                match table.propose([us[0][k], us[1][k], us[2][k], us[3][k]]) {
+            for k in 0..len {
+                match table.propose([u0[k], u1[k], u2[k], u3[k]]) {
                     Some((p, m)) => {
-                        lane[c] = j;
+                        lane[c] = k;
+                        threshold[c] = u3[k] * m;
                         bound[c] = m;
                         point[c] = p;
                         dirs[c] = map.to_direction(p);
                         c += 1;
                     }
                     None => {
-                        idx2.push(idx[j]);
-                        state2.push(state[j]);
-                        tried2.push(tried[j]);
+                        idx2.push(ib[k]);
+                        state2.push(sb[k]);
                     }
                 }
             }
             count_evaluations(c as u64);
             run.eval_block(&dirs[..c], &mut f[..c]);
             for k in 0..c {
-                let (j, m, v, fv) = (lane[k], bound[k], dirs[k], f[k]);
+                let (j, v, fv) = (lane[k], dirs[k], f[k]);
                 let g = match map {
                     DiscMap::Projected => fv,
                     DiscMap::EqualArea => 2.0 * v.z * fv,
                 };
-                violations += u64::from(g > m);
-                if us[3][j - start] * m < g {
-                    emit(idx[j], Some((point[k], v, g)));
+                violations += u64::from(g > bound[k]);
+                if threshold[k] < g {
+                    emit(ib[j], Some((point[k], v, g)));
                 } else {
-                    idx2.push(idx[j]);
-                    state2.push(state[j]);
-                    tried2.push(tried[j]);
+                    idx2.push(ib[j]);
+                    state2.push(sb[j]);
                 }
             }
-            start = end;
         }
         std::mem::swap(&mut idx, &mut idx2);
         std::mem::swap(&mut state, &mut state2);
-        std::mem::swap(&mut tried, &mut tried2);
     }
     audit.trials += trials;
     audit.violations += violations;
