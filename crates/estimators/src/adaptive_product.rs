@@ -499,7 +499,7 @@ impl ProductBatch<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{LocalFrame, ProductScene, quadrature_reference};
+    use crate::{LocalFrame, ProductScene, estimate_srbf_product, quadrature_reference};
     use baselines::CosineHemisphere;
     use envmap::EnvMap;
     use rand::SeedableRng;
@@ -661,7 +661,8 @@ mod tests {
     }
 
     /// The estimator's mean over many points equals the pixel quadrature (|z| < 4) at three
-    /// points, with `adaptive-exact` as the defensive sampler; both mutants are caught.
+    /// points, with `adaptive-exact` as the defensive sampler, also with the pyramid of another
+    /// map (a poor product density); both mutants are caught.
     #[test]
     fn the_estimator_agrees_with_the_quadrature_and_broken_densities_do_not() {
         let m = map();
@@ -676,6 +677,30 @@ mod tests {
             ))
             .unwrap()
             .sampler;
+        // A pyramid of another map (the window 10× dimmer, the patch 10× dimmer, the
+        // background brighter towards the right): a poor product density, the estimator must
+        // stay unbiased. (A map without the window at all is also unbiased but heavy-tailed:
+        // the window is then reached by the defensive samples alone, a few times in the run,
+        // and the mean of 3000 points sits at z = −41 — measured; the quadrature needs a
+        // bounded weight to be a fair yardstick.)
+        let other = EnvMap::new(
+            128,
+            64,
+            (0..128 * 64)
+                .map(|i| {
+                    let (x, y) = (i % 128, i / 128);
+                    if (80..82).contains(&x) && (20..22).contains(&y) {
+                        [40.0; 3]
+                    } else if (20..40).contains(&x) && (10..22).contains(&y) {
+                        [0.3; 3]
+                    } else {
+                        [0.05 + 0.01 * (x / 8) as f32; 3]
+                    }
+                })
+                .collect(),
+        )
+        .unwrap();
+        let other = PowerPyramid::new(&other);
         for (i, (nrm, t, ph)) in POINTS.into_iter().enumerate() {
             let q = query(nrm, t, ph);
             let scene = ProductScene::new(brdf.as_ref(), &m, q.frame, q.wo).unwrap();
@@ -702,10 +727,133 @@ mod tests {
             };
             let good = z(Variant::Correct);
             assert!(good.abs() < 4.0, "point {i}: z = {good}");
+            let poor = ProductBatch {
+                pyramid: &other,
+                ..batch
+            };
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(50 + i as u64);
+            let est = poor.estimate(&points, |_, wi, f| scene.integrand_with_f(wi, f), &mut rng);
+            let (mean, var) = stats::mean_variance(&est);
+            let zp = (mean - reference) / (var / est.len() as f64).sqrt();
+            assert!(zp.abs() < 4.0, "point {i}: another map's pyramid, z = {zp}");
             for v in [Variant::NoJacobian, Variant::ShareOff] {
                 let bad = z(v);
                 assert!(bad.abs() > 4.0, "point {i}: {v:?} not caught, z = {bad}");
             }
         }
+    }
+
+    /// Product against product, per pixel, on a map (env `PRODUCT_MAP`, default the team's
+    /// Grace probe): Tsai's SRBF product (`estimate_srbf_product`, the `product` command's
+    /// default fits and settings) and the adaptive product (`adaptive-exact` defensive), each
+    /// at 64 samples per pixel at 12 random (normal, ωo) of the sphere images' kind (θo ≤ 80°),
+    /// 100 repeats each: ns per pixel (one thread, wall) and the variance of the pixel value
+    /// relative to the quadrature; the efficiency ratio `(var·t)_srbf / (var·t)_adaptive`.
+    /// docs/benchmarks.md §26.6.
+    #[test]
+    #[ignore = "a measurement (a minute or two): docs/benchmarks.md §26.6"]
+    fn product_against_product_per_pixel() {
+        use baselines::srbf::fit_envmap;
+        use baselines::{SrbfOptions, SrbfSampler};
+        use std::time::Instant;
+        let path = std::env::var("PRODUCT_MAP")
+            .unwrap_or_else(|_| "/work/shared/data/envmaps/grace_probe_latlong.hdr".into());
+        let map = EnvMap::load(std::path::Path::new(&path)).unwrap();
+        let spec =
+            std::env::var("PRODUCT_BRDF").unwrap_or_else(|_| "phong:n=50,ks=0.7,kd=0.3".into());
+        let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(&spec).unwrap());
+        let t = Instant::now();
+        let pyr = PowerPyramid::new(&map);
+        eprintln!(
+            "pyramid: {:.1} ms, {} bytes",
+            t.elapsed().as_secs_f64() * 1e3,
+            pyr.bytes_used()
+        );
+        let options = SrbfOptions::default();
+        let t = Instant::now();
+        let brdf_fit = SrbfSampler::build(brdf.as_ref(), &options).unwrap();
+        let t_brdf = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let map_fit = fit_envmap(&map, &options).unwrap();
+        eprintln!(
+            "srbf fits: BRDF {t_brdf:.2} s, map {:.2} s ({} lobes)",
+            t.elapsed().as_secs_f64(),
+            map_fit.lobes.len()
+        );
+        let light = envmap::EnvMapSampler::piecewise_constant(&map).unwrap();
+        let settings = options.product_settings();
+        let sampler = samplers::find("adaptive-exact")
+            .unwrap()
+            .build_direction(&samplers::DirectionRequest::new(
+                std::sync::Arc::clone(&brdf),
+                &brdf_sampling::SetOptions::default(),
+            ))
+            .unwrap()
+            .sampler;
+        let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
+        let (spp, reps) = (64, 100);
+        let mut ratios = Vec::new();
+        for i in 0..12 {
+            let (a, b) = (pick.next_uniform(), pick.next_uniform());
+            let z = 1.0 - 2.0 * a;
+            let r = (1.0 - z * z).sqrt();
+            let normal = [
+                r * (std::f64::consts::TAU * b).cos(),
+                r * (std::f64::consts::TAU * b).sin(),
+                z,
+            ];
+            let theta = 80.0 * pick.next_uniform();
+            let q = Query {
+                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
+                frame: LocalFrame::new(normal, 0.0).unwrap(),
+            };
+            let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
+            let (reference, _) = quadrature_reference(&scene, 1);
+            if !(reference > 0.0) {
+                continue;
+            }
+            let rel_var = |v: &[f64]| {
+                let (m, var) = stats::mean_variance(v);
+                let _ = m;
+                var / (reference * reference)
+            };
+            let t = Instant::now();
+            let srbf: Vec<f64> = (0..reps)
+                .map(|s| {
+                    estimate_srbf_product(
+                        &scene, &brdf_fit, &map_fit, &light, &settings, spp, s as u64,
+                    )
+                    .unwrap()
+                    .0
+                    .estimate
+                })
+                .collect();
+            let t_srbf = t.elapsed().as_secs_f64() * 1e9 / reps as f64;
+            let batch = ProductBatch {
+                sampler: sampler.as_ref(),
+                brdf: brdf.as_ref(),
+                pyramid: &pyr,
+                spp,
+                options: ProductOptions::default(),
+            };
+            let points = vec![q; reps];
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(9 + i);
+            let t = Instant::now();
+            let ours = batch.estimate(&points, |_, wi, f| scene.integrand_with_f(wi, f), &mut rng);
+            let t_ours = t.elapsed().as_secs_f64() * 1e9 / reps as f64;
+            let (vs, vo) = (rel_var(&srbf), rel_var(&ours));
+            let ratio = (vs * t_srbf) / (vo * t_ours);
+            ratios.push(ratio);
+            eprintln!(
+                "pixel {i}: θo {theta:.0}°, srbf {t_srbf:.0} ns/pixel, rel. sd {:.4}; adaptive product {t_ours:.0} ns/pixel, rel. sd {:.4}; efficiency ratio {ratio:.2}",
+                vs.sqrt(),
+                vo.sqrt()
+            );
+        }
+        ratios.sort_by(f64::total_cmp);
+        eprintln!(
+            "median efficiency ratio (srbf var·t / adaptive var·t): {:.2}",
+            ratios[ratios.len() / 2]
+        );
     }
 }
