@@ -1095,6 +1095,9 @@ fn mis_row_rgb<L: LightTechnique + ?Sized>(
 /// sampler and path before repeat `r + 1`), timed on the thread's CPU clock where there is
 /// one; and the BRDF evaluations per sample, the sampler's and the estimator's (counted on this
 /// thread by the study's [`crate::CountingBrdf`], the object the samplers were built with).
+/// With `product = Some((i, pyramid))`, sampler `i` also times the adaptive product at 8 and 24
+/// samples per pixel ([`ProductCost`]).
+#[allow(clippy::too_many_arguments, reason = "the render's parts, passed as they are")]
 fn sample_costs(
     hits: &[Hit],
     segments: &[std::ops::Range<usize>],
