@@ -856,4 +856,199 @@ mod tests {
             ratios[ratios.len() / 2]
         );
     }
+
+    /// The adaptive product's options on a map (env `PRODUCT_MAP`, default the Grace probe) and
+    /// BRDF (`PRODUCT_BRDF`): at the same 12 pixels as [`product_against_product_per_pixel`],
+    /// 100 repeats of 64 samples, the relative variance × ns per pixel of each variant against
+    /// the default's (median over the pixels; > 1: the variant is less efficient).
+    /// docs/benchmarks.md §26.6.
+    #[test]
+    #[ignore = "a measurement (about a minute): docs/benchmarks.md §26.6"]
+    fn product_options_sweep() {
+        use std::time::Instant;
+        let path = std::env::var("PRODUCT_MAP")
+            .unwrap_or_else(|_| "/work/shared/data/envmaps/grace_probe_latlong.hdr".into());
+        let map = EnvMap::load(std::path::Path::new(&path)).unwrap();
+        let spec =
+            std::env::var("PRODUCT_BRDF").unwrap_or_else(|_| "phong:n=50,ks=0.7,kd=0.3".into());
+        let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(&spec).unwrap());
+        let pyr = PowerPyramid::new(&map);
+        let sampler = samplers::find("adaptive-exact")
+            .unwrap()
+            .build_direction(&samplers::DirectionRequest::new(
+                std::sync::Arc::clone(&brdf),
+                &brdf_sampling::SetOptions::default(),
+            ))
+            .unwrap()
+            .sampler;
+        let d = ProductOptions::default();
+        let variants = [
+            ("default (16 cells, 16 splits, α 0.25)", d),
+            ("no splits", ProductOptions { splits: 0, ..d }),
+            ("48 splits", ProductOptions { splits: 48, ..d }),
+            ("8 base cells", ProductOptions { base_cells: 8, ..d }),
+            (
+                "32 base cells",
+                ProductOptions {
+                    base_cells: 32,
+                    ..d
+                },
+            ),
+            (
+                "α 0.1",
+                ProductOptions {
+                    defensive: 0.1,
+                    ..d
+                },
+            ),
+            (
+                "α 0.5",
+                ProductOptions {
+                    defensive: 0.5,
+                    ..d
+                },
+            ),
+        ];
+        let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
+        let (spp, reps) = (64, 100);
+        let mut ratios = vec![Vec::new(); variants.len()];
+        for i in 0..12 {
+            let (a, b) = (pick.next_uniform(), pick.next_uniform());
+            let z = 1.0 - 2.0 * a;
+            let r = (1.0 - z * z).sqrt();
+            let normal = [
+                r * (std::f64::consts::TAU * b).cos(),
+                r * (std::f64::consts::TAU * b).sin(),
+                z,
+            ];
+            let theta = 80.0 * pick.next_uniform();
+            let q = Query {
+                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
+                frame: LocalFrame::new(normal, 0.0).unwrap(),
+            };
+            let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
+            let (reference, _) = quadrature_reference(&scene, 1);
+            if !(reference > 0.0) {
+                continue;
+            }
+            let points = vec![q; reps];
+            let cost: Vec<f64> = variants
+                .iter()
+                .map(|(_, o)| {
+                    let batch = ProductBatch {
+                        sampler: sampler.as_ref(),
+                        brdf: brdf.as_ref(),
+                        pyramid: &pyr,
+                        spp,
+                        options: *o,
+                    };
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9 + i);
+                    let t = Instant::now();
+                    let v =
+                        batch.estimate(&points, |_, wi, f| scene.integrand_with_f(wi, f), &mut rng);
+                    let ns = t.elapsed().as_secs_f64() * 1e9 / reps as f64;
+                    let (_, var) = stats::mean_variance(&v);
+                    var / (reference * reference) * ns
+                })
+                .collect();
+            for (k, c) in cost.iter().enumerate() {
+                ratios[k].push(c / cost[0]);
+            }
+        }
+        for ((name, _), r) in variants.iter().zip(&mut ratios) {
+            r.sort_by(f64::total_cmp);
+            eprintln!(
+                "{name}: var·t / default's, median {:.2} (min {:.2}, max {:.2}) over {} pixels",
+                r[r.len() / 2],
+                r[0],
+                r[r.len() - 1],
+                r.len()
+            );
+        }
+    }
+
+    /// A deterministic workload for instruction counts (`valgrind --tool=cachegrind`): env
+    /// `H12_WORK` = `product` (the adaptive product) or `mis` (MIS of `adaptive-exact` and the
+    /// `envmap-adaptive` sampler, `Batch::mis_given_f`), `H12_POINTS` points (random normals and
+    /// ωo, θo ≤ 80°, each its own batch call) × `H12_SPP` samples (pairs for MIS), phong on the
+    /// Grace probe; prints a checksum. Differences of runs cancel the setup. §26.6.
+    #[test]
+    #[ignore = "a workload for instruction counts: docs/benchmarks.md §26.6"]
+    fn instruction_workload() {
+        let env = |k: &str, d: usize| {
+            std::env::var(k)
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(d)
+        };
+        let (points, spp) = (env("H12_POINTS", 100), env("H12_SPP", 8));
+        let work = std::env::var("H12_WORK").unwrap_or_else(|_| "product".into());
+        let map = EnvMap::load(std::path::Path::new(
+            "/work/shared/data/envmaps/grace_probe_latlong.hdr",
+        ))
+        .unwrap();
+        let brdf: std::sync::Arc<dyn Brdf> =
+            std::sync::Arc::from(brdf::parse_spec("phong:n=50,ks=0.7,kd=0.3").unwrap());
+        let pyr = PowerPyramid::new(&map);
+        let light = envmap::EnvMapSampler::new(
+            &map,
+            envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
+        )
+        .unwrap();
+        let sampler = samplers::find("adaptive-exact")
+            .unwrap()
+            .build_direction(&samplers::DirectionRequest::new(
+                std::sync::Arc::clone(&brdf),
+                &brdf_sampling::SetOptions::default(),
+            ))
+            .unwrap()
+            .sampler;
+        let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
+        let mut sum = 0.0;
+        for _ in 0..points {
+            let (a, b) = (pick.next_uniform(), pick.next_uniform());
+            let z = 1.0 - 2.0 * a;
+            let r = (1.0 - z * z).sqrt();
+            let normal = [
+                r * (std::f64::consts::TAU * b).cos(),
+                r * (std::f64::consts::TAU * b).sin(),
+                z,
+            ];
+            let q = Query {
+                wo: brdf::direction_from_angles(
+                    80.0 * pick.next_uniform(),
+                    360.0 * pick.next_uniform(),
+                ),
+                frame: LocalFrame::new(normal, 0.0).unwrap(),
+            };
+            let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
+            let g = |_: usize, wi: &Vec3, f: f64| scene.integrand_with_f(wi, f);
+            let v = if work == "mis" {
+                crate::Batch {
+                    sampler: sampler.as_ref(),
+                    brdf: brdf.as_ref(),
+                    spp,
+                }
+                .mis_given_f(
+                    &[q],
+                    &light,
+                    crate::MisHeuristic::Balance,
+                    g,
+                    &mut rng,
+                )
+            } else {
+                ProductBatch {
+                    sampler: sampler.as_ref(),
+                    brdf: brdf.as_ref(),
+                    pyramid: &pyr,
+                    spp,
+                    options: ProductOptions::default(),
+                }
+                .estimate(&[q], g, &mut rng)
+            };
+            sum += v[0];
+        }
+        eprintln!("{work}: {points} points × {spp}: checksum {sum:.12e}");
+    }
 }

@@ -1097,7 +1097,10 @@ fn mis_row_rgb<L: LightTechnique + ?Sized>(
 /// thread by the study's [`crate::CountingBrdf`], the object the samplers were built with).
 /// With `product = Some((i, pyramid))`, sampler `i` also times the adaptive product at 8 and 24
 /// samples per pixel ([`ProductCost`]).
-#[allow(clippy::too_many_arguments, reason = "the render's parts, passed as they are")]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the render's parts, passed as they are"
+)]
 fn sample_costs(
     hits: &[Hit],
     segments: &[std::ops::Range<usize>],
