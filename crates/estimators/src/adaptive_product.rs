@@ -1051,4 +1051,96 @@ mod tests {
         }
         eprintln!("{work}: {points} points × {spp}: checksum {sum:.12e}");
     }
+
+    /// At an instruction budget (§26.6: a MIS pair of `adaptive-exact` + `envmap-adaptive`
+    /// costs 3 287 instructions and 4 809 per pixel; the product 1 674 per sample and 74 200 per
+    /// pixel), 25 MIS pairs ≈ 87 k instructions ≈ the product's setup + 8 samples: the relative
+    /// RMS error against the quadrature of each, phong on the Grace probe, the 12 pixels of
+    /// [`product_options_sweep`], 100 repeats.
+    #[test]
+    #[ignore = "a measurement (about a minute): docs/benchmarks.md §26.6"]
+    fn product_8_against_mis_25_per_pixel() {
+        let map = EnvMap::load(std::path::Path::new(
+            "/work/shared/data/envmaps/grace_probe_latlong.hdr",
+        ))
+        .unwrap();
+        let brdf: std::sync::Arc<dyn Brdf> =
+            std::sync::Arc::from(brdf::parse_spec("phong:n=50,ks=0.7,kd=0.3").unwrap());
+        let pyr = PowerPyramid::new(&map);
+        let light = envmap::EnvMapSampler::new(
+            &map,
+            envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
+        )
+        .unwrap();
+        let sampler = samplers::find("adaptive-exact")
+            .unwrap()
+            .build_direction(&samplers::DirectionRequest::new(
+                std::sync::Arc::clone(&brdf),
+                &brdf_sampling::SetOptions::default(),
+            ))
+            .unwrap()
+            .sampler;
+        let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
+        let reps = 100;
+        let (mut sp, mut sm) = (Vec::new(), Vec::new());
+        for i in 0..12 {
+            let (a, b) = (pick.next_uniform(), pick.next_uniform());
+            let z = 1.0 - 2.0 * a;
+            let r = (1.0 - z * z).sqrt();
+            let normal = [
+                r * (std::f64::consts::TAU * b).cos(),
+                r * (std::f64::consts::TAU * b).sin(),
+                z,
+            ];
+            let theta = 80.0 * pick.next_uniform();
+            let q = Query {
+                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
+                frame: LocalFrame::new(normal, 0.0).unwrap(),
+            };
+            let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
+            let (reference, _) = quadrature_reference(&scene, 1);
+            if !(reference > 0.0) {
+                continue;
+            }
+            let points = vec![q; reps];
+            let rms = |v: &[f64]| {
+                (v.iter().map(|x| (x / reference - 1.0).powi(2)).sum::<f64>() / v.len() as f64)
+                    .sqrt()
+            };
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(9 + i);
+            let p = ProductBatch {
+                sampler: sampler.as_ref(),
+                brdf: brdf.as_ref(),
+                pyramid: &pyr,
+                spp: 8,
+                options: ProductOptions::default(),
+            }
+            .estimate(&points, |_, wi, f| scene.integrand_with_f(wi, f), &mut rng);
+            let m = crate::Batch {
+                sampler: sampler.as_ref(),
+                brdf: brdf.as_ref(),
+                spp: 25,
+            }
+            .mis_given_f(
+                &points,
+                &light,
+                crate::MisHeuristic::Balance,
+                |_, wi, f| scene.integrand_with_f(wi, f),
+                &mut rng,
+            );
+            let (ep, em) = (rms(&p), rms(&m));
+            eprintln!(
+                "pixel {i}: θo {theta:.0}°, product 8 spp rel. RMS {ep:.4}, MIS 25 pairs {em:.4}"
+            );
+            sp.push(ep);
+            sm.push(em);
+        }
+        sp.sort_by(f64::total_cmp);
+        sm.sort_by(f64::total_cmp);
+        eprintln!(
+            "median rel. RMS: product 8 spp {:.4}, MIS 25 pairs {:.4}",
+            sp[sp.len() / 2],
+            sm[sm.len() / 2]
+        );
+    }
 }
