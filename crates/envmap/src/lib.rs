@@ -54,6 +54,7 @@ pub mod lanes;
 pub mod latlong;
 mod load;
 mod map;
+pub mod pyramid;
 mod sampler;
 mod sky;
 
@@ -63,5 +64,6 @@ pub use format::MapFormat;
 pub use lanes::LaneRng;
 pub use map::{EnvMap, MAX_PIXELS, luminance};
 pub use partition_sampler::{LeafChoice, Scheme, TreeParams};
+pub use pyramid::{CellGeometry, CellSample, PowerPyramid};
 pub use sampler::{AdaptiveOptions, EnvMapSampler, EnvSample, SamplerKind};
 pub use sky::{SUN_RADIANCE, SUN_RADIUS, SUN_UV, procedural_sky, sun_direction};

@@ -46,6 +46,7 @@
 // Validation is written `if !(x > 0.0)` on purpose so that NaN fails too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod adaptive_product;
 mod batch;
 mod driver;
 mod error;
@@ -56,6 +57,7 @@ mod mis;
 mod product;
 mod scene;
 
+pub use adaptive_product::{ProductBatch, ProductCut, ProductOptions};
 pub use baselines::srbf::ProductSettings;
 pub use batch::{Batch, LightTechnique, Query, Radiance, brdf_value, mis_term};
 pub use driver::{ProductExperiment, ProductOutcome};

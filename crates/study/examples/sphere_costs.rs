@@ -1,7 +1,8 @@
 //! The study's sphere images alone (no variance cells): equal-samples and equal-time images of
 //! the `--quick` study's BRDFs (or those given) under one light, every registered preferred
 //! sampler, BRDF sampling alone and with MIS (each sampler with the light's own sampler), with
-//! the cost table (coherent vs random ωo, MIS). docs/benchmarks.md §21, §23.8.
+//! the cost table (coherent vs random ωo, MIS), and the adaptive product images with the
+//! ranking of every estimator at equal time. docs/benchmarks.md §21, §23.8, §26.6.
 //!
 //! ```text
 //! cargo run --release -p study --example sphere_costs -- LIGHT [PX] [SPP] [BRDF ...]
@@ -63,6 +64,31 @@ fn main() {
             for r in rows {
                 println!(
                     "  {:<24} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
+                    r.sampler,
+                    r.spp,
+                    100.0 * r.error,
+                    100.0 * r.ci95,
+                    100.0 * r.above_best,
+                    100.0 * r.above_best_hw,
+                    if r.tied_with_best { "tied" } else { "worse" }
+                );
+            }
+        }
+    }
+    // Every estimator together at equal time: BRDF only, MIS (`sampler+MIS`), adaptive product.
+    if let Some(pc) = &render.product_cost {
+        println!(
+            "adaptive product cost: setup {:.0} ns per pixel + {:.0} ns per sample ({:.0} ns per pixel sample at 8 spp, {:.1} BRDF evaluations per pixel at 8 spp)",
+            pc.setup_ns, pc.per_sample_ns, pc.at8_ns, pc.evals_per_pixel8
+        );
+        for (spec, rows) in render.sphere_ranking_all() {
+            println!(
+                "sphere `{spec}`, every estimator at equal time: adaptive {}",
+                study::AdaptiveVerdict::of(&rows).word()
+            );
+            for r in rows.iter().take(8) {
+                println!(
+                    "  {:<28} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
                     r.sampler,
                     r.spp,
                     100.0 * r.error,

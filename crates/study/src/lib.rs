@@ -85,8 +85,9 @@ pub use plot::{
 pub use ranking::{Ranking, RankingComparison, compare_rankings, rankings};
 pub use reference::{Reference, reference};
 pub use render::{
-    AdaptiveVerdict, IMAGE_KINDS, Image, Render, RenderConfig, SampleCost, SphereError,
-    TIMING_REPEATS, encode_png, equal_time_spp, rank_pixel_errors, relative_error, stack,
+    AdaptiveVerdict, IMAGE_KINDS, Image, PRODUCT_DEFENSIVE, PRODUCT_KINDS, PRODUCT_NAME,
+    ProductCost, Render, RenderConfig, SampleCost, SphereError, TIMING_REPEATS, encode_png,
+    equal_time_spp, product_equal_time_spp, rank_pixel_errors, relative_error, stack,
 };
 pub use report::{ReportAssets, report_markdown};
 pub use results::{CellResult, Clock, ErrorAtN, LightInfo, SCHEMA, StudyResults, Timing, WithCi};
