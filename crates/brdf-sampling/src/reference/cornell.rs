@@ -208,6 +208,105 @@ mod tests {
         }
     }
 
+    /// The disc rule's totals at doubling evaluation counts against the exact judge, for the
+    /// halving estimate (docs/benchmarks.md §26.4): `CORNELL_FILES`, `NODE_ANGLES` (degrees),
+    /// `DEPTHS` (first partitions `initial:mirror`, default `5:11,3:7`), `FIRST` (first
+    /// checkpoint, default 2 500), `MAX` (default 600 000), `JUDGE_TOL` (default 2·10⁻⁶).
+    /// Prints, per checkpoint `N`: the total, `d = |I_N − I_{N/2}|`, the estimate
+    /// `max(d_N, d_{N/2}/2)`, `Σ |I₈ − I₅|`, the gap to the judge and gap / estimate.
+    /// `cargo test --release -p brdf-sampling --lib halving_survey -- --ignored --nocapture`
+    #[test]
+    #[ignore = "a survey for the record"]
+    fn halving_survey() {
+        let env = |k: &str| std::env::var(k).ok();
+        let files = env("CORNELL_FILES").unwrap_or("acryl_blue,cayman,krylon_blue".into());
+        let angles: Vec<f64> = env("NODE_ANGLES")
+            .unwrap_or("2.8,30.5,62.4,89.5".into())
+            .split(',')
+            .filter_map(|s| s.parse().ok())
+            .collect();
+        let depths: Vec<(u32, u32)> = env("DEPTHS")
+            .unwrap_or("5:11,3:7".into())
+            .split(',')
+            .filter_map(|s| {
+                let (a, b) = s.split_once(':')?;
+                Some((a.parse().ok()?, b.parse().ok()?))
+            })
+            .collect();
+        let orders: Vec<(usize, usize)> = env("ORDERS")
+            .unwrap_or("8:5".into())
+            .split(',')
+            .filter_map(|s| {
+                let (a, b) = s.split_once(':')?;
+                Some((a.parse().ok()?, b.parse().ok()?))
+            })
+            .collect();
+        let first: u64 = env("FIRST").and_then(|s| s.parse().ok()).unwrap_or(2_500);
+        let max: u64 = env("MAX").and_then(|s| s.parse().ok()).unwrap_or(600_000);
+        let tol: f64 = env("JUDGE_TOL")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(2e-6);
+        let mut worst = 0.0f64;
+        for name in files.split(',') {
+            let Some(b) = shared(name) else { continue };
+            for &deg in &angles {
+                let judge = cornell_albedo(&b, deg.to_radians(), tol).unwrap();
+                let j = judge.value;
+                eprintln!(
+                    "{name} {deg}°: judge {j:.9} (rel {:.1e})",
+                    judge.abs_err / j
+                );
+                let wo = brdf::direction_from_radians(deg.to_radians(), 0.0);
+                for (&d, &o) in depths
+                    .iter()
+                    .flat_map(|d| orders.iter().map(move |o| (d, o)))
+                {
+                    let mut rows: Vec<(u64, f64, f64)> = Vec::new();
+                    let mut check = |n: u64, total: f64, err: f64| {
+                        rows.push((n, total, err));
+                        n >= max
+                    };
+                    crate::reference::albedo_on_disc(
+                        |wo, wi| b.eval(wo, wi),
+                        &b,
+                        &wo,
+                        u64::MAX,
+                        d,
+                        crate::normalisation::Grading::Pair(o.0, o.1),
+                        Some((first, &mut check)),
+                    )
+                    .unwrap();
+                    for k in 0..rows.len() {
+                        let (n, t, e) = rows[k];
+                        let dk = |k: usize| (rows[k].1 - rows[k - 1].1).abs();
+                        let est = match k {
+                            0 => f64::NAN,
+                            1 => dk(1),
+                            _ => dk(k).max(0.5 * dk(k - 1)),
+                        };
+                        let gap = (t - j).abs();
+                        let ratio = gap / est;
+                        if k >= 2 && gap > judge.abs_err {
+                            worst = worst.max((gap - judge.abs_err) / est);
+                        }
+                        eprintln!(
+                            "  {}:{} {}/{} N {n:7}: rel est {:.2e}  Σ|Ih−Il| {:.2e}  gap {:+.2e}  gap/est {ratio:.2}  gap/Σ {:.2}",
+                            d.0,
+                            d.1,
+                            o.0,
+                            o.1,
+                            est / j,
+                            e / j,
+                            (t - j) / j,
+                            gap / e,
+                        );
+                    }
+                }
+            }
+        }
+        eprintln!("largest (gap − judge error) / estimate from the third checkpoint: {worst:.2}");
+    }
+
     /// The node rule against the reference rule over the disc, for the record
     /// (docs/benchmarks.md §24.6): `CORNELL_FILES` (default the three shared files),
     /// `NODE_ANGLES` (degrees), `NODE_TOL` (default the nodes' target), `REF_BUDGET` (the disc
