@@ -37,12 +37,6 @@ pub(crate) enum Grading {
     /// value) before it is split. Smooth pieces stop at the cheap pair, whose disagreement
     /// (the order-3 error) bounds the order-5 value's error conservatively.
     Graded,
-    /// Orders `(high, low)` at once, like [`Grading::Fixed`] (`high² + low²` evaluations per
-    /// tensor piece). On an integrand with kinks everywhere (the Cornell interpolant) a piece
-    /// crossed by a kink has an error `∝ h³` whatever the order, so at a given number of
-    /// evaluations low orders (many small pieces) reach a smaller error and a smaller
-    /// `Σ |I_high − I_low|` (docs/benchmarks.md §26.4).
-    Pair(usize, usize),
 }
 
 /// `∫_{rect ∩ D} f dA` by the iterated rule (see the module docs).
@@ -197,40 +191,12 @@ pub(crate) fn adaptive_quadrature(
     budget: u64,
     grading: Grading,
 ) -> LeafIntegrals {
-    adaptive_quadrature_checked(f, leaves, abs_tol, mirror, budget, grading, None)
-}
-
-/// A checkpoint of [`adaptive_quadrature_checked`]: `(evaluations, Î, Σ |I_high − I_low|)`
-/// after the first step at or past each checkpoint; returning `true` stops the rule there
-/// (its result is then that checkpoint's `Î`, bit for bit).
-pub(crate) type Checkpoint<'a> = &'a mut dyn FnMut(u64, f64, f64) -> bool;
-
-/// [`adaptive_quadrature`], also calling `checkpoints.1` each time the evaluations reach
-/// `checkpoints.0 · 2^k` (`k = 0, 1, …`), with the running total: the same pieces in the same
-/// order as without, so the run to `N` passes through the run to `N/2` (the reference rule's
-/// halving estimate, `reference.rs`).
-pub(crate) fn adaptive_quadrature_checked(
-    f: &dyn Density,
-    leaves: impl Iterator<Item = LeafInfo>,
-    abs_tol: f64,
-    mirror: bool,
-    budget: u64,
-    grading: Grading,
-    mut checkpoints: Option<(u64, Checkpoint<'_>)>,
-) -> LeafIntegrals {
     let factor = if mirror { 2.0 } else { 1.0 };
-    let (hi, lo, first) = match grading {
-        Grading::Pair(high, low) => (
-            GaussLegendre::new(high),
-            GaussLegendre::new(low),
-            GaussLegendre::new(FIRST_ORDER),
-        ),
-        _ => (
-            GaussLegendre::new(HIGH_ORDER),
-            GaussLegendre::new(LOW_ORDER),
-            GaussLegendre::new(FIRST_ORDER),
-        ),
-    };
+    let (hi, lo, first) = (
+        GaussLegendre::new(HIGH_ORDER),
+        GaussLegendre::new(LOW_ORDER),
+        GaussLegendre::new(FIRST_ORDER),
+    );
     let evals = std::sync::atomic::AtomicU64::new(0);
     let counted = |p: [f64; 2]| {
         evals.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -239,7 +205,7 @@ pub(crate) fn adaptive_quadrature_checked(
     let piece = |leaf: usize, rect: Rect| {
         let low = integrate_leaf(&counted, &rect, &lo);
         let (value, other, high) = match grading {
-            Grading::Fixed | Grading::Pair(..) => (integrate_leaf(&counted, &rect, &hi), low, true),
+            Grading::Fixed => (integrate_leaf(&counted, &rect, &hi), low, true),
             Grading::Graded => (low, integrate_leaf(&counted, &rect, &first), false),
         };
         WorstFirst(Piece {
@@ -267,25 +233,7 @@ pub(crate) fn adaptive_quadrature_checked(
         .map(|(i, r)| piece(i, r))
         .collect();
     let mut err: f64 = heap.iter().map(|p| p.err).sum();
-    let mut next_check = checkpoints.as_ref().map_or(u64::MAX, |c| c.0.max(1));
     while factor * err > abs_tol && evals.load(std::sync::atomic::Ordering::Relaxed) < budget {
-        let spent = evals.load(std::sync::atomic::Ordering::Relaxed);
-        if spent >= next_check {
-            if let Some((_, check)) = checkpoints.as_mut() {
-                // The total as the end of the rule sums it (storage order).
-                let total = factor * heap.iter().map(|p| p.0.value).sum::<f64>();
-                if check(
-                    spent,
-                    total,
-                    factor * heap.iter().map(|p| p.0.err).sum::<f64>(),
-                ) {
-                    break;
-                }
-            }
-            while next_check <= spent {
-                next_check = next_check.saturating_mul(2);
-            }
-        }
         let Some(WorstFirst(worst)) = heap.pop() else {
             break;
         };

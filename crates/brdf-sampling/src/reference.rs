@@ -36,7 +36,7 @@ pub(crate) use rgl::tests::ibiza as rgl_tests_ibiza;
 pub use rgl::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
 
 use crate::disc::DiscMap;
-use crate::normalisation::{Checkpoint, Grading, adaptive_quadrature_checked};
+use crate::normalisation::{Grading, adaptive_quadrature};
 
 /// Evaluation budget of [`reference_albedo`] (about 0.1–0.3 s for an analytic model).
 pub const REFERENCE_BUDGET: u64 = 4_000_000;
@@ -119,29 +119,6 @@ pub(crate) fn albedo_of(
     wo: &Vec3,
     budget: u64,
 ) -> Result<AlbedoEstimate, ReferenceError> {
-    albedo_on_disc(
-        f,
-        brdf,
-        wo,
-        budget,
-        (INITIAL_DEPTH, MIRROR_DEPTH),
-        Grading::Fixed,
-        None,
-    )
-}
-
-/// [`albedo_of`] from a first partition of `depths.0` levels (cells refined to `depths.1`
-/// around the mirror direction), with the checkpoints of
-/// [`crate::normalisation::adaptive_quadrature_checked`].
-pub(crate) fn albedo_on_disc(
-    f: impl Fn(&Vec3, &Vec3) -> f64 + Sync,
-    brdf: &dyn Brdf,
-    wo: &Vec3,
-    budget: u64,
-    depths: (u32, u32),
-    grading: Grading,
-    checkpoints: Option<(u64, Checkpoint<'_>)>,
-) -> Result<AlbedoEstimate, ReferenceError> {
     let unit = wo.iter().all(|c| c.is_finite()) && (wo.norm() - 1.0).abs() <= 1e-9;
     if !(unit && wo.z > 0.0) {
         return Err(ReferenceError::InvalidDirection {
@@ -171,19 +148,18 @@ pub(crate) fn albedo_on_disc(
     let mut leaves = Vec::new();
     initial_partition(
         Rect::new(-1.0, -1.0, 1.0, 1.0),
-        (0, depths),
+        0,
         peak,
         mirror,
         &mut leaves,
     );
-    let q = adaptive_quadrature_checked(
+    let q = adaptive_quadrature(
         &density,
         leaves.into_iter(),
         REFERENCE_TOL,
         mirror,
         budget,
-        grading,
-        checkpoints,
+        Grading::Fixed,
     );
     if !(q.total.is_finite() && q.abs_err.is_finite()) {
         return Err(ReferenceError::NotFinite(brdf.name().to_string()));
@@ -195,101 +171,9 @@ pub(crate) fn albedo_on_disc(
     })
 }
 
-/// A node rule that stops at a relative error target by the **halving estimate** (the Cornell
-/// set table's normaliser nodes, `exact/set_table.rs`; docs/benchmarks.md §26.4).
-///
-/// The disc rule of [`reference_albedo`] run from the first partition `depths` is read at
-/// `N_k = first · 2^k` evaluations (`I_k`, the running order-8 total). On an integrand with
-/// kinks everywhere its error falls like `1/N` (the kinks cross every piece), so
-/// `I_k − I_{k−1}` is about `I_k`'s own error and `(I_{k−1} − I_{k−2}) / 2` again; the
-/// declared absolute error at `k ≥ 2` is
-///
-/// `E_k = min(safety · max(|I_k − I_{k−1}|, |I_{k−1} − I_{k−2}| / 2), Σ |I₈ − I₅|)`,
-///
-/// the second term the rule's own conservative estimate (the order-5 value's error). The
-/// rule stops at the first `k ≥ 2` with `E_k ≤ rel_tol · I_k`, or once `N_k ≥ max`, and
-/// returns `I_k` with `E_k`. The factor `safety` is not derived: it was set from the gaps to
-/// the exact line rule ([`cornell::cornell_albedo`]) at many `θo` on the three shared files
-/// and is checked by the test `halving_estimate_covers_the_exact_gap`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct HalvingRule {
-    /// Evaluations at the first checkpoint `N_0`.
-    pub(crate) first: u64,
-    /// Evaluations after which the rule stops whatever its estimate.
-    pub(crate) max: u64,
-    /// Relative error target of the declared estimate.
-    pub(crate) rel_tol: f64,
-    /// Factor on the halving differences.
-    pub(crate) safety: f64,
-    /// `(initial, near_mirror)` depths of the first partition.
-    pub(crate) depths: (u32, u32),
-}
-
-/// The declared absolute error `E_k` of [`HalvingRule`] from the last three checkpoint totals
-/// (`totals[k−2..=k]`) and the rule's `Σ |I₈ − I₅|` at `k`.
-pub(crate) fn halving_estimate(totals: [f64; 3], disagreement: f64, safety: f64) -> f64 {
-    let [a, b, c] = totals;
-    (safety * (c - b).abs().max(0.5 * (b - a).abs())).min(disagreement)
-}
-
-/// The directional albedo of `brdf` at `wo` by [`HalvingRule`] `rule`.
-pub(crate) fn halving_albedo(
-    brdf: &dyn Brdf,
-    wo: &Vec3,
-    rule: &HalvingRule,
-) -> Result<AlbedoEstimate, ReferenceError> {
-    let mut totals: Vec<f64> = Vec::new();
-    let mut stopped: Option<(u64, f64, f64)> = None;
-    let mut check = |n: u64, total: f64, disagreement: f64| {
-        totals.push(total);
-        let k = totals.len();
-        let declared = if k >= 3 {
-            halving_estimate(
-                [totals[k - 3], totals[k - 2], totals[k - 1]],
-                disagreement,
-                rule.safety,
-            )
-        } else {
-            disagreement
-        };
-        let done = (k >= 3 && declared <= rule.rel_tol * total.abs()) || n >= rule.max;
-        if done {
-            stopped = Some((n, total, declared));
-        }
-        done
-    };
-    let q = albedo_on_disc(
-        |wo, wi| brdf.eval(wo, wi),
-        brdf,
-        wo,
-        u64::MAX,
-        rule.depths,
-        Grading::Fixed,
-        Some((rule.first, &mut check)),
-    )?;
-    Ok(match stopped {
-        // The rule stopped at a checkpoint: its total is `q.value` bit for bit.
-        Some((_, total, declared)) => AlbedoEstimate {
-            value: total,
-            abs_err: declared,
-            evaluations: q.evaluations,
-        },
-        // It ended otherwise (no piece left to split): its own estimate.
-        None => q,
-    })
-}
-
-/// The uniform `2^initial` grid, with the cells near `peak` (within one cell size) split down
-/// to depth `near_mirror` (`(depth, (initial, near_mirror))`; the reference rule's are
-/// `INITIAL_DEPTH` and `MIRROR_DEPTH`); cells outside the disc (or in `y > 0` with `mirror`)
-/// dropped.
-fn initial_partition(
-    r: Rect,
-    (depth, (initial, near_mirror)): (u32, (u32, u32)),
-    peak: [f64; 2],
-    mirror: bool,
-    out: &mut Vec<LeafInfo>,
-) {
+/// The uniform `2^INITIAL_DEPTH` grid, with the cells near `peak` (within one cell size)
+/// split down to `MIRROR_DEPTH`; cells outside the disc (or in `y > 0` with `mirror`) dropped.
+fn initial_partition(r: Rect, depth: u32, peak: [f64; 2], mirror: bool, out: &mut Vec<LeafInfo>) {
     let outside_disc = {
         let dx = 0f64.clamp(r.x0, r.x1);
         let dy = 0f64.clamp(r.y0, r.y1);
@@ -303,7 +187,7 @@ fn initial_partition(
         && peak[0] < r.x1 + size
         && peak[1] > r.y0 - size
         && peak[1] < r.y1 + size;
-    if depth < initial || (depth < near_mirror && near) {
+    if depth < INITIAL_DEPTH || (depth < MIRROR_DEPTH && near) {
         let c = r.center();
         for q in [
             Rect::new(r.x0, r.y0, c[0], c[1]),
@@ -311,7 +195,7 @@ fn initial_partition(
             Rect::new(r.x0, c[1], c[0], r.y1),
             Rect::new(c[0], c[1], r.x1, r.y1),
         ] {
-            initial_partition(q, (depth + 1, (initial, near_mirror)), peak, mirror, out);
+            initial_partition(q, depth + 1, peak, mirror, out);
         }
     } else {
         out.push(LeafInfo {
