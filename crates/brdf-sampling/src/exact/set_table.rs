@@ -7,12 +7,13 @@
 //! scale of degrees: integrating 9 nodes per interval (~1 250 per build) paid for that width
 //! twice. Here `A` is tabulated once per build on **pieces** of θo, 9 Chebyshev–Lobatto nodes
 //! each; a piece is halved while the 9-node interpolant differs from the nested 5-node one by
-//! more than [`PIECE_TOL`] (relative) anywhere between the nodes, down to
-//! [`MIN_PIECE_DEG`]; a piece that one halving would do is first refined in place to the
-//! 17 Lobatto nodes that contain its 9 ([`NESTED_NODES`]: 8 new nodes instead of 2 × 9, the
-//! 9 kept) and kept if its 17- and 9-node interpolants differ by at most the tolerance, else
-//! halved (docs/benchmarks.md §26.4). An interval's normaliser node is the table's value at the node, with
-//! the table's error: the node's own estimate plus the piece's 9-versus-5 difference (both
+//! more than [`PIECE_TOL`] (relative) anywhere between the nodes, down to [`MIN_PIECE_DEG`].
+//! A piece that misses by at most [`NEST_MAX_EXCESS`] × the tolerance is first refined in
+//! place to the 17 Lobatto nodes that contain its 9 ([`NESTED_NODES`]: 8 new nodes instead
+//! of a halving's 2 × 9, the 9 kept) and kept if its 17- and 9-node interpolants differ by at
+//! most the tolerance, else halved (docs/benchmarks.md §26.4). An interval's normaliser node
+//! is the table's value at the node, with the table's error: the node's own estimate plus the
+//! piece's 9-versus-5 (or 17-versus-9) difference (both
 //! conservative). The values depend on `θo` alone (not on the interval or thread).
 
 use std::collections::HashMap;
@@ -31,6 +32,13 @@ const PIECE_NODES: usize = 9;
 /// test asks for one halving is first refined to these, and kept if its 17- and 9-node
 /// interpolants differ by at most the tolerance (the same test one level up).
 const NESTED_NODES: usize = 17;
+
+/// A piece is refined in place ([`NESTED_NODES`]) only when its 9-versus-5 difference is at
+/// most this many times the tolerance (one halving would do up to 32). Nodes of the three
+/// shared Cornell files' tables (`set_table_nesting_survey`, docs/benchmarks.md §26.4):
+/// 1 977 without, 1 873 / 1 745 / 1 657 with this at 32 / 8 / 4: a refinement that fails
+/// costs 8 nodes on top of the halving, and the larger misses fail more often.
+const NEST_MAX_EXCESS: f64 = 4.0;
 
 /// Largest relative difference between a piece's 9- and 5-node interpolants (between the
 /// nodes) that stops its halving, unless its nodes' error estimate is larger.
@@ -79,17 +87,17 @@ impl SetTable {
     /// (increasing, inside `(lo, top)`); `None` unless [`tabulated::table_normaliser`] serves
     /// `brdf`.
     pub(crate) fn build(brdf: &dyn Brdf, lo: f64, top: f64, breaks: &[f64]) -> Option<Self> {
-        Self::build_with(brdf, lo, top, breaks, true).map(|(t, _)| t)
+        Self::build_with(brdf, lo, top, breaks, Some(NEST_MAX_EXCESS)).map(|(t, _)| t)
     }
 
-    /// [`SetTable::build`], with or without the nested refinement ([`NESTED_NODES`]), and the
-    /// number of nodes integrated.
+    /// [`SetTable::build`] with the nested refinement ([`NESTED_NODES`]) up to the given
+    /// excess (`None`: none), and the number of nodes integrated.
     pub(crate) fn build_with(
         brdf: &dyn Brdf,
         lo: f64,
         top: f64,
         breaks: &[f64],
-        nested: bool,
+        nested: Option<f64>,
     ) -> Option<(Self, usize)> {
         if !tabulated::table_normaliser_exists(brdf) {
             return None;
@@ -105,7 +113,7 @@ impl SetTable {
         lo: f64,
         top: f64,
         breaks: &[f64],
-        nested: bool,
+        nested: Option<f64>,
     ) -> (Self, usize) {
         let mut edges = vec![lo];
         edges.extend(breaks.iter().copied().filter(|&b| b > lo && b < top));
@@ -158,7 +166,10 @@ impl SetTable {
                 let tol = PIECE_TOL.max(node_err);
                 let room = (b - a) / min_width;
                 if !(diff <= tol) && 0.5 * (b - a) >= min_width {
-                    if nested && n == PIECE_NODES && split_count(diff / tol, room) == 2 {
+                    if nested.is_some_and(|m| diff <= m * tol)
+                        && n == PIECE_NODES
+                        && split_count(diff / tol, room) == 2
+                    {
                         // A halving would integrate 2 × 9 fresh nodes and drop these 9; the
                         // 17 nodes that nest them cost 8.
                         next.push((a, b, NESTED_NODES, diff / tol));
@@ -250,7 +261,13 @@ mod tests {
         let (lo, top) = (0.0, 1.5);
         let mut counts = Vec::new();
         for nested in [false, true] {
-            let (table, nodes) = SetTable::build_from(&value, lo, top, &[0.5, 1.0], nested);
+            let (table, nodes) = SetTable::build_from(
+                &value,
+                lo,
+                top,
+                &[0.5, 1.0],
+                nested.then_some(super::NEST_MAX_EXCESS),
+            );
             for k in 0..3000 {
                 let t = lo + (top - lo) * (k as f64 + 0.5) / 3000.0;
                 let (a, declared) = table.at(t);

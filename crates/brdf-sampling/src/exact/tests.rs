@@ -646,7 +646,13 @@ fn set_table_nesting_survey() {
             .collect();
         let top = super::options::THETA_TOP_DEG.to_radians();
         let mut tables = Vec::new();
-        for nested in [false, true] {
+        let excess: Vec<Option<f64>> = std::env::var("NEST_EXCESS")
+            .unwrap_or_else(|_| "0,32".into())
+            .split(',')
+            .filter_map(|s| s.parse::<f64>().ok())
+            .map(|m| (m > 0.0).then_some(m))
+            .collect();
+        for &nested in &excess {
             let start = std::time::Instant::now();
             let (t, nodes) =
                 super::set_table::SetTable::build_with(&b, 0.0, top, &breaks, nested).unwrap();
@@ -655,13 +661,16 @@ fn set_table_nesting_survey() {
                 .map(|i| t.at(0.5 * (edges[i] + edges[i + 1])).1)
                 .fold(0.0, f64::max);
             eprintln!(
-                "{name} nested {nested}: {nodes} nodes, {} pieces, worst declared {worst:.2e}, {:.1} s",
+                "{name} nested {nested:?}: {nodes} nodes, {} pieces, worst declared {worst:.2e}, {:.1} s",
                 edges.len() - 1,
                 start.elapsed().as_secs_f64()
             );
             tables.push(t);
         }
         let (mut gap, mut ratio) = (0.0f64, 0.0f64);
+        if tables.len() < 2 {
+            continue;
+        }
         for k in 0..=600 {
             let t = top * k as f64 / 600.0;
             let (a0, e0) = tables[0].at(t);
