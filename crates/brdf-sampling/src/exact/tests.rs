@@ -620,3 +620,65 @@ pub(super) fn paper_white_fixture() -> Option<brdf::RglBrdf> {
         }
     }
 }
+
+/// The Cornell set table with and without the nested refinement of `set_table.rs`
+/// (`NESTED_NODES`), for the record (docs/benchmarks.md §26.4): nodes integrated, pieces,
+/// the worst declared error, and the two tables against each other at 601 angles.
+/// `CORNELL_FILES` (default the three shared files);
+/// `cargo test --release -p brdf-sampling --lib set_table_nesting_survey -- --ignored --nocapture`
+#[test]
+#[ignore = "a survey for the record (minutes)"]
+fn set_table_nesting_survey() {
+    let files =
+        std::env::var("CORNELL_FILES").unwrap_or_else(|_| "krylon_blue,cayman,acryl_blue".into());
+    for name in files.split(',') {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
+        let Ok(b) = brdf::CornellBrdf::load(&path) else {
+            eprintln!("skipped {name}");
+            continue;
+        };
+        let b = b.with_interpolation(brdf::measured::cornell::Interpolation::Knn);
+        let options = ExactOptions::default();
+        let plan = super::build::Plan::new(&b, &options, None, true);
+        let breaks: Vec<f64> = (1..plan.n0)
+            .map(|i| plan.grid.edge(i << super::grid::EDGE_BITS))
+            .collect();
+        let top = super::options::THETA_TOP_DEG.to_radians();
+        let mut tables = Vec::new();
+        let excess: Vec<Option<f64>> = std::env::var("NEST_EXCESS")
+            .unwrap_or_else(|_| "0,32".into())
+            .split(',')
+            .filter_map(|s| s.parse::<f64>().ok())
+            .map(|m| (m > 0.0).then_some(m))
+            .collect();
+        for &nested in &excess {
+            let start = std::time::Instant::now();
+            let (t, nodes) =
+                super::set_table::SetTable::build_with(&b, 0.0, top, &breaks, nested).unwrap();
+            let edges = t.edges();
+            let worst = (0..edges.len() - 1)
+                .map(|i| t.at(0.5 * (edges[i] + edges[i + 1])).1)
+                .fold(0.0, f64::max);
+            eprintln!(
+                "{name} nested {nested:?}: {nodes} nodes, {} pieces, worst declared {worst:.2e}, {:.1} s",
+                edges.len() - 1,
+                start.elapsed().as_secs_f64()
+            );
+            tables.push(t);
+        }
+        let (mut gap, mut ratio) = (0.0f64, 0.0f64);
+        if tables.len() < 2 {
+            continue;
+        }
+        for k in 0..=600 {
+            let t = top * k as f64 / 600.0;
+            let (a0, e0) = tables[0].at(t);
+            let (a1, e1) = tables[1].at(t);
+            let g = (a1 / a0 - 1.0).abs();
+            gap = gap.max(g);
+            ratio = ratio.max(g / (e0 + e1));
+        }
+        eprintln!("{name}: max |A_nested/A − 1| {gap:.2e}, at most {ratio:.2} of the declared sum");
+    }
+}
