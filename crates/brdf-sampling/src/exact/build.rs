@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use crate::options::SetOptions;
 use crate::set::layout_for;
 
-use super::build_interval::{Built, IntervalContext, build_interval};
+use super::build_interval::{Built, IntervalContext, build_interval, values_of};
 use super::error::ExactError;
 use super::grid::{EDGE_BITS, Grid, MAX_BREAKS, TableVar, initial_breaks, table_var, theta_kinks};
 use super::interval::Interval;
@@ -283,6 +283,7 @@ fn run_jobs(
                     inheritance,
                     axis: trials_axis,
                     phases: counts,
+                    envelope,
                 },
             ) = r?;
             built += 1;
@@ -307,6 +308,9 @@ fn run_jobs(
                 );
                 // Split for its tail: its tree bounds the halves too (`Inheritance`).
                 let mut inheritance = inheritance;
+                if let Some(envelope) = envelope {
+                    inheritance.nodes = values_of(envelope);
+                }
                 if let (false, Some(iv)) = (by_trials, iv) {
                     inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
                 }

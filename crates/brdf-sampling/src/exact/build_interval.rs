@@ -97,6 +97,11 @@ pub(super) struct Built {
     pub(super) axis: Option<bool>,
     /// The BRDF evaluations of this build per phase (see [`PhaseCounts`]).
     pub(super) phases: PhaseCounts,
+    /// A built interval's envelope, whose caching nodes' values go to its children should
+    /// the caller split it for its tail ([`values_of`]): they are gathered into maps only
+    /// then, not for every kept interval. `None` for an interval to be split (its values are
+    /// in `inheritance.nodes`).
+    pub(super) envelope: Option<Arc<IntervalEnvelope>>,
 }
 
 /// Where and on which disc map one interval is built: its clamped θ range and the names its
@@ -563,10 +568,7 @@ pub(super) fn build_interval(
     phases.axis = lap.take();
     // Node evaluations: the cached nodes counted their misses, the others every point.
     let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
-    let build_evals = points * (n_nodes - cached)
-        + envelope
-            .evaluations
-            .load(std::sync::atomic::Ordering::Relaxed);
+    let build_evals = points * (n_nodes - cached) + envelope.evaluations();
     let before = crate::disc::thread_evaluations();
     let mut normalisers = Vec::new();
     let outcome = normaliser_table(
@@ -600,12 +602,20 @@ pub(super) fn build_interval(
         ),
     };
     phases.finish = lap.take();
+    // A kept interval's values are gathered for children only if the caller splits it for
+    // its tail (most are kept as they are, and their maps were built for nothing).
+    let (nodes, envelope) = if interval.is_some() {
+        (Vec::new(), Some(envelope))
+    } else {
+        (values_of(envelope), None)
+    };
     Ok(Built {
         axis,
         phases,
         interval,
+        envelope,
         inheritance: Inheritance {
-            nodes: values_of(envelope),
+            nodes,
             normalisers,
             tree: None,
             table,
@@ -753,8 +763,9 @@ fn split_axis(
 /// ([`split_axis`]).
 const MIN_DELTA_LOSS: f64 = 0.1;
 
-/// The values the caching nodes of a built interval know, for its children.
-fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)> {
+/// The values the caching nodes of a built interval know, for its children (empty unless
+/// the envelope is no longer shared).
+pub(super) fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)> {
     match Arc::try_unwrap(envelope) {
         Ok(env) => env
             .nodes
@@ -769,6 +780,52 @@ fn values_of(envelope: Arc<IntervalEnvelope>) -> Vec<(NodeKey, Arc<NodeValues>)>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 29 (docs/benchmarks.md §26.5): a kept interval hands its envelope back instead of
+    /// its node values gathered into maps, and those values are all there should the caller
+    /// split it for its tail (`values_of`: every caching node, each with values); an interval
+    /// to be split hands its values at once. On two of the RGL fixture's initial intervals (one
+    /// kept, one split by a tight cap on the mean trials). Fails when a kept interval's
+    /// envelope is dropped (tried).
+    #[test]
+    fn kept_intervals_keep_their_envelope_for_a_tail_split() {
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
+            return;
+        };
+        let brdf: Arc<dyn Brdf> = Arc::new(rgl);
+        let one = 1u64 << super::super::grid::EDGE_BITS;
+        let (mut kept, mut split) = (0, 0);
+        // The default cap keeps the fixture's initial intervals; a tight one splits them.
+        for (max_trials, i) in [(2.0, 0), (1.05, 1)] {
+            let opts = ExactOptions {
+                max_trials,
+                ..ExactOptions::default()
+            };
+            let plan = super::super::build::Plan::new(brdf.as_ref(), &opts, Some(true), true);
+            let job = Job {
+                cell: 0,
+                num: [i * one, (i + 1) * one],
+                dnum: [0, one],
+                inherited: Arc::default(),
+            };
+            let built = build_interval(&brdf, &opts, &job, &plan.context(&job)).unwrap();
+            if built.interval.is_some() {
+                kept += 1;
+                assert!(built.inheritance.nodes.is_empty());
+                let envelope = built.envelope.expect("a kept interval's envelope");
+                let caching = envelope.nodes.iter().filter(|n| n.caches()).count();
+                assert!(caching > 0);
+                let values = values_of(envelope);
+                assert_eq!(values.len(), caching);
+                assert!(values.iter().all(|(_, v)| v.known() > 1000));
+            } else {
+                split += 1;
+                assert!(built.envelope.is_none());
+                assert!(!built.inheritance.nodes.is_empty());
+            }
+        }
+        assert!(kept == 1 && split == 1, "kept {kept}, split {split}");
+    }
 
     /// [`extended_table`] keeps the 5 nodes' values, integrates only the 4 nested new nodes
     /// (at the 9-node Lobatto positions), and its table interpolates a smooth `A · cos θo`

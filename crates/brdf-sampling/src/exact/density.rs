@@ -2,7 +2,6 @@
 //! [`DiscMap`]: the query density at one outgoing direction, and the envelope over the
 //! interval that the tree is built from.
 
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex};
 
 use brdf::measured::rgl::PreparedSlice;
@@ -106,6 +105,12 @@ impl NodeValues {
     fn get(&self, key: &[u64; 3]) -> Option<f64> {
         self.layers.iter().find_map(|m| m.get(key).copied())
     }
+
+    /// How many values the layers hold (a test's view).
+    #[cfg(test)]
+    pub(crate) fn known(&self) -> usize {
+        self.layers.iter().map(|m| m.len()).sum()
+    }
 }
 
 /// The identity of a bound node within its azimuth cell: `θ_n = (π/2) · num / den` with the
@@ -158,13 +163,7 @@ impl EnvelopeNode {
         }
     }
 
-    fn value(
-        &self,
-        brdf: &dyn Brdf,
-        rgl: Option<&RglBrdf>,
-        wi: &Vec3,
-        evaluations: &AtomicU64,
-    ) -> f64 {
+    fn value(&self, brdf: &dyn Brdf, rgl: Option<&RglBrdf>, wi: &Vec3) -> f64 {
         let key = [wi.x.to_bits(), wi.y.to_bits(), wi.z.to_bits()];
         if let Some(v) = self.inherited.as_ref().and_then(|m| m.get(&key)) {
             return v;
@@ -180,7 +179,6 @@ impl EnvelopeNode {
             _ => brdf.eval_prepared(&self.wo, &w),
         };
         if let Some(buffers) = &self.fresh {
-            evaluations.fetch_add(1, Relaxed);
             let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
             if let Some(Ok(mut b)) = buffers.get(worker).map(|b| b.0.lock()) {
                 b.push((key, v));
@@ -192,6 +190,17 @@ impl EnvelopeNode {
     /// Whether this node keeps the values it evaluates.
     pub(crate) fn caches(&self) -> bool {
         self.fresh.is_some()
+    }
+
+    /// The BRDF evaluations this node made and kept (0 for a node that does not cache): one
+    /// entry of its buffers per evaluation.
+    fn fresh_evaluations(&self) -> u64 {
+        self.fresh.as_ref().map_or(0, |buffers| {
+            buffers
+                .iter()
+                .map(|b| b.0.lock().map_or(0, |v| v.len() as u64))
+                .sum()
+        })
     }
 
     /// Every value known for this node (inherited and fresh), for the children.
@@ -230,9 +239,6 @@ pub(crate) struct IntervalEnvelope {
     /// nodes are evaluated through [`RglBrdf::eval_in_slice`] (the same values).
     rgl: Option<RglBrdf>,
     pub(crate) nodes: Vec<EnvelopeNode>,
-    /// BRDF evaluations made by nodes that cache (their misses); the others are counted by
-    /// the image map's counter.
-    pub(crate) evaluations: AtomicU64,
 }
 
 impl IntervalEnvelope {
@@ -248,12 +254,15 @@ impl IntervalEnvelope {
                 node.slice = Some(rgl.prepare_slice(node.wo.wo()));
             }
         }
-        Self {
-            brdf,
-            rgl,
-            nodes,
-            evaluations: AtomicU64::new(0),
-        }
+        Self { brdf, rgl, nodes }
+    }
+
+    /// BRDF evaluations made by the nodes that cache (their misses, one kept value each; the
+    /// other nodes' are counted by the image map's counter). Counted from the nodes' buffers
+    /// rather than by a shared atomic counter, which the image map's workers contended for at
+    /// every miss.
+    pub(crate) fn evaluations(&self) -> u64 {
+        self.nodes.iter().map(EnvelopeNode::fresh_evaluations).sum()
     }
 }
 
@@ -269,7 +278,7 @@ pub(crate) fn rgl_itself(brdf: &Arc<dyn Brdf>) -> Option<RglBrdf> {
 impl Brdf for IntervalEnvelope {
     fn eval(&self, _wo: &Vec3, wi: &Vec3) -> f64 {
         self.nodes.iter().fold(0.0f64, |m, node| {
-            m.max(node.value(self.brdf.as_ref(), self.rgl.as_ref(), wi, &self.evaluations))
+            m.max(node.value(self.brdf.as_ref(), self.rgl.as_ref(), wi))
         })
     }
     fn is_mirror_symmetric(&self) -> bool {
@@ -293,6 +302,120 @@ impl Brdf for IntervalEnvelope {
 mod tests {
     use super::*;
     use brdf::{CountingBrdf, direction_from_radians};
+
+    /// A BRDF that counts its evaluations on every thread (the thread-local count of
+    /// [`CountingBrdf`] cannot be summed over a pool's workers).
+    struct Tally {
+        inner: Arc<dyn Brdf>,
+        calls: std::sync::atomic::AtomicU64,
+    }
+
+    impl Brdf for Tally {
+        fn eval(&self, wo: &Vec3, wi: &Vec3) -> f64 {
+            self.calls
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.inner.eval(wo, wi)
+        }
+        fn name(&self) -> &str {
+            "tally"
+        }
+    }
+
+    /// Issue 29 (docs/benchmarks.md §26.5): [`IntervalEnvelope::evaluations`], counted from the
+    /// caching nodes' buffers instead of a shared atomic counter, is every evaluation the
+    /// caching nodes made, also when the image map's workers evaluate in parallel (each worker
+    /// appends to its own buffer), and none of the lookups the inherited values answer. A
+    /// count from one buffer only (tried: the buffer of the calling thread) misses the pool's
+    /// evaluations and fails.
+    #[test]
+    fn envelope_evaluations_are_the_caching_nodes_misses_on_every_worker() {
+        let tally = Arc::new(Tally {
+            inner: Arc::from(brdf::parse_spec("phong:n=40").unwrap()),
+            calls: std::sync::atomic::AtomicU64::new(0),
+        });
+        let brdf: Arc<dyn Brdf> = tally.clone();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let dirs: Vec<Vec3> = (0..3000u32)
+            .map(|k| {
+                let t = 1.5 * ((k as f64 + 0.5) / 3000.0).sqrt();
+                direction_from_radians(t, 2.399_963 * k as f64)
+            })
+            .collect();
+        let node = |k: u64, deg: f64, inherited: Option<Arc<NodeValues>>, cache: bool| {
+            let wo = direction_from_radians(deg.to_radians(), 0.0);
+            EnvelopeNode::new((k, 0), brdf.prepare(&wo), 0.0, inherited, cache)
+        };
+        let wo = Vec3::new(0.0, 0.0, 1.0);
+        // Every worker of the pool evaluates its share of `points` (`broadcast`: each worker
+        // runs once, whatever the scheduling), the calling thread (outside the pool) the rest.
+        let spread = |env: &IntervalEnvelope, points: &[Vec3]| {
+            let n = points.len();
+            pool.broadcast(|w| {
+                for wi in &points[w.index() * n / 4..(w.index() + 1) * n / 4] {
+                    env.eval(&wo, wi);
+                }
+            });
+            for wi in &points[3 * n / 4..] {
+                env.eval(&wo, wi);
+            }
+        };
+        // A parent with two caching nodes and one that does not cache.
+        let parent = pool.install(|| {
+            IntervalEnvelope::new(
+                Arc::clone(&brdf),
+                vec![
+                    node(0, 20.0, None, true),
+                    node(1, 25.0, None, true),
+                    node(2, 30.0, None, false),
+                ],
+                true,
+            )
+        });
+        spread(&parent, &dirs);
+        let calls = tally.calls.load(std::sync::atomic::Ordering::Relaxed);
+        assert_eq!(calls, 3 * dirs.len() as u64);
+        assert_eq!(parent.evaluations(), 2 * dirs.len() as u64);
+        let workers = parent.nodes[0]
+            .fresh
+            .as_ref()
+            .unwrap()
+            .iter()
+            .filter(|b| b.0.lock().is_ok_and(|v| !v.is_empty()))
+            .count();
+        assert_eq!(workers, 4, "buffers written");
+        // A child inherits node 1's values: its lookups are not evaluations, its fresh node's
+        // misses are, and only the directions the parent did not see miss.
+        let values: Vec<_> = parent
+            .nodes
+            .into_iter()
+            .filter(|n| n.caches())
+            .map(EnvelopeNode::into_values)
+            .collect();
+        let inherited = values
+            .iter()
+            .find(|(k, _)| k.0 == 1)
+            .map(|(_, v)| Arc::clone(v));
+        let before = tally.calls.load(std::sync::atomic::Ordering::Relaxed);
+        let child = pool.install(|| {
+            IntervalEnvelope::new(
+                Arc::clone(&brdf),
+                vec![node(1, 25.0, inherited, true), node(3, 22.5, None, true)],
+                true,
+            )
+        });
+        let more: Vec<Vec3> = dirs
+            .iter()
+            .copied()
+            .chain((0..500u32).map(|k| direction_from_radians(0.1 + 0.002 * k as f64, 0.5)))
+            .collect();
+        spread(&child, &more);
+        let made = tally.calls.load(std::sync::atomic::Ordering::Relaxed) - before;
+        assert_eq!(made, (dirs.len() + 500 + 500) as u64);
+        assert_eq!(child.evaluations(), made);
+    }
 
     /// Issue 29 (docs/benchmarks.md §25.4): an envelope whose RGL nodes carry their blended
     /// slices gives every node's value of the two-slice path bit for bit (and so the same
@@ -323,15 +446,14 @@ mod tests {
         assert!(fast.rgl.is_some() && slow.rgl.is_none());
         let wrapped = IntervalEnvelope::new(counted, nodes(), true);
         assert!(wrapped.rgl.is_none() && wrapped.nodes.iter().all(|n| n.slice.is_none()));
-        let count = AtomicU64::new(0);
         let mut positive = 0;
         for k in 0..2000u32 {
             let t = (std::f64::consts::FRAC_PI_2 - 1e-4) * ((k as f64 + 0.5) / 2000.0).sqrt();
             let wi = direction_from_radians(t, 2.399_963 * k as f64);
             for (a, b) in fast.nodes.iter().zip(&slow.nodes) {
                 let (va, vb) = (
-                    a.value(brdf.as_ref(), fast.rgl.as_ref(), &wi, &count),
-                    b.value(brdf.as_ref(), None, &wi, &count),
+                    a.value(brdf.as_ref(), fast.rgl.as_ref(), &wi),
+                    b.value(brdf.as_ref(), None, &wi),
                 );
                 assert_eq!(va.to_bits(), vb.to_bits(), "θi {t}: {va} vs {vb}");
                 positive += usize::from(va > 0.0);
