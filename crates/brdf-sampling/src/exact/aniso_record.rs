@@ -8,7 +8,7 @@
 //! change) on a uniform grid of small cells over the query's own search keys,
 //! `w = √(1 − cos θo)` and the strip key `d` (`tan δ`, or `δ` for wide cells; see
 //! [`Cell::by_tan`](super::layout::Cell::by_tan)): each cell a bicubic in the monomial basis
-//! ([`Patch`], 16 `f32` coefficients on one cache line). A query finds its patch by two
+//! ([`Patch`], 16 coefficients on two cache lines). A query finds its patch by two
 //! multiplications (no search), evaluates 16 coefficients by Horner's rule, and needs neither
 //! `θo` nor `δ` (no `atan`).
 //!
@@ -20,17 +20,11 @@
 //! one-variable fits on 5 lines of `d` meet half of [`REFIT_REL`], and likewise along `d`),
 //! then the grid is doubled along `w` or `d`, whichever lowers the error more, until the
 //! patches agree with the interval's table to [`REFIT_REL`] (relative) at 8 × 8 points inside
-//! every patch (between its nodes), up to [`MAX_PATCHES`] per interval. The fitted
-//! coefficients are then **stored as `f32`** (one 64-byte line per patch instead of two: a query
-//! reads one line fewer, and the grids take half the memory; docs/benchmarks.md §26.2): the
-//! stored values define the pdf's normaliser exactly (sampling and `pdf` read the same
-//! patches), and the largest difference between the *stored* patches and the table at the
-//! same check points — the fit's and the `f32` rounding's, at most `2⁻²⁴ Σ|a_ij|` more than
-//! the fit's — is added to the interval's declared normaliser error
-//! ([`Interval::norm_err`](super::interval::Interval::norm_err)). The grid sizes are the
-//! `f64` fit's (the rounding does not drive the refinement). On anisotropic Ward's
-//! default set (129 intervals) every interval meets the target, with 5 488 patches (343 KiB;
-//! docs/benchmarks.md §24.2, §26.2).
+//! every patch (between its nodes), up to [`MAX_PATCHES`] per interval; the largest
+//! difference found is added to the interval's declared normaliser error
+//! ([`Interval::norm_err`](super::interval::Interval::norm_err)). On anisotropic Ward's
+//! default set (129 intervals) every interval meets the target, with 5 488 patches (686 KiB;
+//! docs/benchmarks.md §24.2).
 
 use super::chebyshev::{tensor_monomial, tensor_series};
 use super::interval::Interval;
@@ -57,43 +51,26 @@ const LINES: usize = 5;
 const CHECKS: usize = 8;
 
 /// One cell of an interval's normaliser grid: `A · cos θo ≈ Σ_{i,j} a[i·P + j] xⁱ yʲ` for the
-/// local coordinates `x, y ∈ [−1, 1]` of the cell, the coefficients `a` stored as `f32` and
-/// evaluated in `f64` (the stored values are the normaliser: see the module docs). 64 bytes,
-/// aligned to a cache line: one line per query.
+/// local coordinates `x, y ∈ [−1, 1]` of the cell. 128 bytes, aligned to a cache line: two
+/// lines per query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[repr(C, align(64))]
-pub(super) struct Patch(pub(super) [f32; P * P]);
+pub(super) struct Patch(pub(super) [f64; P * P]);
 
 impl Patch {
-    /// The patch of the `f64` monomial coefficients `mono` (row `i` the power `xⁱ`), each
-    /// rounded to the nearest `f32`.
-    fn rounded(mono: &[f64]) -> Self {
-        let mut a = [0.0f32; P * P];
-        for (s, &m) in a.iter_mut().zip(mono) {
-            *s = m as f32;
-        }
-        Self(a)
-    }
-
-    /// The bicubic `Σ a_ij xⁱ yʲ` at local coordinates `(x, y)`, in `f64`: Horner's rule along
-    /// `x` for the four `y` powers side by side, then along `y`.
+    /// The bicubic at local coordinates `(x, y)`: Horner's rule along `x` for the four `y`
+    /// powers side by side, then along `y`.
     #[inline]
     pub(super) fn eval(&self, x: f64, y: f64) -> f64 {
-        let a = self.0.map(f64::from);
-        horner(&a, x, y)
-    }
-}
-
-/// `Σ a_ij xⁱ yʲ` for `f64` coefficients `a[i·P + j]` ([`Patch::eval`]'s arithmetic).
-#[inline]
-fn horner(a: &[f64; P * P], x: f64, y: f64) -> f64 {
-    let mut acc = [a[12], a[13], a[14], a[15]];
-    for i in (0..P - 1).rev() {
-        for j in 0..P {
-            acc[j] = acc[j] * x + a[i * P + j];
+        let a = &self.0;
+        let mut acc = [a[12], a[13], a[14], a[15]];
+        for i in (0..P - 1).rev() {
+            for j in 0..P {
+                acc[j] = acc[j] * x + a[i * P + j];
+            }
         }
+        ((acc[3] * y + acc[2]) * y + acc[1]) * y + acc[0]
     }
-    ((acc[3] * y + acc[2]) * y + acc[1]) * y + acc[0]
 }
 
 /// What an anisotropic query reads of its interval besides the sampling table (one cache
@@ -137,22 +114,18 @@ fn cell_of(u: f64, n: u32) -> (usize, f64) {
     (i as usize, 2.0 * (u - i as f64) - 1.0)
 }
 
-/// A refitted grid before it is stored: its size, patches (`f32`), the largest relative
-/// difference of the `f64` fit from the reference (`err`, what the refinement judges) and that
-/// of the stored `f32` patches (`stored_err`, what is declared).
+/// A refitted grid before it is stored: its size, patches and largest relative difference.
 struct Fit {
     nw: u32,
     nd: u32,
     patches: Vec<Patch>,
     err: f64,
-    stored_err: f64,
 }
 
 impl AnisoRecord {
     /// The record of `iv` (an interval of an anisotropic cell whose strip key is `tan δ` when
     /// `by_tan`, otherwise `δ`), its patches appended to `patches`; returns the record and
-    /// the largest relative difference between the stored (`f32`) patches and the interval's
-    /// table at the check points (the grid's size is chosen by the `f64` fit's difference).
+    /// the largest relative difference between the patches and the interval's table.
     pub(super) fn of(iv: &Interval, by_tan: bool, patches: &mut Vec<Patch>) -> (Self, f64) {
         let t = &iv.table;
         let (th_lo, th_hi) = (t.theta[t.theta.len() - 1], t.theta[0]);
@@ -208,7 +181,7 @@ impl AnisoRecord {
             map: iv.map,
         };
         patches.extend_from_slice(&best.patches);
-        (rec, best.stored_err)
+        (rec, best.err)
     }
 
     /// Patches of this record (`[along w, along d]`).
@@ -232,9 +205,8 @@ impl AnisoRecord {
 }
 
 /// The grid of `nw × nd` bicubic patches over `w ∈ [w_lo, w_hi]`, `d ∈ [d_lo, d_hi]`
-/// interpolating `reference` at the 4 × 4 Chebyshev–Lobatto nodes of each cell, and the
-/// largest relative differences from `reference` at [`CHECKS`]² points inside each cell of the
-/// `f64` fit and of its `f32` patches.
+/// interpolating `reference` at the 4 × 4 Chebyshev–Lobatto nodes of each cell, and its
+/// largest relative difference from `reference` at [`CHECKS`]² points inside each cell.
 fn fit_grid(
     reference: &impl Fn(f64, f64) -> f64,
     [w_lo, w_hi]: [f64; 2],
@@ -253,15 +225,7 @@ fn fit_grid(
         .map(|k| -1.0 + (2 * k + 1) as f64 / CHECKS as f64)
         .collect();
     let mut patches = Vec::with_capacity((nw * nd) as usize);
-    // NaN (a zero or non-finite value) counts as failing.
-    let worse = |err: f64, rel: f64| {
-        if rel.is_nan() {
-            f64::INFINITY
-        } else {
-            err.max(rel)
-        }
-    };
-    let (mut err, mut stored_err) = (0.0f64, 0.0f64);
+    let mut err = 0.0f64;
     for i in 0..nw {
         for j in 0..nd {
             let mut values = [0.0; P * P];
@@ -271,14 +235,19 @@ fn fit_grid(
                         reference(at(w_lo, w_hi, nw, i, x), at(d_lo, d_hi, nd, j, y));
                 }
             }
-            let mut mono = [0.0; P * P];
-            mono.copy_from_slice(&tensor_monomial(&tensor_series(&values, P), P));
-            let patch = Patch::rounded(&mono);
+            let mono = tensor_monomial(&tensor_series(&values, P), P);
+            let mut patch = Patch([0.0; P * P]);
+            patch.0.copy_from_slice(&mono);
             for &x in &checks {
                 for &y in &checks {
                     let want = reference(at(w_lo, w_hi, nw, i, x), at(d_lo, d_hi, nd, j, y));
-                    err = worse(err, (horner(&mono, x, y) - want).abs() / want.abs());
-                    stored_err = worse(stored_err, (patch.eval(x, y) - want).abs() / want.abs());
+                    let rel = (patch.eval(x, y) - want).abs() / want.abs();
+                    // NaN (a zero or non-finite value) counts as failing.
+                    err = if rel.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        err.max(rel)
+                    };
                 }
             }
             patches.push(patch);
@@ -289,7 +258,6 @@ fn fit_grid(
         nd,
         patches,
         err,
-        stored_err,
     }
 }
 
@@ -314,20 +282,6 @@ pub(super) mod tests {
         let cubic = |w: f64, d: f64| 2.0 + w - 0.5 * w * w * d + 0.25 * d * d * d * w * w * w;
         let fit = fit_grid(&cubic, [0.1, 0.9], [-0.4, 0.4], 3, 2);
         assert!(fit.err < 1e-14, "{}", fit.err);
-        // Its stored (`f32`) patches: the rounding's difference only, within `2⁻²⁴ Σ|a_ij|`
-        // relative to the smallest value (`|2 + …| ≥ 1` there), and not zero (the rounding
-        // shows).
-        let sum = fit
-            .patches
-            .iter()
-            .map(|p| p.0.iter().map(|&a| f64::from(a).abs()).sum::<f64>())
-            .fold(0.0, f64::max);
-        assert!(
-            fit.stored_err > 0.0 && fit.stored_err <= sum * 2f64.powi(-24),
-            "{} vs {}",
-            fit.stored_err,
-            sum * 2f64.powi(-24)
-        );
         let smooth = |w: f64, d: f64| (1.3 * w).exp() * (2.0 + (3.0 * d).sin());
         let (coarse, fine) = (
             fit_grid(&smooth, [0.0, 1.0], [-0.4, 0.4], 1, 1),
@@ -348,7 +302,7 @@ pub(super) mod tests {
             let got = fine.patches[i * 32 + j].eval(x, y);
             let want = smooth(w, d);
             assert!(
-                (got / want - 1.0).abs() < 2.0 * fine.stored_err,
+                (got / want - 1.0).abs() < 2.0 * fine.err,
                 "({w}, {d}): {got} vs {want}"
             );
         }
@@ -361,8 +315,6 @@ pub(super) mod tests {
     /// declared one. Returns the largest `|grid/table − 1|`. (Called by this module's test,
     /// on wide cells, and by `tests.rs`'s anisotropic-cells test, on narrow ones.)
     pub(in crate::exact) fn assert_normaliser_is_the_table(set: &ExactSet) -> f64 {
-        /// What the `f32` rounding of a patch may add to the fit's difference (relative).
-        const STORED_SLACK: f64 = 8.0 / (1u32 << 24) as f64;
         let mut refined = 0;
         for c in &set.cells {
             assert_eq!(c.aniso.len(), c.intervals.len());
@@ -391,9 +343,7 @@ pub(super) mod tests {
                         let (again, err) = AnisoRecord::of(iv, c.by_tan, &mut Vec::new());
                         assert_eq!(again.size(), rec.size());
                         let full = 2 * rec.size().iter().product::<u32>() as usize > MAX_PATCHES;
-                        // The stored patches: the fit's difference and the `f32` rounding
-                        // (`2⁻²⁴ Σ|a_ij|`, a few `2⁻²⁴` relative for these smooth grids).
-                        assert!(err <= REFIT_REL + STORED_SLACK || full, "{rec:?}: {err:e}");
+                        assert!(err <= REFIT_REL || full, "{rec:?}: {err:e}");
                         err
                     })
                     .collect()
