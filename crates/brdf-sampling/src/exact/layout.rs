@@ -77,15 +77,16 @@ const DIRECT_NONE: u8 = u8::MAX;
 /// [`DIRECT_THETA`] × [`DIRECT_DELTA`] buckets over the search key `k = 1 − cos θo ∈ [0,
 /// range]` and the strip key `d ∈ [−h_d, h_d]` (`h_d = tan h` or `h`); bucket `(g, e)` holds
 /// the keys with `⌊k · s_k⌋ = g` and, along the strip key, **by its sign and magnitude**:
-/// `e = S + j` for `d ≥ 0` and `e = S − 1 − j` for `d < 0`, with `j = ⌊|d| · s_d⌋`
+/// `e = S + j` for `d > 0` and `e = S − 1 − j` for `d ≤ 0`, with `j = ⌊|d| · s_d⌋`
 /// (`S` = [`DIRECT_SIDE`] buckets per side, `s_k = DIRECT_THETA / range`, `s_d = S / h_d`; the
 /// first and last buckets of each axis extend to `∓∞`). The boundary at `d = 0` is a sign test,
-/// exact: an azimuth split at `δ = 0` (the first halving of a cell, `tan 0 = 0`) lies between
-/// two buckets instead of making both meet two intervals (docs/benchmarks.md §26.2).
+/// exact and the search's own (a strip key on an edge belongs to the entry below it): an
+/// azimuth split at `δ = 0` (the first halving of a cell, `tan 0 = 0`) lies between two
+/// buckets instead of making both meet two intervals (docs/benchmarks.md §26.2).
 /// [`Cell::interval_of`] is non-decreasing in `k` (its strip) and, within a strip, in `d`
 /// (the entry), so a bucket whose two extreme corners — widened by a margin of 10⁻⁶ of a
-/// bucket for the rounding of `k · s_k` and `|d| · s_d`, and at `d = 0` the largest negative
-/// float and `+0` — give the same strip and entry has that interval at every key inside: the
+/// bucket for the rounding of `k · s_k` and `|d| · s_d`, and at `d = 0` the keys `0` and the
+/// smallest positive float — give the same strip and entry has that interval at every key inside: the
 /// entry stores it (as `u8`); otherwise [`DIRECT_NONE`], and the query takes the search. The
 /// result is the search's, exactly.
 pub(super) struct DirectIndex {
@@ -210,20 +211,21 @@ impl Cell {
         for g in 0..DIRECT_THETA {
             let [k0, k1] = ends(g, DIRECT_THETA, 0.0, k_scale);
             for e in 0..DIRECT_DELTA {
-                // `|d|` in bucket `j` of its side; the inner end at 0 exact (the sign test).
+                // `|d|` in bucket `j` of its side; the inner ends exact (the sign test): `d = 0`
+                // with the negative side, as the search puts a key on an edge below it.
                 let (d0, d1) = if e >= DIRECT_SIDE {
                     let [a, z] = ends(e - DIRECT_SIDE, DIRECT_SIDE, 0.0, d_scale);
-                    (if e == DIRECT_SIDE { 0.0 } else { a }, z)
+                    (
+                        if e == DIRECT_SIDE {
+                            f64::from_bits(1)
+                        } else {
+                            a
+                        },
+                        z,
+                    )
                 } else {
                     let [a, z] = ends(DIRECT_SIDE - 1 - e, DIRECT_SIDE, 0.0, d_scale);
-                    (
-                        -z,
-                        if e + 1 == DIRECT_SIDE {
-                            -f64::from_bits(1)
-                        } else {
-                            -a
-                        },
-                    )
+                    (-z, if e + 1 == DIRECT_SIDE { 0.0 } else { -a })
                 };
                 let (a, z) = (self.strip_entry(k0, d0), self.strip_entry(k1, d1));
                 if a == z {
@@ -251,7 +253,7 @@ impl Cell {
             // keys are clamped into the last bucket.
             let g = ((key * t.k_scale) as usize).min(DIRECT_THETA - 1);
             let j = ((dkey.abs() * t.d_scale) as usize).min(DIRECT_SIDE - 1);
-            let e = if dkey < 0.0 {
+            let e = if dkey <= 0.0 {
                 DIRECT_SIDE - 1 - j
             } else {
                 DIRECT_SIDE + j
