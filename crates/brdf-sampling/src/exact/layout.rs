@@ -64,8 +64,11 @@ pub(super) struct Cell {
 
 /// Buckets of a [`DirectIndex`] along the θ search key `1 − cos θo`.
 pub(super) const DIRECT_THETA: usize = 256;
-/// Buckets of a [`DirectIndex`] along the strip key (`tan δ` or `δ`).
+/// Buckets of a [`DirectIndex`] along the strip key (`tan δ` or `δ`): half of them on each
+/// side of 0.
 pub(super) const DIRECT_DELTA: usize = 8;
+/// Buckets of a [`DirectIndex`] on each side of the strip key 0.
+const DIRECT_SIDE: usize = DIRECT_DELTA / 2;
 /// A [`DirectIndex`] entry whose bucket meets more than one interval.
 const DIRECT_NONE: u8 = u8::MAX;
 
@@ -73,16 +76,22 @@ const DIRECT_NONE: u8 = u8::MAX;
 /// the strip's δ scan (issue 29: `locate_keys`'s cost on anisotropic Ward). A uniform grid of
 /// [`DIRECT_THETA`] × [`DIRECT_DELTA`] buckets over the search key `k = 1 − cos θo ∈ [0,
 /// range]` and the strip key `d ∈ [−h_d, h_d]` (`h_d = tan h` or `h`); bucket `(g, e)` holds
-/// the keys with `⌊k · s_k⌋ = g` and `⌊(d + h_d) · s_d⌋ = e` (`s_k = DIRECT_THETA / range`,
-/// `s_d = DIRECT_DELTA / (2 h_d)`; the first and last buckets of each axis extend to `∓∞`).
+/// the keys with `⌊k · s_k⌋ = g` and, along the strip key, **by its sign and magnitude**:
+/// `e = S + j` for `d > 0` and `e = S − 1 − j` for `d ≤ 0`, with `j = ⌊|d| · s_d⌋`
+/// (`S` = [`DIRECT_SIDE`] buckets per side, `s_k = DIRECT_THETA / range`, `s_d = S / h_d`; the
+/// first and last buckets of each axis extend to `∓∞`). The boundary at `d = 0` is a sign test,
+/// exact and the search's own (a strip key on an edge belongs to the entry below it): an
+/// azimuth split at `δ = 0` (the first halving of a cell, `tan 0 = 0`) lies between two
+/// buckets instead of making both meet two intervals (docs/benchmarks.md §26.2).
 /// [`Cell::interval_of`] is non-decreasing in `k` (its strip) and, within a strip, in `d`
 /// (the entry), so a bucket whose two extreme corners — widened by a margin of 10⁻⁶ of a
-/// bucket for the rounding of `k · s_k` and `(d + h_d) · s_d` — give the same strip and entry
-/// has that interval at every key inside: the entry stores it (as `u8`); otherwise
-/// [`DIRECT_NONE`], and the query takes the search. The result is the search's, exactly.
+/// bucket for the rounding of `k · s_k` and `|d| · s_d`, and at `d = 0` the keys `0` and the
+/// smallest positive float — give the same strip and entry has that interval at every key inside: the
+/// entry stores it (as `u8`); otherwise [`DIRECT_NONE`], and the query takes the search. The
+/// result is the search's, exactly.
 pub(super) struct DirectIndex {
     k_scale: f64,
-    d_lo: f64,
+    /// `s_d`: buckets per unit of `|d|`.
     d_scale: f64,
     entries: Box<[u8; DIRECT_THETA * DIRECT_DELTA]>,
 }
@@ -181,7 +190,7 @@ impl Cell {
     /// The [`DirectIndex`] of this cell's search (strip keys in `[−half_key, half_key]`).
     fn direct_index(&self, half_key: f64) -> DirectIndex {
         let k_scale = DIRECT_THETA as f64 / self.range;
-        let (d_lo, d_scale) = (-half_key, DIRECT_DELTA as f64 / (2.0 * half_key));
+        let d_scale = DIRECT_SIDE as f64 / half_key;
         // Bucket `b` of `n` over `[lo, lo + n/scale]`: its keys, widened for rounding; the
         // end buckets reach to infinity (keys past the grid are clamped into them).
         let ends = |b: usize, n: usize, lo: f64, scale: f64| {
@@ -202,7 +211,22 @@ impl Cell {
         for g in 0..DIRECT_THETA {
             let [k0, k1] = ends(g, DIRECT_THETA, 0.0, k_scale);
             for e in 0..DIRECT_DELTA {
-                let [d0, d1] = ends(e, DIRECT_DELTA, d_lo, d_scale);
+                // `|d|` in bucket `j` of its side; the inner ends exact (the sign test): `d = 0`
+                // with the negative side, as the search puts a key on an edge below it.
+                let (d0, d1) = if e >= DIRECT_SIDE {
+                    let [a, z] = ends(e - DIRECT_SIDE, DIRECT_SIDE, 0.0, d_scale);
+                    (
+                        if e == DIRECT_SIDE {
+                            f64::from_bits(1)
+                        } else {
+                            a
+                        },
+                        z,
+                    )
+                } else {
+                    let [a, z] = ends(DIRECT_SIDE - 1 - e, DIRECT_SIDE, 0.0, d_scale);
+                    (-z, if e + 1 == DIRECT_SIDE { 0.0 } else { -a })
+                };
                 let (a, z) = (self.strip_entry(k0, d0), self.strip_entry(k1, d1));
                 if a == z {
                     let iv = self.entry_interval(a.1);
@@ -214,7 +238,6 @@ impl Cell {
         }
         DirectIndex {
             k_scale,
-            d_lo,
             d_scale,
             entries,
         }
@@ -229,7 +252,12 @@ impl Cell {
             // `as usize` saturates: negative keys (and NaN) go to bucket 0, past-the-end
             // keys are clamped into the last bucket.
             let g = ((key * t.k_scale) as usize).min(DIRECT_THETA - 1);
-            let e = (((dkey - t.d_lo) * t.d_scale) as usize).min(DIRECT_DELTA - 1);
+            let j = ((dkey.abs() * t.d_scale) as usize).min(DIRECT_SIDE - 1);
+            let e = if dkey <= 0.0 {
+                DIRECT_SIDE - 1 - j
+            } else {
+                DIRECT_SIDE + j
+            };
             let iv = t.entries[g * DIRECT_DELTA + e];
             if iv != DIRECT_NONE {
                 return usize::from(iv);
@@ -379,12 +407,15 @@ pub(super) mod tests {
             assert_eq!(c.direct_bytes(), DIRECT_THETA * DIRECT_DELTA);
             let share = c.direct_share();
             assert!(share > 0.5, "cell {k}: {share} of the buckets served");
-            let h = -t.d_lo;
+            let h = DIRECT_SIDE as f64 / t.d_scale;
             let near = |x: f64| [x.next_down(), x, x.next_up()];
             let mut ks: Vec<f64> = c.keys.iter().flat_map(|&x| near(x)).collect();
             ks.extend((0..=DIRECT_THETA).flat_map(|g| near(g as f64 / t.k_scale)));
             let mut ds: Vec<f64> = c.delta_keys.iter().flat_map(|&x| near(x)).collect();
-            ds.extend((0..=DIRECT_DELTA).flat_map(|e| near(t.d_lo + e as f64 / t.d_scale)));
+            ds.extend(
+                (0..=DIRECT_DELTA).flat_map(|e| near((e as f64 - DIRECT_SIDE as f64) / t.d_scale)),
+            );
+            ds.extend([0.0, -0.0, f64::from_bits(1), -f64::from_bits(1)]);
             let mut pairs: Vec<(f64, f64)> = Vec::new();
             for &x in &ks {
                 pairs.push((x, h * (2.4 * rng.next_uniform() - 1.2)));
