@@ -40,6 +40,19 @@ pub trait UniformSource {
             self.next_uniform(),
         ]
     }
+
+    /// Four uniforms on `[0, 1)` for one rejection trial, each with **at least 32 random
+    /// bits**: `k · 2⁻³²` for a uniform integer `k < 2³²` (or finer). A generator
+    /// ([`rand::Rng`]) draws them from two 64-bit words `w₀, w₁` as their halves
+    /// `[hi(w₀), lo(w₀), hi(w₁), lo(w₁)] · 2⁻³²` — half the generator steps of
+    /// [`Self::next_uniform4`], another stream; the default is [`Self::next_uniform4`]
+    /// (caller-given sequences keep their values and their order). For consumers whose law
+    /// needs no finer grid than 2⁻³² (the exact BRDF sampler's leaf pick, point and accept
+    /// test, issue 29).
+    #[inline]
+    fn next_uniform4_split(&mut self) -> [f64; 4] {
+        self.next_uniform4()
+    }
 }
 
 /// 53 random mantissa bits of `bits`: uniform on `[0, 1)` with spacing 2⁻⁵³.
@@ -63,6 +76,23 @@ impl<R: Rng + ?Sized> UniformSource for R {
             unit_from_bits(self.next_u64()),
         ]
     }
+
+    #[inline]
+    fn next_uniform4_split(&mut self) -> [f64; 4] {
+        let (w0, w1) = (self.next_u64(), self.next_u64());
+        [
+            halves_unit(w0 >> 32),
+            halves_unit(w0 & 0xffff_ffff),
+            halves_unit(w1 >> 32),
+            halves_unit(w1 & 0xffff_ffff),
+        ]
+    }
+}
+
+/// `k · 2⁻³²` for `k < 2³²`: exact in `f64`.
+#[inline(always)]
+fn halves_unit(k: u64) -> f64 {
+    k as f64 * (1.0 / (1u64 << 32) as f64)
 }
 
 /// Uniform numbers read from a caller-given slice, in order.
@@ -144,5 +174,52 @@ pub struct AsDistribution<'a, S: ?Sized>(pub &'a S);
 impl<S: Sampler2D + ?Sized> rand::distr::Distribution<Sample2> for AsDistribution<'_, S> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> Sample2 {
         self.0.sample(rng)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{Rng, SeedableRng};
+
+    use super::{UniformSequence, UniformSource};
+
+    /// A generator's split trial is the halves of its next two words, high half first, and
+    /// advances the generator by exactly two words; every value is `k · 2⁻³²` in `[0, 1)`,
+    /// and over many draws each of the four positions has mean ½ and its low bits alive.
+    #[test]
+    fn a_generators_split_trial_is_the_halves_of_two_words() {
+        let mut a = Xoshiro256PlusPlus::seed_from_u64(11);
+        let mut b = a.clone();
+        let mut sums = [0.0; 4];
+        let mut low_bits = [0u64; 4];
+        let n = 20_000;
+        for _ in 0..n {
+            let us = a.next_uniform4_split();
+            let (w0, w1) = (b.next_u64(), b.next_u64());
+            let want = [w0 >> 32, w0 & 0xffff_ffff, w1 >> 32, w1 & 0xffff_ffff];
+            for j in 0..4 {
+                let k = us[j] * 4_294_967_296.0;
+                assert_eq!(k, want[j] as f64);
+                assert!((0.0..1.0).contains(&us[j]));
+                sums[j] += us[j];
+                low_bits[j] += want[j] & 1;
+            }
+        }
+        assert_eq!(a.next_u64(), b.next_u64());
+        for j in 0..4 {
+            assert!((sums[j] / f64::from(n) - 0.5).abs() < 0.01, "{sums:?}");
+            assert!(low_bits[j] > 9_000 && low_bits[j] < 11_000, "{low_bits:?}");
+        }
+    }
+
+    /// A caller-given sequence hands its own values, in order, to a split trial.
+    #[test]
+    fn a_sequences_split_trial_is_its_next_four_values() {
+        let v = [0.1, 0.2, 0.3, 0.4, 0.5];
+        let mut s = UniformSequence::new(&v);
+        assert_eq!(s.next_uniform4_split(), [0.1, 0.2, 0.3, 0.4]);
+        assert_eq!(s.next_uniform(), 0.5);
+        assert_eq!(s.consumed(), 5);
     }
 }

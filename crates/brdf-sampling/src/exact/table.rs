@@ -96,9 +96,12 @@ impl LeafTable {
     /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds
     /// (`g ≤ M_i` on leaf `i`; a trial above its bound is counted in `audit.violations`), and
     /// `g` there; `None` after [`MAX_TRIALS_PER_SAMPLE`] trials (counted as exhausted). Four
-    /// uniforms per trial, in one [`UniformSource::next_uniform4`] call: the leaf pick, the
-    /// point's two coordinates and the acceptance test. `g` is called inside the unit circle
-    /// only.
+    /// uniforms per trial, in one [`UniformSource::next_uniform4_split`] call (a generator's
+    /// two 64-bit words, 32 bits per uniform): the leaf pick, the point's two coordinates and
+    /// the acceptance test. The law is the envelope rejection's with uniforms on the grid
+    /// `k · 2⁻³²`: the pick `s = u₀ · n` (exact in `f64` for `n < 2²¹` leaves) gives each leaf
+    /// its alias probability to within `n · 2⁻³²` relative, the accept test `u₃ · M_i < g`
+    /// its probability `g / M_i` to within `2⁻³²`. `g` is called inside the unit circle only.
     #[inline]
     pub(super) fn draw<G, U>(&self, g: &G, u: &mut U, audit: &mut Audit) -> Option<(Point2, f64)>
     where
@@ -111,7 +114,7 @@ impl LeafTable {
                 audit.exhausted += 1;
                 break None;
             }
-            let us = u.next_uniform4();
+            let us = u.next_uniform4_split();
             trials += 1;
             let Some(([x, y], m)) = self.propose(us) else {
                 continue;
@@ -156,14 +159,33 @@ impl LeafTable {
 pub(super) mod walks {
     use super::*;
 
+    /// A generator whose every four-uniform call is its split trial: the tree's walk
+    /// ([`UniformSource::next_uniform4`]) and the table's
+    /// ([`UniformSource::next_uniform4_split`]) then read the same four values per trial.
+    struct Split<R>(R);
+
+    impl<R: rand::Rng> UniformSource for Split<R> {
+        fn next_uniform(&mut self) -> f64 {
+            self.0.next_uniform()
+        }
+        fn next_uniform4(&mut self) -> [f64; 4] {
+            self.0.next_uniform4_split()
+        }
+        fn next_uniform4_split(&mut self) -> [f64; 4] {
+            self.0.next_uniform4_split()
+        }
+    }
+
     /// Test support: every interval of `set` has a table, and its walk draws the very points of
-    /// the interval tree's own walk (same uniforms, same bits, same trial, violation and sample
-    /// counts) for two test densities, one below most leaves' bounds and one above many (the
-    /// violations counted alike). Returns the number of walks compared.
+    /// the interval tree's own walk given the same four uniforms per trial (same bits, same
+    /// trial, violation and sample counts, the streams in step) for two test densities, one
+    /// below most leaves' bounds and one above many (the violations counted alike); and from a
+    /// plain generator the table's walk consumes two 64-bit words per trial. Returns the number
+    /// of walks compared.
     pub(in crate::exact) fn assert_table_walks_match_trees(set: &super::super::ExactSet) -> usize {
         use partition_sampler::diagnostics::AuditedDraws;
-        use rand::SeedableRng;
         use rand::rngs::Xoshiro256PlusPlus;
+        use rand::{Rng, SeedableRng};
 
         let mut checked = 0;
         for cell in &set.cells {
@@ -178,8 +200,8 @@ pub(super) mod walks {
                 for scale in [0.06, 0.6] {
                     let g = |p: [f64; 2]| scale * m0 * (1.0 - 0.5 * p[0] * p[0]);
                     let (mut r1, mut r2) = (
-                        Xoshiro256PlusPlus::seed_from_u64(3),
-                        Xoshiro256PlusPlus::seed_from_u64(3),
+                        Split(Xoshiro256PlusPlus::seed_from_u64(3)),
+                        Split(Xoshiro256PlusPlus::seed_from_u64(3)),
                     );
                     let (mut a1, mut a2) = (Audit::default(), Audit::default());
                     for _ in 0..100 {
@@ -189,6 +211,18 @@ pub(super) mod walks {
                     }
                     assert_eq!(a1, a2);
                     assert_eq!(r1.next_uniform(), r2.next_uniform());
+                    // Two words per trial from a plain generator.
+                    let mut r3 = Xoshiro256PlusPlus::seed_from_u64(3);
+                    let mut a3 = Audit::default();
+                    for _ in 0..100 {
+                        table.draw(&g, &mut r3, &mut a3);
+                    }
+                    assert_eq!(a3, a2);
+                    let mut r4 = Xoshiro256PlusPlus::seed_from_u64(3);
+                    for _ in 0..2 * a3.trials {
+                        r4.next_u64();
+                    }
+                    assert_eq!(r3.next_u64(), r4.next_u64());
                     checked += 1;
                 }
             }
