@@ -53,9 +53,10 @@ fn main() {
     // The reference's own error (estimated from its halves), weights and pilot variances.
     let re = &render.reference_error;
     println!(
-        "reference: {:.1} s, own relative error {:.3} % (whole row)",
+        "reference: {:.1} s, own relative error {:.3} % (whole row); process CPU s (MIS part, pilots, product part): {:?}",
         render.reference.seconds,
-        100.0 * re.whole
+        100.0 * re.whole,
+        re.cpu_seconds
     );
     for (j, spec) in render.brdfs.iter().enumerate() {
         println!(

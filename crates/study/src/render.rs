@@ -130,6 +130,9 @@ pub struct ReferenceError {
     pub pilot_rel_var: Vec<(f64, f64)>,
     /// The whole row: `mean_p |d_p| / Y(R_p)` over every pixel with non-null luminance.
     pub whole: f64,
+    /// Process CPU seconds (all threads; a timing) of the MIS part, the pilots and the product
+    /// part (0 for a part not made); `None` where the platform has no process CPU clock.
+    pub cpu_seconds: Option<[f64; 3]>,
 }
 
 /// The MIS part's weight `w = V_K / (V_M + V_K)` (inverse-variance, the weights sum to 1) of the
@@ -909,8 +912,15 @@ impl StudyPlan {
             ),
             None => (cfg.reference_spp.max(2), 0),
         };
+        let cpu = crate::machine::process_cpu_seconds;
+        let mut cpu_parts = [0.0; 3];
+        let c0 = cpu();
         let m1 = ref_mis(mis_spp / 2, "reference");
         let m2 = ref_mis(mis_spp - mis_spp / 2, "reference half 2");
+        let c1 = cpu();
+        if let (Some(a), Some(b)) = (c0, c1) {
+            cpu_parts[0] = b - a;
+        }
         let (ref_rgb, ref_d, mis_weight, pilot_rel_var) = match product {
             Some((d, pyramid)) => {
                 let pm = [
@@ -933,6 +943,10 @@ impl StudyPlan {
                         )
                     })
                     .collect();
+                let c2 = cpu();
+                if let (Some(a), Some(b)) = (c1, c2) {
+                    cpu_parts[1] = b - a;
+                }
                 let k1 = ref_product(d, pyramid, product_spp / 2, "reference product 1");
                 let k2 = ref_product(
                     d,
@@ -940,6 +954,9 @@ impl StudyPlan {
                     product_spp - product_spp / 2,
                     "reference product 2",
                 );
+                if let (Some(a), Some(b)) = (c2, cpu()) {
+                    cpu_parts[2] = b - a;
+                }
                 let w: Vec<f64> = fitted.iter().map(|f| f.0).collect();
                 let (rgb, dd) = combine_reference([&m1, &m2], Some([&k1, &k2]), |p| {
                     let w = w[(p % width) / px];
@@ -965,6 +982,7 @@ impl StudyPlan {
             whole: reference_self_error(&ref_rgb, &ref_d, &all_pixels),
             mis_weight,
             pilot_rel_var,
+            cpu_seconds: c0.map(|_| cpu_parts),
         };
         progress(1);
         let reference = Image {
