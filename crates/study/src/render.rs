@@ -32,7 +32,12 @@
 //! reference BRDF sampler (`adaptive`, checked by the validation suite) and the light's own
 //! sampler (the `envmap-adaptive` registry sampler for maps, uniform directions in the cone of
 //! the area light; BRDF sampling alone under constant light), `reference_spp` samples of each
-//! per pixel.
+//! per pixel. With the adaptive product images (a map light, MIS images, `adaptive-exact`
+//! built), the reference is `w M + (1 − w) K`: `M` that MIS at `reference_spp / 4` pairs, `K`
+//! the adaptive product at `3/2 · reference_spp` samples (own seeds), `w` per sphere the
+//! inverse-relative-variance weight from independent pilot renders (so the reference stays
+//! unbiased). Each part is made as two independent halves, whose difference estimates the
+//! reference's own relative error ([`ReferenceError`], printed with the reference).
 //!
 //! **Error.** The papers' relative error: the mean over pixels with non-null reference
 //! luminance of `|Y(I) − Y(I_ref)| / Y(I_ref)`.
