@@ -2,7 +2,7 @@
 //! the `--quick` study's BRDFs (or those given) under one light, every registered preferred
 //! sampler, BRDF sampling alone and with MIS (each sampler with the light's own sampler), with
 //! the cost table (coherent vs random ωo, MIS), and the adaptive product images with the
-//! ranking of every estimator at equal time. docs/benchmarks.md §21, §23.8, §26.6.
+//! ranking of every estimator at equal time. docs/benchmarks.md §21, §23.8, §26.6, §26.7 (the reference).
 //!
 //! ```text
 //! cargo run --release -p study --example sphere_costs -- LIGHT [PX] [SPP] [BRDF ...]
@@ -50,6 +50,23 @@ fn main() {
         std::process::exit(1);
     });
     println!("{}", render.markdown(&[]));
+    // The reference's own error (estimated from its halves), weights and pilot variances.
+    let re = &render.reference_error;
+    println!(
+        "reference: {:.1} s, own relative error {:.3} % (whole row); process CPU s (MIS part, pilots, product part): {:?}",
+        render.reference.seconds,
+        100.0 * re.whole,
+        re.cpu_seconds
+    );
+    for (j, spec) in render.brdfs.iter().enumerate() {
+        println!(
+            "  reference on `{spec}`: own error {:.3} %, MIS weight {:.4}, pilot relative variance per sample MIS {:.4} / product {:.4}",
+            100.0 * re.per_sphere[j],
+            re.mis_weight[j],
+            re.pilot_rel_var[j].0,
+            re.pilot_rel_var[j].1
+        );
+    }
     // Per sphere: each sampler's relative error at equal time, best first, BRDF sampling alone
     // and with MIS.
     for kind in ["equal time", "MIS equal time"] {

@@ -32,7 +32,12 @@
 //! reference BRDF sampler (`adaptive`, checked by the validation suite) and the light's own
 //! sampler (the `envmap-adaptive` registry sampler for maps, uniform directions in the cone of
 //! the area light; BRDF sampling alone under constant light), `reference_spp` samples of each
-//! per pixel.
+//! per pixel. With the adaptive product images (a map light, MIS images, `adaptive-exact`
+//! built), the reference is `w M + (1 − w) K`: `M` that MIS at `reference_spp / 4` pairs, `K`
+//! the adaptive product at `3/2 · reference_spp` samples (own seeds), `w` per sphere the
+//! inverse-relative-variance weight from independent pilot renders (so the reference stays
+//! unbiased). Each part is made as two independent halves, whose difference estimates the
+//! reference's own relative error ([`ReferenceError`], printed with the reference).
 //!
 //! **Error.** The papers' relative error: the mean over pixels with non-null reference
 //! luminance of `|Y(I) − Y(I_ref)| / Y(I_ref)`.
@@ -99,6 +104,131 @@ pub const PRODUCT_NAME: &str = "adaptive-product";
 
 /// The defensive BRDF sampler of the adaptive product images.
 pub const PRODUCT_DEFENSIVE: &str = "adaptive-exact";
+
+/// Samples per pixel of each pilot render that fixes the reference's weights (two independent
+/// pilots per part, seeds of their own).
+pub(crate) const REFERENCE_PILOT_SPP: usize = 16;
+
+/// With product images, the reference's MIS part gets `reference_spp / REFERENCE_MIS_DIVISOR`
+/// pairs per pixel and its adaptive product part `reference_spp · 3/2` samples (about the time
+/// of `reference_spp` MIS pairs alone: docs/benchmarks.md §26.7).
+pub(crate) const REFERENCE_MIS_DIVISOR: usize = 4;
+
+/// The reference's own error, estimated from its samples. Each part of the reference is the
+/// mean of two independent half renders `h₁, h₂` (own seeds); the reference per pixel is
+/// `R_p = w M_p + (1 − w) K_p` (`M` the MIS part, `K` the adaptive product part, `w` fixed per
+/// sphere from independent pilot renders, so `w` does not depend on the parts' samples and
+/// `R_p` is unbiased). `d_p = w (M₁ − M₂)/2 + (1 − w)(K₁ − K₂)/2` (luminance) has the variance of
+/// `R_p` and mean 0, so for a normal `R_p` the expected relative error
+/// `E|R_p − μ_p| / μ_p = √(2/π) sd_p / μ_p` is estimated by `|d_p| / Y(R_p)`; the figures are
+/// its mean over the pixels with non-null reference luminance (the images' error metric).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceError {
+    /// Per sphere, left to right: the MIS part's weight `w` (the product part's is `1 − w`;
+    /// 1 without a product part).
+    pub mis_weight: Vec<f64>,
+    /// Per sphere: the estimated mean relative error of the reference, `mean_p |d_p| / Y(R_p)`.
+    pub per_sphere: Vec<f64>,
+    /// Per sphere: the pilots' relative variance per sample of the MIS part (per pair) and of
+    /// the product part (per sample; 0 without one), `mean_p Var_p / Ŷ_p² · n` over the sphere's
+    /// pixels, `Ŷ_p` the pilots' mean luminance: what the weights are made of.
+    pub pilot_rel_var: Vec<(f64, f64)>,
+    /// The whole row: `mean_p |d_p| / Y(R_p)` over every pixel with non-null luminance.
+    pub whole: f64,
+    /// Process CPU seconds (all threads; a timing) of the MIS part, the pilots and the product
+    /// part (0 for a part not made); `None` where the platform has no process CPU clock.
+    pub cpu_seconds: Option<[f64; 3]>,
+}
+
+/// The MIS part's weight `w = V_K / (V_M + V_K)` (inverse-variance, the weights sum to 1) of the
+/// pixels `idx`, from two independent pilot renders of each part at `pilot_spp`:
+/// `V_X = mean_p (Y(X₁) − Y(X₂))_p² / (2 Ŷ_p²) · pilot_spp / n_X`, the mean relative variance of
+/// part `X` at its `n_X` samples per pixel (`Ŷ_p` the mean luminance of the four pilots; pixels with
+/// `Ŷ_p = 0` skipped). Also returns the per-sample relative variances `(V_M n_M, V_K n_K)`.
+/// 1 (MIS alone) when the product's variance is not a finite number or both are 0.
+fn reference_mis_weight(
+    mis: [&[[f64; 3]]; 2],
+    product: [&[[f64; 3]]; 2],
+    idx: &[usize],
+    pilot_spp: usize,
+    n_mis: usize,
+    n_product: usize,
+) -> (f64, f64, f64) {
+    let y = |v: &[[f64; 3]], p: usize| colour::luminance(v[p]);
+    let (mut vm, mut vk, mut count) = (0.0, 0.0, 0usize);
+    for &p in idx {
+        let mean = (y(mis[0], p) + y(mis[1], p) + y(product[0], p) + y(product[1], p)) / 4.0;
+        if mean > 0.0 {
+            vm += (y(mis[0], p) - y(mis[1], p)).powi(2) / (2.0 * mean * mean);
+            vk += (y(product[0], p) - y(product[1], p)).powi(2) / (2.0 * mean * mean);
+            count += 1;
+        }
+    }
+    let scale = pilot_spp as f64 / count.max(1) as f64;
+    let (per_m, per_k) = (vm * scale, vk * scale);
+    let (vm, vk) = (per_m / n_mis.max(1) as f64, per_k / n_product.max(1) as f64);
+    let w = vk / (vm + vk);
+    if w.is_finite() {
+        (w.clamp(0.0, 1.0), per_m, per_k)
+    } else {
+        (1.0, per_m, per_k)
+    }
+}
+
+/// The reference from the parts' halves: per pixel `R = w_M M + w_K K`, `M = (M₁ + M₂)/2`,
+/// `K = (K₁ + K₂)/2` (`K` absent: `R = M`), `(w_M, w_K) = weights(pixel)` (the render passes
+/// `(w, 1 − w)`: unbiased); and per pixel the luminance
+/// `d_p = w_M (M₁ − M₂)/2 + w_K (K₁ − K₂)/2` of [`ReferenceError`].
+fn combine_reference(
+    mis: [&[[f64; 3]]; 2],
+    product: Option<[&[[f64; 3]]; 2]>,
+    weights: impl Fn(usize) -> (f64, f64),
+) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let n = mis[0].len();
+    let mut rgb = vec![[0.0; 3]; n];
+    let mut d = vec![0.0; n];
+    for p in 0..n {
+        let (w, wk) = weights(p);
+        let half = |a: [f64; 3], b: [f64; 3]| {
+            (
+                [
+                    (a[0] + b[0]) / 2.0,
+                    (a[1] + b[1]) / 2.0,
+                    (a[2] + b[2]) / 2.0,
+                ],
+                (colour::luminance(a) - colour::luminance(b)) / 2.0,
+            )
+        };
+        let (m, dm) = half(mis[0][p], mis[1][p]);
+        match product {
+            Some(k) => {
+                let (k, dk) = half(k[0][p], k[1][p]);
+                for c in 0..3 {
+                    rgb[p][c] = w * m[c] + wk * k[c];
+                }
+                d[p] = w * dm + wk * dk;
+            }
+            None => {
+                rgb[p] = m;
+                d[p] = dm;
+            }
+        }
+    }
+    (rgb, d)
+}
+
+/// `mean_p |d_p| / Y(R_p)` over the pixels `idx` with `Y(R_p) > 0` (0 when there are none).
+fn reference_self_error(rgb: &[[f64; 3]], d: &[f64], idx: &[usize]) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for &p in idx {
+        let y = colour::luminance(rgb[p]);
+        if y > 0.0 {
+            sum += d[p].abs() / y;
+            count += 1;
+        }
+    }
+    if count == 0 { 0.0 } else { sum / count as f64 }
+}
 
 /// Samples (or MIS pairs) per pixel at equal time: `spp × budget_ns / ns` rounded, at least 1
 /// (`budget_ns` the time per sample of the budget's sampler at `spp`, `ns` this sampler's time
@@ -362,6 +492,8 @@ pub struct Render {
     pub reference_method: String,
     /// The reference.
     pub reference: Image,
+    /// The reference's own error, estimated from its samples, and its weights.
+    pub reference_error: ReferenceError,
     /// One equal-samples and one equal-time image per sampler that could be built, each
     /// followed by its two MIS images when there are MIS images.
     pub images: Vec<Image>,
@@ -711,39 +843,6 @@ impl StudyPlan {
         };
         let light_sampler = LightSampler::new(light)?;
         let segments = segments(&hits, width);
-        let start = Instant::now();
-        let ref_rgb = render_segments(
-            &hits,
-            &segments,
-            width * height,
-            |seg, rng| {
-                let sphere = seg[0].sphere;
-                mis_row(
-                    brdfs[sphere],
-                    light,
-                    seg,
-                    reference_samplers[sphere].as_ref(),
-                    &light_sampler,
-                    cfg.reference_spp,
-                    rng,
-                )
-            },
-            cfg.seed ^ name_hash("reference"),
-        );
-        progress(1);
-        let reference = Image {
-            sampler: "reference".into(),
-            kind: "reference".into(),
-            spp: cfg.reference_spp,
-            width,
-            height,
-            rgb: ref_rgb,
-            rel_error: None,
-            seconds: start.elapsed().as_secs_f64(),
-        };
-        // Time per pixel sample, one thread, on every 11th row segment: median of
-        // `TIMING_REPEATS` interleaved runs, coherent (the render's path) and random ωo, and
-        // MIS (coherent) when there are MIS images.
         let mis_light = match (&light_sampler, cfg.mis) {
             (LightSampler::None, _) | (_, false) => None,
             (l, true) => Some(l),
@@ -767,6 +866,143 @@ impl StudyPlan {
                 .position(|&s| self.entries[s].name == PRODUCT_DEFENSIVE)
                 .map(|d| (d, p))
         });
+        // The reference (see `ReferenceError`): each part as two independent halves; with the
+        // product, weights per sphere from independent pilots.
+        let start = Instant::now();
+        let ref_mis = |spp: usize, tag: &str| {
+            render_segments(
+                &hits,
+                &segments,
+                width * height,
+                |seg, rng| {
+                    let sphere = seg[0].sphere;
+                    mis_row(
+                        brdfs[sphere],
+                        light,
+                        seg,
+                        reference_samplers[sphere].as_ref(),
+                        &light_sampler,
+                        spp,
+                        rng,
+                    )
+                },
+                cfg.seed ^ name_hash(tag),
+            )
+        };
+        let ref_product = |d: usize, pyramid: &PowerPyramid, spp: usize, tag: &str| {
+            let s = timed[d];
+            render_segments(
+                &hits,
+                &segments,
+                width * height,
+                |seg, rng| {
+                    let sphere = seg[0].sphere;
+                    match built[s][sphere].as_deref() {
+                        None => vec![[0.0; 3]; seg.len()],
+                        Some(smp) => product_row(brdfs[sphere], light, seg, smp, pyramid, spp, rng),
+                    }
+                },
+                cfg.seed ^ name_hash(tag),
+            )
+        };
+        let sphere_pixels = |j: usize| -> Vec<usize> {
+            (0..width * height)
+                .filter(|p| (p % width) / px == j)
+                .collect()
+        };
+        let (mis_spp, product_spp) = match product {
+            Some(_) => (
+                (cfg.reference_spp / REFERENCE_MIS_DIVISOR).max(2),
+                (cfg.reference_spp * 3 / 2).max(2),
+            ),
+            None => (cfg.reference_spp.max(2), 0),
+        };
+        let cpu = crate::machine::process_cpu_seconds;
+        let mut cpu_parts = [0.0; 3];
+        let c0 = cpu();
+        let m1 = ref_mis(mis_spp / 2, "reference");
+        let m2 = ref_mis(mis_spp - mis_spp / 2, "reference half 2");
+        let c1 = cpu();
+        if let (Some(a), Some(b)) = (c0, c1) {
+            cpu_parts[0] = b - a;
+        }
+        let (ref_rgb, ref_d, mis_weight, pilot_rel_var) = match product {
+            Some((d, pyramid)) => {
+                let pm = [
+                    ref_mis(REFERENCE_PILOT_SPP, "reference pilot mis 1"),
+                    ref_mis(REFERENCE_PILOT_SPP, "reference pilot mis 2"),
+                ];
+                let pk = [
+                    ref_product(d, pyramid, REFERENCE_PILOT_SPP, "reference pilot product 1"),
+                    ref_product(d, pyramid, REFERENCE_PILOT_SPP, "reference pilot product 2"),
+                ];
+                let fitted: Vec<(f64, f64, f64)> = (0..chosen.len())
+                    .map(|j| {
+                        reference_mis_weight(
+                            [&pm[0], &pm[1]],
+                            [&pk[0], &pk[1]],
+                            &sphere_pixels(j),
+                            REFERENCE_PILOT_SPP,
+                            mis_spp,
+                            product_spp,
+                        )
+                    })
+                    .collect();
+                let c2 = cpu();
+                if let (Some(a), Some(b)) = (c1, c2) {
+                    cpu_parts[1] = b - a;
+                }
+                let k1 = ref_product(d, pyramid, product_spp / 2, "reference product 1");
+                let k2 = ref_product(
+                    d,
+                    pyramid,
+                    product_spp - product_spp / 2,
+                    "reference product 2",
+                );
+                if let (Some(a), Some(b)) = (c2, cpu()) {
+                    cpu_parts[2] = b - a;
+                }
+                let w: Vec<f64> = fitted.iter().map(|f| f.0).collect();
+                let (rgb, dd) = combine_reference([&m1, &m2], Some([&k1, &k2]), |p| {
+                    let w = w[(p % width) / px];
+                    (w, 1.0 - w)
+                });
+                (rgb, dd, w, fitted.iter().map(|f| (f.1, f.2)).collect())
+            }
+            None => {
+                let (rgb, dd) = combine_reference([&m1, &m2], None, |_| (1.0, 0.0));
+                (
+                    rgb,
+                    dd,
+                    vec![1.0; chosen.len()],
+                    vec![(0.0, 0.0); chosen.len()],
+                )
+            }
+        };
+        let all_pixels: Vec<usize> = (0..width * height).collect();
+        let reference_error = ReferenceError {
+            per_sphere: (0..chosen.len())
+                .map(|j| reference_self_error(&ref_rgb, &ref_d, &sphere_pixels(j)))
+                .collect(),
+            whole: reference_self_error(&ref_rgb, &ref_d, &all_pixels),
+            mis_weight,
+            pilot_rel_var,
+            cpu_seconds: c0.map(|_| cpu_parts),
+        };
+        progress(1);
+        let reference = Image {
+            sampler: "reference".into(),
+            kind: "reference".into(),
+            spp: cfg.reference_spp,
+            width,
+            height,
+            rgb: ref_rgb,
+            rel_error: None,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        // Time per pixel sample, one thread, on every 11th row segment: median of
+        // `TIMING_REPEATS` interleaved runs, coherent (the render's path) and random ωo, and
+        // MIS (coherent) when there are MIS images.
         let (timed_costs, product_cost) = sample_costs(
             &hits,
             &segments,
@@ -896,11 +1132,23 @@ impl StudyPlan {
             config: cfg.clone(),
             light: self.config.lights[cfg.light].clone(),
             brdfs: chosen.iter().map(|&b| self.brdfs[b].spec.clone()).collect(),
-            reference_method: format!(
-                "MIS (balance heuristic) of the adaptive BRDF sampler and {light_method}, {} samples of each per pixel",
-                cfg.reference_spp
-            ),
+            reference_method: if product_spp > 0 {
+                format!(
+                    "w × MIS (balance heuristic) of the adaptive BRDF sampler and {light_method} at {mis_spp} samples of each per pixel + (1 − w) × the adaptive product at {product_spp} samples per pixel (own seeds), w per sphere from independent pilots at {REFERENCE_PILOT_SPP} spp (inverse relative variance): {}",
+                    reference_error
+                        .mis_weight
+                        .iter()
+                        .map(|w| format!("{w:.3}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            } else {
+                format!(
+                    "MIS (balance heuristic) of the adaptive BRDF sampler and {light_method}, {mis_spp} samples of each per pixel"
+                )
+            },
             reference,
+            reference_error,
             images,
             ns_per_sample: ns_per_sample
                 .iter()
@@ -1549,7 +1797,7 @@ impl Render {
         let mut s = String::from("## Sphere images\n\n");
         let _ = writeln!(
             s,
-            "Spheres, left to right: {}; under `{}`; {}×{} pixels per sphere, orthographic camera, direct lighting, no shadows. Reference: {} ({:.1} s †). Relative error = mean over pixels with non-null reference luminance of |Y − Y_ref| / Y_ref. Equal time: samples per pixel scaled by the measured time per sample (†) to the `adaptive` sampler's budget of {} spp.\n",
+            "Spheres, left to right: {}; under `{}`; {}×{} pixels per sphere, orthographic camera, direct lighting, no shadows. Reference: {} ({:.1} s †); its own relative error, estimated from its two independent halves (mean over pixels of |d_p| / Y_ref, see `ReferenceError`), {:.2} % (per sphere: {}). Relative error = mean over pixels with non-null reference luminance of |Y − Y_ref| / Y_ref. Equal time: samples per pixel scaled by the measured time per sample (†) to the `adaptive` sampler's budget of {} spp.\n",
             self.brdfs
                 .iter()
                 .map(|b| format!("`{}`", crate::names::short_brdf(b)))
@@ -1560,6 +1808,13 @@ impl Render {
             self.config.sphere_px,
             self.reference_method,
             self.reference.seconds,
+            100.0 * self.reference_error.whole,
+            self.reference_error
+                .per_sphere
+                .iter()
+                .map(|e| format!("{:.2} %", 100.0 * e))
+                .collect::<Vec<_>>()
+                .join(", "),
             self.config.spp,
         );
         s.push_str("| sampler | ns / sample † | spp (equal samples) | rel. error | spp (equal time †) | rel. error |\n|---|---|---|---|---|---|\n");
@@ -2522,6 +2777,126 @@ mod tests {
         let (x, k) = chi2(&render(&pyramid, true), &one);
         eprintln!("reversed product rows: Σz² = {x:.1}");
         assert!(x > limit(k), "reversed rows not caught: Σz² = {x:.1}");
+    }
+
+    /// The reference's error estimate ([`ReferenceError`]: `|d_p| / Y(R_p)` from the parts'
+    /// independent halves) against its actual error over `K` = 40 independent references of a
+    /// small scene (`lambert`, `phong:n=20`, 10 px, a 64 × 32 procedural sky; `adaptive-exact`
+    /// for the MIS part and as the product's defensive sampler; MIS 8 + 8 pairs, product 8 + 8
+    /// samples, weights per sphere from pilots at 16 spp, as the render makes it), the truth an
+    /// independent product render at 16 384 spp: the mean estimate over the mean actual error
+    /// `mean_p |Y(R_p) − Y_true,p| / Y_true,p` within [0.85, 1.15] (docs/benchmarks.md §26.7 gives
+    /// the measured ratio). Broken: weights summing to 1.1 (`w_K = 1.1 − w`: a biased reference,
+    /// its estimate blind to the bias) and halves drawn with one seed (not independent: `d = 0`)
+    /// fail.
+    #[test]
+    fn the_reference_error_estimate_matches_its_error_over_independent_references() {
+        let map = envmap::procedural_sky(64, 32).unwrap();
+        let light = Light::Map {
+            map: map.clone(),
+            label: "sky".into(),
+        };
+        let (brdfs, built) = lambert_and_phong_built("adaptive-exact", false);
+        let light_sampler = LightSampler::new(&light).unwrap();
+        let pyramid = PowerPyramid::new(&map);
+        let px = 10;
+        let width = 2 * px;
+        let hs = hits(2, px);
+        let segs = segments(&hs, width);
+        let pixels = width * px;
+        let mis = |spp: usize, seed: u64| {
+            render_segments(
+                &hs,
+                &segs,
+                pixels,
+                |seg, rng| {
+                    let b = seg[0].sphere;
+                    let (brdf, smp) = (brdfs[b].as_ref(), built[b].as_ref());
+                    mis_row(brdf, &light, seg, smp, &light_sampler, spp, rng)
+                },
+                seed,
+            )
+        };
+        let product = |spp: usize, seed: u64| {
+            render_segments(
+                &hs,
+                &segs,
+                pixels,
+                |seg, rng| {
+                    let b = seg[0].sphere;
+                    let (brdf, smp) = (brdfs[b].as_ref(), built[b].as_ref());
+                    product_row(brdf, &light, seg, smp, &pyramid, spp, rng)
+                },
+                seed,
+            )
+        };
+        let sphere_pixels =
+            |j: usize| -> Vec<usize> { (0..pixels).filter(|p| (p % width) / px == j).collect() };
+        let truth = product(16384, 99);
+        let idx: Vec<usize> = (0..pixels)
+            .filter(|&p| colour::luminance(truth[p]) > 0.0)
+            .collect();
+        assert!(idx.len() > 100, "{} lit pixels", idx.len());
+        // 0: as rendered; 1: weights summing to 1.1; 2: halves of one seed.
+        let reference = |seed: u64, variant: u8| -> (f64, f64) {
+            let s = 1000 * seed;
+            let pm = [mis(16, s + 1), mis(16, s + 2)];
+            let pk = [product(16, s + 3), product(16, s + 4)];
+            let w: Vec<f64> = (0..2)
+                .map(|j| {
+                    reference_mis_weight(
+                        [&pm[0], &pm[1]],
+                        [&pk[0], &pk[1]],
+                        &sphere_pixels(j),
+                        16,
+                        16,
+                        16,
+                    )
+                    .0
+                })
+                .collect();
+            let second = if variant == 2 { 0 } else { 10 };
+            let (m1, m2) = (mis(8, s + 5), mis(8, s + 5 + second));
+            let (k1, k2) = (product(8, s + 6), product(8, s + 6 + second));
+            let (rgb, d) = combine_reference([&m1, &m2], Some([&k1, &k2]), |p| {
+                let w = w[(p % width) / px];
+                (w, if variant == 1 { 1.1 - w } else { 1.0 - w })
+            });
+            let actual = idx
+                .iter()
+                .map(|&p| {
+                    let t = colour::luminance(truth[p]);
+                    (colour::luminance(rgb[p]) - t).abs() / t
+                })
+                .sum::<f64>()
+                / idx.len() as f64;
+            (reference_self_error(&rgb, &d, &idx), actual)
+        };
+        let k = 40;
+        let ratio = |variant: u8| {
+            let (mut est, mut act) = (0.0, 0.0);
+            for seed in 0..k {
+                let (e, a) = reference(seed, variant);
+                est += e;
+                act += a;
+            }
+            let r = est / act;
+            eprintln!(
+                "variant {variant}: estimated {:.5}, actual {:.5} (ratio {r:.3})",
+                est / k as f64,
+                act / k as f64
+            );
+            r
+        };
+        let r = ratio(0);
+        assert!((0.85..=1.15).contains(&r), "estimate / actual = {r:.3}");
+        for broken in [1, 2] {
+            let r = ratio(broken);
+            assert!(
+                !(0.85..=1.15).contains(&r),
+                "broken {broken} not caught: estimate / actual = {r:.3}"
+            );
+        }
     }
 
     /// Equal time with a per-pixel setup: `(spp · budget − setup) / per_sample`, at least 1.
