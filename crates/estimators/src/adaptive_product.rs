@@ -528,6 +528,49 @@ mod tests {
         EnvMap::new(w, h, rgb).unwrap()
     }
 
+    /// The measurements' map: env `PRODUCT_MAP`, by default the Grace probe of the team's data
+    /// directory beside the repository (`../shared/data/envmaps`; not in a user's clone).
+    fn measurement_map() -> EnvMap {
+        let path = std::env::var("PRODUCT_MAP").unwrap_or_else(|_| {
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../../shared/data/envmaps/grace_probe_latlong.hdr"
+            )
+            .into()
+        });
+        EnvMap::load(std::path::Path::new(&path))
+            .unwrap_or_else(|e| panic!("measurement map {path}: {e} (set PRODUCT_MAP)"))
+    }
+
+    /// The measurements' fixed setup: [`measurement_map`], the sphere images' glossy Phong, its
+    /// power pyramid, the map's adaptive sampler and `adaptive-exact`.
+    fn phong_on_the_map() -> (
+        EnvMap,
+        std::sync::Arc<dyn Brdf>,
+        PowerPyramid,
+        envmap::EnvMapSampler,
+        std::sync::Arc<dyn DirectionSampler>,
+    ) {
+        let map = measurement_map();
+        let brdf: std::sync::Arc<dyn Brdf> =
+            std::sync::Arc::from(brdf::parse_spec("phong:n=50,ks=0.7,kd=0.3").unwrap());
+        let pyr = PowerPyramid::new(&map);
+        let light = envmap::EnvMapSampler::new(
+            &map,
+            envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
+        )
+        .unwrap();
+        let sampler = samplers::find("adaptive-exact")
+            .unwrap()
+            .build_direction(&samplers::DirectionRequest::new(
+                std::sync::Arc::clone(&brdf),
+                &brdf_sampling::SetOptions::default(),
+            ))
+            .unwrap()
+            .sampler;
+        (map, brdf, pyr, light, sampler)
+    }
+
     fn options() -> ProductOptions {
         ProductOptions {
             base_cells: 16,
@@ -756,9 +799,7 @@ mod tests {
         use baselines::srbf::fit_envmap;
         use baselines::{SrbfOptions, SrbfSampler};
         use std::time::Instant;
-        let path = std::env::var("PRODUCT_MAP")
-            .unwrap_or_else(|_| "/work/shared/data/envmaps/grace_probe_latlong.hdr".into());
-        let map = EnvMap::load(std::path::Path::new(&path)).unwrap();
+        let map = measurement_map();
         let spec =
             std::env::var("PRODUCT_BRDF").unwrap_or_else(|_| "phong:n=50,ks=0.7,kd=0.3".into());
         let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(&spec).unwrap());
@@ -866,9 +907,7 @@ mod tests {
     #[ignore = "a measurement (about a minute): docs/benchmarks.md §26.6"]
     fn product_options_sweep() {
         use std::time::Instant;
-        let path = std::env::var("PRODUCT_MAP")
-            .unwrap_or_else(|_| "/work/shared/data/envmaps/grace_probe_latlong.hdr".into());
-        let map = EnvMap::load(std::path::Path::new(&path)).unwrap();
+        let map = measurement_map();
         let spec =
             std::env::var("PRODUCT_BRDF").unwrap_or_else(|_| "phong:n=50,ks=0.7,kd=0.3".into());
         let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(&spec).unwrap());
@@ -983,26 +1022,7 @@ mod tests {
         };
         let (points, spp) = (env("H12_POINTS", 100), env("H12_SPP", 8));
         let work = std::env::var("H12_WORK").unwrap_or_else(|_| "product".into());
-        let map = EnvMap::load(std::path::Path::new(
-            "/work/shared/data/envmaps/grace_probe_latlong.hdr",
-        ))
-        .unwrap();
-        let brdf: std::sync::Arc<dyn Brdf> =
-            std::sync::Arc::from(brdf::parse_spec("phong:n=50,ks=0.7,kd=0.3").unwrap());
-        let pyr = PowerPyramid::new(&map);
-        let light = envmap::EnvMapSampler::new(
-            &map,
-            envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
-        )
-        .unwrap();
-        let sampler = samplers::find("adaptive-exact")
-            .unwrap()
-            .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
-                &brdf_sampling::SetOptions::default(),
-            ))
-            .unwrap()
-            .sampler;
+        let (map, brdf, pyr, light, sampler) = phong_on_the_map();
         let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
         let mut sum = 0.0;
@@ -1060,26 +1080,7 @@ mod tests {
     #[test]
     #[ignore = "a measurement (about a minute): docs/benchmarks.md §26.6"]
     fn product_8_against_mis_25_per_pixel() {
-        let map = EnvMap::load(std::path::Path::new(
-            "/work/shared/data/envmaps/grace_probe_latlong.hdr",
-        ))
-        .unwrap();
-        let brdf: std::sync::Arc<dyn Brdf> =
-            std::sync::Arc::from(brdf::parse_spec("phong:n=50,ks=0.7,kd=0.3").unwrap());
-        let pyr = PowerPyramid::new(&map);
-        let light = envmap::EnvMapSampler::new(
-            &map,
-            envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
-        )
-        .unwrap();
-        let sampler = samplers::find("adaptive-exact")
-            .unwrap()
-            .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
-                &brdf_sampling::SetOptions::default(),
-            ))
-            .unwrap()
-            .sampler;
+        let (map, brdf, pyr, light, sampler) = phong_on_the_map();
         let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
         let reps = 100;
         let (mut sp, mut sm) = (Vec::new(), Vec::new());
