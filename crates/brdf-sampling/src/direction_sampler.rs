@@ -15,6 +15,15 @@ pub struct DirSample {
     pub pdf: f64,
 }
 
+impl DirSample {
+    /// The sample that contributes nothing (no direction for this `ωo`): `ωi` = the normal,
+    /// pdf 0.
+    pub const NONE: Self = Self {
+        wi: Vec3::new(0.0, 0.0, 1.0),
+        pdf: 0.0,
+    };
+}
+
 /// One sampled incident direction with the BRDF value the estimator `f cos θi / pdf` needs: the
 /// result of [`DirectionSampler::sample_eval`] (Mitsuba's `eval_pdf_sample`).
 #[derive(Debug, Clone, Copy, PartialEq)]

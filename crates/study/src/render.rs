@@ -1740,9 +1740,9 @@ impl Render {
     /// "An adaptive sampler significantly lowest at equal time: BRDF only on k of n spheres
     /// (t tied); with MIS on …".
     pub fn goal_summary(&self) -> String {
-        let count = |kind: &str| {
-            let v: Vec<AdaptiveVerdict> = self
-                .sphere_ranking(kind)
+        // (lowest, tied, spheres) of the per-sphere rankings.
+        let tally = |rankings: &[(String, Vec<SphereError>)]| {
+            let v: Vec<AdaptiveVerdict> = rankings
                 .iter()
                 .filter(|(_, r)| !r.is_empty())
                 .map(|(_, r)| AdaptiveVerdict::of(r))
@@ -1757,6 +1757,7 @@ impl Render {
                 .count();
             (lowest, tied, v.len())
         };
+        let count = |kind: &str| tally(&self.sphere_ranking(kind));
         let (l, t, n) = count(IMAGE_KINDS[1]);
         let mut s = format!(
             "An adaptive sampler significantly lowest at equal time (95 %, Šidák over the comparisons with the best): BRDF only on {l} of {n} spheres ({t} tied)"
@@ -1766,23 +1767,9 @@ impl Render {
             s.push_str(&format!("; with MIS on {l} of {n} ({t} tied)"));
         }
         if self.images.iter().any(|i| i.kind == PRODUCT_KINDS[1]) {
-            let v: Vec<AdaptiveVerdict> = self
-                .sphere_ranking_all()
-                .iter()
-                .filter(|(_, r)| !r.is_empty())
-                .map(|(_, r)| AdaptiveVerdict::of(r))
-                .collect();
-            let l = v
-                .iter()
-                .filter(|x| matches!(x, AdaptiveVerdict::Lowest(_)))
-                .count();
-            let t = v
-                .iter()
-                .filter(|x| matches!(x, AdaptiveVerdict::Tied { .. }))
-                .count();
+            let (l, t, n) = tally(&self.sphere_ranking_all());
             s.push_str(&format!(
-                "; over every estimator (BRDF only, MIS, adaptive product) on {l} of {} ({t} tied)",
-                v.len()
+                "; over every estimator (BRDF only, MIS, adaptive product) on {l} of {n} ({t} tied)"
             ));
         }
         s.push('.');

@@ -427,13 +427,7 @@ impl ExactSet {
                 let emit = |i: usize, d: Option<Drawn>| {
                     let (s, f) = match d {
                         Some((_, v, gx)) => accepted_at(rec.map, &at.turn, v, gx, at.a),
-                        None => (
-                            DirSample {
-                                wi: Vec3::new(0.0, 0.0, 1.0),
-                                pdf: 0.0,
-                            },
-                            f64::NAN,
-                        ),
+                        None => (DirSample::NONE, f64::NAN),
                     };
                     out[run[i]] = self.finish_iso(brdf, at.wo, s, f);
                 };
@@ -480,13 +474,7 @@ impl ExactSet {
             };
             let (s, f) = match drawn {
                 Some((x, gx)) => accepted(rec.map, &at.turn, x, gx, at.a),
-                None => (
-                    DirSample {
-                        wi: Vec3::new(0.0, 0.0, 1.0),
-                        pdf: 0.0,
-                    },
-                    f64::NAN,
-                ),
+                None => (DirSample::NONE, f64::NAN),
             };
             out[k] = self.finish_iso(brdf, at.wo, s, f);
         }
@@ -524,15 +512,7 @@ impl ExactSet {
                             let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
                             self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
                         }
-                        None => self.finish(
-                            brdf,
-                            wo,
-                            DirSample {
-                                wi: Vec3::new(0.0, 0.0, 1.0),
-                                pdf: 0.0,
-                            },
-                            None,
-                        ),
+                        None => self.finish(brdf, wo, DirSample::NONE, None),
                     };
                 };
                 wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
@@ -554,15 +534,7 @@ impl ExactSet {
                     let (s, f) = accepted(iv.map, &q.turn, x, gx, a);
                     self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
                 }
-                None => self.finish(
-                    brdf,
-                    wo,
-                    DirSample {
-                        wi: Vec3::new(0.0, 0.0, 1.0),
-                        pdf: 0.0,
-                    },
-                    None,
-                ),
+                None => self.finish(brdf, wo, DirSample::NONE, None),
             };
         }
     }

@@ -82,10 +82,7 @@ impl ExactSet {
             }
         };
         let Some((x, gx)) = drawn else {
-            let none = DirSample {
-                wi: Vec3::new(0.0, 0.0, 1.0),
-                pdf: 0.0,
-            };
+            let none = DirSample::NONE;
             return (none, f64::NAN);
         };
         accepted(rec.map, &turn, x, gx, a)

@@ -194,13 +194,7 @@ impl ExactSet {
                 let served = q.wo == *wo;
                 (s, (served && f.is_finite()).then_some(f))
             }
-            None => (
-                DirSample {
-                    wi: Vec3::new(0.0, 0.0, 1.0),
-                    pdf: 0.0,
-                },
-                None,
-            ),
+            None => (DirSample::NONE, None),
         }
     }
 

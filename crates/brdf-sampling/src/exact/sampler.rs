@@ -23,10 +23,7 @@ impl DirectionSampler for ExactSet {
                 self.counters.record(&a);
                 s
             }
-            None => DirSample {
-                wi: Vec3::new(0.0, 0.0, 1.0),
-                pdf: 0.0,
-            },
+            None => DirSample::NONE,
         }
     }
 
