@@ -593,6 +593,24 @@ mod tests {
         }
     }
 
+    /// A pixel of the measurements: a uniform normal on the sphere (two uniforms), then
+    /// `θo` uniform in [0°, 80°] and `φo` in [0°, 360°), the frame's tangent at angle 0.
+    fn random_pixel(pick: &mut Xoshiro256PlusPlus) -> Query {
+        let (a, b) = (pick.next_uniform(), pick.next_uniform());
+        let z = 1.0 - 2.0 * a;
+        let r = (1.0 - z * z).sqrt();
+        let normal = [
+            r * (std::f64::consts::TAU * b).cos(),
+            r * (std::f64::consts::TAU * b).sin(),
+            z,
+        ];
+        let theta = 80.0 * pick.next_uniform();
+        Query {
+            wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
+            frame: LocalFrame::new(normal, 0.0).unwrap(),
+        }
+    }
+
     /// `∫ p_prod dσ` over the sphere by the map's pixels, each split `s × s` (exact for the
     /// correct density, piecewise constant per pixel).
     fn integral(cut: &ProductCut, pyr: &PowerPyramid, map: &EnvMap, s: usize) -> f64 {
@@ -835,19 +853,8 @@ mod tests {
         let (spp, reps) = (64, 100);
         let mut ratios = Vec::new();
         for i in 0..12 {
-            let (a, b) = (pick.next_uniform(), pick.next_uniform());
-            let z = 1.0 - 2.0 * a;
-            let r = (1.0 - z * z).sqrt();
-            let normal = [
-                r * (std::f64::consts::TAU * b).cos(),
-                r * (std::f64::consts::TAU * b).sin(),
-                z,
-            ];
-            let theta = 80.0 * pick.next_uniform();
-            let q = Query {
-                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
-                frame: LocalFrame::new(normal, 0.0).unwrap(),
-            };
+            let q = random_pixel(&mut pick);
+            let theta = q.wo.z.acos().to_degrees();
             let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
             let (reference, _) = quadrature_reference(&scene, 1);
             if !(reference > 0.0) {
@@ -952,19 +959,7 @@ mod tests {
         let (spp, reps) = (64, 100);
         let mut ratios = vec![Vec::new(); variants.len()];
         for i in 0..12 {
-            let (a, b) = (pick.next_uniform(), pick.next_uniform());
-            let z = 1.0 - 2.0 * a;
-            let r = (1.0 - z * z).sqrt();
-            let normal = [
-                r * (std::f64::consts::TAU * b).cos(),
-                r * (std::f64::consts::TAU * b).sin(),
-                z,
-            ];
-            let theta = 80.0 * pick.next_uniform();
-            let q = Query {
-                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
-                frame: LocalFrame::new(normal, 0.0).unwrap(),
-            };
+            let q = random_pixel(&mut pick);
             let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
             let (reference, _) = quadrature_reference(&scene, 1);
             if !(reference > 0.0) {
@@ -1027,21 +1022,7 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
         let mut sum = 0.0;
         for _ in 0..points {
-            let (a, b) = (pick.next_uniform(), pick.next_uniform());
-            let z = 1.0 - 2.0 * a;
-            let r = (1.0 - z * z).sqrt();
-            let normal = [
-                r * (std::f64::consts::TAU * b).cos(),
-                r * (std::f64::consts::TAU * b).sin(),
-                z,
-            ];
-            let q = Query {
-                wo: brdf::direction_from_angles(
-                    80.0 * pick.next_uniform(),
-                    360.0 * pick.next_uniform(),
-                ),
-                frame: LocalFrame::new(normal, 0.0).unwrap(),
-            };
+            let q = random_pixel(&mut pick);
             let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
             let g = |_: usize, wi: &Vec3, f: f64| scene.integrand_with_f(wi, f);
             let v = if work == "mis" {
@@ -1085,19 +1066,8 @@ mod tests {
         let reps = 100;
         let (mut sp, mut sm) = (Vec::new(), Vec::new());
         for i in 0..12 {
-            let (a, b) = (pick.next_uniform(), pick.next_uniform());
-            let z = 1.0 - 2.0 * a;
-            let r = (1.0 - z * z).sqrt();
-            let normal = [
-                r * (std::f64::consts::TAU * b).cos(),
-                r * (std::f64::consts::TAU * b).sin(),
-                z,
-            ];
-            let theta = 80.0 * pick.next_uniform();
-            let q = Query {
-                wo: brdf::direction_from_angles(theta, 360.0 * pick.next_uniform()),
-                frame: LocalFrame::new(normal, 0.0).unwrap(),
-            };
+            let q = random_pixel(&mut pick);
+            let theta = q.wo.z.acos().to_degrees();
             let scene = ProductScene::new(brdf.as_ref(), &map, q.frame, q.wo).unwrap();
             let (reference, _) = quadrature_reference(&scene, 1);
             if !(reference > 0.0) {

@@ -78,18 +78,7 @@ fn main() {
                 "sphere `{spec}`, {kind} (sampler, spp, rel. error ± 95 %, above the best ± Šidák 95 %, tied with the best): adaptive {}",
                 study::AdaptiveVerdict::of(&rows).word()
             );
-            for r in rows {
-                println!(
-                    "  {:<24} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
-                    r.sampler,
-                    r.spp,
-                    100.0 * r.error,
-                    100.0 * r.ci95,
-                    100.0 * r.above_best,
-                    100.0 * r.above_best_hw,
-                    if r.tied_with_best { "tied" } else { "worse" }
-                );
-            }
+            print_rows(&rows, 24);
         }
     }
     // Every estimator together at equal time: BRDF only, MIS (`sampler+MIS`), adaptive product.
@@ -103,21 +92,27 @@ fn main() {
                 "sphere `{spec}`, every estimator at equal time: adaptive {}",
                 study::AdaptiveVerdict::of(&rows).word()
             );
-            for r in rows.iter().take(8) {
-                println!(
-                    "  {:<28} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
-                    r.sampler,
-                    r.spp,
-                    100.0 * r.error,
-                    100.0 * r.ci95,
-                    100.0 * r.above_best,
-                    100.0 * r.above_best_hw,
-                    if r.tied_with_best { "tied" } else { "worse" }
-                );
-            }
+            print_rows(&rows[..rows.len().min(8)], 28);
         }
     }
     if let Some(v) = render.equal_time_verdict() {
         println!("{v}");
+    }
+}
+
+/// One line per sampler: relative error ± its 95 % half-width, the distance above the best ±
+/// its Šidák 95 % half-width, tied or worse; the sampler's name padded to `width`.
+fn print_rows(rows: &[study::SphereError], width: usize) {
+    for r in rows {
+        println!(
+            "  {:<width$} {:>5} {:>8.3} ± {:.3} %  {:>+7.3} ± {:.3}  {}",
+            r.sampler,
+            r.spp,
+            100.0 * r.error,
+            100.0 * r.ci95,
+            100.0 * r.above_best,
+            100.0 * r.above_best_hw,
+            if r.tied_with_best { "tied" } else { "worse" }
+        );
     }
 }

@@ -2131,6 +2131,40 @@ mod tests {
         assert!(lit > 20, "{lit} lit pixels");
     }
 
+    /// Two spheres of `px` pixels (`lambert`, `phong:n=20`, `adaptive-exact` built for each)
+    /// under a 64 × 32 procedural sky: the scene of the product and reference tests.
+    struct SkyScene {
+        light: Light,
+        brdfs: Vec<std::sync::Arc<dyn Brdf>>,
+        built: Vec<std::sync::Arc<dyn DirectionSampler>>,
+        light_sampler: LightSampler,
+        pyramid: PowerPyramid,
+        hs: Vec<Hit>,
+        segs: Vec<std::ops::Range<usize>>,
+    }
+
+    fn sky_scene(px: usize) -> SkyScene {
+        let map = envmap::procedural_sky(64, 32).unwrap();
+        let pyramid = PowerPyramid::new(&map);
+        let light = Light::Map {
+            map,
+            label: "sky".into(),
+        };
+        let (brdfs, built) = lambert_and_phong_built("adaptive-exact", false);
+        let light_sampler = LightSampler::new(&light).unwrap();
+        let hs = hits(2, px);
+        let segs = segments(&hs, 2 * px);
+        SkyScene {
+            light,
+            brdfs,
+            built,
+            light_sampler,
+            pyramid,
+            hs,
+            segs,
+        }
+    }
+
     /// `lambert` and `phong:n=20` with `sampler` built for each (8 slices where it has them);
     /// with `counted`, each BRDF wrapped in the study's evaluation counter and the sampler built
     /// **with that wrapped object** (as the study builds them).
@@ -2718,17 +2752,16 @@ mod tests {
     #[test]
     fn the_product_rows_have_the_law_of_the_per_pixel_mis_and_a_misordered_row_fails() {
         use statrs::distribution::{ChiSquared, ContinuousCDF};
-        let map = envmap::procedural_sky(64, 32).unwrap();
-        let light = Light::Map {
-            map: map.clone(),
-            label: "sky".into(),
-        };
-        let (brdfs, built) = lambert_and_phong_built("adaptive-exact", false);
-        let light_sampler = LightSampler::new(&light).unwrap();
-        let pyramid = PowerPyramid::new(&map);
         let px = 10;
-        let hs = hits(2, px);
-        let segs = segments(&hs, 2 * px);
+        let SkyScene {
+            light,
+            brdfs,
+            built,
+            light_sampler,
+            pyramid,
+            hs,
+            segs,
+        } = sky_scene(px);
         let spp = 300;
         let render = |pyr: &PowerPyramid, reverse: bool| -> Vec<[f64; 3]> {
             let mut out = Vec::new();
@@ -2778,18 +2811,17 @@ mod tests {
     /// fail.
     #[test]
     fn the_reference_error_estimate_matches_its_error_over_independent_references() {
-        let map = envmap::procedural_sky(64, 32).unwrap();
-        let light = Light::Map {
-            map: map.clone(),
-            label: "sky".into(),
-        };
-        let (brdfs, built) = lambert_and_phong_built("adaptive-exact", false);
-        let light_sampler = LightSampler::new(&light).unwrap();
-        let pyramid = PowerPyramid::new(&map);
         let px = 10;
         let width = 2 * px;
-        let hs = hits(2, px);
-        let segs = segments(&hs, width);
+        let SkyScene {
+            light,
+            brdfs,
+            built,
+            light_sampler,
+            pyramid,
+            hs,
+            segs,
+        } = sky_scene(px);
         let pixels = width * px;
         let mis = |spp: usize, seed: u64| {
             render_segments(
