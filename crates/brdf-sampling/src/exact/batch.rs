@@ -10,6 +10,9 @@ use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
 use super::fused::{IsoQuery, accepted, accepted_at};
+use super::lanes::{self, Trials};
+#[cfg(test)]
+use super::lanes::{GOLDEN_GAMMA, mix64, unit};
 use super::table::LeafTable;
 use super::{ExactSet, Query};
 use crate::disc::{DiscMap, count_evaluations};
@@ -29,78 +32,18 @@ pub(super) const PREPARED_RUN_MIN: usize = 512;
 /// `f` are evaluated in one [`PreparedRun::eval_block`] call.
 const WAVE: usize = 256;
 
-/// SplitMix64's output function (Steele, Lea & Flood 2014): a bijection of `u64` whose
-/// outputs at the states `key + k·γ` are SplitMix64's stream.
-#[inline(always)]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// SplitMix64's increment `γ`.
-const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-
-/// The stream of sample `i` of a wavefront: SplitMix64 started at `mix64(seed ⊕ mix64(i))`.
+/// The stream of sample `i` of a wavefront: SplitMix64 started at `mix64(seed ⊕ mix64(i))`
+/// (test support: the wavefront makes these states in lanes, [`lanes::keys`]).
+#[cfg(test)]
 #[derive(Clone, Copy)]
 struct Stream(u64);
 
-/// A SplitMix64 output as a uniform on `[0, 1)`: its top 53 bits times `2⁻⁵³` (as
-/// `UniformSource` for a generator). The bits fit in an `i64`, so the signed conversion (one
-/// instruction) gives the value of the unsigned one.
-#[inline(always)]
-fn unit(z: u64) -> f64 {
-    ((z >> 11) as i64) as f64 * (1.0 / (1u64 << 53) as f64)
-}
-
+#[cfg(test)]
 impl Stream {
     #[inline(always)]
     fn of(seed: u64, i: usize) -> Self {
         Self(mix64(seed ^ mix64(i as u64)))
     }
-}
-
-/// The four uniforms of one trial for every pending sample of a block, in structure-of-arrays
-/// form: `u[k][j]` is the `k`-th of the next four uniforms of the stream whose state is
-/// `state[j]` (SplitMix64: state `+ γ`, output [`unit`]`(mix64(state))`), which advances by four
-/// steps. One pass over independent lanes, so the compiler keeps it in
-/// vector registers (the instruction set of `pulp`'s dispatch, [`uniforms`]).
-#[inline(always)]
-fn uniforms_soa(state: &mut [u64], u: &mut [Vec<f64>; 4]) {
-    let [u0, u1, u2, u3] = u;
-    let n = state.len();
-    let (u0, u1, u2, u3) = (&mut u0[..n], &mut u1[..n], &mut u2[..n], &mut u3[..n]);
-    for (j, s) in state.iter_mut().enumerate() {
-        let s1 = s.wrapping_add(GOLDEN_GAMMA);
-        let s2 = s1.wrapping_add(GOLDEN_GAMMA);
-        let s3 = s2.wrapping_add(GOLDEN_GAMMA);
-        let s4 = s3.wrapping_add(GOLDEN_GAMMA);
-        u0[j] = unit(mix64(s1));
-        u1[j] = unit(mix64(s2));
-        u2[j] = unit(mix64(s3));
-        u3[j] = unit(mix64(s4));
-        *s = s4;
-    }
-}
-
-/// [`uniforms_soa`] as a `pulp` operation, compiled for the instruction set the host offers.
-struct Uniforms<'a> {
-    state: &'a mut [u64],
-    u: &'a mut [Vec<f64>; 4],
-}
-
-impl pulp::WithSimd for Uniforms<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        uniforms_soa(self.state, self.u);
-    }
-}
-
-/// [`uniforms_soa`] dispatched at run time (`pulp`: AVX-512 as `V4`, AVX2 + FMA as `V3`, else
-/// the baseline); the same bits on every level (integer arithmetic and one exact conversion).
-fn uniforms(arch: pulp::Arch, state: &mut [u64], u: &mut [Vec<f64>; 4]) {
-    arch.dispatch(Uniforms { state, u });
 }
 
 /// The key of a wavefront's streams: one 64-bit word made of two uniforms of `u` (their 53-bit
@@ -141,9 +84,10 @@ pub(super) type Drawn = (Point2, Vec3, f64);
 /// no particular order of `i`).
 ///
 /// The pending samples are kept in structure-of-arrays form (index, stream state), a pass
-/// generating a block's uniforms in vector lanes ([`uniforms`]), proposing its trials,
-/// evaluating those inside the disc in one call and testing them; every pending sample makes
-/// one trial per pass, so a pass count stands for every sample's trial count.
+/// making a block's trials in vector lanes ([`lanes::trials`]: uniforms, leaf pick, point,
+/// bound, threshold and direction), evaluating those inside the disc in one call and testing
+/// them; every pending sample makes one trial per pass, so a pass count stands for every
+/// sample's trial count.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`MAX_TRIALS_PER_SAMPLE`]: partition_sampler::MAX_TRIALS_PER_SAMPLE
@@ -164,15 +108,13 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     // The pending samples: index and stream state (and the next pass's). Every pending sample
     // makes one trial per pass, so after `pass` passes each has made `pass` trials.
     let mut idx: Vec<usize> = (0..n).collect();
-    let mut state: Vec<u64> = (0..n).map(|i| Stream::of(seed, i).0).collect();
+    let mut state: Vec<u64> = vec![0; n];
+    lanes::keys(arch, seed, &mut state);
     let (mut idx2, mut state2) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    // One block's uniforms, and its candidates: lane, acceptance threshold `u₃·M_i`, bound,
-    // point, direction, value.
-    let mut us: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; wave]);
+    // One block's trials (`lanes.rs`), and its candidates inside the disc: the trial's entry
+    // in the block, direction, value.
+    let mut t = Trials::new(wave);
     let mut lane: Vec<usize> = vec![0; wave];
-    let mut threshold: Vec<f64> = vec![0.0; wave];
-    let mut bound: Vec<f64> = vec![0.0; wave];
-    let mut point: Vec<Point2> = vec![[0.0; 2]; wave];
     let mut dirs: Vec<Vec3> = vec![Vec3::zeros(); wave];
     let mut f = vec![0.0; wave];
     let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
@@ -190,40 +132,34 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         state2.clear();
         for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
             let len = ib.len();
-            uniforms(arch, sb, &mut us);
-            let [u0, u1, u2, u3] = &us;
-            let (u0, u1, u2, u3) = (&u0[..len], &u1[..len], &u2[..len], &u3[..len]);
+            lanes::trials(arch, table, map, sb, &mut t);
+            // The candidates inside the disc, compacted without branches; the others (a few
+            // per cent) propose again next pass.
             let mut c = 0;
             for k in 0..len {
-                match table.propose([u0[k], u1[k], u2[k], u3[k]]) {
-                    Some((p, m)) => {
-                        lane[c] = k;
-                        threshold[c] = u3[k] * m;
-                        bound[c] = m;
-                        point[c] = p;
-                        dirs[c] = map.to_direction(p);
-                        c += 1;
-                    }
-                    None => {
-                        idx2.push(ib[k]);
-                        state2.push(sb[k]);
-                    }
+                lane[c] = k;
+                dirs[c] = t.dir[k];
+                c += usize::from(t.inside[k]);
+            }
+            if c < len {
+                for k in (0..len).filter(|&k| !t.inside[k]) {
+                    idx2.push(ib[k]);
+                    state2.push(sb[k]);
                 }
             }
             count_evaluations(c as u64);
             run.eval_block(&dirs[..c], &mut f[..c]);
-            for k in 0..c {
-                let (j, v, fv) = (lane[k], dirs[k], f[k]);
+            for ((&k, &v), &fv) in lane[..c].iter().zip(&dirs[..c]).zip(&f[..c]) {
                 let g = match map {
                     DiscMap::Projected => fv,
                     DiscMap::EqualArea => 2.0 * v.z * fv,
                 };
-                violations += u64::from(g > bound[k]);
-                if threshold[k] < g {
-                    emit(ib[j], Some((point[k], v, g)));
+                violations += u64::from(g > t.bound[k]);
+                if t.threshold[k] < g {
+                    emit(ib[k], Some(([t.x[k], t.y[k]], v, g)));
                 } else {
-                    idx2.push(ib[j]);
-                    state2.push(sb[j]);
+                    idx2.push(ib[k]);
+                    state2.push(sb[k]);
                 }
             }
         }

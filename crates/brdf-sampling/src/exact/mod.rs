@@ -76,6 +76,7 @@ mod grid;
 mod interval;
 mod iso_record;
 mod jobs;
+mod lanes;
 mod layout;
 mod lookup;
 mod options;

@@ -152,6 +152,29 @@ impl LeafTable {
         let y = f64::from(e.y0) + us[2] * f64::from(e.dy);
         (x * x + y * y < 1.0).then_some(([x, y], f64::from(e.m)))
     }
+
+    /// The leaf [`LeafTable::propose`] picks from its first uniform `u0`, as
+    /// `[x0, dx, y0, dy, M_i]` (the record's `f32` values, exactly): `propose`'s point is
+    /// `(x0 + u₁·dx, y0 + u₂·dy)`, kept inside when `x² + y² < 1`. For the wavefront's trials
+    /// in vector lanes (`exact/lanes.rs`), which do that arithmetic over many trials at once;
+    /// the alias fallback is a select.
+    #[inline(always)]
+    pub(super) fn leaf_of(&self, u0: f64) -> [f64; 5] {
+        let entries = &*self.entries;
+        let last = entries.len() - 1;
+        let s = u0 * self.n;
+        let i = floor_index(s, last);
+        let first = &entries[i];
+        let alias = first.alias as usize;
+        // `entries.get(alias).unwrap_or(first)` as a select.
+        let k = if s - index_to_f64(i) < first.prob || alias > last {
+            i
+        } else {
+            alias
+        };
+        let e = &entries[k.min(last)];
+        [e.x0, e.dx, e.y0, e.dy, e.m].map(f64::from)
+    }
 }
 
 /// The test-only check that every interval's table draws what its tree draws.
