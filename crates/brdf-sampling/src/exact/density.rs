@@ -122,6 +122,15 @@ pub(crate) type NodeKey = (u64, u64);
 /// for 64 points at a time).
 pub(crate) const ENVELOPE_BLOCK: usize = 64;
 
+/// Directions per group of the RGL block evaluation's vector lanes (`measured/rgl/lanes.rs`
+/// pads a shorter group to this many).
+const LANES_GROUP: usize = 16;
+
+/// A tail of fewer misses than this (after the full groups) is evaluated one by one
+/// (`eval_in_slice`, the same values): ≈ 460 instructions per padded lane against ≈ 660 per
+/// scalar evaluation (AVX2, docs/benchmarks.md §25.3, §27.4).
+const LANES_MIN_TAIL: usize = 8;
+
 /// One thread's fresh values, on a cache line of its own (the image map evaluates in
 /// parallel; each worker appends to its own buffer, uncontended).
 #[repr(align(128))]
@@ -221,7 +230,14 @@ impl EnvelopeNode {
         let mut fresh = [0.0f64; ENVELOPE_BLOCK];
         match (rgl, &self.slice) {
             (Some(rgl), Some(slice)) => {
-                rgl.eval_block_in_slice(slice, &self.wo, &turned[..m], &mut fresh[..m]);
+                // The lanes evaluate groups of `LANES_GROUP`, padded: a short tail (the few
+                // misses of a node whose values are mostly inherited) costs less one by one.
+                let tail = m % LANES_GROUP;
+                let lanes = if tail < LANES_MIN_TAIL { m - tail } else { m };
+                rgl.eval_block_in_slice(slice, &self.wo, &turned[..lanes], &mut fresh[..lanes]);
+                for (v, w) in fresh[lanes..m].iter_mut().zip(&turned[lanes..m]) {
+                    *v = rgl.eval_in_slice(slice, &self.wo, w);
+                }
             }
             _ => {
                 for (v, w) in fresh[..m].iter_mut().zip(&turned[..m]) {

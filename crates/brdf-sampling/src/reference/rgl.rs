@@ -316,10 +316,9 @@ fn grid_nodes(n: usize) -> Vec<f64> {
     (0..n).map(|k| k as f64 / (n - 1) as f64).collect()
 }
 
-/// Sorted, with breaks closer than [`MERGE`] merged. (Unstable: elements equal under the
-/// total order are the same bits, so the result is the stable sort's.)
+/// Sorted, with breaks closer than [`MERGE`] merged.
 fn sort_merge(b: &mut Vec<f64>) {
-    b.sort_unstable_by(f64::total_cmp);
+    b.sort_by(f64::total_cmp);
     b.dedup_by(|a, c| (*a - *c).abs() <= MERGE);
 }
 
