@@ -87,6 +87,13 @@ impl Density for Counted<'_> {
         self.counter.add(1);
         self.f.eval(p)
     }
+
+    /// [`DiscBrdf`]'s block evaluation (bit for bit `eval`), one count per point.
+    #[inline]
+    fn eval_block(&self, points: &[Point2], out: &mut [f64]) {
+        self.counter.add(points.len().min(out.len()) as u64);
+        self.f.eval_block(points, out)
+    }
 }
 
 /// Maxima of `f` in the rim band, per azimuth bin and height.
@@ -120,12 +127,24 @@ impl RimBand {
         radii.sort_by(f64::total_cmp);
         // f at azimuth a_q = q · 2π / (2 bins), q = 0 .. 2 bins, for every radius.
         let angles = 2 * bins;
+        // One column's points in one block evaluation (an envelope's nodes evaluate their
+        // misses together, `DiscBrdf::eval_block`; bit for bit `eval`), checked in order as
+        // `eval_checked` checks them.
         let column = |q: usize| -> Result<Vec<f64>, DensityError> {
             let (s, c) = (q as f64 * TAU / angles as f64).sin_cos();
-            radii
-                .iter()
-                .map(|&r| f.eval_checked([r * c, r * s]))
-                .collect()
+            let points: Vec<Point2> = radii.iter().map(|&r| [r * c, r * s]).collect();
+            let mut values = vec![0.0f64; points.len()];
+            f.eval_block(&points, &mut values);
+            for (p, &v) in points.iter().zip(&values) {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(DensityError::InvalidSample {
+                        x: p[0],
+                        y: p[1],
+                        value: v,
+                    });
+                }
+            }
+            Ok(values)
         };
         // With f(x, −y) = f(x, y), azimuth q and angles − q share a column: only
         // q ≤ angles/2 is needed. Otherwise column `angles` is column 0 again.

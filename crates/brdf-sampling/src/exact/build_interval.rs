@@ -539,7 +539,8 @@ pub(super) fn build_interval(
     let n_nodes = nodes.len() as u64;
     let envelope = Arc::new(IntervalEnvelope::new(Arc::clone(brdf), nodes, true));
     let centre = span.centre(ctx.phi_k);
-    let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, span.map);
+    let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, span.map)
+        .with_blocks(Arc::clone(&envelope) as Arc<dyn crate::disc::DirectionBlock>);
     let track = delta_nodes(
         &ctx.grid,
         job,

@@ -9,7 +9,7 @@ use brdf::{Brdf, Outgoing, RglBrdf, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
 use rustc_hash::FxHashMap;
 
-use crate::disc::{DiscMap, count_evaluations};
+use crate::disc::{DirectionBlock, DiscMap, count_evaluations};
 use crate::layout::Turn;
 
 /// The disc density of `f_r(ωo, R_rot ·) cos θi` at one outgoing direction:
@@ -118,6 +118,19 @@ impl NodeValues {
 /// shared nodes with the same `num` (see `exact::Grid`), hence the same `ωo_n` bits.
 pub(crate) type NodeKey = (u64, u64);
 
+/// Directions per block of [`IntervalEnvelope::eval_block`] (the image map's lattice asks
+/// for 64 points at a time).
+pub(crate) const ENVELOPE_BLOCK: usize = 64;
+
+/// Directions per group of the RGL block evaluation's vector lanes (`measured/rgl/lanes.rs`
+/// pads a shorter group to this many).
+const LANES_GROUP: usize = 16;
+
+/// A tail of fewer misses than this (after the full groups) is evaluated one by one
+/// (`eval_in_slice`, the same values): ≈ 460 instructions per padded lane against ≈ 660 per
+/// scalar evaluation (AVX2, docs/benchmarks.md §25.3, §27.4).
+const LANES_MIN_TAIL: usize = 8;
+
 /// One thread's fresh values, on a cache line of its own (the image map evaluates in
 /// parallel; each worker appends to its own buffer, uncontended).
 #[repr(align(128))]
@@ -185,6 +198,65 @@ impl EnvelopeNode {
             }
         }
         v
+    }
+
+    /// `out[k] =` [`value`](Self::value)`(wi[k])` for every `k` (`wi.len() ≤`
+    /// [`ENVELOPE_BLOCK`], `out` as long), bit for bit: the inherited values looked up, the
+    /// misses evaluated together — for an RGL node with its slice in vector lanes
+    /// ([`RglBrdf::eval_block_in_slice`], `eval_in_slice` bit for bit) — and kept with one
+    /// lock of the worker's buffer per block.
+    fn values_block(&self, brdf: &dyn Brdf, rgl: Option<&RglBrdf>, wi: &[Vec3], out: &mut [f64]) {
+        debug_assert!(wi.len() <= ENVELOPE_BLOCK && out.len() == wi.len());
+        let mut slot = [0usize; ENVELOPE_BLOCK];
+        let mut turned = [Vec3::new(0.0, 0.0, 0.0); ENVELOPE_BLOCK];
+        let mut m = 0;
+        for (k, w) in wi.iter().enumerate() {
+            let key = [w.x.to_bits(), w.y.to_bits(), w.z.to_bits()];
+            if let Some(v) = self.inherited.as_ref().and_then(|n| n.get(&key)) {
+                out[k] = v;
+                continue;
+            }
+            slot[m] = k;
+            turned[m] = if self.delta == 0.0 {
+                *w
+            } else {
+                rotate_z(w, self.delta)
+            };
+            m += 1;
+        }
+        if m == 0 {
+            return;
+        }
+        let mut fresh = [0.0f64; ENVELOPE_BLOCK];
+        match (rgl, &self.slice) {
+            (Some(rgl), Some(slice)) => {
+                // The lanes evaluate groups of `LANES_GROUP`, padded: a short tail (the few
+                // misses of a node whose values are mostly inherited) costs less one by one.
+                let tail = m % LANES_GROUP;
+                let lanes = if tail < LANES_MIN_TAIL { m - tail } else { m };
+                rgl.eval_block_in_slice(slice, &self.wo, &turned[..lanes], &mut fresh[..lanes]);
+                for (v, w) in fresh[lanes..m].iter_mut().zip(&turned[lanes..m]) {
+                    *v = rgl.eval_in_slice(slice, &self.wo, w);
+                }
+            }
+            _ => {
+                for (v, w) in fresh[..m].iter_mut().zip(&turned[..m]) {
+                    *v = brdf.eval_prepared(&self.wo, w);
+                }
+            }
+        }
+        for (&k, &v) in slot[..m].iter().zip(&fresh[..m]) {
+            out[k] = v;
+        }
+        if let Some(buffers) = &self.fresh {
+            let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
+            if let Some(Ok(mut b)) = buffers.get(worker).map(|b| b.0.lock()) {
+                b.extend(slot[..m].iter().zip(&fresh[..m]).map(|(&k, &v)| {
+                    let w = &wi[k];
+                    ([w.x.to_bits(), w.y.to_bits(), w.z.to_bits()], v)
+                }));
+            }
+        }
     }
 
     /// Whether this node keeps the values it evaluates.
@@ -257,12 +329,42 @@ impl IntervalEnvelope {
         Self { brdf, rgl, nodes }
     }
 
+    /// `out[k] = F(wi[k])` ([`Brdf::eval`] of the envelope) for `k < min(wi.len(), out.len())`,
+    /// bit for bit: node by node over blocks of [`ENVELOPE_BLOCK`] directions (each node's
+    /// misses evaluated together, [`EnvelopeNode::values_block`]), the max taken in node
+    /// order as `eval` takes it. What the image map's lattice calls through
+    /// [`DiscBrdf`](crate::DiscBrdf)'s `eval_block` ([`DirectionBlock`]).
+    pub(crate) fn eval_block(&self, wi: &[Vec3], out: &mut [f64]) {
+        let mut node = [0.0f64; ENVELOPE_BLOCK];
+        for (wi, out) in wi
+            .chunks(ENVELOPE_BLOCK)
+            .zip(out.chunks_mut(ENVELOPE_BLOCK))
+        {
+            let n = wi.len().min(out.len());
+            let (wi, out) = (&wi[..n], &mut out[..n]);
+            out.fill(0.0);
+            for nd in &self.nodes {
+                nd.values_block(self.brdf.as_ref(), self.rgl.as_ref(), wi, &mut node[..n]);
+                for (m, &v) in out.iter_mut().zip(&node[..n]) {
+                    *m = m.max(v);
+                }
+            }
+        }
+    }
+
     /// BRDF evaluations made by the nodes that cache (their misses, one kept value each; the
     /// other nodes' are counted by the image map's counter). Counted from the nodes' buffers
     /// rather than by a shared atomic counter, which the image map's workers contended for at
     /// every miss.
     pub(crate) fn evaluations(&self) -> u64 {
         self.nodes.iter().map(EnvelopeNode::fresh_evaluations).sum()
+    }
+}
+
+impl DirectionBlock for IntervalEnvelope {
+    #[inline]
+    fn eval_directions(&self, wi: &[Vec3], out: &mut [f64]) {
+        self.eval_block(wi, out);
     }
 }
 
@@ -462,5 +564,120 @@ mod tests {
             assert_eq!(fast.eval(&wo, &wi).to_bits(), slow.eval(&wo, &wi).to_bits());
         }
         assert!(positive > 6000, "{positive} positive values");
+    }
+
+    /// Issue 29 (docs/benchmarks.md §27.4): the envelope evaluated in blocks (each node's
+    /// misses together; RGL nodes in vector lanes at their slices) is `eval` bit for bit —
+    /// with inherited values, caching and non-caching nodes, a turned node (`δ ≠ 0`) and a
+    /// node whose slice does not hold its blend —, keeps the same fresh values (same count,
+    /// same map), and the disc density built on it (`DiscBrdf::with_blocks`, both maps, a zero
+    /// floor, points on and outside the circle) is its `eval` bit for bit.
+    #[test]
+    fn envelope_blocks_are_eval_bit_for_bit() {
+        use crate::disc::{DiscBrdf, DiscMap};
+        use partition_sampler::Density;
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
+            return;
+        };
+        let brdf: Arc<dyn Brdf> = Arc::new(rgl);
+        let dirs: Vec<Vec3> = (0..3001u32)
+            .map(|k| {
+                let t = (std::f64::consts::FRAC_PI_2 - 1e-4) * ((k as f64 + 0.5) / 3001.0).sqrt();
+                direction_from_radians(t, 2.399_963 * k as f64)
+            })
+            .collect();
+        let make = |inherited: Option<Arc<NodeValues>>| -> IntervalEnvelope {
+            let nodes = [(20.0f64, 0.0), (23.0, 0.0), (26.0, 0.3), (88.9, 0.0)]
+                .iter()
+                .enumerate()
+                .map(|(k, &(deg, delta))| {
+                    let wo = direction_from_radians(deg.to_radians(), 0.0);
+                    let inh = if k == 1 { inherited.clone() } else { None };
+                    EnvelopeNode::new((k as u64, 0), brdf.prepare(&wo), delta, inh, k != 2)
+                })
+                .collect();
+            let mut env = IntervalEnvelope::new(Arc::clone(&brdf), nodes, true);
+            // The last node's slice is another angle's: `eval_in_slice` falls back to the
+            // two-slice tables, and so must the block.
+            let other = env
+                .rgl
+                .as_ref()
+                .unwrap()
+                .prepare_slice(&direction_from_radians(0.5, 0.0));
+            env.nodes[3].slice = Some(other);
+            env
+        };
+        // A parent evaluated pointwise hands node 1's values (of every other direction) down.
+        let parent = make(None);
+        let wo = Vec3::new(0.0, 0.0, 1.0);
+        for wi in dirs.iter().step_by(2) {
+            parent.eval(&wo, wi);
+        }
+        let inherited = parent
+            .nodes
+            .into_iter()
+            .map(EnvelopeNode::into_values)
+            .find(|(k, _)| k.0 == 1)
+            .map(|(_, v)| v);
+        let (pointwise, block) = (make(inherited.clone()), make(inherited));
+        let want: Vec<f64> = dirs.iter().map(|wi| pointwise.eval(&wo, wi)).collect();
+        let mut got = vec![f64::NAN; dirs.len()];
+        // Blocks of every length up to two full blocks and a partial one.
+        let mut at = 0;
+        for len in (1..=ENVELOPE_BLOCK).chain([2 * ENVELOPE_BLOCK + 7]).cycle() {
+            if at == dirs.len() {
+                break;
+            }
+            let end = (at + len).min(dirs.len());
+            block.eval_block(&dirs[at..end], &mut got[at..end]);
+            at = end;
+        }
+        let mut positive = 0;
+        for (k, (a, b)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(a.to_bits(), b.to_bits(), "{k}: {a} vs {b}");
+            positive += usize::from(*a > 0.0);
+        }
+        assert!(positive > 2500, "{positive}");
+        assert_eq!(block.evaluations(), pointwise.evaluations());
+        assert!(block.evaluations() > 0);
+        let maps = |env: IntervalEnvelope| -> Vec<Vec<(u64, u64, u64, u64)>> {
+            env.nodes
+                .into_iter()
+                .filter(|n| n.caches())
+                .map(|n| {
+                    let (_, v) = n.into_values();
+                    let mut all: Vec<_> = v
+                        .layers
+                        .iter()
+                        .flat_map(|m| m.iter().map(|(k, v)| (k[0], k[1], k[2], v.to_bits())))
+                        .collect();
+                    all.sort_unstable();
+                    all
+                })
+                .collect()
+        };
+        // The disc density on an envelope, pointwise and by blocks.
+        let env = Arc::new(make(None));
+        let points: Vec<Point2> = (0..2500u32)
+            .map(|k| {
+                let r = 1.02 * ((k as f64 + 0.5) / 2500.0).sqrt();
+                let a = 2.399_963 * k as f64;
+                [r * a.cos(), r * a.sin()]
+            })
+            .chain([[1.0, 0.0], [0.0, -1.0], [0.6, 0.8]])
+            .collect();
+        for map in [DiscMap::Projected, DiscMap::EqualArea] {
+            let plain = DiscBrdf::with_map(Arc::clone(&env) as Arc<dyn Brdf>, wo, map)
+                .with_zero_floor(1e-3);
+            let fast = plain
+                .clone()
+                .with_blocks(Arc::clone(&env) as Arc<dyn DirectionBlock>);
+            let mut out = vec![f64::NAN; points.len()];
+            fast.eval_block(&points, &mut out);
+            for (p, v) in points.iter().zip(&out) {
+                assert_eq!(v.to_bits(), plain.eval(*p).to_bits(), "{map:?} {p:?}");
+            }
+        }
+        assert_eq!(maps(block), maps(pointwise));
     }
 }

@@ -216,29 +216,98 @@ impl<'a> CellRule<'a> {
         b.push(0.0);
         b.push(x_max);
         sort_merge(&mut b);
-        let wo = &self.wo;
-        let f = |x: f64| {
-            let theta_m = x * x * FRAC_PI_2;
-            let (st, ct) = theta_m.sin_cos();
-            let m = Vec3::new(st * cos_p, st * sin_p, ct);
-            let dot = wo.dot(&m);
-            let wi = m * (2.0 * dot) - wo;
-            if !(wi.z > 0.0 && dot > 0.0) {
-                return 0.0;
-            }
-            let f = match self.run {
-                Some(run) => run.eval(&wi),
-                None => self.brdf.eval_prepared(&self.q, &wi),
-            };
-            let fc = f * wi.z;
-            fc * 8.0 * PI * PI * x * st * dot
-        };
-        let mut total = 0.0;
-        for w in b.windows(2) {
-            total += self.gl.integrate(w[0], w[1], f);
-        }
-        (total, ((b.len() - 1) * self.gl.nodes().len()) as u64)
+        let (total, evaluations) = LINE.with(|line| {
+            let mut line = line.borrow_mut();
+            self.line_integral(&b, cos_p, sin_p, &mut line)
+        });
+        debug_assert_eq!(evaluations, ((b.len() - 1) * self.gl.nodes().len()) as u64);
+        (total, evaluations)
     }
+
+    /// `(Σ over the pieces between consecutive breaks `b` of the Gauss rule of
+    /// g(x) = f cos θi · 8π² x sin θm (ωo·m), evaluations)` on the line of azimuth
+    /// `(cos φ, sin φ)`. The incident directions of every piece's points are gathered first
+    /// and evaluated in one [`PreparedRun::eval_block`] call (vector lanes for RGL runs;
+    /// `eval` bit for bit by the trait's contract), then each piece is summed in
+    /// [`GaussLegendre::integrate`]'s order: the value is the point-by-point rule's bit for
+    /// bit (tested). Without a run, `eval_prepared` per point.
+    fn line_integral(&self, b: &[f64], cos_p: f64, sin_p: f64, line: &mut Line) -> (f64, u64) {
+        let (nodes, weights) = (self.gl.nodes(), self.gl.weights());
+        let wo = &self.wo;
+        line.clear();
+        for w in b.windows(2) {
+            let half = 0.5 * (w[1] - w[0]);
+            let mid = 0.5 * (w[0] + w[1]);
+            for x in nodes {
+                let x = mid + half * x;
+                let theta_m = x * x * FRAC_PI_2;
+                let (st, ct) = theta_m.sin_cos();
+                let m = Vec3::new(st * cos_p, st * sin_p, ct);
+                let dot = wo.dot(&m);
+                let wi = m * (2.0 * dot) - wo;
+                // `(x, sin θm, ωo·m)`; `x = NaN`: no contribution (below the horizon or a
+                // back-facing half vector).
+                if wi.z > 0.0 && dot > 0.0 {
+                    line.wi.push(wi);
+                    line.jac.push([x, st, dot]);
+                } else {
+                    line.jac.push([f64::NAN; 3]);
+                }
+            }
+        }
+        line.f.clear();
+        line.f.resize(line.wi.len(), 0.0);
+        match self.run {
+            Some(run) => run.eval_block(&line.wi, &mut line.f),
+            None => {
+                for (o, wi) in line.f.iter_mut().zip(&line.wi) {
+                    *o = self.brdf.eval_prepared(&self.q, wi);
+                }
+            }
+        }
+        let mut total = 0.0;
+        let (mut k, mut e) = (0, 0);
+        for (w, jac) in b.windows(2).zip(line.jac.chunks_exact(nodes.len())) {
+            let half = 0.5 * (w[1] - w[0]);
+            let mut s = 0.0;
+            for (wt, &[x, st, dot]) in weights.iter().zip(jac) {
+                let g = if x.is_nan() {
+                    0.0
+                } else {
+                    // The point rule's value and order of products, bit for bit.
+                    let fc = line.f[e] * line.wi[e].z;
+                    e += 1;
+                    fc * 8.0 * PI * PI * x * st * dot
+                };
+                s += wt * g;
+                k += 1;
+            }
+            total += s * half;
+        }
+        (total, k as u64)
+    }
+}
+
+/// A line's gathered points, reused between the lines a thread integrates.
+#[derive(Default)]
+struct Line {
+    /// Incident directions of the points that contribute, in point order.
+    wi: Vec<Vec3>,
+    /// `f_r(ωo, wi)` of each.
+    f: Vec<f64>,
+    /// Per point (piece-major), `(x, sin θm, ωo·m)`, or `NaN`s for a point that contributes 0.
+    jac: Vec<[f64; 3]>,
+}
+
+impl Line {
+    fn clear(&mut self) {
+        self.wi.clear();
+        self.jac.clear();
+    }
+}
+
+thread_local! {
+    static LINE: std::cell::RefCell<Line> = std::cell::RefCell::new(Line::default());
 }
 
 /// The nodes `k/(n − 1)` of a grid of `n ≥ 2` points.
@@ -352,6 +421,88 @@ pub(crate) mod tests {
             assert_eq!(fast.abs_err.to_bits(), slow.abs_err.to_bits(), "{deg}°");
             assert_eq!(fast.evaluations, slow.evaluations, "{deg}°");
         }
+    }
+
+    /// The line integral as the rule computed it before the gathered blocks: each piece by
+    /// [`GaussLegendre::integrate`], one evaluation per point.
+    fn inner_pointwise(rule: &CellRule<'_>, y: f64) -> (f64, u64) {
+        let phi = TAU * y - PI;
+        let (sin_p, cos_p) = phi.sin_cos();
+        let (sin_o, cos_o) = rule.theta_o.sin_cos();
+        let alpha = (sin_o * cos_p).atan2(cos_o);
+        let theta_max = (0.5 * alpha + FRAC_PI_4).clamp(0.0, FRAC_PI_2);
+        let x_max = (theta_max / FRAC_PI_2).sqrt();
+        if !(x_max > 0.0) {
+            return (0.0, 0);
+        }
+        let vndf = rule.rgl.vndf();
+        let s_y = vndf.invert([0.0, y], rule.theta_o).0[1];
+        let mut b: Vec<f64> = rule
+            .x_nodes
+            .iter()
+            .copied()
+            .chain(
+                rule.s_nodes
+                    .iter()
+                    .map(|&sx| vndf.sample([sx, s_y], rule.theta_o).0[0]),
+            )
+            .filter(|&x| x < x_max)
+            .collect();
+        b.push(0.0);
+        b.push(x_max);
+        sort_merge(&mut b);
+        let wo = &rule.wo;
+        let f = |x: f64| {
+            let theta_m = x * x * FRAC_PI_2;
+            let (st, ct) = theta_m.sin_cos();
+            let m = Vec3::new(st * cos_p, st * sin_p, ct);
+            let dot = wo.dot(&m);
+            let wi = m * (2.0 * dot) - wo;
+            if !(wi.z > 0.0 && dot > 0.0) {
+                return 0.0;
+            }
+            let f = match rule.run {
+                Some(run) => run.eval(&wi),
+                None => rule.brdf.eval_prepared(&rule.q, &wi),
+            };
+            let fc = f * wi.z;
+            fc * 8.0 * PI * PI * x * st * dot
+        };
+        let mut total = 0.0;
+        for w in b.windows(2) {
+            total += rule.gl.integrate(w[0], w[1], f);
+        }
+        (total, ((b.len() - 1) * rule.gl.nodes().len()) as u64)
+    }
+
+    /// Issue 29 (docs/benchmarks.md §27.4): a line gathered and evaluated in one block (RGL:
+    /// vector lanes) is the point-by-point rule bit for bit, with the run and without one, at
+    /// orders 8 and 4, on lines crossing the horizon's cut and the grids' kinks, from normal
+    /// incidence to grazing.
+    #[test]
+    fn gathered_lines_are_the_pointwise_rule_bit_for_bit() {
+        let Some(rgl) = fixture() else { return };
+        let mut lines = 0;
+        for deg in [0.0f64, 30.0, 63.7, 85.0, 89.5] {
+            let t = deg.to_radians();
+            let wo = brdf::direction_from_radians(t, 0.0);
+            let run = rgl.prepare_run(&wo);
+            let no_run = NoRun(&rgl);
+            for (brdf, run) in [(&rgl as &dyn Brdf, run.as_deref()), (&no_run, None)] {
+                for order in [RGL_CELL_ORDER, RGL_CELL_ORDER / 2] {
+                    let rule = CellRule::new(brdf, &rgl, t, order, run);
+                    for k in 0..97 {
+                        let y = (k as f64 + 0.3) / 97.0;
+                        let (v, e) = rule.inner(y);
+                        let (w, f) = inner_pointwise(&rule, y);
+                        assert_eq!(v.to_bits(), w.to_bits(), "{deg}° y {y}: {v} vs {w}");
+                        assert_eq!(e, f, "{deg}° y {y}");
+                        lines += usize::from(e > 0);
+                    }
+                }
+            }
+        }
+        assert!(lines > 1500, "{lines}");
     }
 
     #[test]

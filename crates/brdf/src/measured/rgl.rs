@@ -783,6 +783,27 @@ impl RglBrdf {
         self.eval_on_slice(p, q, wi)
     }
 
+    /// `out[k] =` [`eval_in_slice`](Self::eval_in_slice)`(p, q, wi[k])` for
+    /// `k < min(wi.len(), out.len())`, bit for bit: in vector lanes (`measured/rgl/lanes.rs`,
+    /// as a run's [`PreparedRun::eval_block`](crate::brdf::PreparedRun::eval_block)) when `p`
+    /// holds `q`'s blend, else one direction at a time through the two-slice tables.
+    pub fn eval_block_in_slice(
+        &self,
+        p: &PreparedSlice,
+        q: &Outgoing,
+        wi: &[Vec3],
+        out: &mut [f64],
+    ) {
+        let (i, w) = self.prepared_slice(q);
+        if !p.matches(self.owner(), i, w) {
+            for (o, wi) in out.iter_mut().zip(wi) {
+                *o = self.eval_blended(q, wi);
+            }
+            return;
+        }
+        lanes::eval_block(&block_run(self, q, p), wi, out);
+    }
+
     /// [`eval_in_slice`](Self::eval_in_slice) for a slice known to hold `q`'s blend.
     #[inline]
     fn eval_on_slice(&self, p: &PreparedSlice, q: &Outgoing, wi: &Vec3) -> f64 {
@@ -807,18 +828,24 @@ struct RglRun<'a> {
 impl RglRun<'_> {
     /// The run as the block evaluation reads it.
     fn block_run(&self) -> lanes::BlockRun<'_> {
-        let c = self.q.cache();
-        lanes::BlockRun {
-            wo: *self.q.wo(),
-            cos_o: c[prepared::COS_PHI],
-            sin_o: c[prepared::SIN_PHI],
-            four_sigma: c[prepared::FOUR_SIGMA],
-            jacobian: self.brdf.tables.jacobian,
-            valid: c[prepared::VALID] == 1.0 && c[prepared::FOUR_SIGMA] > 0.0,
-            vndf: &self.slice.vndf,
-            ndf: &self.brdf.tables.ndf,
-            lum: &self.slice.rgb_luminance,
-        }
+        block_run(self.brdf, &self.q, &self.slice)
+    }
+}
+
+/// `brdf` at `q` (prepared by it) on the slice `slice` holding `q`'s blend, as the block
+/// evaluation reads it.
+fn block_run<'a>(brdf: &'a RglBrdf, q: &Outgoing, slice: &'a PreparedSlice) -> lanes::BlockRun<'a> {
+    let c = q.cache();
+    lanes::BlockRun {
+        wo: *q.wo(),
+        cos_o: c[prepared::COS_PHI],
+        sin_o: c[prepared::SIN_PHI],
+        four_sigma: c[prepared::FOUR_SIGMA],
+        jacobian: brdf.tables.jacobian,
+        valid: c[prepared::VALID] == 1.0 && c[prepared::FOUR_SIGMA] > 0.0,
+        vndf: &slice.vndf,
+        ndf: &brdf.tables.ndf,
+        lum: &slice.rgb_luminance,
     }
 }
 

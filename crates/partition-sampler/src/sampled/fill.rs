@@ -132,19 +132,18 @@ fn fill_fine_cells<D: Density>(
 }
 
 /// Statistics of one boundary cell: (max, integral on the fine sub-grid, on the coarse one).
+///
+/// The cell's points (the fine sub-grid's inside the disc, the radial projections onto the
+/// circle of those outside that fall in the cell, the coarse sub-grid's inside the disc) are
+/// gathered and evaluated in one [`Density::eval_block`] call, then checked and summed in the
+/// order a point-by-point evaluation takes them: the same statistics and the same first
+/// invalid value, bit for bit.
 fn boundary_cell<D: Density>(
     f: &D,
     cell: &Rect,
     sub: Subgrid,
 ) -> Result<(f64, f64, f64), DensityError> {
     let disc = Domain::UnitDisc;
-    let eval = |p| {
-        if disc.contains(p) {
-            f.eval_checked(p)
-        } else {
-            Ok(0.0)
-        }
-    };
     let (w, h) = (cell.width(), cell.height());
     let at = |a: usize, b: usize, k: usize| {
         [
@@ -152,30 +151,79 @@ fn boundary_cell<D: Density>(
             cell.y0 + (b as f64 + 0.5) / k as f64 * h,
         ]
     };
-    let mut max = 0.0f64;
-    let mut fine = 0.0;
+    // Per point of the rule, in order: what it adds (`Fine`: the fine sum and the max;
+    // `Edge`: the max; `Coarse`: the coarse sum) and whether `f` is evaluated there.
+    #[derive(Clone, Copy)]
+    enum Role {
+        Fine,
+        Edge,
+        Coarse,
+    }
+    let mut roles: Vec<(Role, bool)> =
+        Vec::with_capacity(2 * sub.fine * sub.fine + sub.coarse * sub.coarse);
+    let mut points: Vec<Point2> = Vec::with_capacity(roles.capacity());
     for b in 0..sub.fine {
         for a in 0..sub.fine {
             let p = at(a, b, sub.fine);
             let r2 = p[0] * p[0] + p[1] * p[1];
             if r2 <= 1.0 {
-                let v = eval(p)?;
-                fine += v;
-                max = max.max(v);
+                let inside = disc.contains(p);
+                roles.push((Role::Fine, inside));
+                if inside {
+                    points.push(p);
+                }
             } else {
                 // Radial projection onto the circle, kept if it lies in the cell.
                 let k = (1.0 - 1e-12) / r2.sqrt();
                 let q = [p[0] * k, p[1] * k];
                 if cell.contains(q) {
-                    max = max.max(eval(q)?);
+                    let inside = disc.contains(q);
+                    roles.push((Role::Edge, inside));
+                    if inside {
+                        points.push(q);
+                    }
                 }
             }
         }
     }
-    let mut coarse = 0.0;
     for b in 0..sub.coarse {
         for a in 0..sub.coarse {
-            coarse += eval(at(a, b, sub.coarse))?;
+            let p = at(a, b, sub.coarse);
+            let inside = disc.contains(p);
+            roles.push((Role::Coarse, inside));
+            if inside {
+                points.push(p);
+            }
+        }
+    }
+    let mut values = vec![0.0f64; points.len()];
+    f.eval_block(&points, &mut values);
+    let mut max = 0.0f64;
+    let mut fine = 0.0;
+    let mut coarse = 0.0;
+    let mut next = 0;
+    for &(role, inside) in &roles {
+        let v = if inside {
+            let (p, v) = (points[next], values[next]);
+            next += 1;
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(DensityError::InvalidSample {
+                    x: p[0],
+                    y: p[1],
+                    value: v,
+                });
+            }
+            v
+        } else {
+            0.0
+        };
+        match role {
+            Role::Fine => {
+                fine += v;
+                max = max.max(v);
+            }
+            Role::Edge => max = max.max(v),
+            Role::Coarse => coarse += v,
         }
     }
     let area = cell.area();
@@ -450,4 +498,117 @@ fn keep_block(
         }
     }
     simpson - five
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The boundary cell's statistics as they were computed before the gathered block: one
+    /// `eval_checked` per point.
+    fn boundary_cell_pointwise<D: Density>(
+        f: &D,
+        cell: &Rect,
+        sub: Subgrid,
+    ) -> Result<(f64, f64, f64), DensityError> {
+        let disc = Domain::UnitDisc;
+        let eval = |p| {
+            if disc.contains(p) {
+                f.eval_checked(p)
+            } else {
+                Ok(0.0)
+            }
+        };
+        let (w, h) = (cell.width(), cell.height());
+        let at = |a: usize, b: usize, k: usize| {
+            [
+                cell.x0 + (a as f64 + 0.5) / k as f64 * w,
+                cell.y0 + (b as f64 + 0.5) / k as f64 * h,
+            ]
+        };
+        let mut max = 0.0f64;
+        let mut fine = 0.0;
+        for b in 0..sub.fine {
+            for a in 0..sub.fine {
+                let p = at(a, b, sub.fine);
+                let r2 = p[0] * p[0] + p[1] * p[1];
+                if r2 <= 1.0 {
+                    let v = eval(p)?;
+                    fine += v;
+                    max = max.max(v);
+                } else {
+                    // Radial projection onto the circle, kept if it lies in the cell.
+                    let k = (1.0 - 1e-12) / r2.sqrt();
+                    let q = [p[0] * k, p[1] * k];
+                    if cell.contains(q) {
+                        max = max.max(eval(q)?);
+                    }
+                }
+            }
+        }
+        let mut coarse = 0.0;
+        for b in 0..sub.coarse {
+            for a in 0..sub.coarse {
+                coarse += eval(at(a, b, sub.coarse))?;
+            }
+        }
+        let area = cell.area();
+        Ok((
+            max,
+            fine * area / (sub.fine * sub.fine) as f64,
+            coarse * area / (sub.coarse * sub.coarse) as f64,
+        ))
+    }
+
+    /// Issue 29 (docs/benchmarks.md §27.4): a boundary cell's points gathered into one
+    /// `eval_block` call give the point-by-point statistics bit for bit (max, fine and coarse
+    /// integrals) on every cell of a 64² grid crossing the circle, for both sub-grids, and the
+    /// same error (the first invalid value in the rule's order).
+    #[test]
+    fn gathered_boundary_cells_are_the_pointwise_rule() {
+        let f = |p: Point2| (1.0 + 3.0 * p[0] - p[1] * p[1]).abs() + (7.0 * p[1]).sin().abs();
+        let geo = Geometry {
+            grid: Domain::UnitDisc.bounding_rect(),
+            n: 64,
+            disc: true,
+        };
+        let mut cells = 0;
+        let mut picked = None;
+        for sub in [DENSE_SUBGRID, REFINED_SUBGRID] {
+            for b in 0..geo.n {
+                for a in 0..geo.n {
+                    if geo.class(a, b, 1) != Class::Boundary {
+                        continue;
+                    }
+                    cells += 1;
+                    let r = geo.rect(a, b, 1);
+                    if cells == 40 {
+                        picked = Some(r);
+                    }
+                    let (m, fi, co) = boundary_cell(&f, &r, sub).unwrap();
+                    let (m2, fi2, co2) = boundary_cell_pointwise(&f, &r, sub).unwrap();
+                    assert_eq!(
+                        [m.to_bits(), fi.to_bits(), co.to_bits()],
+                        [m2.to_bits(), fi2.to_bits(), co2.to_bits()],
+                        "cell ({a}, {b})"
+                    );
+                }
+            }
+        }
+        assert!(cells > 300, "{cells}");
+        // Invalid values at two of a cell's points: the error names the first in rule order.
+        let r = picked.unwrap();
+        let bad = |p: Point2| {
+            if p[0] > r.x0 + 0.4 * r.width() {
+                -1.0 - p[1]
+            } else {
+                1.0
+            }
+        };
+        for sub in [DENSE_SUBGRID, REFINED_SUBGRID] {
+            let e = format!("{:?}", boundary_cell(&bad, &r, sub).unwrap_err());
+            let e2 = format!("{:?}", boundary_cell_pointwise(&bad, &r, sub).unwrap_err());
+            assert_eq!(e, e2);
+        }
+    }
 }
