@@ -71,16 +71,9 @@ impl ExactSet {
         let mut group = vec![UNSERVED; wos.len()];
         let mut count = vec![0u32; groups as usize + 1];
         for (k, wo) in wos.iter().enumerate() {
-            if let Some(q) = self.locate_keys(wo) {
-                let (cell, interval) = (q.cell as u32, q.interval as u32);
-                located[k] = Located {
-                    keys: q.keys,
-                    cos: q.cos,
-                    turn: q.turn,
-                    cell,
-                    interval,
-                };
-                let g = base[q.cell] + interval;
+            if let Some(q) = self.locate_aniso(wo) {
+                located[k] = q;
+                let g = base[q.cell as usize] + q.interval;
                 group[k] = g;
                 count[g as usize + 1] += 1;
             }
@@ -103,6 +96,46 @@ impl ExactSet {
             out[k] = self.draw_aniso(brdf, &wos[k], &located[k], u, &mut audit);
         }
         self.counters.record(&audit);
+    }
+
+    /// [`ExactSet::locate_keys`]'s query of `wo` as a [`Located`] record, the same values bit
+    /// for bit: inline for the common case (`ωo` served as given in a narrow azimuth cell,
+    /// [`super::walk::cell_offset`]), through `locate_keys` otherwise (wide cells, the grazing
+    /// top, below the horizon).
+    #[inline(always)]
+    fn locate_aniso(&self, wo: &Vec3) -> Option<Located> {
+        let narrow = if wo.z >= self.top_cos && wo.x.is_finite() && wo.y.is_finite() {
+            super::walk::cell_offset(
+                wo,
+                self.period,
+                self.cells[0].tan_half,
+                |k| self.cells[k].phi_turn,
+                self.cells.len(),
+            )
+        } else {
+            None
+        };
+        let Some((cell, turn, tan)) = narrow else {
+            let q = self.locate_keys(wo)?;
+            return Some(Located {
+                keys: q.keys,
+                cos: q.cos,
+                turn: q.turn,
+                cell: q.cell as u32,
+                interval: q.interval as u32,
+            });
+        };
+        // `locate_with`'s arithmetic for a query served as given (`wo.z ≥ top_cos > 0`).
+        let cos = wo.z.min(1.0);
+        let c = &self.cells[cell];
+        let interval = c.interval_direct(c.search_key(cos, f64::NAN), tan);
+        Some(Located {
+            keys: [(1.0 - cos).sqrt(), tan],
+            cos,
+            turn,
+            cell: cell as u32,
+            interval: interval as u32,
+        })
     }
 
     /// One sample of a located anisotropic query `q` of `wo`: [`ExactSet::draw_located`]'s
