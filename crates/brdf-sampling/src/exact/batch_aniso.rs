@@ -8,9 +8,11 @@
 //! in that order by [`ExactSet::draw_located`]'s arithmetic — so from the same uniforms the
 //! same bits. What differs is the bookkeeping: one 48-byte record per query ([`Located`]:
 //! the normaliser grid's keys, `cos θo`, the rotation and the interval) instead of the general
-//! path's 112-byte `Option<(Located, usize)>`, the normaliser and the trials' density made
+//! path's 112-byte `Option<(batch::Located, usize)>`, the normaliser and the trials' density made
 //! from it directly, and a query's whole `Query` rebuilt only when it was served at another
-//! `ωo` (above [`THETA_TOP_DEG`](super::THETA_TOP_DEG)).
+//! `ωo` (above [`THETA_TOP_DEG`](super::THETA_TOP_DEG)). As there, consecutive queries with
+//! the same `ωo` bits (a pixel's samples) are located once, and such a run's density and
+//! normaliser are made once.
 
 use brdf::{Brdf, Vec3};
 use partition_sampler::diagnostics::AuditedDraws;
@@ -36,6 +38,12 @@ struct Located {
 
 /// The group of a query that is not served (at or below the horizon, not finite).
 const UNSERVED: u32 = u32::MAX;
+
+/// The bits of a direction: the queries of one run share them.
+#[inline]
+fn bits(wo: &Vec3) -> [u64; 3] {
+    [wo.x.to_bits(), wo.y.to_bits(), wo.z.to_bits()]
+}
 
 impl ExactSet {
     /// The batch path of an anisotropic set: `out[k]` for `wos[k]`, the samples of
@@ -70,7 +78,20 @@ impl ExactSet {
         let mut located = vec![dummy; wos.len()];
         let mut group = vec![UNSERVED; wos.len()];
         let mut count = vec![0u32; groups as usize + 1];
+        // Whether a query continues its predecessor's run (the same `ωo` bits).
+        let mut follows = vec![false; wos.len()];
         for (k, wo) in wos.iter().enumerate() {
+            // A query with its predecessor's bits (a pixel's samples) takes its location.
+            if k > 0 && bits(&wos[k - 1]) == bits(wo) {
+                let g = group[k - 1];
+                if g != UNSERVED {
+                    located[k] = located[k - 1];
+                    group[k] = g;
+                    count[g as usize + 1] += 1;
+                    follows[k] = true;
+                }
+                continue;
+            }
             if let Some(q) = self.locate_aniso(wo) {
                 located[k] = q;
                 let g = base[q.cell as usize] + q.interval;
@@ -91,9 +112,21 @@ impl ExactSet {
             }
         }
         let mut audit = Audit::default();
-        for &k in &order {
-            let k = k as usize;
-            out[k] = self.draw_aniso(brdf, &wos[k], &located[k], u, &mut audit);
+        // Runs of one `ωo` of the caller's order stay runs in the serving order (they share
+        // their interval, and the sort is stable): the density and normaliser made once.
+        let mut a = 0;
+        while a < order.len() {
+            let k = order[a] as usize;
+            let mut b = a + 1;
+            while b < order.len() && follows[order[b] as usize] {
+                b += 1;
+            }
+            if b == a + 1 {
+                out[k] = self.draw_aniso(brdf, &wos[k], &located[k], u, &mut audit);
+            } else {
+                self.serve_aniso_run(brdf, &wos[k], &located[k], &order[a..b], u, &mut audit, out);
+            }
+            a = b;
         }
         self.counters.record(&audit);
     }
@@ -173,6 +206,58 @@ impl ExactSet {
         let a = c.aniso[i].normaliser(q.keys[0], q.keys[1], q.cos, &c.patches);
         let (s, f) = accepted(iv.map, &q.turn, x, gx, a);
         self.finish(brdf, wo, s, f.is_finite().then_some(f))
+    }
+
+    /// The queries `run` (indices into `out`) of one located anisotropic query `q` of `wo`:
+    /// [`ExactSet::draw_located`]'s arithmetic (the same density, table, trials, normaliser
+    /// and samples) with the density and the normaliser made once, each sample finished as
+    /// [`ExactSet::finish`] does.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn serve_aniso_run(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        q: &Located,
+        run: &[u32],
+        u: &mut dyn UniformSource,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
+        if !(wo.z >= self.top_cos) {
+            // Served at the top angle (another `ωo`): the general path, whose `f` is not the
+            // query's.
+            let Some(full) = self.locate_keys(wo) else {
+                return;
+            };
+            for &k in run {
+                let (s, f) = self.draw_located(&full, wo, u, audit);
+                out[k as usize] = self.finish(brdf, wo, s, f);
+            }
+            return;
+        }
+        let c = &self.cells[q.cell as usize];
+        let i = q.interval as usize;
+        let iv = &c.intervals[i];
+        let g = QueryDensity::in_frame(self.brdf.as_ref(), false, wo, q.turn, iv.map);
+        let g = |p| g.at(p);
+        let mut a = None;
+        for &k in run {
+            let drawn = match &c.tables[i] {
+                Some(table) => table.draw(&g, u, audit),
+                None => iv.tree.sample_envelope_of(&g, u, audit),
+            };
+            out[k as usize] = match drawn {
+                Some((x, gx)) => {
+                    let a = *a.get_or_insert_with(|| {
+                        c.aniso[i].normaliser(q.keys[0], q.keys[1], q.cos, &c.patches)
+                    });
+                    let (s, f) = accepted(iv.map, &q.turn, x, gx, a);
+                    self.finish(brdf, wo, s, f.is_finite().then_some(f))
+                }
+                None => self.finish(brdf, wo, DirSample::NONE, None),
+            };
+        }
     }
 }
 
