@@ -66,6 +66,7 @@
 
 mod aniso_record;
 mod batch;
+mod batch_aniso;
 mod build;
 mod build_interval;
 mod chebyshev;

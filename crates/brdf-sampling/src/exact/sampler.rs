@@ -57,6 +57,9 @@ impl DirectionSampler for ExactSet {
         u: &mut dyn UniformSource,
         out: &mut Vec<EvalSample>,
     ) {
+        if !self.isotropic {
+            return self.sample_eval_aniso(brdf, wos, u, out);
+        }
         self.sample_eval_grouped(brdf, wos, u, out);
     }
 
