@@ -40,13 +40,25 @@ pub(crate) enum Grading {
 }
 
 /// `∫_{rect ∩ D} f dA` by the iterated rule (see the module docs).
+#[cfg_attr(not(test), allow(dead_code))]
 fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
+    integrate_leaf_counted(f, rect, rule).0
+}
+
+/// [`integrate_leaf`] and the evaluations of `f` it made (counted here, so the adaptive rule
+/// adds them once per piece instead of once per evaluation: the same calls of `f` in the same
+/// order, the same value bit for bit).
+fn integrate_leaf_counted(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> (f64, u64) {
     let chord = |x: f64| (1.0 - x * x).max(0.0).sqrt();
+    let count = std::cell::Cell::new(0u64);
     let inner = |x: f64| {
         let half = chord(x);
         let (ya, yb) = (rect.y0.max(-half), rect.y1.min(half));
         if yb > ya {
-            rule.integrate(ya, yb, |y| f.eval([x, y]))
+            rule.integrate(ya, yb, |y| {
+                count.set(count.get() + 1);
+                f.eval([x, y])
+            })
         } else {
             0.0
         }
@@ -67,7 +79,8 @@ fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
     cuts.dedup();
     // Outer variable x = sin t: the chord √(1 − x²) = cos t is smooth in t even where the
     // circle is vertical (x → ±1), where a rule in x converges like h^1.5 only.
-    cuts.windows(2)
+    let value = cuts
+        .windows(2)
         .map(|w| {
             let (a, b) = (w[0].max(-1.0), w[1].min(1.0));
             if b > a {
@@ -76,7 +89,8 @@ fn integrate_leaf(f: &dyn Density, rect: &Rect, rule: &GaussLegendre) -> f64 {
                 0.0
             }
         })
-        .sum()
+        .sum();
+    (value, count.get())
 }
 
 /// Evaluation budget of one slice's adaptive rule (under a tenth of its image map).
@@ -198,15 +212,17 @@ pub(crate) fn adaptive_quadrature(
         GaussLegendre::new(FIRST_ORDER),
     );
     let evals = std::sync::atomic::AtomicU64::new(0);
-    let counted = |p: [f64; 2]| {
-        evals.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        f.eval(p)
+    // Evaluations counted per piece (one atomic add per piece, not per evaluation).
+    let counted = |rect: &Rect, rule: &GaussLegendre| {
+        let (value, n) = integrate_leaf_counted(f, rect, rule);
+        evals.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        value
     };
     let piece = |leaf: usize, rect: Rect| {
-        let low = integrate_leaf(&counted, &rect, &lo);
+        let low = counted(&rect, &lo);
         let (value, other, high) = match grading {
-            Grading::Fixed => (integrate_leaf(&counted, &rect, &hi), low, true),
-            Grading::Graded => (low, integrate_leaf(&counted, &rect, &first), false),
+            Grading::Fixed => (counted(&rect, &hi), low, true),
+            Grading::Graded => (low, counted(&rect, &first), false),
         };
         WorstFirst(Piece {
             leaf,
@@ -240,7 +256,7 @@ pub(crate) fn adaptive_quadrature(
         err -= worst.err;
         if !worst.high {
             // Raise the order before splitting: the order-5 value becomes the comparison.
-            let value = integrate_leaf(&counted, &worst.rect, &hi);
+            let value = counted(&worst.rect, &hi);
             let p = Piece {
                 value,
                 err: (value - worst.value).abs(),

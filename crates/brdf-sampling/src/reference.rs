@@ -29,6 +29,7 @@ use partition_sampler::{LeafInfo, Rect};
 
 mod cornell;
 mod rgl;
+pub(crate) use cornell::cornell_node_albedo;
 pub use cornell::{CORNELL_REFERENCE_REL_TOL, cornell_reference_albedo};
 pub(crate) use rgl::albedo_in_cells_of;
 #[cfg(test)]

@@ -125,9 +125,11 @@ pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)
     {
         // The tabulated interpolant's albedo, exact up to rounding (docs/benchmarks.md §24.6).
         (value, abs_err, 0)
-    } else if any.is::<CornellBrdf>() {
+    } else if let Some(cornell) = any.downcast_ref::<CornellBrdf>() {
+        // The reference rule on the material's quadrature evaluator, its bound declared
+        // (docs/benchmarks.md §27.3).
         let wo = direction_from_radians(theta, 0.0);
-        match crate::reference::reference_albedo_with_budget(brdf, &wo, CORNELL_NODE_BUDGET) {
+        match crate::reference::cornell_node_albedo(cornell, &wo, CORNELL_NODE_BUDGET) {
             Ok(a) => (a.value, a.abs_err, a.evaluations),
             Err(_) => (f64::NAN, f64::INFINITY, 0),
         }

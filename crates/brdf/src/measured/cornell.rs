@@ -130,9 +130,11 @@ pub struct NegativeValues {
 
 mod grid;
 mod line;
+mod node;
 mod search;
 
 pub use line::{LINE_ORDER, LineIntegral, SEGMENT_REL_TOL};
+pub use node::{QUADRATURE_REL_BOUND, QuadratureEval};
 
 // The search keeps the blended samples and the one their weights are cut at.
 const _: () = assert!(search::K == NEIGHBOURS + 1);

@@ -276,6 +276,14 @@ impl Tree {
         Some(self.grid.list(self, ix + GRID * (iy + GRID * iz)))
     }
 
+    /// The [`CellList`] of `q`'s grid cell when `q` is in the remapped unit cube (up to the
+    /// grid's padding), else `None` (see [`Tree::nearest_fast`]).
+    #[inline]
+    pub(super) fn cell_list_of(&self, q: &[f64; 3]) -> Option<&CellList> {
+        let cell = self.grid.cell(q)?;
+        Some(self.grid.cell_list(self, cell))
+    }
+
     /// Sample `i`'s remapped point (the file's index).
     #[inline]
     pub(super) fn point(&self, i: u32) -> [f64; 3] {
@@ -416,8 +424,48 @@ const GRID_PAD: f64 = 1e-9;
 /// evaluations pays for a few cells, not for all (≈ 26 000 instructions a cell).
 #[derive(Default)]
 struct Grid {
-    /// Each cell's candidates (file indices), once made.
-    cells: Vec<std::sync::OnceLock<Box<[u32]>>>,
+    /// Each cell's candidates, once made.
+    cells: Vec<std::sync::OnceLock<CellList>>,
+}
+
+/// One cell's candidates: their file indices and, for the quadrature evaluator's lanes, their
+/// remapped points as structure of arrays (`x` of every candidate, then `y`, then `z`, each
+/// padded to a multiple of [`SOA_PAD`] with [`SOA_FAR`], a point no query comes near).
+pub(super) struct CellList {
+    /// File indices, nearest to the cell's centre first.
+    pub(super) index: Box<[u32]>,
+    /// `[x…, y…, z…]`, each of [`CellList::stride`] entries.
+    pub(super) xyz: Box<[f64]>,
+}
+
+/// The structure-of-arrays rows of a [`CellList`] are padded to a multiple of this.
+pub(super) const SOA_PAD: usize = 4;
+
+/// Coordinate of the padding points of a [`CellList`] (squared distance ≥ 3·(10³ − 1)² from
+/// any point of the unit cube: never among the nearest).
+pub(super) const SOA_FAR: f64 = 1e3;
+
+impl CellList {
+    fn new(tree: &Tree, index: Box<[u32]>) -> Self {
+        let stride = index.len().div_ceil(SOA_PAD) * SOA_PAD;
+        let mut xyz = vec![SOA_FAR; 3 * stride];
+        for (k, &i) in index.iter().enumerate() {
+            let p = tree.by_index[i as usize];
+            for d in 0..3 {
+                xyz[d * stride + k] = p[d];
+            }
+        }
+        Self {
+            index,
+            xyz: xyz.into_boxed_slice(),
+        }
+    }
+
+    /// Entries per row of [`CellList::xyz`].
+    #[inline]
+    pub(super) fn stride(&self) -> usize {
+        self.xyz.len() / 3
+    }
 }
 
 impl Grid {
@@ -432,7 +480,13 @@ impl Grid {
     /// Cell `c`'s candidates, made on first use.
     #[inline]
     fn list<'a>(&'a self, tree: &Tree, c: usize) -> &'a [u32] {
-        self.cells[c].get_or_init(|| Self::candidates(tree, c))
+        &self.cell_list(tree, c).index
+    }
+
+    /// Cell `c`'s [`CellList`], made on first use.
+    #[inline]
+    fn cell_list<'a>(&'a self, tree: &Tree, c: usize) -> &'a CellList {
+        self.cells[c].get_or_init(|| CellList::new(tree, Self::candidates(tree, c)))
     }
 
     /// Cell `c`'s candidates (see the type's docs).
