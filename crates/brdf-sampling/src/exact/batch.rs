@@ -374,9 +374,22 @@ impl ExactSet {
     ) {
         out.clear();
         out.resize(wos.len(), EvalSample::NONE);
+        self.sample_eval_passes(brdf, wos, u, out, MAX_PASS);
+    }
+
+    /// [`ExactSet::sample_eval_grouped`] with `out` sized, in passes of at most `pass` (≥ 1,
+    /// ≤ [`MAX_PASS`]) queries: each pass is grouped and served on its own, in turn.
+    fn sample_eval_passes(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut [EvalSample],
+        pass: usize,
+    ) {
         let mut scratch = SCRATCH.with(|s| s.take()).unwrap_or_default();
         let mut base = 0;
-        for part in wos.chunks(MAX_PASS) {
+        for part in wos.chunks(pass.clamp(1, MAX_PASS)) {
             let end = base + part.len();
             self.grouped_pass(brdf, part, u, &mut out[base..end], &mut scratch);
             base = end;
@@ -411,28 +424,35 @@ impl ExactSet {
         }
         // Isotropic queries by the fast path's locate (`ExactSet::locate_iso`), the others
         // (anisotropic, grazing) by the general one; a query with its predecessor's bits takes
-        // its key (a general query's is its stored query's).
+        // its key (a general query's is its stored query's). Each served query is counted in
+        // its group's bucket (`start[g + 1]`) on the way.
         key.clear();
         general.clear();
-        let mut prev: Option<([u64; 3], u32)> = None;
+        start.clear();
+        start.resize(groups + 1, 0);
+        let mut prev: Option<([u64; 3], u32, usize)> = None;
         for wo in wos {
             let b = bits(wo);
-            let k = match prev {
-                Some((pb, pk)) if pb == b => pk,
+            let (k, g) = match prev {
+                Some((pb, pk, pg)) if pb == b => (pk, pg),
                 _ => match self.locate_iso(wo) {
-                    Some(q) => q.interval as u32,
+                    Some(q) => (q.interval as u32, q.interval),
                     None => match self.locate_keys(wo) {
                         Some(q) => {
-                            let g = (offsets[q.cell] + q.interval) as u32;
-                            general.push((g, q));
-                            GENERAL | (general.len() - 1) as u32
+                            let g = offsets[q.cell] + q.interval;
+                            general.push((g as u32, q));
+                            (GENERAL | (general.len() - 1) as u32, g)
                         }
-                        None => UNSERVED,
+                        None => (UNSERVED, groups),
                     },
                 },
             };
+            // An unserved query (`g = groups`) has no bucket.
+            if let Some(c) = start.get_mut(g + 1) {
+                *c += 1;
+            }
             key.push(k);
-            prev = Some((b, k));
+            prev = Some((b, k, g));
         }
         // Counting sort of the served queries' indices by group (stable).
         let group = |k: u32| -> Option<usize> {
@@ -444,13 +464,6 @@ impl ExactSet {
                 Some(general[(k & !GENERAL) as usize].0 as usize)
             }
         };
-        start.clear();
-        start.resize(groups + 1, 0);
-        for &k in key.iter() {
-            if let Some(g) = group(k) {
-                start[g + 1] += 1;
-            }
-        }
         for g in 0..groups {
             start[g + 1] += start[g];
         }
@@ -484,7 +497,14 @@ impl ExactSet {
                     r: (wo.x * wo.x + wo.y * wo.y).sqrt(),
                     cos,
                 };
-                self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out);
+                if b == a + 1 {
+                    // A run of one query (a random ωo): the one-query path itself, whose
+                    // arithmetic `serve_iso_run` repeats for a run (the same bits).
+                    let (s, f) = self.draw_iso(&q, wo, u, &mut audit);
+                    out[first] = self.finish_iso(brdf, wo, s, f);
+                } else {
+                    self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out);
+                }
             } else {
                 let q = &general[(k & !GENERAL) as usize].1;
                 self.serve_general_run(brdf, q, wo, run, u, &mut audit, out);
@@ -863,6 +883,77 @@ mod tests {
                 assert_eq!(through_runs, 0);
             }
         }
+    }
+
+    /// The batch's working arrays, kept per thread between calls, carry nothing from one batch
+    /// to the next: on one thread, after batches of another set and size (Ward: general
+    /// queries; Phong: 5000 queries, some grazing or below the horizon), a Phong batch equals
+    /// the same batch on a fresh thread, bit for bit. And batches served in passes: 3000
+    /// queries in passes of 1000 are three batches of 1000 from the same stream.
+    #[test]
+    fn kept_working_arrays_and_passes_change_nothing() {
+        let phong: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
+        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
+        let p = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
+        let w = ExactSet::build(Arc::clone(&ward), &small, None).unwrap();
+        let mut qr = Xoshiro256PlusPlus::seed_from_u64(41);
+        let mut wos = |n: usize| -> Vec<Vec3> {
+            (0..n)
+                .map(|k| match k % 97 {
+                    0 => brdf::direction_from_angles(89.995, 10.0),
+                    1 => brdf::direction_from_angles(95.0, 10.0),
+                    _ => brdf::direction_from_angles(
+                        89.0 * qr.next_uniform(),
+                        360.0 * qr.next_uniform(),
+                    ),
+                })
+                .collect()
+        };
+        let (big, ward_q, last) = (wos(5000), wos(3000), wos(700));
+        let key = |v: &[EvalSample]| -> Vec<[u64; 5]> {
+            v.iter()
+                .map(|s| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits))
+                .collect()
+        };
+        let fresh = std::thread::scope(|sc| {
+            sc.spawn(|| key(&batch(&p, phong.as_ref(), &last, 12)))
+                .join()
+                .unwrap()
+        });
+        let reused = std::thread::scope(|sc| {
+            sc.spawn(|| {
+                batch(&w, ward.as_ref(), &ward_q, 10);
+                batch(&p, phong.as_ref(), &big, 11);
+                batch(&w, ward.as_ref(), &ward_q[..50], 10);
+                key(&batch(&p, phong.as_ref(), &last, 12))
+            })
+            .join()
+            .unwrap()
+        });
+        assert_eq!(fresh, reused);
+
+        let mut r1 = Xoshiro256PlusPlus::seed_from_u64(13);
+        let mut passes = vec![EvalSample::NONE; big[..3000].len()];
+        p.sample_eval_passes(phong.as_ref(), &big[..3000], &mut r1, &mut passes, 1000);
+        let mut r2 = Xoshiro256PlusPlus::seed_from_u64(13);
+        let mut parts = Vec::new();
+        let mut out = Vec::new();
+        for part in big[..3000].chunks(1000) {
+            p.sample_eval_batch(phong.as_ref(), part, &mut r2, &mut out);
+            parts.extend_from_slice(&out);
+        }
+        assert_eq!(key(&passes), key(&parts));
+        assert_eq!(r1.next_uniform(), r2.next_uniform());
+        // One pass of all 3000 is another grouping: other samples.
+        let mut r3 = Xoshiro256PlusPlus::seed_from_u64(13);
+        p.sample_eval_batch(phong.as_ref(), &big[..3000], &mut r3, &mut out);
+        assert_ne!(key(&out), key(&parts));
     }
 
     /// The mean of `cos θi` over the batch's samples at `wo` against its exact value under the
