@@ -387,14 +387,19 @@ impl ExactSet {
         out: &mut [EvalSample],
         pass: usize,
     ) {
-        let mut scratch = SCRATCH.with(|s| s.take()).unwrap_or_default();
+        // `try_with`: during the thread's teardown (no thread-local any more) a fresh one.
+        let mut scratch = SCRATCH
+            .try_with(|s| s.take())
+            .ok()
+            .flatten()
+            .unwrap_or_default();
         let mut base = 0;
         for part in wos.chunks(pass.clamp(1, MAX_PASS)) {
             let end = base + part.len();
             self.grouped_pass(brdf, part, u, &mut out[base..end], &mut scratch);
             base = end;
         }
-        SCRATCH.with(|s| s.set(Some(scratch)));
+        let _ = SCRATCH.try_with(|s| s.set(Some(scratch)));
     }
 
     /// One pass of [`ExactSet::sample_eval_grouped`] over at most [`MAX_PASS`] queries, `out`
