@@ -189,11 +189,38 @@ fn wavefront(
     drawn
 }
 
-/// A query located by the isotropic fast path or the general one.
-#[derive(Clone, Copy)]
-enum Located {
-    Iso(IsoQuery),
-    General(Query),
+/// A query's group key in [`ExactSet::sample_eval_grouped`]'s locate pass, one `u32`: an
+/// isotropic fast-path query's interval (`< GENERAL`), or [`GENERAL`]` | j` for a query
+/// located by the general path and stored as `general[j]`, or [`UNSERVED`] for a query the set
+/// does not serve (at or below the horizon).
+const GENERAL: u32 = 1 << 31;
+
+/// The key of a query the set does not serve.
+const UNSERVED: u32 = u32::MAX;
+
+/// Most queries one grouped pass takes: its keys and indices are `u32` below [`GENERAL`]
+/// (longer batches are served as consecutive passes of this many).
+const MAX_PASS: usize = (GENERAL - 1) as usize;
+
+/// The batch path's working arrays, kept per thread between calls (no allocation and no
+/// zero-filled buffer per call once a thread has served a batch of the size): the queries'
+/// group keys, the general queries, the counting sort's bucket starts and the serving order.
+#[derive(Default)]
+struct Scratch {
+    /// Per query, in the caller's order: its key (see [`GENERAL`]).
+    key: Vec<u32>,
+    /// The general path's queries, `(group, query)`, in the caller's order.
+    general: Vec<(u32, Query)>,
+    /// Per group `g`, where its queries start in `order` (then, after the scatter, end).
+    start: Vec<u32>,
+    /// The served queries' indices, by group, the caller's order within one.
+    order: Vec<u32>,
+}
+
+thread_local! {
+    /// This thread's [`Scratch`], taken for the length of a batch (a nested batch on the
+    /// same thread finds none and makes its own).
+    static SCRATCH: std::cell::Cell<Option<Box<Scratch>>> = const { std::cell::Cell::new(None) };
 }
 
 /// The bits of a direction: queries of one run share them.
@@ -242,14 +269,13 @@ impl ExactSet {
         offsets
     }
 
-    /// The located query of `wo` and its group (the interval's index in the set's list).
-    #[inline]
-    fn locate_grouped(&self, wo: &Vec3, offsets: &[usize]) -> Option<(Located, usize)> {
+    /// The group of `wo` in the batch path (the interval's index in the set's list), `None`
+    /// for a query the set does not serve (test support: the serving order).
+    #[cfg(test)]
+    fn group_of(&self, wo: &Vec3, offsets: &[usize]) -> Option<usize> {
         match self.locate_iso(wo) {
-            Some(q) => Some((Located::Iso(q), q.interval)),
-            None => self
-                .locate_keys(wo)
-                .map(|q| (Located::General(q), offsets[q.cell] + q.interval)),
+            Some(q) => Some(q.interval),
+            None => self.locate_keys(wo).map(|q| offsets[q.cell] + q.interval),
         }
     }
 
@@ -259,6 +285,12 @@ impl ExactSet {
     /// horizon get [`EvalSample::NONE`] and consume nothing. Each sample is drawn by the
     /// one-query path's arithmetic ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so
     /// its law is the same, and from the same uniforms the same bits.
+    ///
+    /// The locate pass keeps one `u32` key per query ([`GENERAL`]): an isotropic fast-path
+    /// query is re-derived from its `ωo` when served (`r = |(ωo.x, ωo.y)|`, `cos θo`, the
+    /// interval from the key: [`ExactSet::locate_iso`]'s values, bit for bit), a general one is
+    /// stored once; the counting sort moves `u32` indices only. Batches of more than
+    /// [`MAX_PASS`] queries are served as consecutive passes of that many.
     ///
     /// **Runs of one `ωo`** (consecutive queries with the same bits: a pixel's samples, a
     /// fixed-`ωo` benchmark) are located once, and their per-query work — the BRDF's
@@ -278,32 +310,111 @@ impl ExactSet {
     ) {
         out.clear();
         out.resize(wos.len(), EvalSample::NONE);
+        self.sample_eval_passes(brdf, wos, u, out, MAX_PASS);
+    }
+
+    /// [`ExactSet::sample_eval_grouped`] with `out` sized, in passes of at most `pass` (≥ 1,
+    /// ≤ [`MAX_PASS`]) queries: each pass is grouped and served on its own, in turn.
+    fn sample_eval_passes(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut [EvalSample],
+        pass: usize,
+    ) {
+        // `try_with`: during the thread's teardown (no thread-local any more) a fresh one.
+        let mut scratch = SCRATCH
+            .try_with(|s| s.take())
+            .ok()
+            .flatten()
+            .unwrap_or_default();
+        let mut base = 0;
+        for part in wos.chunks(pass.clamp(1, MAX_PASS)) {
+            let end = base + part.len();
+            self.grouped_pass(brdf, part, u, &mut out[base..end], &mut scratch);
+            base = end;
+        }
+        let _ = SCRATCH.try_with(|s| s.set(Some(scratch)));
+    }
+
+    /// One pass of [`ExactSet::sample_eval_grouped`] over at most [`MAX_PASS`] queries, `out`
+    /// holding [`EvalSample::NONE`] for each.
+    fn grouped_pass(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        u: &mut dyn UniformSource,
+        out: &mut [EvalSample],
+        scratch: &mut Scratch,
+    ) {
+        let Scratch {
+            key,
+            general,
+            start,
+            order,
+        } = scratch;
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
+        if groups >= MAX_PASS {
+            // Never for a set this crate builds (a few hundred intervals): one query at a time.
+            for (o, wo) in out.iter_mut().zip(wos) {
+                *o = crate::DirectionSampler::sample_eval(self, brdf, wo, u);
+            }
+            return;
+        }
         // Isotropic queries by the fast path's locate (`ExactSet::locate_iso`), the others
         // (anisotropic, grazing) by the general one; a query with its predecessor's bits takes
-        // its location.
-        let mut located: Vec<Option<(Located, usize)>> = Vec::with_capacity(wos.len());
-        for (k, wo) in wos.iter().enumerate() {
-            let l = match k.checked_sub(1) {
-                Some(j) if bits(&wos[j]) == bits(wo) => located[j],
-                _ => self.locate_grouped(wo, &offsets),
+        // its key (a general query's is its stored query's). Each served query is counted in
+        // its group's bucket (`start[g + 1]`) on the way.
+        key.clear();
+        general.clear();
+        start.clear();
+        start.resize(groups + 1, 0);
+        let mut prev: Option<([u64; 3], u32, usize)> = None;
+        for wo in wos {
+            let b = bits(wo);
+            let (k, g) = match prev {
+                Some((pb, pk, pg)) if pb == b => (pk, pg),
+                _ => match self.locate_iso(wo) {
+                    Some(q) => (q.interval as u32, q.interval),
+                    None => match self.locate_keys(wo) {
+                        Some(q) => {
+                            let g = offsets[q.cell] + q.interval;
+                            general.push((g as u32, q));
+                            (GENERAL | (general.len() - 1) as u32, g)
+                        }
+                        None => (UNSERVED, groups),
+                    },
+                },
             };
-            located.push(l);
+            // An unserved query (`g = groups`) has no bucket.
+            if let Some(c) = start.get_mut(g + 1) {
+                *c += 1;
+            }
+            key.push(k);
+            prev = Some((b, k, g));
         }
-        // Counting sort of the located queries by interval (stable).
-        let mut start = vec![0usize; groups + 1];
-        for (_, g) in located.iter().flatten() {
-            start[g + 1] += 1;
-        }
+        // Counting sort of the served queries' indices by group (stable).
+        let group = |k: u32| -> Option<usize> {
+            if k < GENERAL {
+                Some(k as usize)
+            } else if k == UNSERVED {
+                None
+            } else {
+                Some(general[(k & !GENERAL) as usize].0 as usize)
+            }
+        };
         for g in 0..groups {
             start[g + 1] += start[g];
         }
-        let mut order = vec![0usize; start[groups]];
-        for (k, l) in located.iter().enumerate() {
-            if let Some((_, g)) = l {
-                order[start[*g]] = k;
-                start[*g] += 1;
+        let served = start[groups] as usize;
+        order.clear();
+        order.resize(served, 0);
+        for (i, &k) in key.iter().enumerate() {
+            if let Some(g) = group(k) {
+                order[start[g] as usize] = i as u32;
+                start[g] += 1;
             }
         }
         let mut audit = Audit::default();
@@ -311,21 +422,33 @@ impl ExactSet {
         // the caller's order stays one run here.
         let mut a = 0;
         while a < order.len() {
-            let key = bits(&wos[order[a]]);
+            let first = order[a] as usize;
+            let wo = &wos[first];
+            let b0 = bits(wo);
             let mut b = a + 1;
-            while b < order.len() && bits(&wos[order[b]]) == key {
+            while b < order.len() && bits(&wos[order[b] as usize]) == b0 {
                 b += 1;
             }
             let run = &order[a..b];
-            let Some((q, _)) = located[run[0]] else {
-                unreachable!("only located queries are ordered")
-            };
-            let wo = &wos[run[0]];
-            match q {
-                Located::Iso(q) => self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out),
-                Located::General(q) => {
-                    self.serve_general_run(brdf, &q, wo, run, u, &mut audit, out)
+            let k = key[first];
+            if k < GENERAL {
+                let cos = wo.z.min(1.0);
+                let q = IsoQuery {
+                    interval: k as usize,
+                    r: (wo.x * wo.x + wo.y * wo.y).sqrt(),
+                    cos,
+                };
+                if b == a + 1 {
+                    // A run of one query (a random ωo): the one-query path itself, whose
+                    // arithmetic `serve_iso_run` repeats for a run (the same bits).
+                    let (s, f) = self.draw_iso(&q, wo, u, &mut audit);
+                    out[first] = self.finish_iso(brdf, wo, s, f);
+                } else {
+                    self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out);
                 }
+            } else {
+                let q = &general[(k & !GENERAL) as usize].1;
+                self.serve_general_run(brdf, q, wo, run, u, &mut audit, out);
             }
             a = b;
         }
@@ -340,7 +463,7 @@ impl ExactSet {
         brdf: &dyn Brdf,
         q: &IsoQuery,
         wo: &Vec3,
-        run: &[usize],
+        run: &[u32],
         u: &mut dyn UniformSource,
         audit: &mut Audit,
         out: &mut [EvalSample],
@@ -365,7 +488,7 @@ impl ExactSet {
                         Some((_, v, gx)) => accepted_at(rec.map, &at.turn, v, gx, at.a),
                         None => (DirSample::NONE, f64::NAN),
                     };
-                    out[run[i]] = self.finish_iso(brdf, at.wo, s, f);
+                    out[run[i] as usize] = self.finish_iso(brdf, at.wo, s, f);
                 };
                 wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
             }
@@ -394,7 +517,7 @@ impl ExactSet {
         brdf: &dyn Brdf,
         at: &IsoRun<'_>,
         g: &G,
-        run: &[usize],
+        run: &[u32],
         u: &mut dyn UniformSource,
         audit: &mut Audit,
         out: &mut [EvalSample],
@@ -404,6 +527,7 @@ impl ExactSet {
         let rec = &cell.iso[at.q.interval];
         let table = cell.tables[at.q.interval].as_ref();
         for &k in run {
+            let k = k as usize;
             let drawn = match table {
                 Some(table) => table.draw(g, u, audit),
                 None => iv.tree.sample_envelope_of(g, u, audit),
@@ -424,7 +548,7 @@ impl ExactSet {
         brdf: &dyn Brdf,
         q: &Query,
         wo: &Vec3,
-        run: &[usize],
+        run: &[u32],
         u: &mut dyn UniformSource,
         audit: &mut Audit,
         out: &mut [EvalSample],
@@ -443,7 +567,7 @@ impl ExactSet {
                 let a = self.normaliser_of(q);
                 let served = q.wo == *wo;
                 let emit = |i: usize, d: Option<Drawn>| {
-                    out[run[i]] = match d {
+                    out[run[i] as usize] = match d {
                         Some((_, v, gx)) => {
                             let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
                             self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
@@ -461,6 +585,7 @@ impl ExactSet {
         let a = self.normaliser_of(q);
         let served = q.wo == *wo;
         for &k in run {
+            let k = k as usize;
             let drawn = match table {
                 Some(table) => table.draw(&g, u, audit),
                 None => iv.tree.sample_envelope_of(&g, u, audit),
@@ -670,7 +795,7 @@ mod tests {
             let mut order: Vec<(usize, usize)> = wos
                 .iter()
                 .enumerate()
-                .filter_map(|(k, wo)| set.locate_grouped(wo, &offsets).map(|(_, g)| (g, k)))
+                .filter_map(|(k, wo)| set.group_of(wo, &offsets).map(|g| (g, k)))
                 .collect();
             order.sort_by_key(|&(g, _)| g);
             let mut r2 = Xoshiro256PlusPlus::seed_from_u64(3);
@@ -699,6 +824,77 @@ mod tests {
                 assert_eq!(through_runs, 0);
             }
         }
+    }
+
+    /// The batch's working arrays, kept per thread between calls, carry nothing from one batch
+    /// to the next: on one thread, after batches of another set and size (Ward: general
+    /// queries; Phong: 5000 queries, some grazing or below the horizon), a Phong batch equals
+    /// the same batch on a fresh thread, bit for bit. And batches served in passes: 3000
+    /// queries in passes of 1000 are three batches of 1000 from the same stream.
+    #[test]
+    fn kept_working_arrays_and_passes_change_nothing() {
+        let phong: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
+        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
+        let p = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
+        let w = ExactSet::build(Arc::clone(&ward), &small, None).unwrap();
+        let mut qr = Xoshiro256PlusPlus::seed_from_u64(41);
+        let mut wos = |n: usize| -> Vec<Vec3> {
+            (0..n)
+                .map(|k| match k % 97 {
+                    0 => brdf::direction_from_angles(89.995, 10.0),
+                    1 => brdf::direction_from_angles(95.0, 10.0),
+                    _ => brdf::direction_from_angles(
+                        89.0 * qr.next_uniform(),
+                        360.0 * qr.next_uniform(),
+                    ),
+                })
+                .collect()
+        };
+        let (big, ward_q, last) = (wos(5000), wos(3000), wos(700));
+        let key = |v: &[EvalSample]| -> Vec<[u64; 5]> {
+            v.iter()
+                .map(|s| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits))
+                .collect()
+        };
+        let fresh = std::thread::scope(|sc| {
+            sc.spawn(|| key(&batch(&p, phong.as_ref(), &last, 12)))
+                .join()
+                .unwrap()
+        });
+        let reused = std::thread::scope(|sc| {
+            sc.spawn(|| {
+                batch(&w, ward.as_ref(), &ward_q, 10);
+                batch(&p, phong.as_ref(), &big, 11);
+                batch(&w, ward.as_ref(), &ward_q[..50], 10);
+                key(&batch(&p, phong.as_ref(), &last, 12))
+            })
+            .join()
+            .unwrap()
+        });
+        assert_eq!(fresh, reused);
+
+        let mut r1 = Xoshiro256PlusPlus::seed_from_u64(13);
+        let mut passes = vec![EvalSample::NONE; big[..3000].len()];
+        p.sample_eval_passes(phong.as_ref(), &big[..3000], &mut r1, &mut passes, 1000);
+        let mut r2 = Xoshiro256PlusPlus::seed_from_u64(13);
+        let mut parts = Vec::new();
+        let mut out = Vec::new();
+        for part in big[..3000].chunks(1000) {
+            p.sample_eval_batch(phong.as_ref(), part, &mut r2, &mut out);
+            parts.extend_from_slice(&out);
+        }
+        assert_eq!(key(&passes), key(&parts));
+        assert_eq!(r1.next_uniform(), r2.next_uniform());
+        // One pass of all 3000 is another grouping: other samples.
+        let mut r3 = Xoshiro256PlusPlus::seed_from_u64(13);
+        p.sample_eval_batch(phong.as_ref(), &big[..3000], &mut r3, &mut out);
+        assert_ne!(key(&out), key(&parts));
     }
 
     /// The mean of `cos θi` over the batch's samples at `wo` against its exact value under the
