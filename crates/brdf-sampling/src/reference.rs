@@ -327,32 +327,7 @@ mod tests {
     #[test]
     #[ignore = "a cachegrind probe"]
     fn cornell_node_cost_probe() {
-        let env = |k: &str| std::env::var(k).ok();
-        let path = env("CORNELL_FILE")
-            .map(std::path::PathBuf::from)
-            .unwrap_or_else(|| {
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("../../../shared/data/measured/cornell/cayman.brdf")
-            });
-        let Ok(b) = brdf::CornellBrdf::load(&path) else {
-            eprintln!("skipped: {} is not readable", path.display());
-            return;
-        };
-        let theta: f64 = env("NODE_THETA")
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(30.5);
-        let budget: u64 = env("NODE_BUDGET")
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(150_000);
-        let repeat: usize = env("NODE_REPEAT").and_then(|s| s.parse().ok()).unwrap_or(1);
-        let wo = brdf::direction_from_radians(theta.to_radians(), 0.0);
-        for _ in 0..repeat {
-            let a = reference_albedo_with_budget(&b, &wo, budget).expect("node");
-            eprintln!(
-                "{} ± {:.2e} in {} evaluations",
-                a.value, a.abs_err, a.evaluations
-            );
-        }
+        cornell::node_cost_probe(|b, wo, budget| reference_albedo_with_budget(b, wo, budget));
     }
 
     const GGX_0_1_AT_89_5: f64 = 0.920_846_216_790;

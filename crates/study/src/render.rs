@@ -2753,27 +2753,19 @@ mod tests {
     fn the_product_rows_have_the_law_of_the_per_pixel_mis_and_a_misordered_row_fails() {
         use statrs::distribution::{ChiSquared, ContinuousCDF};
         let px = 10;
-        let SkyScene {
-            light,
-            brdfs,
-            built,
-            light_sampler,
-            pyramid,
-            hs,
-            segs,
-        } = sky_scene(px);
+        let sc = sky_scene(px);
         let spp = 300;
         let render = |pyr: &PowerPyramid, reverse: bool| -> Vec<[f64; 3]> {
             let mut out = Vec::new();
-            for r in &segs {
-                let seg = &hs[r.clone()];
+            for r in &sc.segs {
+                let seg = &sc.hs[r.clone()];
                 let b = seg[0].sphere;
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(47, r.start as u64));
                 let mut v = product_row(
-                    brdfs[b].as_ref(),
-                    &light,
+                    sc.brdfs[b].as_ref(),
+                    &sc.light,
                     seg,
-                    built[b].as_ref(),
+                    sc.built[b].as_ref(),
                     pyr,
                     spp,
                     &mut rng,
@@ -2785,16 +2777,24 @@ mod tests {
             }
             out
         };
-        let one = one_query_mis(&hs, &brdfs, &built, &light, &light_sampler, spp, 43);
+        let one = one_query_mis(
+            &sc.hs,
+            &sc.brdfs,
+            &sc.built,
+            &sc.light,
+            &sc.light_sampler,
+            spp,
+            43,
+        );
         let limit = |k: usize| ChiSquared::new(k as f64).unwrap().inverse_cdf(1.0 - 1e-3);
-        let (x, k) = chi2(&render(&pyramid, false), &one);
+        let (x, k) = chi2(&render(&sc.pyramid, false), &one);
         assert!(k > 100, "{k} lit pixels");
         eprintln!(
             "product rows: Σz² = {x:.1} over {k} pixels (limit {:.1})",
             limit(k)
         );
         assert!(x < limit(k), "Σz² = {x:.1} over {k} pixels");
-        let (x, k) = chi2(&render(&pyramid, true), &one);
+        let (x, k) = chi2(&render(&sc.pyramid, true), &one);
         eprintln!("reversed product rows: Σz² = {x:.1}");
         assert!(x > limit(k), "reversed rows not caught: Σz² = {x:.1}");
     }
@@ -2813,38 +2813,30 @@ mod tests {
     fn the_reference_error_estimate_matches_its_error_over_independent_references() {
         let px = 10;
         let width = 2 * px;
-        let SkyScene {
-            light,
-            brdfs,
-            built,
-            light_sampler,
-            pyramid,
-            hs,
-            segs,
-        } = sky_scene(px);
+        let sc = sky_scene(px);
         let pixels = width * px;
         let mis = |spp: usize, seed: u64| {
             render_segments(
-                &hs,
-                &segs,
+                &sc.hs,
+                &sc.segs,
                 pixels,
                 |seg, rng| {
                     let b = seg[0].sphere;
-                    let (brdf, smp) = (brdfs[b].as_ref(), built[b].as_ref());
-                    mis_row(brdf, &light, seg, smp, &light_sampler, spp, rng)
+                    let (brdf, smp) = (sc.brdfs[b].as_ref(), sc.built[b].as_ref());
+                    mis_row(brdf, &sc.light, seg, smp, &sc.light_sampler, spp, rng)
                 },
                 seed,
             )
         };
         let product = |spp: usize, seed: u64| {
             render_segments(
-                &hs,
-                &segs,
+                &sc.hs,
+                &sc.segs,
                 pixels,
                 |seg, rng| {
                     let b = seg[0].sphere;
-                    let (brdf, smp) = (brdfs[b].as_ref(), built[b].as_ref());
-                    product_row(brdf, &light, seg, smp, &pyramid, spp, rng)
+                    let (brdf, smp) = (sc.brdfs[b].as_ref(), sc.built[b].as_ref());
+                    product_row(brdf, &sc.light, seg, smp, &sc.pyramid, spp, rng)
                 },
                 seed,
             )

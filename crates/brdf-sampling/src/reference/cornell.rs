@@ -210,6 +210,42 @@ pub(crate) fn cornell_node_albedo(
     Ok(a)
 }
 
+/// The Cornell node probes' workload (`reference::tests::cornell_node_cost_probe`, and this
+/// module's with the quadrature evaluator): env `CORNELL_FILE` (default the shared `cayman`),
+/// `NODE_THETA` (degrees, 30.5), `NODE_BUDGET` (1.5·10⁵ evaluations), `NODE_REPEAT` (1) nodes
+/// by `node`, each printed; a file that is not readable skips.
+#[cfg(test)]
+pub(crate) fn node_cost_probe(
+    node: impl Fn(&CornellBrdf, &brdf::Vec3, u64) -> Result<AlbedoEstimate, ReferenceError>,
+) {
+    let env = |k: &str| std::env::var(k).ok();
+    let path = env("CORNELL_FILE")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../../shared/data/measured/cornell/cayman.brdf")
+        });
+    let Ok(b) = CornellBrdf::load(&path) else {
+        eprintln!("skipped: {} is not readable", path.display());
+        return;
+    };
+    let theta: f64 = env("NODE_THETA")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(30.5);
+    let budget: u64 = env("NODE_BUDGET")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(150_000);
+    let repeat: usize = env("NODE_REPEAT").and_then(|s| s.parse().ok()).unwrap_or(1);
+    let wo = brdf::direction_from_radians(theta.to_radians(), 0.0);
+    for _ in 0..repeat {
+        let a = node(&b, &wo, budget).expect("node");
+        eprintln!(
+            "{} ± {:.2e} in {} evaluations",
+            a.value, a.abs_err, a.evaluations
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,32 +311,7 @@ mod tests {
     #[test]
     #[ignore = "a cachegrind probe"]
     fn cornell_quadrature_node_cost_probe() {
-        let env = |k: &str| std::env::var(k).ok();
-        let path = env("CORNELL_FILE")
-            .map(std::path::PathBuf::from)
-            .unwrap_or_else(|| {
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("../../../shared/data/measured/cornell/cayman.brdf")
-            });
-        let Ok(b) = CornellBrdf::load(&path) else {
-            eprintln!("skipped: {} is not readable", path.display());
-            return;
-        };
-        let theta: f64 = env("NODE_THETA")
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(30.5);
-        let budget: u64 = env("NODE_BUDGET")
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(150_000);
-        let repeat: usize = env("NODE_REPEAT").and_then(|s| s.parse().ok()).unwrap_or(1);
-        let wo = brdf::direction_from_radians(theta.to_radians(), 0.0);
-        for _ in 0..repeat {
-            let a = cornell_node_albedo(&b, &wo, budget).expect("node");
-            eprintln!(
-                "{} ± {:.2e} in {} evaluations",
-                a.value, a.abs_err, a.evaluations
-            );
-        }
+        node_cost_probe(cornell_node_albedo);
     }
 
     /// The node rule against the reference rule over the disc, for the record

@@ -306,6 +306,7 @@ pub(super) fn atan2_upper(y: f64, x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::search::tests::xorshift;
     use super::*;
 
     /// The team's Cornell files when the data repository sits beside this one, and the
@@ -324,15 +325,6 @@ mod tests {
             }
         }
         out
-    }
-
-    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        }
     }
 
     /// The direction of the equal-area disc point `(x, y)` (the reference rule's map).

@@ -625,11 +625,11 @@ impl Neighbourhood {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A xorshift64 stream of uniforms in [0, 1) (53 bits) from `state`.
-    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+    pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
         move || {
             state ^= state << 13;
             state ^= state >> 7;
