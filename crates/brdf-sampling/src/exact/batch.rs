@@ -350,6 +350,33 @@ impl<'a> Ahead<'a> {
     }
 }
 
+/// The batch path's uniform source: the caller's stream itself, or [`Ahead`] over it.
+trait Source: UniformSource {
+    /// Sets [`Ahead`]'s lower bound of the split trials still to be drawn (nothing for the
+    /// caller's stream).
+    fn set_left(&mut self, _left: usize) {}
+    /// This source as a `dyn UniformSource`.
+    fn as_dyn(&mut self) -> &mut dyn UniformSource;
+}
+
+impl Source for dyn UniformSource + '_ {
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn UniformSource {
+        self
+    }
+}
+
+impl Source for Ahead<'_> {
+    #[inline]
+    fn set_left(&mut self, left: usize) {
+        self.left = left;
+    }
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn UniformSource {
+        self
+    }
+}
+
 #[cfg(test)]
 thread_local! {
     /// Test support: `true` makes [`Ahead`] pass every call through (the reference).
@@ -587,6 +614,7 @@ impl ExactSet {
         // holds each of its runs whole), whose uniforms are filled ahead (`Ahead`).
         reach.clear();
         reach.resize(groups, 0);
+        let mut spans = false;
         if let Some(cell) = self.cells.first().filter(|_| self.isotropic) {
             let mut end = 0;
             for g in (0..groups.min(cell.tables.len())).rev() {
@@ -594,12 +622,12 @@ impl ExactSet {
                 if size == 0 || ((size as usize) < PREPARED_RUN_MIN && cell.tables[g].is_some()) {
                     end = if end == 0 { start[g + 1] } else { end };
                     reach[g] = end;
+                    spans |= size > 0;
                 } else {
                     end = 0;
                 }
             }
         }
-        let mut u = Ahead::new(u);
         let served = start[groups] as usize;
         order.clear();
         order.resize(served, 0);
@@ -610,6 +638,34 @@ impl ExactSet {
             }
         }
         let mut audit = Audit::default();
+        let (key, general, order) = (&key[..], &general[..], &order[..]);
+        if spans {
+            let mut u = Ahead::new(u);
+            self.serve_order(
+                brdf, wos, key, general, reach, order, &mut u, &mut audit, out,
+            );
+        } else {
+            // No group to fill ahead for (an anisotropic set, say): the caller's stream itself.
+            self.serve_order(brdf, wos, key, general, reach, order, u, &mut audit, out);
+        }
+        self.counters.record(&audit);
+    }
+
+    /// [`ExactSet::grouped_pass`]'s serving: the served queries in `order`, run by run, from
+    /// `u` ([`Ahead`] when some group's uniforms are filled ahead, `reach` its spans).
+    #[allow(clippy::too_many_arguments)]
+    fn serve_order<U: Source + ?Sized>(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        key: &[u32],
+        general: &[(u32, Query)],
+        reach: &[u32],
+        order: &[u32],
+        u: &mut U,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
         // Runs in the serving order: queries of one `ωo` share their interval, so a run of
         // the caller's order stays one run here.
         let mut a = 0;
@@ -625,11 +681,11 @@ impl ExactSet {
             let k = key[first];
             // Within a span of groups whose every draw is a split trial, each query from the
             // run's last to the span's end draws at least one: the uniforms filled ahead.
-            u.left = if k < GENERAL {
+            u.set_left(if k < GENERAL {
                 (reach[k as usize] as usize).saturating_sub(b - 1)
             } else {
                 0
-            };
+            });
             if k < GENERAL {
                 let cos = wo.z.min(1.0);
                 let q = IsoQuery {
@@ -640,18 +696,17 @@ impl ExactSet {
                 if b == a + 1 {
                     // A run of one query (a random ωo): the one-query path itself, whose
                     // arithmetic `serve_iso_run` repeats for a run (the same bits).
-                    let (s, f) = self.draw_iso(&q, wo, &mut u, &mut audit);
+                    let (s, f) = self.draw_iso(&q, wo, u, audit);
                     out[first] = self.finish_iso(brdf, wo, s, f);
                 } else {
-                    self.serve_iso_run(brdf, &q, wo, run, &mut u, &mut audit, out);
+                    self.serve_iso_run(brdf, &q, wo, run, u.as_dyn(), audit, out);
                 }
             } else {
                 let q = &general[(k & !GENERAL) as usize].1;
-                self.serve_general_run(brdf, q, wo, run, &mut u, &mut audit, out);
+                self.serve_general_run(brdf, q, wo, run, u.as_dyn(), audit, out);
             }
             a = b;
         }
-        self.counters.record(&audit);
     }
 
     /// The queries `run` (indices into `out`) of one isotropic query `q` at `wo`:
