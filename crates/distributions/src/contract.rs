@@ -53,6 +53,18 @@ pub trait UniformSource {
     fn next_uniform4_split(&mut self) -> [f64; 4] {
         self.next_uniform4()
     }
+
+    /// `out.len()` split trials in order: `out[k]` is the `k`-th of as many
+    /// [`Self::next_uniform4_split`] calls (the same values, the same state afterwards; one
+    /// call through a `dyn UniformSource` for a block of trials). A consumer that fills
+    /// ahead must consume every filled trial before the stream's next use, or the order (and
+    /// the state after it) changes.
+    #[inline]
+    fn fill_uniform4_split(&mut self, out: &mut [[f64; 4]]) {
+        for us in out {
+            *us = self.next_uniform4_split();
+        }
+    }
 }
 
 /// 53 random mantissa bits of `bits`: uniform on `[0, 1)` with spacing 2⁻⁵³.
@@ -86,6 +98,19 @@ impl<R: Rng + ?Sized> UniformSource for R {
             halves_unit(w1 >> 32),
             halves_unit(w1 & 0xffff_ffff),
         ]
+    }
+
+    #[inline]
+    fn fill_uniform4_split(&mut self, out: &mut [[f64; 4]]) {
+        for us in out {
+            let (w0, w1) = (self.next_u64(), self.next_u64());
+            *us = [
+                halves_unit(w0 >> 32),
+                halves_unit(w0 & 0xffff_ffff),
+                halves_unit(w1 >> 32),
+                halves_unit(w1 & 0xffff_ffff),
+            ];
+        }
     }
 }
 
@@ -211,6 +236,28 @@ mod tests {
             assert!((sums[j] / f64::from(n) - 0.5).abs() < 0.01, "{sums:?}");
             assert!(low_bits[j] > 9_000 && low_bits[j] < 11_000, "{low_bits:?}");
         }
+    }
+
+    /// A block of split trials is the same trials as one call each, in order, and leaves the
+    /// generator (and a caller-given sequence) where those calls would.
+    #[test]
+    fn a_block_of_split_trials_is_that_many_calls() {
+        let mut a = Xoshiro256PlusPlus::seed_from_u64(5);
+        let mut b = a.clone();
+        let mut block = [[0.0; 4]; 37];
+        a.fill_uniform4_split(&mut block[..0]);
+        a.fill_uniform4_split(&mut block);
+        for us in &block {
+            assert_eq!(*us, b.next_uniform4_split());
+        }
+        assert_eq!(a.next_u64(), b.next_u64());
+        let v: Vec<f64> = (0..11).map(|k| f64::from(k) / 11.0).collect();
+        let (mut s, mut t) = (UniformSequence::new(&v), UniformSequence::new(&v));
+        let mut two = [[0.0; 4]; 2];
+        s.fill_uniform4_split(&mut two);
+        assert_eq!(two, [t.next_uniform4_split(), t.next_uniform4_split()]);
+        assert_eq!(s.consumed(), 8);
+        assert_eq!(s.next_uniform(), t.next_uniform());
     }
 
     /// A caller-given sequence hands its own values, in order, to a split trial.

@@ -215,12 +215,148 @@ struct Scratch {
     start: Vec<u32>,
     /// The served queries' indices, by group, the caller's order within one.
     order: Vec<u32>,
+    /// Per group, the end in `order` of the span of groups from it on whose every draw is a
+    /// split trial, or 0 for a group of other draws (see [`Ahead`]).
+    reach: Vec<u32>,
 }
 
 thread_local! {
     /// This thread's [`Scratch`], taken for the length of a batch (a nested batch on the
     /// same thread finds none and makes its own).
     static SCRATCH: std::cell::Cell<Option<Box<Scratch>>> = const { std::cell::Cell::new(None) };
+}
+
+/// Split trials ([`UniformSource::next_uniform4_split`]) filled ahead per block call of
+/// [`Ahead`].
+const TRIALS_AHEAD: usize = 64;
+
+/// The batch path's uniforms: `src`'s split trials filled [`TRIALS_AHEAD`] at a time
+/// ([`UniformSource::fill_uniform4_split`], one call through the `dyn` per block instead of one
+/// per trial) and handed out in order — **the same trials in the same order** as calls on
+/// `src`. A block is at most `left` trials, `left` a lower bound (set by the caller) of the
+/// split trials the pass will still draw, so every filled trial is consumed and `src` ends
+/// where one call per trial would leave it. `left = 0` passes every call through.
+///
+/// Only a group whose every draw is a split trial fills ahead (in
+/// [`ExactSet::grouped_pass`]); the other calls (never made while trials are filled) take the filled trials' values one by
+/// one first (for a sequence the same values in the same order; for a generator still
+/// uniforms on `[0, 1)`), then `src`'s.
+struct Ahead<'a> {
+    src: &'a mut dyn UniformSource,
+    buf: [[f64; 4]; TRIALS_AHEAD],
+    /// The next filled trial, and the end of the filled ones.
+    pos: usize,
+    len: usize,
+    /// Within a filled trial, the next value for [`UniformSource::next_uniform`].
+    part: usize,
+    /// A lower bound of the split trials still to be drawn (see the type's doc).
+    left: usize,
+}
+
+impl<'a> Ahead<'a> {
+    fn new(src: &'a mut dyn UniformSource) -> Self {
+        Self {
+            src,
+            buf: [[0.0; 4]; TRIALS_AHEAD],
+            pos: 0,
+            len: 0,
+            part: 0,
+            left: 0,
+        }
+    }
+
+    /// The next trial when none is filled: a block of at most `left` (≥ 2) filled, else one
+    /// passed through.
+    #[inline(never)]
+    fn refill(&mut self) -> [f64; 4] {
+        let k = self.left.min(TRIALS_AHEAD);
+        #[cfg(test)]
+        let k = if NO_FILL.with(std::cell::Cell::get) {
+            0
+        } else {
+            k
+        };
+        if k < 2 {
+            return self.src.next_uniform4_split();
+        }
+        self.src.fill_uniform4_split(&mut self.buf[..k]);
+        self.pos = 1;
+        self.len = k;
+        self.buf[0]
+    }
+}
+
+/// The batch path's uniform source: the caller's stream itself, or [`Ahead`] over it.
+trait Source: UniformSource {
+    /// Sets [`Ahead`]'s lower bound of the split trials still to be drawn (nothing for the
+    /// caller's stream).
+    fn set_left(&mut self, _left: usize) {}
+    /// This source as a `dyn UniformSource`.
+    fn as_dyn(&mut self) -> &mut dyn UniformSource;
+}
+
+impl Source for dyn UniformSource + '_ {
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn UniformSource {
+        self
+    }
+}
+
+impl Source for Ahead<'_> {
+    #[inline]
+    fn set_left(&mut self, left: usize) {
+        self.left = left;
+    }
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn UniformSource {
+        self
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test support: `true` makes [`Ahead`] pass every call through (the reference).
+    static NO_FILL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+impl UniformSource for Ahead<'_> {
+    fn next_uniform(&mut self) -> f64 {
+        if self.pos < self.len {
+            let v = self.buf[self.pos][self.part];
+            self.part += 1;
+            if self.part == 4 {
+                self.part = 0;
+                self.pos += 1;
+            }
+            return v;
+        }
+        self.src.next_uniform()
+    }
+
+    fn next_uniform4(&mut self) -> [f64; 4] {
+        if self.pos < self.len {
+            return [
+                self.next_uniform(),
+                self.next_uniform(),
+                self.next_uniform(),
+                self.next_uniform(),
+            ];
+        }
+        self.src.next_uniform4()
+    }
+
+    #[inline(always)]
+    fn next_uniform4_split(&mut self) -> [f64; 4] {
+        if self.pos < self.len && self.part == 0 {
+            let us = self.buf[self.pos];
+            self.pos += 1;
+            return us;
+        }
+        if self.pos < self.len {
+            return self.next_uniform4();
+        }
+        self.refill()
+    }
 }
 
 /// The bits of a direction: queries of one run share them.
@@ -353,6 +489,7 @@ impl ExactSet {
             general,
             start,
             order,
+            reach,
         } = scratch;
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
@@ -408,6 +545,25 @@ impl ExactSet {
         for g in 0..groups {
             start[g + 1] += start[g];
         }
+        // The spans of groups whose every draw is a split trial (an empty group, or an
+        // isotropic interval with a table and fewer queries than a prepared run's: a group
+        // holds each of its runs whole), whose uniforms are filled ahead (`Ahead`).
+        reach.clear();
+        reach.resize(groups, 0);
+        let mut spans = false;
+        if let Some(cell) = self.cells.first().filter(|_| self.isotropic) {
+            let mut end = 0;
+            for g in (0..groups.min(cell.tables.len())).rev() {
+                let size = start[g + 1] - start[g];
+                if size == 0 || ((size as usize) < PREPARED_RUN_MIN && cell.tables[g].is_some()) {
+                    end = if end == 0 { start[g + 1] } else { end };
+                    reach[g] = end;
+                    spans |= size > 0;
+                } else {
+                    end = 0;
+                }
+            }
+        }
         let served = start[groups] as usize;
         order.clear();
         order.resize(served, 0);
@@ -418,6 +574,34 @@ impl ExactSet {
             }
         }
         let mut audit = Audit::default();
+        let (key, general, order) = (&key[..], &general[..], &order[..]);
+        if spans {
+            let mut u = Ahead::new(u);
+            self.serve_order(
+                brdf, wos, key, general, reach, order, &mut u, &mut audit, out,
+            );
+        } else {
+            // No group to fill ahead for (an anisotropic set, say): the caller's stream itself.
+            self.serve_order(brdf, wos, key, general, reach, order, u, &mut audit, out);
+        }
+        self.counters.record(&audit);
+    }
+
+    /// [`ExactSet::grouped_pass`]'s serving: the served queries in `order`, run by run, from
+    /// `u` ([`Ahead`] when some group's uniforms are filled ahead, `reach` its spans).
+    #[allow(clippy::too_many_arguments)]
+    fn serve_order<U: Source + ?Sized>(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        key: &[u32],
+        general: &[(u32, Query)],
+        reach: &[u32],
+        order: &[u32],
+        u: &mut U,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
         // Runs in the serving order: queries of one `ωo` share their interval, so a run of
         // the caller's order stays one run here.
         let mut a = 0;
@@ -431,6 +615,13 @@ impl ExactSet {
             }
             let run = &order[a..b];
             let k = key[first];
+            // Within a span of groups whose every draw is a split trial, each query from the
+            // run's last to the span's end draws at least one: the uniforms filled ahead.
+            u.set_left(if k < GENERAL {
+                (reach[k as usize] as usize).saturating_sub(b - 1)
+            } else {
+                0
+            });
             if k < GENERAL {
                 let cos = wo.z.min(1.0);
                 let q = IsoQuery {
@@ -441,18 +632,17 @@ impl ExactSet {
                 if b == a + 1 {
                     // A run of one query (a random ωo): the one-query path itself, whose
                     // arithmetic `serve_iso_run` repeats for a run (the same bits).
-                    let (s, f) = self.draw_iso(&q, wo, u, &mut audit);
+                    let (s, f) = self.draw_iso(&q, wo, u, audit);
                     out[first] = self.finish_iso(brdf, wo, s, f);
                 } else {
-                    self.serve_iso_run(brdf, &q, wo, run, u, &mut audit, out);
+                    self.serve_iso_run(brdf, &q, wo, run, u.as_dyn(), audit, out);
                 }
             } else {
                 let q = &general[(k & !GENERAL) as usize].1;
-                self.serve_general_run(brdf, q, wo, run, u, &mut audit, out);
+                self.serve_general_run(brdf, q, wo, run, u.as_dyn(), audit, out);
             }
             a = b;
         }
-        self.counters.record(&audit);
     }
 
     /// The queries `run` (indices into `out`) of one isotropic query `q` at `wo`:
@@ -823,6 +1013,71 @@ mod tests {
             } else {
                 assert_eq!(through_runs, 0);
             }
+        }
+    }
+
+    /// The uniforms filled ahead (`Ahead`) are the trials one call each would draw: random-ωo
+    /// batches (some grazing, some below the horizon) around a run drawn by the wavefront
+    /// (Phong with a block-preferring run) or of general queries (Ward) give the same samples
+    /// bit for bit, and leave the generator in the same state (the next batch and word
+    /// equal), as with every call passed through.
+    #[test]
+    fn uniforms_filled_ahead_change_no_sample_and_no_stream_state() {
+        use super::{NO_FILL, PREPARED_RUN_MIN};
+        let phong = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks: true,
+        });
+        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
+        let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
+            [(phong.clone(), ExactOptions::default()), (ward, small)];
+        for (brdf, opts) in cases {
+            let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+            let mut qr = Xoshiro256PlusPlus::seed_from_u64(31);
+            let mut random = |n: usize| -> Vec<Vec3> {
+                (0..n)
+                    .map(|k| match k % 97 {
+                        0 => brdf::direction_from_angles(89.995, 10.0),
+                        1 => brdf::direction_from_angles(95.0, 10.0),
+                        _ => brdf::direction_from_angles(
+                            89.0 * qr.next_uniform(),
+                            360.0 * qr.next_uniform(),
+                        ),
+                    })
+                    .collect()
+            };
+            // Random ωo around a run long enough for the prepared run (drawn by the
+            // wavefront: other calls than split trials), and a short run.
+            let mut wos = random(1500);
+            let at = wos[7];
+            wos.extend(std::iter::repeat_n(at, PREPARED_RUN_MIN + 20));
+            wos.extend(random(1200));
+            wos.extend(std::iter::repeat_n(wos[20], 6));
+            wos.extend(random(300));
+            let key = |v: &[EvalSample]| -> Vec<[u64; 5]> {
+                v.iter()
+                    .map(|s| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits))
+                    .collect()
+            };
+            let mut drawn = Vec::new();
+            for no_fill in [false, true] {
+                NO_FILL.with(|c| c.set(no_fill));
+                let mut r = Xoshiro256PlusPlus::seed_from_u64(17);
+                let mut out = Vec::new();
+                set.sample_eval_batch(brdf.as_ref(), &wos, &mut r, &mut out);
+                let first = key(&out);
+                set.sample_eval_batch(brdf.as_ref(), &wos[..2000], &mut r, &mut out);
+                drawn.push((first, key(&out), r.next_uniform().to_bits()));
+            }
+            NO_FILL.with(|c| c.set(false));
+            assert!(drawn[0] == drawn[1], "{}", brdf.name());
         }
     }
 
