@@ -877,6 +877,34 @@ mod tests {
         blocks: bool,
     }
 
+    /// Anisotropic Ward (`alpha_x = 0.2, alpha_y = 0.4`) with options for a quick build (the
+    /// general batch path's cases).
+    fn small_ward() -> (Arc<dyn Brdf>, ExactOptions) {
+        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
+        let small = ExactOptions {
+            max_trials: 8.0,
+            normaliser_tol: 1e-3,
+            initial_phi_cells: 4,
+            ..ExactOptions::default()
+        };
+        (ward, small)
+    }
+
+    /// Phong `n = 50` with a counting caller-held run whose `prefers_blocks` is `blocks`, and
+    /// the two cases of the run tests: that Phong with the default options, [`small_ward`].
+    #[allow(clippy::type_complexity)]
+    fn phong_and_small_ward(blocks: bool) -> (Arc<WithRun>, [(Arc<dyn Brdf>, ExactOptions); 2]) {
+        let phong = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks,
+        });
+        let (ward, small) = small_ward();
+        let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
+            [(phong.clone(), ExactOptions::default()), (ward, small)];
+        (phong, cases)
+    }
+
     struct Run<'a> {
         brdf: &'a WithRun,
         wo: Vec3,
@@ -928,20 +956,7 @@ mod tests {
     #[test]
     fn runs_of_one_wo_draw_the_one_query_paths_bits() {
         use super::PREPARED_RUN_MIN;
-        let phong = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: false,
-        });
-        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
-        let small = ExactOptions {
-            max_trials: 8.0,
-            normaliser_tol: 1e-3,
-            initial_phi_cells: 4,
-            ..ExactOptions::default()
-        };
-        let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
-            [(phong.clone(), ExactOptions::default()), (ward, small)];
+        let (phong, cases) = phong_and_small_ward(false);
         for (brdf, opts) in cases {
             let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
             let mut qr = Xoshiro256PlusPlus::seed_from_u64(21);
@@ -1024,20 +1039,7 @@ mod tests {
     #[test]
     fn uniforms_filled_ahead_change_no_sample_and_no_stream_state() {
         use super::{NO_FILL, PREPARED_RUN_MIN};
-        let phong = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: true,
-        });
-        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
-        let small = ExactOptions {
-            max_trials: 8.0,
-            normaliser_tol: 1e-3,
-            initial_phi_cells: 4,
-            ..ExactOptions::default()
-        };
-        let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
-            [(phong.clone(), ExactOptions::default()), (ward, small)];
+        let (_, cases) = phong_and_small_ward(true);
         for (brdf, opts) in cases {
             let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
             let mut qr = Xoshiro256PlusPlus::seed_from_u64(31);
@@ -1089,13 +1091,7 @@ mod tests {
     #[test]
     fn kept_working_arrays_and_passes_change_nothing() {
         let phong: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
-        let ward: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.2,alpha_y=0.4").unwrap());
-        let small = ExactOptions {
-            max_trials: 8.0,
-            normaliser_tol: 1e-3,
-            initial_phi_cells: 4,
-            ..ExactOptions::default()
-        };
+        let (ward, small) = small_ward();
         let p = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
         let w = ExactSet::build(Arc::clone(&ward), &small, None).unwrap();
         let mut qr = Xoshiro256PlusPlus::seed_from_u64(41);
