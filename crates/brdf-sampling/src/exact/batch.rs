@@ -877,6 +877,20 @@ mod tests {
         blocks: bool,
     }
 
+    /// `n` outgoing directions from `qr`: uniform in θo ∈ [0°, 89°) and φo, except every 97th
+    /// grazing (89.995°) and the next below the horizon (95°).
+    fn mixed_wos(qr: &mut Xoshiro256PlusPlus, n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|k| match k % 97 {
+                0 => brdf::direction_from_angles(89.995, 10.0),
+                1 => brdf::direction_from_angles(95.0, 10.0),
+                _ => {
+                    brdf::direction_from_angles(89.0 * qr.next_uniform(), 360.0 * qr.next_uniform())
+                }
+            })
+            .collect()
+    }
+
     /// Anisotropic Ward (`alpha_x = 0.2, alpha_y = 0.4`) with options for a quick build (the
     /// general batch path's cases).
     fn small_ward() -> (Arc<dyn Brdf>, ExactOptions) {
@@ -1043,18 +1057,7 @@ mod tests {
         for (brdf, opts) in cases {
             let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
             let mut qr = Xoshiro256PlusPlus::seed_from_u64(31);
-            let mut random = |n: usize| -> Vec<Vec3> {
-                (0..n)
-                    .map(|k| match k % 97 {
-                        0 => brdf::direction_from_angles(89.995, 10.0),
-                        1 => brdf::direction_from_angles(95.0, 10.0),
-                        _ => brdf::direction_from_angles(
-                            89.0 * qr.next_uniform(),
-                            360.0 * qr.next_uniform(),
-                        ),
-                    })
-                    .collect()
-            };
+            let mut random = |n: usize| mixed_wos(&mut qr, n);
             // Random ωo around a run long enough for the prepared run (drawn by the
             // wavefront: other calls than split trials), and a short run.
             let mut wos = random(1500);
@@ -1095,18 +1098,7 @@ mod tests {
         let p = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
         let w = ExactSet::build(Arc::clone(&ward), &small, None).unwrap();
         let mut qr = Xoshiro256PlusPlus::seed_from_u64(41);
-        let mut wos = |n: usize| -> Vec<Vec3> {
-            (0..n)
-                .map(|k| match k % 97 {
-                    0 => brdf::direction_from_angles(89.995, 10.0),
-                    1 => brdf::direction_from_angles(95.0, 10.0),
-                    _ => brdf::direction_from_angles(
-                        89.0 * qr.next_uniform(),
-                        360.0 * qr.next_uniform(),
-                    ),
-                })
-                .collect()
-        };
+        let mut wos = |n: usize| mixed_wos(&mut qr, n);
         let (big, ward_q, last) = (wos(5000), wos(3000), wos(700));
         let key = |v: &[EvalSample]| -> Vec<[u64; 5]> {
             v.iter()
