@@ -560,15 +560,21 @@ mod tests {
             envmap::SamplerKind::Adaptive(envmap::AdaptiveOptions::default()),
         )
         .unwrap();
-        let sampler = samplers::find("adaptive-exact")
+        let sampler = adaptive_exact(&brdf);
+        (map, brdf, pyr, light, sampler)
+    }
+
+    /// `adaptive-exact` built for `brdf` with the default set options (the defensive sampler
+    /// of these tests).
+    fn adaptive_exact(brdf: &std::sync::Arc<dyn Brdf>) -> std::sync::Arc<dyn DirectionSampler> {
+        samplers::find("adaptive-exact")
             .unwrap()
             .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
+                std::sync::Arc::clone(brdf),
                 &brdf_sampling::SetOptions::default(),
             ))
             .unwrap()
-            .sampler;
-        (map, brdf, pyr, light, sampler)
+            .sampler
     }
 
     fn options() -> ProductOptions {
@@ -730,14 +736,7 @@ mod tests {
         let pyr = PowerPyramid::new(&m);
         let spec = "phong:n=50,ks=0.7,kd=0.3";
         let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(spec).unwrap());
-        let sampler = samplers::find("adaptive-exact")
-            .unwrap()
-            .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
-                &brdf_sampling::SetOptions::default(),
-            ))
-            .unwrap()
-            .sampler;
+        let sampler = adaptive_exact(&brdf);
         // A pyramid of another map (the window 10× dimmer, the patch 10× dimmer, the
         // background brighter towards the right): a poor product density, the estimator must
         // stay unbiased. (A map without the window at all is also unbiased but heavy-tailed:
@@ -841,14 +840,7 @@ mod tests {
         );
         let light = envmap::EnvMapSampler::piecewise_constant(&map).unwrap();
         let settings = options.product_settings();
-        let sampler = samplers::find("adaptive-exact")
-            .unwrap()
-            .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
-                &brdf_sampling::SetOptions::default(),
-            ))
-            .unwrap()
-            .sampler;
+        let sampler = adaptive_exact(&brdf);
         let mut pick = Xoshiro256PlusPlus::seed_from_u64(3);
         let (spp, reps) = (64, 100);
         let mut ratios = Vec::new();
@@ -919,14 +911,7 @@ mod tests {
             std::env::var("PRODUCT_BRDF").unwrap_or_else(|_| "phong:n=50,ks=0.7,kd=0.3".into());
         let brdf: std::sync::Arc<dyn Brdf> = std::sync::Arc::from(brdf::parse_spec(&spec).unwrap());
         let pyr = PowerPyramid::new(&map);
-        let sampler = samplers::find("adaptive-exact")
-            .unwrap()
-            .build_direction(&samplers::DirectionRequest::new(
-                std::sync::Arc::clone(&brdf),
-                &brdf_sampling::SetOptions::default(),
-            ))
-            .unwrap()
-            .sampler;
+        let sampler = adaptive_exact(&brdf);
         let d = ProductOptions::default();
         let variants = [
             ("default (16 cells, 16 splits, α 0.25)", d),
