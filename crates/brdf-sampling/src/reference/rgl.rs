@@ -189,8 +189,10 @@ impl<'a> CellRule<'a> {
             .fold((0.0, 0), |(s, e), &(v, n)| (s + v, e + n))
     }
 
-    /// `(∫ f cos θi · 8π² u sin θm (ωo·m) du, evaluations)` along the line `u_m.y = y`.
-    fn inner(&self, y: f64) -> (f64, u64) {
+    /// The line `u_m.y = y`: its azimuth `(cos φ, sin φ)` and the sorted breaks of its pieces
+    /// on `[0, x_max]` (the grids' kinks and the horizon's cut `x_max`); `None` when the line
+    /// has no length above the horizon.
+    fn line_breaks(&self, y: f64) -> Option<(f64, f64, Vec<f64>)> {
         let phi = TAU * y - PI;
         let (sin_p, cos_p) = phi.sin_cos();
         let (sin_o, cos_o) = self.theta_o.sin_cos();
@@ -198,7 +200,7 @@ impl<'a> CellRule<'a> {
         let theta_max = (0.5 * alpha + FRAC_PI_4).clamp(0.0, FRAC_PI_2);
         let x_max = (theta_max / FRAC_PI_2).sqrt();
         if !(x_max > 0.0) {
-            return (0.0, 0);
+            return None;
         }
         let vndf = self.rgl.vndf();
         let s_y = vndf.invert([0.0, y], self.theta_o).0[1];
@@ -216,6 +218,14 @@ impl<'a> CellRule<'a> {
         b.push(0.0);
         b.push(x_max);
         sort_merge(&mut b);
+        Some((cos_p, sin_p, b))
+    }
+
+    /// `(∫ f cos θi · 8π² u sin θm (ωo·m) du, evaluations)` along the line `u_m.y = y`.
+    fn inner(&self, y: f64) -> (f64, u64) {
+        let Some((cos_p, sin_p, b)) = self.line_breaks(y) else {
+            return (0.0, 0);
+        };
         let (total, evaluations) = LINE.with(|line| {
             let mut line = line.borrow_mut();
             self.line_integral(&b, cos_p, sin_p, &mut line)
@@ -426,31 +436,9 @@ pub(crate) mod tests {
     /// The line integral as the rule computed it before the gathered blocks: each piece by
     /// [`GaussLegendre::integrate`], one evaluation per point.
     fn inner_pointwise(rule: &CellRule<'_>, y: f64) -> (f64, u64) {
-        let phi = TAU * y - PI;
-        let (sin_p, cos_p) = phi.sin_cos();
-        let (sin_o, cos_o) = rule.theta_o.sin_cos();
-        let alpha = (sin_o * cos_p).atan2(cos_o);
-        let theta_max = (0.5 * alpha + FRAC_PI_4).clamp(0.0, FRAC_PI_2);
-        let x_max = (theta_max / FRAC_PI_2).sqrt();
-        if !(x_max > 0.0) {
+        let Some((cos_p, sin_p, b)) = rule.line_breaks(y) else {
             return (0.0, 0);
-        }
-        let vndf = rule.rgl.vndf();
-        let s_y = vndf.invert([0.0, y], rule.theta_o).0[1];
-        let mut b: Vec<f64> = rule
-            .x_nodes
-            .iter()
-            .copied()
-            .chain(
-                rule.s_nodes
-                    .iter()
-                    .map(|&sx| vndf.sample([sx, s_y], rule.theta_o).0[0]),
-            )
-            .filter(|&x| x < x_max)
-            .collect();
-        b.push(0.0);
-        b.push(x_max);
-        sort_merge(&mut b);
+        };
         let wo = &rule.wo;
         let f = |x: f64| {
             let theta_m = x * x * FRAC_PI_2;
