@@ -88,6 +88,7 @@ mod report;
 mod sampler;
 mod set;
 mod set_table;
+mod sub_box;
 mod table;
 mod tabulated;
 mod walk;
