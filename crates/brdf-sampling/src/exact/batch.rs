@@ -744,7 +744,7 @@ impl ExactSet {
         out: &mut [EvalSample],
     ) {
         let iv = self.interval(q);
-        let table = self.cells[q.cell].table_at(q.interval, &q.keys);
+        let table = self.cells[q.cell].tables[q.interval].as_ref();
         if let Some(table) = table.filter(|_| self.isotropic && run.len() >= PREPARED_RUN_MIN) {
             // `QueryDensity::in_frame`'s frame for an isotropic set: ωo turned back by the
             // query's rotation, the trials' directions unrotated.

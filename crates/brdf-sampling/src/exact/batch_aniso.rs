@@ -196,7 +196,7 @@ impl ExactSet {
         let i = q.interval as usize;
         let iv = &c.intervals[i];
         let g = QueryDensity::in_frame(self.brdf.as_ref(), false, wo, q.turn, iv.map);
-        let drawn = match c.table_at(i, &q.keys) {
+        let drawn = match &c.tables[i] {
             Some(table) => table.draw(&|p| g.at(p), u, audit),
             None => iv.tree.sample_envelope_of(&|p| g.at(p), u, audit),
         };
@@ -242,9 +242,8 @@ impl ExactSet {
         let g = QueryDensity::in_frame(self.brdf.as_ref(), false, wo, q.turn, iv.map);
         let g = |p| g.at(p);
         let mut a = None;
-        let table = c.table_at(i, &q.keys);
         for &k in run {
-            let drawn = match table {
+            let drawn = match &c.tables[i] {
                 Some(table) => table.draw(&g, u, audit),
                 None => iv.tree.sample_envelope_of(&g, u, audit),
             };

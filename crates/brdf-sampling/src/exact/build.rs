@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use crate::options::SetOptions;
 use crate::set::layout_for;
 
-use super::build_interval::{Built, IntervalContext, build_interval, sub_box_bounds, values_of};
+use super::build_interval::{Built, IntervalContext, build_interval, values_of};
 use super::error::ExactError;
 use super::grid::{EDGE_BITS, Grid, MAX_BREAKS, TableVar, initial_breaks, table_var, theta_kinks};
 use super::interval::Interval;
@@ -85,10 +85,7 @@ impl ExactSet {
                     .map(Arc::new);
         }
         phases.plan = lap.take();
-        let mut done = run_jobs(&brdf, options, &plan, progress, &mut phases)?;
-        if !plan.isotropic {
-            sub_box_pass(&brdf, options, &plan, &mut done)?;
-        }
+        let done = run_jobs(&brdf, options, &plan, progress, &mut phases)?;
         let cells = assemble_cells(done, &plan);
         let set = Self {
             brdf,
@@ -342,29 +339,6 @@ fn run_jobs(
         jobs.extend(next.into_iter().rev());
     }
     Ok(done)
-}
-
-/// The leaf bounds per (θo, δ) sub-box of every kept anisotropic interval
-/// ([`super::sub_box`], `build_interval::sub_box_bounds`), in parallel; the layout is final.
-fn sub_box_pass(
-    brdf: &Arc<dyn Brdf>,
-    options: &ExactOptions,
-    plan: &Plan,
-    done: &mut [(usize, Placed)],
-) -> Result<(), ExactError> {
-    done.par_iter_mut().try_for_each(|(cell, (num, dnum, iv))| {
-        let job = Job {
-            cell: *cell,
-            num: *num,
-            dnum: *dnum,
-            inherited: Arc::new(Inheritance::default()),
-        };
-        let ctx = plan.context(&job);
-        let (split, bounds) = sub_box_bounds(brdf, options, &job, &ctx, iv.tree.tree())?;
-        iv.sub_split = split.unwrap_or([f64::NAN; 2]);
-        iv.sub_bounds = bounds;
-        Ok(())
-    })
 }
 
 /// The axis to halve (`Some(true)`: δ), if any: too many trials (either axis, `trials_axis`

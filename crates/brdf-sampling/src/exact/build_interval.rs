@@ -4,8 +4,7 @@ use std::sync::Arc;
 
 use brdf::{Brdf, direction_from_radians, rotate_z};
 use partition_sampler::{
-    GridOptions, LeafChoice, QuadTree, QuadTreeBuilder, QuadTreeSampler, RegionStats, Scheme,
-    TreeParams,
+    GridOptions, LeafChoice, QuadTree, QuadTreeBuilder, QuadTreeSampler, Scheme, TreeParams,
 };
 
 use crate::disc::{DiscBrdf, DiscMap, SliceDensity};
@@ -662,8 +661,6 @@ fn finish_interval(
         norm_err,
         quad_err,
         evaluations,
-        sub_split: [f64::NAN; 2],
-        sub_bounds: Vec::new(),
     })
 }
 
@@ -708,154 +705,6 @@ pub(super) fn worst_trials(table: &ChebyshevTable, volume: f64, var: TableVar) -
         .enumerate()
         .map(|(k, ac)| volume * var.cos(table.theta[k / table.delta.len()]) / ac)
         .fold(0.0, f64::max)
-}
-
-/// The θ and δ of the splits of `job`'s interval into sub-boxes ([`super::sub_box`]): its
-/// middle θ bound node (clamped to [`THETA_TOP_DEG`] as the nodes are) and middle δ bound node;
-/// `None` for isotropic intervals and when there is no middle node along an axis (fewer than 3
-/// θ nodes, or an even count: [`ExactOptions::bound_nodes`]).
-pub(super) fn sub_split(
-    options: &ExactOptions,
-    job: &Job,
-    ctx: &IntervalContext,
-) -> Option<[f64; 2]> {
-    let grid = ctx.grid;
-    let n_delta = delta_node_count(options, ctx.delta);
-    if grid.half == 0.0 || grid.m < 2 || grid.m % 2 != 0 || n_delta < 3 || n_delta % 2 != 1 {
-        return None;
-    }
-    let theta = grid
-        .node(job.num, grid.m / 2)
-        .1
-        .min(THETA_TOP_DEG.to_radians());
-    let delta = delta_nodes(&grid, job, false, n_delta)[n_delta / 2];
-    Some([theta, delta])
-}
-
-/// The leaf bounds of `tree` (the kept interval of `job`) per sub-box ([`super::sub_box`]):
-/// [`SUBS`](super::sub_box::SUBS) runs of one `f32` per leaf, sub-box `(iθ, iδ)` the run
-/// `iθ · SUB_DELTA + iδ`; with the splits. For each sub-box, the envelope of the interval's bound
-/// nodes inside it (closed: the middle nodes belong to both sides) is mapped by the build's
-/// image map (the same grid, refinement, rim band, safety factor and dilation as
-/// [`envelope_tree`]) with the peak track of the sub-box's outgoing directions, and leaf `i`
-/// gets `min(M_i, region(leaf_i) rounded up to f32)`. Empty (and `None`) when the interval has
-/// no sub-boxes ([`sub_split`]).
-pub(super) fn sub_box_bounds(
-    brdf: &Arc<dyn Brdf>,
-    options: &ExactOptions,
-    job: &Job,
-    ctx: &IntervalContext,
-    tree: &QuadTree,
-) -> Result<(Option<[f64; 2]>, Vec<f32>), ExactError> {
-    use super::sub_box::{SUB_DELTA, SUB_THETA, SUBS};
-    let Some(split) = sub_split(options, job, ctx) else {
-        return Ok((None, Vec::new()));
-    };
-    let span = Span::new(brdf.as_ref(), options, job, ctx);
-    let n_delta = delta_node_count(options, ctx.delta);
-    let n_theta = ctx.grid.m as usize + 1;
-    let nodes = bound_nodes(brdf, job, ctx, &span, n_delta);
-    debug_assert_eq!(nodes.len(), n_theta * n_delta);
-    let track_all = delta_nodes(
-        &ctx.grid,
-        job,
-        false,
-        PEAK_TRACK_DELTAS.max(4 * n_delta - 3),
-    );
-    let leaves: Vec<partition_sampler::LeafInfo> = tree.leaves().collect();
-    let mut bounds = vec![0.0f32; SUBS * leaves.len()];
-    let set = &options.set;
-    let (mt, md) = (n_theta / 2, n_delta / 2);
-    // Sub-box `k` of `n` (1 or 2) along an axis of `count` nodes split at node `mid` (value
-    // `at`) over `[lo, hi]`: its nodes and its range.
-    let part =
-        |k: usize, n: usize, count: usize, mid: usize, lo: f64, at: f64, hi: f64| match (n, k) {
-            (1, _) => (0..=count - 1, lo, hi),
-            (_, 0) => (0..=mid, lo, at),
-            _ => (mid..=count - 1, at, hi),
-        };
-    for it in 0..SUB_THETA {
-        let (ti, ta, tb) = part(it, SUB_THETA, n_theta, mt, span.ta, split[0], span.tb);
-        for id in 0..SUB_DELTA {
-            let (di, da, db) = part(
-                id,
-                SUB_DELTA,
-                n_delta,
-                md,
-                ctx.delta[0],
-                split[1],
-                ctx.delta[1],
-            );
-            let sub_nodes: Vec<EnvelopeNode> = ti
-                .clone()
-                .flat_map(|i| di.clone().map(move |j| i * n_delta + j))
-                .map(|k| {
-                    let n = &nodes[k];
-                    EnvelopeNode::new(n.key, n.wo, n.delta, None, false)
-                })
-                .collect();
-            let envelope = Arc::new(IntervalEnvelope::new(Arc::clone(brdf), sub_nodes, true));
-            let centre = direction_from_radians(0.5 * (ta + tb), ctx.phi_k);
-            let f = DiscBrdf::with_map(Arc::clone(&envelope) as Arc<dyn Brdf>, centre, span.map)
-                .with_blocks(Arc::clone(&envelope) as Arc<dyn crate::disc::DirectionBlock>);
-            let counter = EvalCounter::new();
-            let grid_options = GridOptions {
-                refinement: set.grid_refinement,
-                mirror_y: span.mirror_y,
-                ..GridOptions::default()
-            };
-            let image = SliceImageMap::new(
-                Counted {
-                    f: &f,
-                    counter: &counter,
-                },
-                set.grid,
-                set.safety_factor,
-                set.dilation_for(brdf.as_ref()),
-                &grid_options,
-            )
-            .map_err(|source| SetError::Density {
-                slice: span.slice,
-                theta_deg: span.theta_deg,
-                phi_deg: span.phi_deg,
-                source,
-            })?;
-            // The track's δ inside the sub-box (its ends included: the middle node is one).
-            let track_deltas: Vec<f64> = track_all
-                .iter()
-                .copied()
-                .filter(|&d| d >= da && d <= db)
-                .collect();
-            let image = image.with_track(peak_track(
-                brdf.as_ref(),
-                ta,
-                tb,
-                ctx.phi_k,
-                &track_deltas,
-                span.map,
-            ));
-            let s = it * SUB_DELTA + id;
-            for (b, leaf) in bounds[s * leaves.len()..(s + 1) * leaves.len()]
-                .iter_mut()
-                .zip(&leaves)
-            {
-                let own = leaf.max_bound as f32;
-                let m = image.region(&leaf.rect).max_bound;
-                *b = if m.is_finite() && m >= 0.0 {
-                    round_up_f32(m).min(own)
-                } else {
-                    own
-                };
-            }
-        }
-    }
-    Ok((Some(split), bounds))
-}
-
-/// The smallest `f32` at least `x` (`x` finite, ≥ 0).
-fn round_up_f32(x: f64) -> f32 {
-    let r = x as f32;
-    if f64::from(r) < x { r.next_up() } else { r }
 }
 
 /// The axis to halve (`Some(true)`: δ) should the interval's mean trials exceed the cap, if it

@@ -30,12 +30,6 @@ pub(super) struct Interval {
     /// The quadrature's part of it.
     pub(super) quad_err: f64,
     pub(super) evaluations: u64,
-    /// Anisotropic intervals: the θ and δ of the splits into sub-boxes (the middle bound
-    /// nodes; NaN: none), see [`super::sub_box`].
-    pub(super) sub_split: [f64; 2],
-    /// Anisotropic intervals: the leaf bounds per sub-box, [`super::sub_box::SUBS`] runs of one
-    /// `f32` per leaf of `tree` (empty: none; the interval's own bounds serve every query).
-    pub(super) sub_bounds: Vec<f32>,
 }
 
 impl Interval {

@@ -4,7 +4,6 @@ use crate::layout::Turn;
 
 use super::grid::{Grid, TableVar};
 use super::interval::Interval;
-use super::sub_box::SubTables;
 use super::table::LeafTable;
 use super::walk::TAN_HALF_MAX;
 
@@ -49,10 +48,6 @@ pub(super) struct Cell {
     /// Per interval, the compact table its samples are drawn from ([`LeafTable`]; `None`: the
     /// tree's own walk).
     pub(super) tables: Vec<Option<LeafTable>>,
-    /// Per interval of an anisotropic cell, the tables of its (θo, δ) sub-boxes
-    /// ([`SubTables`]; `None`: the interval's own table in [`Cell::tables`] serves every query,
-    /// which is then `None` where this is not). Empty for isotropic cells.
-    pub(super) subs: Vec<Option<SubTables>>,
     /// Per interval, what the isotropic fast path reads besides the table
     /// ([`IsoRecord`](super::iso_record::IsoRecord); unused by anisotropic cells).
     pub(super) iso: Vec<super::iso_record::IsoRecord>,
@@ -160,26 +155,7 @@ impl Cell {
                 aniso.push(rec);
             }
         }
-        // Anisotropic intervals with sub-box bounds draw from their sub-boxes' tables only.
-        let subs: Vec<Option<SubTables>> = if grid.half > 0.0 {
-            intervals
-                .iter()
-                .map(|iv| SubTables::of(iv, by_tan))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let tables = intervals
-            .iter()
-            .enumerate()
-            .map(|(i, iv)| {
-                if subs.get(i).is_some_and(Option::is_some) {
-                    None
-                } else {
-                    LeafTable::of(&iv.tree)
-                }
-            })
-            .collect();
+        let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
         let half_key = if by_tan { tan_half } else { grid.half };
         let iso = intervals
             .iter()
@@ -200,7 +176,6 @@ impl Cell {
             members: if plain { Vec::new() } else { entries },
             intervals,
             tables,
-            subs,
             iso,
             aniso,
             patches,
@@ -289,18 +264,6 @@ impl Cell {
             }
         }
         self.interval_of(key, dkey)
-    }
-
-    /// The table a query of interval `i` with grid keys `keys` (`w = √(1 − cos θo)` and the
-    /// strip key, [`super::interval::Query::keys`]) draws from: its sub-box's
-    /// ([`SubTables`]) when the interval has them, otherwise the interval's own; `None`: the
-    /// tree's own walk.
-    #[inline(always)]
-    pub(super) fn table_at(&self, i: usize, keys: &[f64; 2]) -> Option<&LeafTable> {
-        match self.subs.get(i) {
-            Some(Some(sub)) => Some(sub.table(keys)),
-            _ => self.tables[i].as_ref(),
-        }
     }
 
     /// Bytes of this cell's [`DirectIndex`] table (0 without one).

@@ -183,7 +183,7 @@ impl ExactSet {
         let q = *q;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
-        let drawn = match self.cells[q.cell].table_at(q.interval, &q.keys) {
+        let drawn = match &self.cells[q.cell].tables[q.interval] {
             Some(table) => table.draw(&|p| g.at(p), u, audit),
             None => iv.tree.sample_envelope_of(&|p| g.at(p), u, audit),
         };

@@ -88,7 +88,6 @@ mod report;
 mod sampler;
 mod set;
 mod set_table;
-mod sub_box;
 mod table;
 mod tabulated;
 mod walk;

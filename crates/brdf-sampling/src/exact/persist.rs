@@ -5,10 +5,8 @@
 //! of: the BRDF spec and name, 32 probe values of the BRDF (as the quadtree sets,
 //! `crate::persist`), the options, the build's time, and per azimuth cell its intervals: θ and δ
 //! numerators (see `Grid`), normaliser table (nodes and values of `A · cos θo`), the
-//! quadrature's error estimate, the build's evaluation count, the tree in partition-sampler's
-//! own versioned format ([`partition_sampler::FORMAT_VERSION`]) and, for anisotropic intervals,
-//! the leaf bounds per (θo, δ) sub-box (`sub_box.rs`; 4 `f32` per leaf, since version 2; a
-//! file of version 1 is refused with [`SetFileError::UnsupportedVersion`]: rebuild it).
+//! quadrature's error estimate, the build's evaluation count and the tree in partition-sampler's
+//! own versioned format ([`partition_sampler::FORMAT_VERSION`]).
 //!
 //! The BRDF is not stored: it is re-attached on load, which checks that the spec matches and
 //! that the BRDF reproduces the probes. The set's grid, cells, table variable and azimuth
@@ -33,7 +31,7 @@ use crate::persist::{
 };
 
 use super::build::Plan;
-use super::build_interval::{stored_density, sub_split, worst_trials};
+use super::build_interval::{stored_density, worst_trials};
 use super::chebyshev::ChebyshevTable;
 use super::grid::EDGE_BITS;
 use super::interval::Interval;
@@ -42,9 +40,8 @@ use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
 use super::set::ExactSet;
 
-/// Version of the stored `adaptive-exact` format; bumped on any incompatible change (2: the
-/// anisotropic intervals' leaf bounds per (θo, δ) sub-box, docs/benchmarks.md §28.1).
-pub const EXACT_FORMAT_VERSION: u32 = 2;
+/// Version of the stored `adaptive-exact` format; bumped on any incompatible change.
+pub const EXACT_FORMAT_VERSION: u32 = 1;
 
 const MAGIC: &[u8; 4] = b"BRQE";
 
@@ -70,8 +67,6 @@ struct StoredInterval {
     quad_err: f64,
     evaluations: u64,
     tree: Vec<u8>,
-    /// The leaf bounds per (θo, δ) sub-box ([`super::sub_box`]; empty: none).
-    sub_bounds: Vec<f32>,
 }
 
 impl StoredInterval {
@@ -85,7 +80,6 @@ impl StoredInterval {
             quad_err: iv.quad_err,
             evaluations: iv.evaluations,
             tree: iv.tree.tree().to_bytes(),
-            sub_bounds: iv.sub_bounds.clone(),
         }
     }
 }
@@ -309,26 +303,6 @@ fn load_interval(
             "mean trials {worst:.3e} at a normaliser node: the table does not fit the tree"
         )));
     }
-    // The sub-box bounds: one run per sub-box of one bound per leaf, each at most the leaf's
-    // own (`sub_box.rs`), and only where the build makes sub-boxes.
-    let split = sub_split(options, &job, &ctx);
-    if !iv.sub_bounds.is_empty() {
-        let leaves: Vec<f64> = sampler.tree().leaves().map(|l| l.max_bound).collect();
-        let n = leaves.len();
-        let fits = split.is_some()
-            && iv.sub_bounds.len() == super::sub_box::SUBS * n
-            && iv
-                .sub_bounds
-                .iter()
-                .enumerate()
-                .all(|(k, &b)| b >= 0.0 && f64::from(b) <= leaves[k % n]);
-        if !fits {
-            return Err(bad(format!(
-                "{} sub-box bounds for {n} leaves, or a bound outside [0, the leaf's]",
-                iv.sub_bounds.len()
-            )));
-        }
-    }
     let grid = &plan.grid;
     Ok(Interval {
         num: iv.num,
@@ -342,10 +316,5 @@ fn load_interval(
         worst_trials: worst,
         quad_err: iv.quad_err,
         evaluations: iv.evaluations,
-        sub_split: match split {
-            Some(split) if !iv.sub_bounds.is_empty() => split,
-            _ => [f64::NAN; 2],
-        },
-        sub_bounds: iv.sub_bounds,
     })
 }

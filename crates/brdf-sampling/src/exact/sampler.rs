@@ -135,11 +135,6 @@ impl DirectionSampler for ExactSet {
                             .flatten()
                             .map(|t| t.bytes_used())
                             .sum::<usize>()
-                        + c.subs
-                            .iter()
-                            .flatten()
-                            .map(|t| t.bytes_used())
-                            .sum::<usize>()
                         + c.intervals
                             .iter()
                             .map(|iv| {

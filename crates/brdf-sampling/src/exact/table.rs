@@ -47,44 +47,22 @@ impl LeafTable {
     /// reads, or there is no leaf of positive weight: the tree's own walk serves such an
     /// interval.
     pub(super) fn of<D: RegionStats>(tree: &QuadTreeSampler<D>) -> Option<Self> {
-        Self::with_bounds(tree, None)
-    }
-
-    /// [`LeafTable::of`] with the bound of leaf `i` taken from `bounds[i]` instead of the
-    /// tree's (`bounds`: one per leaf, each at most the tree's bound and not negative; `None`:
-    /// the tree's): the table of one (θo, δ) sub-box of an anisotropic interval
-    /// ([`super::sub_box`]), the same leaves with their bounds over the sub-box. The alias
-    /// weights are `V_i = (dx · dy) · bounds[i]`; a leaf of bound 0 is never picked. `None` as
-    /// for `of`, or when `bounds` has not one value per leaf.
-    pub(super) fn with_bounds<D: RegionStats>(
-        tree: &QuadTreeSampler<D>,
-        bounds: Option<&[f32]>,
-    ) -> Option<Self> {
-        let leaves = tree.tree().leaves();
-        if bounds.is_some_and(|b| b.len() != leaves.len()) {
-            return None;
-        }
-        let mut entries = Vec::with_capacity(leaves.len());
+        let mut entries = Vec::with_capacity(tree.tree().leaves().len());
         let mut weights = Vec::with_capacity(entries.capacity());
-        for (i, l) in leaves.enumerate() {
+        for l in tree.tree().leaves() {
             let r = l.rect;
             let (x0, y0) = (r.x0 as f32, r.y0 as f32);
             let (dx, dy) = ((r.x1 - r.x0) as f32, (r.y1 - r.y0) as f32);
-            let own = l.max_bound as f32;
+            let m = l.max_bound as f32;
             let exact = f64::from(x0) == r.x0
                 && f64::from(y0) == r.y0
                 && f64::from(x0) + f64::from(dx) == r.x1
                 && f64::from(y0) + f64::from(dy) == r.y1
-                && f64::from(own) == l.max_bound
-                && own.is_finite();
+                && f64::from(m) == l.max_bound
+                && m.is_finite();
             if !exact {
                 return None;
             }
-            let m = match bounds {
-                Some(b) if b[i] >= 0.0 && b[i] <= own => b[i],
-                Some(_) => return None,
-                None => own,
-            };
             weights.push((f64::from(dx) * f64::from(dy)) * f64::from(m));
             entries.push(Entry {
                 x0,
@@ -235,20 +213,8 @@ pub(super) mod walks {
         let mut checked = 0;
         for cell in &set.cells {
             assert_eq!(cell.tables.len(), cell.intervals.len());
-            for (i, (iv, table)) in cell.intervals.iter().zip(&cell.tables).enumerate() {
-                // An interval drawn from its sub-boxes' tables keeps none of its own: the
-                // interval's table made here (the construction every table shares).
-                let own = match table {
-                    Some(_) => None,
-                    None => {
-                        assert!(cell.subs.get(i).is_some_and(Option::is_some));
-                        LeafTable::of(&iv.tree)
-                    }
-                };
-                let table = table
-                    .as_ref()
-                    .or(own.as_ref())
-                    .expect("a table for every interval");
+            for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
+                let table = table.as_ref().expect("a table for every interval");
                 let m0 = table
                     .entries
                     .iter()
