@@ -39,6 +39,36 @@ struct Located {
 /// The group of a query that is not served (at or below the horizon, not finite).
 const UNSERVED: u32 = u32::MAX;
 
+/// The flag of a query that continues its predecessor's run (the same `ωo` bits), on its
+/// group and on its entry of the serving order (whose other bits are the query's index).
+const FOLLOWS: u32 = 1 << 31;
+
+/// Most queries of one pass (their indices below [`FOLLOWS`]).
+const MAX_PASS: usize = (FOLLOWS - 1) as usize;
+
+/// Most azimuth cells this path serves (the options allow 64 per turn).
+const MAX_CELLS: usize = 64;
+
+/// The anisotropic batch path's working arrays, kept per thread between calls (no allocation
+/// and no zero-filled buffer per call once a thread has served a batch of the size).
+#[derive(Default)]
+struct Scratch {
+    /// Per query, its location (written before it is read; never cleared).
+    located: Vec<Located>,
+    /// Per query, its group with its run flag (see [`FOLLOWS`]), or [`UNSERVED`].
+    group: Vec<u32>,
+    /// The counting sort's bucket starts (then ends) per group.
+    count: Vec<u32>,
+    /// The serving order: query indices with their run flags.
+    order: Vec<u32>,
+}
+
+thread_local! {
+    /// This thread's [`Scratch`], taken for the length of a batch (a nested batch on the
+    /// same thread finds none and makes its own).
+    static SCRATCH: std::cell::Cell<Option<Box<Scratch>>> = const { std::cell::Cell::new(None) };
+}
+
 /// The bits of a direction: the queries of one run share them.
 #[inline]
 fn bits(wo: &Vec3) -> [u64; 3] {
@@ -61,12 +91,34 @@ impl ExactSet {
         debug_assert!(!self.isotropic);
         out.clear();
         out.resize(wos.len(), EvalSample::NONE);
+        // Passes of at most `MAX_PASS` queries: a query index and its run flag share a `u32`.
+        if wos.len() > MAX_PASS {
+            let mut part = Vec::new();
+            for (k, chunk) in wos.chunks(MAX_PASS).enumerate() {
+                self.sample_eval_aniso(brdf, chunk, u, &mut part);
+                out[k * MAX_PASS..k * MAX_PASS + chunk.len()].copy_from_slice(&part);
+            }
+            return;
+        }
+        // This thread's working arrays (none when a batch is nested on the thread: fresh ones).
+        let mut scratch = SCRATCH.with(std::cell::Cell::take).unwrap_or_default();
+        let Scratch {
+            located,
+            group,
+            count,
+            order,
+        } = &mut *scratch;
         // The first group of each cell: groups are the set's intervals in one list.
-        let mut base = Vec::with_capacity(self.cells.len() + 1);
+        let mut base = [0u32; MAX_CELLS];
         let mut groups = 0u32;
-        for c in &self.cells {
-            base.push(groups);
+        for (b, c) in base.iter_mut().zip(&self.cells) {
+            *b = groups;
             groups += c.intervals.len() as u32;
+        }
+        if self.cells.len() > MAX_CELLS || groups >= FOLLOWS {
+            // Not the layouts this path is for (never built by the options' ranges).
+            SCRATCH.with(|s| s.set(Some(scratch)));
+            return self.sample_eval_grouped(brdf, wos, u, out);
         }
         let dummy = Located {
             keys: [0.0; 2],
@@ -75,40 +127,55 @@ impl ExactSet {
             cell: 0,
             interval: 0,
         };
-        let mut located = vec![dummy; wos.len()];
-        let mut group = vec![UNSERVED; wos.len()];
-        let mut count = vec![0u32; groups as usize + 1];
-        // Whether a query continues its predecessor's run (the same `ωo` bits).
-        let mut follows = vec![false; wos.len()];
+        // Grown, never cleared: every entry read below is written first.
+        if located.len() < wos.len() {
+            located.resize(wos.len(), dummy);
+        }
+        group.clear();
+        group.reserve(wos.len());
+        count.clear();
+        count.resize(groups as usize + 1, 0);
+        // `group[k]`: the query's group, with `FOLLOWS` when it continues its predecessor's
+        // run (the same `ωo` bits: a pixel's samples take the predecessor's location), or
+        // `UNSERVED`.
+        let mut prev = [u64::MAX; 3];
+        let mut prev_group = UNSERVED;
         for (k, wo) in wos.iter().enumerate() {
-            // A query with its predecessor's bits (a pixel's samples) takes its location.
-            if k > 0 && bits(&wos[k - 1]) == bits(wo) {
-                let g = group[k - 1];
-                if g != UNSERVED {
+            let now = bits(wo);
+            let g = if k > 0 && now == prev {
+                if prev_group != UNSERVED {
                     located[k] = located[k - 1];
-                    group[k] = g;
-                    count[g as usize + 1] += 1;
-                    follows[k] = true;
+                    count[prev_group as usize + 1] += 1;
+                    prev_group | FOLLOWS
+                } else {
+                    UNSERVED
                 }
-                continue;
-            }
-            if let Some(q) = self.locate_aniso(wo) {
+            } else if let Some(q) = self.locate_aniso(wo) {
                 located[k] = q;
                 let g = base[q.cell as usize] + q.interval;
-                group[k] = g;
                 count[g as usize + 1] += 1;
-            }
+                prev_group = g;
+                g
+            } else {
+                prev_group = UNSERVED;
+                UNSERVED
+            };
+            group.push(g);
+            prev = now;
         }
-        // Counting sort by group (stable: the caller's order within a group).
+        // Counting sort by group (stable: the caller's order within a group); each entry of
+        // `order` the query's index with its run flag.
         for g in 0..groups as usize {
             count[g + 1] += count[g];
         }
         let served = count[groups as usize] as usize;
-        let mut order = vec![0u32; served];
+        order.clear();
+        order.resize(served, 0);
         for (k, &g) in group.iter().enumerate() {
             if g != UNSERVED {
-                order[count[g as usize] as usize] = k as u32;
-                count[g as usize] += 1;
+                let at = &mut count[(g & !FOLLOWS) as usize];
+                order[*at as usize] = k as u32 | (g & FOLLOWS);
+                *at += 1;
             }
         }
         let mut audit = Audit::default();
@@ -116,9 +183,9 @@ impl ExactSet {
         // their interval, and the sort is stable): the density and normaliser made once.
         let mut a = 0;
         while a < order.len() {
-            let k = order[a] as usize;
+            let k = (order[a] & !FOLLOWS) as usize;
             let mut b = a + 1;
-            while b < order.len() && follows[order[b] as usize] {
+            while b < order.len() && order[b] & FOLLOWS != 0 {
                 b += 1;
             }
             if b == a + 1 {
@@ -128,6 +195,7 @@ impl ExactSet {
             }
             a = b;
         }
+        SCRATCH.with(|s| s.set(Some(scratch)));
         self.counters.record(&audit);
     }
 
@@ -232,7 +300,7 @@ impl ExactSet {
             };
             for &k in run {
                 let (s, f) = self.draw_located(&full, wo, u, audit);
-                out[k as usize] = self.finish(brdf, wo, s, f);
+                out[(k & !FOLLOWS) as usize] = self.finish(brdf, wo, s, f);
             }
             return;
         }
@@ -247,7 +315,7 @@ impl ExactSet {
                 Some(table) => table.draw(&g, u, audit),
                 None => iv.tree.sample_envelope_of(&g, u, audit),
             };
-            out[k as usize] = match drawn {
+            out[(k & !FOLLOWS) as usize] = match drawn {
                 Some((x, gx)) => {
                     let a = *a.get_or_insert_with(|| {
                         c.aniso[i].normaliser(q.keys[0], q.keys[1], q.cos, &c.patches)
@@ -278,8 +346,9 @@ mod tests {
     /// set's list, `cell` then `interval`; the caller's order within one) from the same seed —
     /// `ωi`, pdf and `f` — and leaves the stream in the same state; with the set's own BRDF
     /// object (the accepted trial's `f`) and with another object of the same model (`f`
-    /// evaluated). The queries: random θo up to 89.999°, repeated `ωo` (runs), the grazing top
-    /// (served at another `ωo`), at and below the horizon, and a non-finite one.
+    /// evaluated). The queries: random θo up to 89.999°, repeated `ωo` (runs, one of them again
+    /// after a query of its interval: two runs), the grazing top (served at another `ωo`), at
+    /// and below the horizon, and a non-finite one twice in a row.
     #[test]
     fn aniso_batch_draws_the_one_query_paths_bits_in_serving_order() {
         let spec = "ward:alpha_x=0.12,alpha_y=0.3";
@@ -313,6 +382,17 @@ mod tests {
         let run = brdf::direction_from_angles(41.0, 123.0);
         wos.extend(std::iter::repeat_n(run, 50));
         wos.push(Vec3::new(f64::NAN, 0.0, 1.0));
+        // A run after an unserved one of the same bits, and the first run again after another
+        // query of its interval's group (separate runs in the serving order).
+        wos.push(Vec3::new(f64::NAN, 0.0, 1.0));
+        let near = brdf::direction_from_angles(41.5, 123.5);
+        let (a, b) = (
+            set.locate_keys(&run).unwrap(),
+            set.locate_keys(&near).unwrap(),
+        );
+        assert_eq!((a.cell, a.interval), (b.cell, b.interval));
+        wos.push(near);
+        wos.extend(std::iter::repeat_n(run, 3));
         wos.extend(wos[..300].to_vec());
         // The serving order: by interval in the set's list, the caller's order within one.
         let mut base = vec![0];
