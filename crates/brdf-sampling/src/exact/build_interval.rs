@@ -19,7 +19,9 @@ use super::interval::Interval;
 use super::jobs::{
     INHERITED_TAIL_CAP, Inheritance, InheritedTable, Job, Normaliser, NormaliserKey,
 };
-use super::options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+use super::options::{
+    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_tree_params,
+};
 use super::phases::{Lap, PhaseCounts};
 use super::tabulated;
 
@@ -263,7 +265,7 @@ fn envelope_tree(
     let params = TreeParams {
         scheme: Scheme::Envelope,
         leaf_choice: LeafChoice::Alias,
-        ..set.tree
+        ..envelope_tree_params(set, brdf)
     };
     let tree = QuadTreeBuilder::from_params(params)
         .build_tree(&image)

@@ -93,7 +93,10 @@ mod tabulated;
 mod walk;
 
 pub use error::ExactError;
-pub use options::{ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG};
+pub use options::{
+    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, RGL_N_MAX, RGL_VOLUME_TOLERANCE, THETA_TOP_DEG,
+    envelope_tree_params,
+};
 pub use persist::EXACT_FORMAT_VERSION;
 pub use phases::{BuildPhases, PhaseCounts};
 pub use report::{CellLayout, ExactReport};

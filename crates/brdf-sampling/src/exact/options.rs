@@ -1,5 +1,7 @@
 //! The settings of an [`ExactSet`](crate::ExactSet)(crate::ExactSet) and its public constants.
 
+use partition_sampler::TreeParams;
+
 use crate::options::SetOptions;
 
 use super::error::ExactError;
@@ -14,6 +16,37 @@ pub const THETA_TOP_DEG: f64 = 89.99;
 /// 90° cell with 3 nodes let 3 trials in 10⁶ exceed their bound on `ward` with
 /// `alpha_x = 0.1, alpha_y = 0.3`).
 pub const MAX_DELTA_NODE_SPACING_DEG: f64 = 11.25;
+
+/// Largest split threshold `n_max` of an RGL material's envelope trees (issue 29): a leaf is
+/// split while `n_max · I_i / V_i < 1`, i.e. until its bound volume `V_i = area_i · M_i` is at
+/// most `n_max` times its envelope integral `I_i`. At the sets' defaults (1.8, volume
+/// tolerance 2 %) the paper_white intervals had 60–72 leaves and the leaf
+/// bounds' excess over the envelope, `Σ max_i F · area_i / ∫ F`, was a factor 1.34–1.38 of
+/// the 1.51–1.56 evaluations per sample (the safety factor 1.11, the θo range 1.005–1.025);
+/// at 1.2 and 0.2 %, 1.11 and 1.24–1.27 per sample (docs/benchmarks.md §28.5).
+pub const RGL_N_MAX: f64 = 1.2;
+
+/// Largest `volume_tolerance` of an RGL material's envelope trees (issue 29): a leaf whose
+/// bound volume is at most this share of the root's envelope integral is not split. The sets'
+/// default 2 % stopped the paper_white trees at ~65 leaves whatever `n_max`.
+pub const RGL_VOLUME_TOLERANCE: f64 = 2e-3;
+
+/// The tree parameters of an interval's envelope tree for `brdf`: `set.tree`, with `n_max` and
+/// `volume_tolerance` at most [`RGL_N_MAX`] and [`RGL_VOLUME_TOLERANCE`] for an RGL material
+/// (finer leaves: fewer rejected trials, hence fewer evaluations of the costly interpolant
+/// per sample). The bound rule is unchanged — `M_i = safety_factor ×` the largest image-map
+/// sample over leaf `i` — so at every point the bound is still at least `safety_factor ×` the
+/// samples of the image-map cells around it, the margin the coarse leaves had at their
+/// maximum; finer leaves drop only the slack of a coarse leaf's maximum elsewhere in it. Other
+/// BRDFs get `set.tree` unchanged.
+pub fn envelope_tree_params(set: &SetOptions, brdf: &dyn brdf::Brdf) -> TreeParams {
+    let mut tree = set.tree;
+    if brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>()) {
+        tree.n_max = tree.n_max.min(RGL_N_MAX);
+        tree.volume_tolerance = tree.volume_tolerance.min(RGL_VOLUME_TOLERANCE);
+    }
+    tree
+}
 
 /// Settings of [`ExactSet`](crate::ExactSet). `set` supplies the tree parameters, image map, safety factor,
 /// disc-map policy and symmetries (its slice counts are unused: the intervals and azimuth cells
@@ -127,5 +160,36 @@ impl ExactOptions {
 impl Default for ExactOptions {
     fn default() -> Self {
         Self::with_set(SetOptions::default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// RGL materials get `n_max` and `volume_tolerance` capped at the RGL values (a tighter
+    /// setting of the caller's is kept); other BRDFs get `set.tree` unchanged.
+    #[test]
+    fn envelope_tree_params_cap_rgl_materials_only() {
+        let set = SetOptions::default();
+        let phong = brdf::parse_spec("phong:n=50").unwrap();
+        assert_eq!(envelope_tree_params(&set, phong.as_ref()), set.tree);
+        // The repository's RGL fixture, loaded here (not through `exact::tests`: no file
+        // imports another round a loop).
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let Ok(rgl) = brdf::RglBrdf::load(&path) else {
+            eprintln!("skipped: the RGL fixture {} is missing", path.display());
+            return;
+        };
+        let tree = envelope_tree_params(&set, &rgl);
+        assert_eq!(tree.n_max, RGL_N_MAX);
+        assert_eq!(tree.volume_tolerance, RGL_VOLUME_TOLERANCE);
+        assert_eq!(tree.max_depth, set.tree.max_depth);
+        let mut tight = set;
+        tight.tree.n_max = 1.1;
+        tight.tree.volume_tolerance = 1e-4;
+        let tree = envelope_tree_params(&tight, &rgl);
+        assert_eq!((tree.n_max, tree.volume_tolerance), (1.1, 1e-4));
     }
 }
