@@ -205,26 +205,7 @@ pub(crate) fn cornell_node_albedo(
     budget: u64,
 ) -> Result<AlbedoEstimate, ReferenceError> {
     let q = brdf.quadrature_eval();
-    // One cursor per node, its points in the rule's fixed order: the same values every run,
-    // whatever the thread (the lock is never contended: the rule is sequential).
-    let cursor = std::sync::Mutex::new(brdf::measured::cornell::NodeCursor::new());
-    let plain = std::env::var_os("CORNELL_NO_CURSOR").is_some();
-    let mut a = super::albedo_of(
-        |wo, wi| {
-            if plain {
-                return q.eval(wo, wi);
-            }
-            let mut c = cursor.lock().unwrap_or_else(|e| e.into_inner());
-            q.eval_with(&mut c, wo, wi)
-        },
-        brdf,
-        wo,
-        budget,
-    )?;
-    if std::env::var_os("CORNELL_CURSOR_STATS").is_some() {
-        let c = cursor.lock().unwrap_or_else(|e| e.into_inner());
-        eprintln!("cursor: {} hits, {} searches", c.hits(), c.searches());
-    }
+    let mut a = super::albedo_of(|wo, wi| q.eval(wo, wi), brdf, wo, budget)?;
     a.abs_err += brdf::measured::cornell::QUADRATURE_REL_BOUND * 1.001 * a.value.abs();
     Ok(a)
 }

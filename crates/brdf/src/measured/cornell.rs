@@ -134,7 +134,7 @@ mod node;
 mod search;
 
 pub use line::{LINE_ORDER, LineIntegral, SEGMENT_REL_TOL};
-pub use node::{NodeCursor, QUADRATURE_REL_BOUND, QuadratureEval};
+pub use node::{QUADRATURE_REL_BOUND, QuadratureEval};
 
 // The search keeps the blended samples and the one their weights are cut at.
 const _: () = assert!(search::K == NEIGHBOURS + 1);

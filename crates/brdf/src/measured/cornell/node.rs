@@ -118,246 +118,6 @@ impl QuadratureEval<'_> {
     }
 }
 
-impl QuadratureEval<'_> {
-    /// [`QuadratureEval::eval`] for a rule's successive points, remembering in `cursor` the
-    /// last point whose neighbours it searched (docs/benchmarks.md §28.3): `f_r(ωo, ωi)`
-    /// within [`QUADRATURE_REL_BOUND`] relative of [`Brdf::eval`], the same interpolant.
-    ///
-    /// At a searched point `a` (the *anchor*) of grid cell `C`, with `d₉ ≤ d₁₀` its 9-th and
-    /// 10-th smallest distances to the candidates of `C`'s list `L` (with multiplicity) and
-    /// `S` its 9 nearest: a later point `q` of the same cell with `|q − a| = e` and
-    /// `2e < d₁₀ − d₉` has `|q − s| ≤ d₉ + e < d₁₀ − e ≤ |q − y|` for every `s ∈ S` and
-    /// `y ∈ L \ S` (triangle inequality), and its 9 nearest samples are in `L` (the list's
-    /// property), so they are exactly `S`, strictly nearer than every other sample: only the
-    /// 9 distances to `S`, their maximum (the cut `c`) and the weights are computed, with the
-    /// formulas of the search, so the weights are the search's bit for bit and the value
-    /// differs from [`QuadratureEval::eval`]'s in the summation order only. The gap is
-    /// shrunk by `10⁻⁹` relative at each end against the distances' rounding (≈ 10⁻¹⁵).
-    /// A point elsewhere is searched in full and becomes the anchor. The value at a point
-    /// depends on the cursor's history only through that summation order, so a rule that
-    /// calls this in a fixed order with a fresh cursor gets the same values every run.
-    #[inline]
-    pub fn eval_with(&self, cursor: &mut NodeCursor, wo: &Vec3, wi: &Vec3) -> f64 {
-        if !(wo.z > 0.0 && wi.z > 0.0) || self.brdf.interp != Interpolation::Knn {
-            return self.brdf.eval(wo, wi);
-        }
-        let (ri, ro) = (wi.x * wi.x + wi.y * wi.y, wo.x * wo.x + wo.y * wo.y);
-        if !(ri > 0.0 && ro > 0.0) {
-            return self.brdf.eval(wo, wi);
-        }
-        let cross = wo.x * wi.y - wo.y * wi.x;
-        let dot = wo.x * wi.x + wo.y * wi.y;
-        let p = [
-            (ri * ro).sqrt(),
-            atan2_upper(cross.abs(), dot) / PI,
-            wi.z * wo.z,
-        ];
-        let data = &*self.brdf.data;
-        self.arch
-            .dispatch(CursorBlend {
-                tree: &data.tree,
-                lum: &data.lum,
-                p,
-                cursor,
-            })
-            .unwrap_or_else(|| self.brdf.eval(wo, wi))
-    }
-}
-
-/// A rule's memory for [`QuadratureEval::eval_with`]: the last fully searched point of the
-/// kNN interpolant (its grid cell, remapped point, 9 nearest samples and their luminances)
-/// and the squared radius `((d₁₀ − d₉)/2)²` (shrunk) around it within which its 9 nearest
-/// are every point's of the same cell. One per rule run (per normaliser node): not shared
-/// between threads.
-#[derive(Clone, Debug)]
-pub struct NodeCursor {
-    /// The anchor's grid cell; `usize::MAX` when there is none.
-    cell: usize,
-    anchor: [f64; 3],
-    /// The anchor's [`KEEP`] nearest candidates (structure of arrays, padded with
-    /// [`search::SOA_FAR`]) and their luminances.
-    x: [f64; KEEP],
-    y: [f64; KEEP],
-    z: [f64; KEEP],
-    lum: [f64; KEEP],
-    /// Squared reach: a point of the cell nearer the anchor than its square root has the
-    /// anchor's 9 nearest.
-    reach2: f64,
-    hits: u64,
-    searches: u64,
-}
-
-impl Default for NodeCursor {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl NodeCursor {
-    /// A cursor with no anchor (the first point is searched).
-    pub fn new() -> Self {
-        Self {
-            cell: usize::MAX,
-            anchor: [0.0; 3],
-            x: [search::SOA_FAR; KEEP],
-            y: [search::SOA_FAR; KEEP],
-            z: [search::SOA_FAR; KEEP],
-            lum: [0.0; KEEP],
-            reach2: 0.0,
-            hits: 0,
-            searches: 0,
-        }
-    }
-
-    /// Points whose 9 nearest were the anchor's (no search).
-    pub fn hits(&self) -> u64 {
-        self.hits
-    }
-
-    /// Points searched in full (each became the anchor).
-    pub fn searches(&self) -> u64 {
-        self.searches
-    }
-}
-
-/// One point's blend with a cursor as a `pulp` operation.
-struct CursorBlend<'a> {
-    tree: &'a search::Tree,
-    lum: &'a [f64],
-    p: [f64; 3],
-    cursor: &'a mut NodeCursor,
-}
-
-impl pulp::WithSimd for CursorBlend<'_> {
-    type Output = Option<f64>;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Option<f64> {
-        blend_cursor(self.tree, self.lum, &self.p, self.cursor)
-    }
-}
-
-/// Relative shrink of each end of the anchor's gap (see [`QuadratureEval::eval_with`]).
-const REACH_MARGIN: f64 = 1e-9;
-
-/// Most candidates an anchor keeps: those within [`KEEP_RADIUS`] × its 9-th distance, when
-/// there are at most this many (else it keeps none and reaches nowhere).
-pub(super) const KEEP: usize = 16;
-
-/// An anchor keeps the candidates within this multiple of its 9-th distance `d₉`.
-const KEEP_RADIUS: f64 = 1.25;
-
-/// The kNN interpolant's luminance at `p` with the anchor of `cur` (see
-/// [`QuadratureEval::eval_with`]); `None` where `eval` must decide.
-#[inline(always)]
-fn blend_cursor(
-    tree: &search::Tree,
-    lum: &[f64],
-    p: &[f64; 3],
-    cur: &mut NodeCursor,
-) -> Option<f64> {
-    let c = tree.cell_of(p)?;
-    if c == cur.cell {
-        let (a, b, e) = (
-            p[0] - cur.anchor[0],
-            p[1] - cur.anchor[1],
-            p[2] - cur.anchor[2],
-        );
-        if a * a + b * b + e * e < cur.reach2 {
-            cur.hits += 1;
-            return blend_kept(cur, p);
-        }
-    }
-    cur.cell = usize::MAX;
-    let cell = tree.cell_list_at(c);
-    if cell.index.len() < K {
-        return None;
-    }
-    let s = cell.stride();
-    let (xs, rest) = cell.xyz.split_at(s);
-    let (ys, zs) = rest.split_at(s);
-    // The value as `blend` makes it.
-    let (kept, at) = nearest_values::<K>(xs, ys, zs, p)?;
-    let cut = kept.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x));
-    let mut lv = [0.0f64; K];
-    for (v, &k) in lv.iter_mut().zip(&at) {
-        *v = lum[cell.index[k] as usize];
-    }
-    let value = weigh(&kept, cut, &lv);
-    // The anchor: every candidate within `KEEP_RADIUS · d₉` (the 9 nearest among them) and
-    // the smallest squared distance beyond.
-    let thr = cut * (KEEP_RADIUS * KEEP_RADIUS);
-    let (mut count, mut next) = (0usize, f64::INFINITY);
-    for (i, ((&x, &y), &z)) in xs.iter().zip(ys).zip(zs).enumerate() {
-        let (a, b, e) = (x - p[0], y - p[1], z - p[2]);
-        let d = a * a + b * b + e * e;
-        if d <= thr {
-            if count < KEEP {
-                cur.x[count] = x;
-                cur.y[count] = y;
-                cur.z[count] = z;
-                cur.lum[count] = lum[cell.index[i] as usize];
-            }
-            count += 1;
-        } else {
-            next = next.min(d);
-        }
-    }
-    cur.searches += 1;
-    if count > KEEP {
-        return value;
-    }
-    for k in count..KEEP {
-        cur.x[k] = search::SOA_FAR;
-        cur.y[k] = search::SOA_FAR;
-        cur.z[k] = search::SOA_FAR;
-        cur.lum[k] = 0.0;
-    }
-    let half = 0.5 * (next.sqrt() * (1.0 - REACH_MARGIN) - cut.sqrt() * (1.0 + REACH_MARGIN));
-    cur.reach2 = if half > 0.0 { half * half } else { 0.0 };
-    cur.anchor = *p;
-    cur.cell = c;
-    value
-}
-
-/// The blend at `p` from the anchor's kept candidates (`p` within its reach): all [`KEEP`]
-/// squared distances (padding far away), the cut `c` = the 9-th smallest with multiplicity
-/// = `min {d_k : #{j : d_j ≤ d_k} ≥ 9}`, and the weights `expm1(max(0, c − d_k)/2h²)`: the
-/// search's weights for the 9 nearest bit for bit, 0 for the others.
-#[inline(always)]
-fn blend_kept(cur: &NodeCursor, p: &[f64; 3]) -> Option<f64> {
-    let mut d = [0.0f64; KEEP];
-    for k in 0..KEEP {
-        let (a, b, e) = (cur.x[k] - p[0], cur.y[k] - p[1], cur.z[k] - p[2]);
-        d[k] = a * a + b * b + e * e;
-    }
-    let mut rank = [0.0f64; KEEP];
-    for &dj in &d {
-        for k in 0..KEEP {
-            rank[k] += if dj <= d[k] { 1.0 } else { 0.0 };
-        }
-    }
-    let mut cut = f64::INFINITY;
-    for k in 0..KEEP {
-        cut = cut.min(if rank[k] >= K as f64 {
-            d[k]
-        } else {
-            f64::INFINITY
-        });
-    }
-    let inv = 1.0 / (2.0 * BANDWIDTH * BANDWIDTH);
-    let mut w = [0.0f64; KEEP];
-    for k in 0..KEEP {
-        w[k] = expm1_nonneg(((cut - d[k]) * inv).max(0.0));
-    }
-    let (mut sum, mut total) = (0.0, 0.0);
-    for k in 0..KEEP {
-        sum += w[k] * cur.lum[k];
-        total += w[k];
-    }
-    (total > 0.0).then(|| sum / total)
-}
-
 /// One point's blend as a `pulp` operation.
 struct Blend<'a> {
     tree: &'a search::Tree,
@@ -378,39 +138,21 @@ impl pulp::WithSimd for Blend<'_> {
 #[inline(always)]
 fn blend(tree: &search::Tree, lum: &[f64], p: &[f64; 3]) -> Option<f64> {
     let cell = tree.cell_list_of(p)?;
-    if cell.index.len() < K {
+    let (n, s) = (cell.index.len(), cell.stride());
+    if n < K {
         return None;
     }
-    let s = cell.stride();
     let (xs, rest) = cell.xyz.split_at(s);
     let (ys, zs) = rest.split_at(s);
-    let (kept, at) = nearest_values::<K>(xs, ys, zs, p)?;
-    let cut = kept.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x));
-    let mut lv = [0.0f64; K];
-    for (v, &k) in lv.iter_mut().zip(&at) {
-        *v = lum[cell.index[k] as usize];
-    }
-    weigh(&kept, cut, &lv)
-}
-
-/// The `N` smallest squared distances from `p` to the points `(xs, ys, zs)` (structure of
-/// arrays, a multiple of [`SOA_PAD`] long, real points first, padding with
-/// [`search::SOA_FAR`]; in no order; ties in any order: see the module docs) and where they
-/// are; `None` when there are fewer than `N` points.
-#[inline(always)]
-fn nearest_values<const N: usize>(
-    xs: &[f64],
-    ys: &[f64],
-    zs: &[f64],
-    p: &[f64; 3],
-) -> Option<([f64; N], [usize; N])> {
-    // The first K candidates, then each nearer one replaces the farthest kept. The distances
-    // by blocks of `SOA_PAD` lanes with the search's `dist2` formula (so the same bits); a
-    // block whose smallest is not below the farthest kept is passed over whole (the list is
-    // ordered by distance to the cell's centre, so after the first blocks most are). Padding
-    // points are never kept: the `n ≥ K` real candidates come first and every one is nearer.
-    let mut kept = [0.0f64; N];
-    let mut at = [0usize; N];
+    // The K smallest squared distances (in no order; ties in any order: see the module docs)
+    // and where they are in the list: the first K candidates, then each nearer one replaces
+    // the farthest kept. The distances by blocks of `SOA_PAD` lanes with the search's `dist2`
+    // formula (so the same bits); a block whose smallest is not below the farthest kept is
+    // passed over whole (the list is ordered by distance to the cell's centre, so after the
+    // first blocks most are). Padding points are never kept: the `n ≥ K` real candidates come
+    // first and every one is nearer.
+    let mut kept = [0.0f64; K];
+    let mut at = [0usize; K];
     let (mut len, mut far, mut far_at) = (0usize, f64::INFINITY, 0usize);
     let blocks = xs
         .chunks_exact(SOA_PAD)
@@ -427,11 +169,11 @@ fn nearest_values<const N: usize>(
             continue;
         }
         for (l, &dl) in d.iter().enumerate() {
-            if len < N {
+            if len < K {
                 kept[len] = dl;
                 at[len] = b * SOA_PAD + l;
                 len += 1;
-                if len < N {
+                if len < K {
                     continue;
                 }
             } else if dl < far {
@@ -448,19 +190,16 @@ fn nearest_values<const N: usize>(
             }
         }
     }
-    (len == N).then_some((kept, at))
-}
-
-/// The blend of the kept samples' luminances `lv` at squared distances `kept` with the cut
-/// `cut` (the K-th smallest squared distance): every kept sample at the cut (the farthest,
-/// and any tied with it) gets weight `expm1(0) = 0`, every other kept one is strictly
-/// nearer: `eval`'s blended samples with positive weight, the same weights. `None` when
-/// every blended sample is as far as the cut (`eval`'s equal weights).
-#[inline(always)]
-fn weigh(kept: &[f64; K], cut: f64, lv: &[f64; K]) -> Option<f64> {
+    if len < K {
+        return None;
+    }
+    // The cut: the K-th smallest squared distance. Every kept sample at it (the farthest,
+    // and any tied with it) gets weight `expm1(0) = 0`, every other kept one is strictly
+    // nearer: `eval`'s blended samples with positive weight, the same weights.
+    let cut = far;
     let inv = 1.0 / (2.0 * BANDWIDTH * BANDWIDTH);
     let mut x = [0.0f64; K];
-    for (x, &d) in x.iter_mut().zip(kept) {
+    for (x, &d) in x.iter_mut().zip(&kept) {
         *x = (cut - d) * inv;
     }
     let mut w = [0.0f64; K];
@@ -468,10 +207,11 @@ fn weigh(kept: &[f64; K], cut: f64, lv: &[f64; K]) -> Option<f64> {
         *w = expm1_nonneg(x);
     }
     let (mut sum, mut total) = (0.0, 0.0);
-    for (&w, &v) in w.iter().zip(lv) {
-        sum += w * v;
+    for (&w, &k) in w.iter().zip(&at) {
+        sum += w * lum[cell.index[k] as usize];
         total += w;
     }
+    // Every blended sample as far as the cut one: `eval`'s equal weights.
     (total > 0.0).then(|| sum / total)
 }
 

@@ -284,19 +284,6 @@ impl Tree {
         Some(self.grid.cell_list(self, cell))
     }
 
-    /// The grid cell of `q` (an index below `GRID³`) if `q` is in the unit cube (up to the
-    /// grid's padding), else `None`; its list is [`Tree::cell_list_at`].
-    #[inline]
-    pub(super) fn cell_of(&self, q: &[f64; 3]) -> Option<usize> {
-        self.grid.cell(q)
-    }
-
-    /// The [`CellList`] of the grid cell `cell` (from [`Tree::cell_of`]), made on first use.
-    #[inline]
-    pub(super) fn cell_list_at(&self, cell: usize) -> &CellList {
-        self.grid.cell_list(self, cell)
-    }
-
     /// Sample `i`'s remapped point (the file's index).
     #[inline]
     pub(super) fn point(&self, i: u32) -> [f64; 3] {
