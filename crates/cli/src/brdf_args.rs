@@ -37,7 +37,8 @@ pub(crate) struct AdaptiveArgs {
     #[arg(long, default_value_t = SetOptions::DEFAULT_SLICES,
           value_parser = values::int(1, SetOptions::MAX_SLICES), allow_negative_numbers = true)]
     pub(crate) slices: usize,
-    /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max).
+    /// Split threshold n_max ≥ 1 (mean trials per sample ≤ n_max). `adaptive-exact` on an RGL
+    /// file splits its envelope trees further, to n_max ≤ 1.2 (fewer costly evaluations).
     #[arg(long, default_value_t = SetOptions::DEFAULT_N_MAX,
           value_parser = values::real(End::Closed(1.0), End::None), allow_hyphen_values = true)]
     pub(crate) n_max: f64,
