@@ -707,15 +707,7 @@ impl ExactSet {
                     }
                 }
                 self.serve_iso_wave(
-                    brdf,
-                    wos,
-                    k as usize,
-                    &wv.members,
-                    wv.seed,
-                    wv.arch,
-                    wv.w,
-                    audit,
-                    out,
+                    brdf, wos, k as usize, wv.members, wv.seed, wv.arch, wv.w, audit, out,
                 );
                 a = end;
                 continue;
@@ -1215,15 +1207,33 @@ mod tests {
     /// Random ωo (no two consecutive queries alike), on Phong and GGX with grazing and
     /// below-horizon queries among them: every isotropic fast-path query is drawn by its
     /// group's wavefront, and its sample is, bit for bit, [`ExactSet::draw_iso`]'s at its own
-    /// `ωo` from its own stream (`Stream::of(seed, i)`, `seed` from the caller's stream at the
-    /// batch's start, `i` the query's index), finished as the one-query path finishes it —
+    /// `ωo` from its own stream — SplitMix64 as a **generator** (`SplitMix`, started at
+    /// `Stream::of(seed, i)`'s state, `seed` from the caller's stream at the batch's start, `i`
+    /// the query's index), whose split trials `distributions` makes from two outputs —
+    /// finished as the one-query path finishes it —
     /// so a function of the seed, `i` and `ωo_i` only, with `draw_iso`'s law; the same when
     /// the batch's other queries change; the grazing queries (the general path) are their own
     /// query's samples, the ones below the horizon empty.
     #[test]
     fn random_wo_groups_draw_draw_isos_samples_from_their_own_streams() {
+        use super::super::lanes::{GOLDEN_GAMMA, mix64};
         use super::{Stream, wave_seed};
         use partition_sampler::Audit;
+        /// SplitMix64 as a `rand` generator (its outputs `mix64(state + k·γ)`, `k ≥ 1`).
+        struct SplitMix(u64);
+        impl rand::TryRng for SplitMix {
+            type Error = std::convert::Infallible;
+            fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
+                self.try_next_u64().map(|w| (w >> 32) as u32)
+            }
+            fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
+                self.0 = self.0.wrapping_add(GOLDEN_GAMMA);
+                Ok(mix64(self.0))
+            }
+            fn try_fill_bytes(&mut self, _: &mut [u8]) -> Result<(), Self::Error> {
+                unimplemented!("not used")
+            }
+        }
         let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
         for spec in ["phong:n=50", "ggx:alpha=0.2"] {
             let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
@@ -1239,7 +1249,7 @@ mod tests {
             for (i, (wo, o)) in wos.iter().zip(&out).enumerate() {
                 match set.locate_iso(wo) {
                     Some(q) => {
-                        let mut s = Stream::of(seed, i);
+                        let mut s = SplitMix(Stream::of(seed, i).0);
                         let (d, f) = set.draw_iso(&q, wo, &mut s, &mut audit);
                         let want = set.finish_iso(brdf.as_ref(), wo, d, f);
                         assert_eq!(key(o), key(&want), "{spec} query {i}: {o:?} vs {want:?}");

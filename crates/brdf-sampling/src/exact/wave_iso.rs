@@ -8,7 +8,11 @@
 //! Each query's law is [`ExactSet::draw_iso`]'s — the same trial, density, acceptance test,
 //! normaliser and pdf — with its uniforms from its own stream: query `i` of a pass (the
 //! caller's index) reads SplitMix64 started at `mix64(seed ⊕ mix64(i))`, `seed` one 64-bit
-//! word made of two uniforms of the caller's stream at the pass's start. So a sample is a
+//! word made of two uniforms of the caller's stream at the pass's start, two outputs per
+//! trial split into its four 32-bit uniforms ([`lanes::split_trial`]: what
+//! `UniformSource::next_uniform4_split` makes of a generator's two words, the uniforms
+//! `draw_iso` reads); the last pending queries of a group (fewer than a lane group) draw one
+//! by one from the same streams. So a sample is a
 //! function of that stream's state, `i` and `ωo_i` only (not of the other queries, the block
 //! size, the grouping or the thread), and bit for bit `draw_iso` from the stream
 //! (tested in `batch.rs`). These are other samples than the one-query path's from the same
@@ -27,6 +31,10 @@ use crate::{DirSample, EvalSample};
 /// Pending queries per block of [`ExactSet::serve_iso_wave`]: at most this many trials are
 /// made in lanes and evaluated per block.
 const WAVE_ISO: usize = 256;
+
+/// Pending queries below which [`ExactSet::serve_iso_wave`] finishes them one by one (a lane
+/// group's 16 trials would be mostly padding).
+const WAVE_TAIL: usize = 16;
 
 /// The working arrays of [`ExactSet::serve_iso_wave`], kept by the caller between groups (and
 /// per thread between batches): per query of the group its prepared `ωo`, normaliser and
@@ -117,10 +125,11 @@ impl ExactSet {
             w.idx.push(k as u32);
             w.state.push(stream_key(seed, u64::from(i)));
         }
-        w.idx2.clear();
-        w.idx2.resize(n, 0);
-        w.state2.clear();
-        w.state2.resize(n, 0);
+        // Room for the next pass's list (its entries are written before they are read).
+        if w.idx2.len() < n {
+            w.idx2.resize(n, 0);
+            w.state2.resize(n, 0);
+        }
         let IsoWave {
             prep,
             norm,
@@ -137,7 +146,7 @@ impl ExactSet {
         let model = self.brdf.as_ref();
         let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
         let mut pending = n;
-        while pending > 0 {
+        while pending >= WAVE_TAIL {
             if pass >= MAX_TRIALS_PER_SAMPLE {
                 for &k in &idx[..pending] {
                     audit.exhausted += 1;
@@ -156,7 +165,7 @@ impl ExactSet {
                 .zip(state[..pending].chunks_mut(WAVE_ISO))
             {
                 let len = ib.len();
-                lanes::trials(arch, table, map, sb, t);
+                lanes::trials_split(arch, table, map, sb, t);
                 // The candidates inside the disc, compacted without branches; the others (a
                 // few per cent) propose again next pass.
                 let mut c = 0;
@@ -209,6 +218,44 @@ impl ExactSet {
             std::mem::swap(idx, idx2);
             std::mem::swap(state, state2);
             pending = np;
+        }
+        // The last few pending queries (fewer than a lane group) one by one: the same trials
+        // from the same streams, `LeafTable::draw`'s loop with the passes' trials counted.
+        for (&q, &st) in idx[..pending].iter().zip(&state[..pending]) {
+            let q = q as usize;
+            let i = members[q] as usize;
+            let mut st = st;
+            let mut made = pass;
+            let found = loop {
+                if made >= MAX_TRIALS_PER_SAMPLE {
+                    audit.exhausted += 1;
+                    break None;
+                }
+                let us = lanes::split_trial(&mut st);
+                made += 1;
+                let Some((x, m)) = table.propose(us) else {
+                    continue;
+                };
+                count_evaluations(1);
+                let v = map.to_direction(x);
+                let f = model.eval_prepared(&prep[q], &v);
+                #[cfg(test)]
+                let f = skewed(f, &v);
+                let gx = match map {
+                    DiscMap::Projected => f,
+                    DiscMap::EqualArea => 2.0 * v.z * f,
+                };
+                violations += u64::from(gx > m);
+                if us[3] * m < gx {
+                    break Some((v, gx));
+                }
+            };
+            trials += made - pass;
+            let (s, f) = match found {
+                Some((v, gx)) => accepted_at(map, &turn[q], v, gx, norm[q]),
+                None => (DirSample::NONE, f64::NAN),
+            };
+            out[i] = self.finish_iso(brdf, &wos[i], s, f);
         }
         audit.trials += trials;
         audit.violations += violations;
