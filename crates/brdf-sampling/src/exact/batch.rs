@@ -10,6 +10,7 @@ use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
 use super::fused::{IsoQuery, accepted, accepted_at};
+use super::grid::TableVar;
 use super::lanes::{self, Trials};
 #[cfg(test)]
 use super::lanes::{GOLDEN_GAMMA, mix64, unit};
@@ -463,6 +464,13 @@ impl ExactSet {
     /// one-query path's arithmetic ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so
     /// its law is the same, and from the same uniforms the same bits.
     ///
+    /// **Random `ωo`**: an interval group of an isotropic `cos θo`-table set (the fast path)
+    /// whose queries hold no run of more than one query (no query with its predecessor's bits,
+    /// in the caller's order) is drawn as one wavefront ([`ExactSet::serve_iso_wave`]): each
+    /// fast-path query `draw_iso`'s law from its own SplitMix64 stream keyed by one word of
+    /// `u` drawn at the pass's start and by the query's index — other samples than the
+    /// one-query path's from the same seed, still a function of the seed only.
+    ///
     /// The locate pass keeps one `u32` key per query ([`GENERAL`]): an isotropic fast-path
     /// query is re-derived from its `ωo` when served (`r = |(ωo.x, ωo.y)|`, `cos θo`, the
     /// interval from the key: [`ExactSet::locate_iso`]'s values, bit for bit), a general one is
@@ -595,12 +603,14 @@ impl ExactSet {
         for g in 0..groups {
             start[g + 1] += start[g];
         }
-        // The groups drawn as a random-ωo wavefront: an isotropic interval with a table, some
-        // query, and no run of more than one query (a run is drawn once prepared, below).
+        // The groups drawn as a random-ωo wavefront: an interval of an isotropic `cos θo`-table
+        // set (the fast path's) with a table, some query, and no run of more than one query (a
+        // run is drawn once prepared, below).
         wave.clear();
         wave.resize(groups, false);
         let mut waves = false;
-        if let Some(cell) = self.cells.first().filter(|_| self.isotropic && wave_on()) {
+        let fast = self.isotropic && self.var == TableVar::Cos;
+        if let Some(cell) = self.cells.first().filter(|_| fast && wave_on()) {
             for g in 0..groups.min(cell.tables.len()) {
                 let w = start[g + 1] > start[g] && !repeat[g] && cell.tables[g].is_some();
                 wave[g] = w;
@@ -734,7 +744,8 @@ impl ExactSet {
                     cos,
                 };
                 if b == a + 1 {
-                    // A run of one query (a random ωo): the one-query path itself, whose
+                    // A run of one query (a random ωo in a group that is no wavefront, or
+                    // with the wavefront off): the one-query path itself, whose
                     // arithmetic `serve_iso_run` repeats for a run (the same bits).
                     let (s, f) = self.draw_iso(&q, wo, u, audit);
                     out[first] = self.finish_iso(brdf, wo, s, f);
