@@ -10,10 +10,12 @@ use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
 use super::fused::{IsoQuery, accepted, accepted_at};
+use super::grid::TableVar;
 use super::lanes::{self, Trials};
 #[cfg(test)]
 use super::lanes::{GOLDEN_GAMMA, mix64, unit};
 use super::table::LeafTable;
+use super::wave_iso::IsoWave;
 use super::{ExactSet, Query};
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
@@ -218,6 +220,46 @@ struct Scratch {
     /// Per group, the end in `order` of the span of groups from it on whose every draw is a
     /// split trial, or 0 for a group of other draws (see [`Ahead`]).
     reach: Vec<u32>,
+    /// Per group: some query has its predecessor's `ωo` bits (a run of more than one query in
+    /// the caller's order); then, whether the group's fast-path queries are drawn as one
+    /// random-`ωo` wavefront ([`ExactSet::serve_iso_wave`]).
+    repeat: Vec<bool>,
+    wave: Vec<bool>,
+    /// One wave group's fast-path queries, and the wavefront's working arrays.
+    members: Vec<u32>,
+    iso_wave: IsoWave,
+}
+
+/// The wave groups of a pass ([`ExactSet::serve_iso_wave`]): their streams' key, the `pulp`
+/// dispatch, which groups they are, where each group ends in the serving order, and the
+/// working arrays.
+struct Waves<'a> {
+    seed: u64,
+    arch: pulp::Arch,
+    wave: &'a [bool],
+    end: &'a [u32],
+    members: &'a mut Vec<u32>,
+    w: &'a mut IsoWave,
+}
+
+/// Whether groups may be drawn as random-`ωo` wavefronts (always, but for tests that compare
+/// the other paths' bits).
+#[inline]
+fn wave_on() -> bool {
+    #[cfg(test)]
+    {
+        !NO_WAVE.with(std::cell::Cell::get)
+    }
+    #[cfg(not(test))]
+    {
+        true
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test support: `true` turns the random-ωo wavefront off (every group served run by run).
+    static NO_WAVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 thread_local! {
@@ -422,6 +464,13 @@ impl ExactSet {
     /// one-query path's arithmetic ([`ExactSet::draw_iso`] or [`ExactSet::draw_located`]), so
     /// its law is the same, and from the same uniforms the same bits.
     ///
+    /// **Random `ωo`**: an interval group of an isotropic `cos θo`-table set (the fast path)
+    /// whose queries hold no run of more than one query (no query with its predecessor's bits,
+    /// in the caller's order) is drawn as one wavefront ([`ExactSet::serve_iso_wave`]): each
+    /// fast-path query `draw_iso`'s law from its own SplitMix64 stream keyed by one word of
+    /// `u` drawn at the pass's start and by the query's index — other samples than the
+    /// one-query path's from the same seed, still a function of the seed only.
+    ///
     /// The locate pass keeps one `u32` key per query ([`GENERAL`]): an isotropic fast-path
     /// query is re-derived from its `ωo` when served (`r = |(ωo.x, ωo.y)|`, `cos θo`, the
     /// interval from the key: [`ExactSet::locate_iso`]'s values, bit for bit), a general one is
@@ -490,6 +539,10 @@ impl ExactSet {
             start,
             order,
             reach,
+            repeat,
+            wave,
+            members,
+            iso_wave,
         } = scratch;
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
@@ -508,11 +561,16 @@ impl ExactSet {
         general.clear();
         start.clear();
         start.resize(groups + 1, 0);
+        repeat.clear();
+        repeat.resize(groups + 1, false);
         let mut prev: Option<([u64; 3], u32, usize)> = None;
         for wo in wos {
             let b = bits(wo);
             let (k, g) = match prev {
-                Some((pb, pk, pg)) if pb == b => (pk, pg),
+                Some((pb, pk, pg)) if pb == b => {
+                    repeat[pg] = true;
+                    (pk, pg)
+                }
                 _ => match self.locate_iso(wo) {
                     Some(q) => (q.interval as u32, q.interval),
                     None => match self.locate_keys(wo) {
@@ -545,6 +603,20 @@ impl ExactSet {
         for g in 0..groups {
             start[g + 1] += start[g];
         }
+        // The groups drawn as a random-ωo wavefront: an interval of an isotropic `cos θo`-table
+        // set (the fast path's) with a table, some query, and no run of more than one query (a
+        // run is drawn once prepared, below).
+        wave.clear();
+        wave.resize(groups, false);
+        let mut waves = false;
+        let fast = self.isotropic && self.var == TableVar::Cos;
+        if let Some(cell) = self.cells.first().filter(|_| fast && wave_on()) {
+            for g in 0..groups.min(cell.tables.len()) {
+                let w = start[g + 1] > start[g] && !repeat[g] && cell.tables[g].is_some();
+                wave[g] = w;
+                waves |= w;
+            }
+        }
         // The spans of groups whose every draw is a split trial (an empty group, or an
         // isotropic interval with a table and fewer queries than a prepared run's: a group
         // holds each of its runs whole), whose uniforms are filled ahead (`Ahead`).
@@ -555,7 +627,10 @@ impl ExactSet {
             let mut end = 0;
             for g in (0..groups.min(cell.tables.len())).rev() {
                 let size = start[g + 1] - start[g];
-                if size == 0 || ((size as usize) < PREPARED_RUN_MIN && cell.tables[g].is_some()) {
+                if !wave[g]
+                    && (size == 0
+                        || ((size as usize) < PREPARED_RUN_MIN && cell.tables[g].is_some()))
+                {
                     end = if end == 0 { start[g + 1] } else { end };
                     reach[g] = end;
                     spans |= size > 0;
@@ -574,15 +649,27 @@ impl ExactSet {
             }
         }
         let mut audit = Audit::default();
+        // The wave groups' streams are keyed by one word of `u`, drawn before any other draw of
+        // the pass.
+        let mut waves = waves.then(|| Waves {
+            seed: wave_seed(u),
+            arch: pulp::Arch::new(),
+            wave,
+            end: start,
+            members,
+            w: iso_wave,
+        });
         let (key, general, order) = (&key[..], &general[..], &order[..]);
         if spans {
             let mut u = Ahead::new(u);
             self.serve_order(
-                brdf, wos, key, general, reach, order, &mut u, &mut audit, out,
+                brdf, wos, key, general, reach, order, &mut waves, &mut u, &mut audit, out,
             );
         } else {
             // No group to fill ahead for (an anisotropic set, say): the caller's stream itself.
-            self.serve_order(brdf, wos, key, general, reach, order, u, &mut audit, out);
+            self.serve_order(
+                brdf, wos, key, general, reach, order, &mut waves, u, &mut audit, out,
+            );
         }
         self.counters.record(&audit);
     }
@@ -598,6 +685,7 @@ impl ExactSet {
         general: &[(u32, Query)],
         reach: &[u32],
         order: &[u32],
+        waves: &mut Option<Waves<'_>>,
         u: &mut U,
         audit: &mut Audit,
         out: &mut [EvalSample],
@@ -607,6 +695,33 @@ impl ExactSet {
         let mut a = 0;
         while a < order.len() {
             let first = order[a] as usize;
+            let k = key[first];
+            if let Some(wv) = waves
+                .as_mut()
+                .filter(|wv| k < GENERAL && wv.wave[k as usize])
+            {
+                // A wave group from here to its end: its fast-path queries as one wavefront,
+                // its general ones (grazing, at the last interval) one by one.
+                let end = wv.end[k as usize] as usize;
+                wv.members.clear();
+                for &i in &order[a..end] {
+                    let ki = key[i as usize];
+                    if ki < GENERAL {
+                        wv.members.push(i);
+                    } else {
+                        u.set_left(0);
+                        let q = &general[(ki & !GENERAL) as usize].1;
+                        let one = std::slice::from_ref(&i);
+                        let wo = &wos[i as usize];
+                        self.serve_general_run(brdf, q, wo, one, u.as_dyn(), audit, out);
+                    }
+                }
+                self.serve_iso_wave(
+                    brdf, wos, k as usize, wv.members, wv.seed, wv.arch, wv.w, audit, out,
+                );
+                a = end;
+                continue;
+            }
             let wo = &wos[first];
             let b0 = bits(wo);
             let mut b = a + 1;
@@ -614,7 +729,6 @@ impl ExactSet {
                 b += 1;
             }
             let run = &order[a..b];
-            let k = key[first];
             // Within a span of groups whose every draw is a split trial, each query from the
             // run's last to the span's end draws at least one: the uniforms filled ahead.
             u.set_left(if k < GENERAL {
@@ -630,7 +744,8 @@ impl ExactSet {
                     cos,
                 };
                 if b == a + 1 {
-                    // A run of one query (a random ωo): the one-query path itself, whose
+                    // A run of one query (a random ωo in a group that is no wavefront, or
+                    // with the wavefront off): the one-query path itself, whose
                     // arithmetic `serve_iso_run` repeats for a run (the same bits).
                     let (s, f) = self.draw_iso(&q, wo, u, audit);
                     out[first] = self.finish_iso(brdf, wo, s, f);
@@ -967,9 +1082,12 @@ mod tests {
     /// leaves the stream in the same state. Runs of 1 to 700 queries, alternating `ωo` (runs
     /// of 1), two runs at one θo and two azimuths, grazing and below-horizon runs; on Phong with a caller-held run (used by the
     /// runs of at least [`PREPARED_RUN_MIN`] only) and on anisotropic Ward (the general path).
+    /// With the random-ωo wavefront off (a group of runs of one is drawn by it otherwise:
+    /// other samples, tested below).
     #[test]
     fn runs_of_one_wo_draw_the_one_query_paths_bits() {
-        use super::PREPARED_RUN_MIN;
+        use super::{NO_WAVE, PREPARED_RUN_MIN};
+        NO_WAVE.with(|c| c.set(true));
         let (phong, cases) = phong_and_small_ward(false);
         for (brdf, opts) in cases {
             let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
@@ -1043,18 +1161,24 @@ mod tests {
                 assert_eq!(through_runs, 0);
             }
         }
+        NO_WAVE.with(|c| c.set(false));
     }
 
     /// The uniforms filled ahead (`Ahead`) are the trials one call each would draw: random-ωo
     /// batches (some grazing, some below the horizon) around a run drawn by the wavefront
     /// (Phong with a block-preferring run) or of general queries (Ward) give the same samples
     /// bit for bit, and leave the generator in the same state (the next batch and word
-    /// equal), as with every call passed through.
+    /// equal), as with every call passed through; with the random-ωo wavefront off (so the
+    /// random queries' groups fill ahead) and on.
     #[test]
     fn uniforms_filled_ahead_change_no_sample_and_no_stream_state() {
-        use super::{NO_FILL, PREPARED_RUN_MIN};
+        use super::{NO_FILL, NO_WAVE, PREPARED_RUN_MIN};
         let (_, cases) = phong_and_small_ward(true);
-        for (brdf, opts) in cases {
+        for ((brdf, opts), no_wave) in cases
+            .into_iter()
+            .flat_map(|c| [(c.clone(), true), (c, false)])
+        {
+            NO_WAVE.with(|c| c.set(no_wave));
             let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
             let mut qr = Xoshiro256PlusPlus::seed_from_u64(31);
             let mut random = |n: usize| mixed_wos(&mut qr, n);
@@ -1082,7 +1206,217 @@ mod tests {
                 drawn.push((first, key(&out), r.next_uniform().to_bits()));
             }
             NO_FILL.with(|c| c.set(false));
-            assert!(drawn[0] == drawn[1], "{}", brdf.name());
+            NO_WAVE.with(|c| c.set(false));
+            assert!(
+                drawn[0] == drawn[1],
+                "{} (wavefront off: {no_wave})",
+                brdf.name()
+            );
+        }
+    }
+
+    /// Random ωo (no two consecutive queries alike), on Phong and GGX with grazing and
+    /// below-horizon queries among them: every isotropic fast-path query is drawn by its
+    /// group's wavefront, and its sample is, bit for bit, [`ExactSet::draw_iso`]'s at its own
+    /// `ωo` from its own stream — SplitMix64 as a **generator** (`SplitMix`, started at
+    /// `Stream::of(seed, i)`'s state, `seed` from the caller's stream at the batch's start, `i`
+    /// the query's index), whose split trials `distributions` makes from two outputs —
+    /// finished as the one-query path finishes it —
+    /// so a function of the seed, `i` and `ωo_i` only, with `draw_iso`'s law; the same when
+    /// the batch's other queries change; the grazing queries (the general path) are their own
+    /// query's samples, the ones below the horizon empty.
+    #[test]
+    fn random_wo_groups_draw_draw_isos_samples_from_their_own_streams() {
+        use super::super::lanes::{GOLDEN_GAMMA, mix64};
+        use super::{Stream, wave_seed};
+        use partition_sampler::Audit;
+        /// SplitMix64 as a `rand` generator (its outputs `mix64(state + k·γ)`, `k ≥ 1`).
+        struct SplitMix(u64);
+        impl rand::TryRng for SplitMix {
+            type Error = std::convert::Infallible;
+            fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
+                self.try_next_u64().map(|w| (w >> 32) as u32)
+            }
+            fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
+                self.0 = self.0.wrapping_add(GOLDEN_GAMMA);
+                Ok(mix64(self.0))
+            }
+            fn try_fill_bytes(&mut self, _: &mut [u8]) -> Result<(), Self::Error> {
+                unimplemented!("not used")
+            }
+        }
+        let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
+        for spec in ["phong:n=50", "ggx:alpha=0.2"] {
+            let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
+            let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+            let mut qr = Xoshiro256PlusPlus::seed_from_u64(51);
+            let mut wos = mixed_wos(&mut qr, 4000);
+            let rng = Xoshiro256PlusPlus::seed_from_u64(19);
+            let seed = wave_seed(&mut rng.clone());
+            let mut out = Vec::new();
+            set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng.clone(), &mut out);
+            let mut audit = Audit::default();
+            let (mut fast, mut general) = (0, 0);
+            for (i, (wo, o)) in wos.iter().zip(&out).enumerate() {
+                match set.locate_iso(wo) {
+                    Some(q) => {
+                        let mut s = SplitMix(Stream::of(seed, i).0);
+                        let (d, f) = set.draw_iso(&q, wo, &mut s, &mut audit);
+                        let want = set.finish_iso(brdf.as_ref(), wo, d, f);
+                        assert_eq!(key(o), key(&want), "{spec} query {i}: {o:?} vs {want:?}");
+                        fast += 1;
+                    }
+                    None if wo.z > 0.0 => {
+                        assert!(o.pdf > 0.0 && o.wi.z > 0.0, "{spec} query {i}: {o:?}");
+                        approx::assert_relative_eq!(o.pdf, set.pdf(wo, &o.wi), max_relative = 1e-9);
+                        approx::assert_relative_eq!(
+                            o.f,
+                            brdf.eval(wo, &o.wi),
+                            max_relative = 1e-12
+                        );
+                        general += 1;
+                    }
+                    None => assert_eq!(*o, EvalSample::NONE, "{spec} query {i}"),
+                }
+            }
+            assert!(
+                fast > 3850 && general >= 40,
+                "{spec}: {fast} fast, {general} grazing"
+            );
+            assert!(audit.trials > audit.samples, "{spec}: some trials rejected");
+            // Other queries around them: the fast-path samples of the queries kept are the same.
+            let before = out.clone();
+            for k in (0..wos.len()).filter(|k| k % 3 == 2) {
+                wos[k] = brdf::direction_from_angles(
+                    80.0 * qr.next_uniform(),
+                    360.0 * qr.next_uniform(),
+                );
+            }
+            set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng.clone(), &mut out);
+            let mut same = 0;
+            for (k, (a, b)) in before.iter().zip(&out).enumerate() {
+                if k % 3 != 2 && set.locate_iso(&wos[k]).is_some() {
+                    assert_eq!(key(a), key(b), "{spec} query {k}");
+                    same += 1;
+                }
+            }
+            assert!(same > 2500, "{spec}: {same}");
+        }
+    }
+
+    /// The random-ωo wavefront gives the same bits at every instruction-set level of the host
+    /// (`pulp`: the baseline, AVX2 + FMA, AVX-512): Phong `n = 50`, 3000 random ωo served by
+    /// [`ExactSet::serve_iso_wave`] interval by interval at each level, outputs and audits
+    /// compared.
+    #[test]
+    fn random_wo_wavefront_bits_are_the_same_at_every_level() {
+        use super::super::wave_iso::IsoWave;
+        use partition_sampler::Audit;
+        let mut levels = vec![pulp::Arch::Scalar];
+        #[cfg(target_arch = "x86_64")]
+        {
+            levels.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
+            levels.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
+        }
+        let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
+        let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let mut qr = Xoshiro256PlusPlus::seed_from_u64(61);
+        let wos: Vec<Vec3> = (0..3000)
+            .map(|_| {
+                brdf::direction_from_angles(89.0 * qr.next_uniform(), 360.0 * qr.next_uniform())
+            })
+            .collect();
+        let intervals = set.cells[0].intervals.len();
+        let mut by_interval = vec![Vec::new(); intervals];
+        for (i, wo) in wos.iter().enumerate() {
+            by_interval[set.locate_iso(wo).expect("fast path").interval].push(i as u32);
+        }
+        let key = |v: &[EvalSample]| -> Vec<[u64; 5]> {
+            v.iter()
+                .map(|s| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits))
+                .collect()
+        };
+        let mut first = None;
+        for (level, &arch) in levels.iter().enumerate() {
+            let mut out = vec![EvalSample::NONE; wos.len()];
+            let mut audit = Audit::default();
+            let mut w = IsoWave::default();
+            for (iv, members) in by_interval.iter().enumerate() {
+                set.serve_iso_wave(
+                    brdf.as_ref(),
+                    &wos,
+                    iv,
+                    members,
+                    0x5eed,
+                    arch,
+                    &mut w,
+                    &mut audit,
+                    &mut out,
+                );
+            }
+            assert!(out.iter().all(|s| s.pdf > 0.0));
+            let got = (key(&out), audit);
+            match &first {
+                None => first = Some(got),
+                Some(f) => assert!(*f == got, "level {level} of {}", levels.len()),
+            }
+        }
+        assert!(levels.len() >= 2, "{} levels", levels.len());
+    }
+
+    /// The random-ωo wavefront's law by χ² (α = 10⁻⁴, 16 × 32 `(cos θ, φ)` bins, 4·10⁴ samples
+    /// per angle): a batch alternating two ωo (no two consecutive alike, so both groups are
+    /// wavefronts) at θo = 35° (projected map) and 85° (equal-area map) passes against the set's
+    /// pdf at each, and two deliberately broken wavefronts are rejected at both — one that
+    /// misreports each candidate's `f` by the factor `0.6 + 0.8 cos θi`, one that accepts every
+    /// candidate (the envelope's law).
+    #[test]
+    fn random_wo_wavefront_passes_chi_square_and_broken_ones_fail() {
+        use super::super::wave_iso::SKEW;
+        let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
+        let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
+        let quad = stats::QuadratureOptions {
+            min_depth: 2,
+            ..stats::QuadratureOptions::default()
+        };
+        let dirs = [35.0, 85.0].map(|t: f64| brdf::direction_from_angles(t, 30.0 + t));
+        let p_values = |skew: f64| -> Vec<f64> {
+            SKEW.with(|c| c.set(skew));
+            let wos: Vec<Vec3> = (0..80_000).map(|k| dirs[k % 2]).collect();
+            let out = batch(&set, brdf.as_ref(), &wos, 29);
+            SKEW.with(|c| c.set(0.0));
+            dirs.iter()
+                .enumerate()
+                .map(|(j, wo)| {
+                    let pts: Vec<[f64; 3]> = out
+                        .iter()
+                        .skip(j)
+                        .step_by(2)
+                        .map(|s| [s.wi.x, s.wi.y, s.wi.z])
+                        .collect();
+                    let pdf = |d: [f64; 3]| set.pdf(wo, &Vec3::new(d[0], d[1], d[2]));
+                    stats::chi_square_test(&bins, &pdf, &pts, &quad)
+                        .unwrap()
+                        .p_value
+                })
+                .collect()
+        };
+        for (j, p) in p_values(0.0).into_iter().enumerate() {
+            assert!(
+                p >= 1e-4,
+                "honest wavefront rejected at ωo {:?}: p = {p}",
+                dirs[j]
+            );
+        }
+        for skew in [0.4, -1.0] {
+            for (j, p) in p_values(skew).into_iter().enumerate() {
+                assert!(
+                    p < 1e-4,
+                    "broken wavefront ({skew}) passed at ωo {:?}: p = {p}",
+                    dirs[j]
+                );
+            }
         }
     }
 

@@ -208,3 +208,123 @@ impl pulp::WithSimd for Keys<'_> {
 pub(super) fn keys(arch: pulp::Arch, seed: u64, state: &mut [u64]) {
     arch.dispatch(Keys { seed, state });
 }
+
+/// `k · 2⁻³²` for the 32-bit `k` (exact; as `distributions`' split trials make it). The bits
+/// fit in an `i64`, so the signed conversion gives the unsigned one's value.
+#[inline(always)]
+fn half_unit(k: u64) -> f64 {
+    (k as i64) as f64 * (1.0 / (1u64 << 32) as f64)
+}
+
+/// The next **split** trial of a SplitMix64 stream at `state` (advanced by two steps): the
+/// halves of its next two outputs `w₀, w₁`, `[hi(w₀), lo(w₀), hi(w₁), lo(w₁)] · 2⁻³²` — what
+/// `UniformSource::next_uniform4_split` makes of a generator's two words, the uniforms of
+/// [`LeafTable::draw`] (the random-ωo wavefront's, `wave_iso.rs`).
+///
+/// [`LeafTable::draw`]: super::table::LeafTable::draw
+#[inline(always)]
+pub(super) fn split_trial(state: &mut u64) -> [f64; 4] {
+    let s1 = state.wrapping_add(GOLDEN_GAMMA);
+    let s2 = s1.wrapping_add(GOLDEN_GAMMA);
+    *state = s2;
+    let (w0, w1) = (mix64(s1), mix64(s2));
+    [
+        half_unit(w0 >> 32),
+        half_unit(w0 & 0xffff_ffff),
+        half_unit(w1 >> 32),
+        half_unit(w1 & 0xffff_ffff),
+    ]
+}
+
+/// [`pass`] with split trials ([`split_trial`]: two SplitMix64 outputs per trial instead of
+/// four), for the random-ωo wavefront: the same leaf pick, point, bound, threshold and
+/// direction arithmetic.
+#[inline(always)]
+fn pass_split<D: Fn(f64, f64) -> Vec3>(
+    table: &LeafTable,
+    state: &mut [u64],
+    t: &mut Trials,
+    to_dir: D,
+) {
+    let z = [0.0; LANES];
+    let groups = state
+        .chunks_mut(LANES)
+        .zip(t.x.chunks_exact_mut(LANES))
+        .zip(t.y.chunks_exact_mut(LANES))
+        .zip(t.bound.chunks_exact_mut(LANES))
+        .zip(t.threshold.chunks_exact_mut(LANES))
+        .zip(t.inside.chunks_exact_mut(LANES))
+        .zip(t.dir.chunks_exact_mut(LANES));
+    for ((((((st, xs), ys), ms), th), ok), dir) in groups {
+        let n = st.len();
+        let mut s0 = [0u64; LANES];
+        for (a, b) in s0.iter_mut().zip(st.iter()) {
+            *a = *b;
+        }
+        let (mut u0, mut u1, mut u2, mut u3) = (z, z, z, z);
+        for j in 0..LANES {
+            let [a, b, c, d] = split_trial(&mut s0[j]);
+            u0[j] = a;
+            u1[j] = b;
+            u2[j] = c;
+            u3[j] = d;
+        }
+        st.copy_from_slice(&s0[..n]);
+        let mut leaf = [[0.0; 5]; LANES];
+        for j in 0..LANES {
+            leaf[j] = table.leaf_of(u0[j]);
+        }
+        for j in 0..LANES {
+            let [x0, dx, y0, dy, m] = leaf[j];
+            let x = x0 + u1[j] * dx;
+            let y = y0 + u2[j] * dy;
+            xs[j] = x;
+            ys[j] = y;
+            ms[j] = m;
+            th[j] = u3[j] * m;
+            ok[j] = x * x + y * y < 1.0;
+            dir[j] = to_dir(x, y);
+        }
+    }
+}
+
+/// [`pass_split`] as a `pulp` operation.
+struct PassSplit<'a> {
+    table: &'a LeafTable,
+    map: DiscMap,
+    state: &'a mut [u64],
+    t: &'a mut Trials,
+}
+
+impl pulp::WithSimd for PassSplit<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        match self.map {
+            DiscMap::Projected => pass_split(self.table, self.state, self.t, projected),
+            DiscMap::EqualArea => pass_split(self.table, self.state, self.t, equal_area),
+        }
+    }
+}
+
+/// [`trials`] with split trials: entry `j`'s uniforms are [`split_trial`] of `state[j]`
+/// (advanced by two steps), as [`LeafTable::draw`] reads them from the stream through
+/// `next_uniform4_split`; the point and bound [`LeafTable::propose`]'s. Dispatched at run time
+/// (`pulp`); the same bits on every level.
+///
+/// [`LeafTable::draw`]: super::table::LeafTable::draw
+/// [`LeafTable::propose`]: super::table::LeafTable::propose
+pub(super) fn trials_split(
+    arch: pulp::Arch,
+    table: &LeafTable,
+    map: DiscMap,
+    state: &mut [u64],
+    t: &mut Trials,
+) {
+    arch.dispatch(PassSplit {
+        table,
+        map,
+        state,
+        t,
+    });
+}
