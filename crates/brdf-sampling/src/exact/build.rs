@@ -411,7 +411,9 @@ fn job_done(shared: &JobShared<'_, '_>, job: Job, b: Built) -> Vec<Job> {
         if let Some(iv) = iv {
             state.phases.kept.add(&counts);
             state.phases.kept_intervals += 1;
-            state.phases.record(&plan.grid, &job, Some(&iv), &counts, None);
+            state
+                .phases
+                .record(&plan.grid, &job, Some(&iv), &counts, None);
             // Only the edges are kept (the node values go with `job`).
             state.done.push((job.cell, (job.num, job.dnum, iv)));
         }
