@@ -194,7 +194,11 @@ fn the_set_does_not_depend_on_the_thread_count() {
     for k in 0..2000 {
         let wo = brdf::direction_from_angles(k as f64 * 0.0449, k as f64 * 3.7);
         let (s, t) = (one.sample(&wo, &mut r1), three.sample(&wo, &mut r2));
-        assert_eq!((s.wi, s.pdf.to_bits()), (t.wi, t.pdf.to_bits()), "sample {k}");
+        assert_eq!(
+            (s.wi, s.pdf.to_bits()),
+            (t.wi, t.pdf.to_bits()),
+            "sample {k}"
+        );
     }
 }
 
