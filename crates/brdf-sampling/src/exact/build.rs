@@ -1,11 +1,11 @@
 //! [`ExactSet::build`]: the intervals, built in parallel and halved until they meet the caps.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Instant;
 
 use brdf::{Brdf, direction_from_radians};
 use partition_sampler::AuditCounters;
+use rayon::prelude::*;
 
 use crate::options::SetOptions;
 use crate::set::layout_for;
@@ -250,41 +250,8 @@ impl Plan {
     }
 }
 
-/// What the tasks of [`run_jobs`] share: the kept intervals, the phases, the counts of the
-/// progress report and the first error (by the failing interval's place, not by time).
-struct JobState<'p> {
-    done: Vec<(usize, Placed)>,
-    phases: &'p mut BuildPhases,
-    built: usize,
-    queued: usize,
-    error: Option<(JobKey, ExactError)>,
-}
-
-/// An interval's place: its cell, then its θ and δ edges (what [`assemble_cells`] sorts by).
-type JobKey = (usize, [u64; 2], [u64; 2]);
-
-/// What every task of [`run_jobs`] reads.
-struct JobShared<'a, 'p> {
-    brdf: &'a Arc<dyn Brdf>,
-    options: &'a ExactOptions,
-    plan: &'a Plan,
-    progress: Option<crate::Progress<'a>>,
-    state: Mutex<JobState<'p>>,
-    /// Set once an interval failed: no further interval is started.
-    failed: AtomicBool,
-}
-
 /// Builds every interval, halving those that miss the caps, and returns the kept ones with
-/// their cells (in the order they were built; [`assemble_cells`] sorts them).
-///
-/// Every interval is a task of one `rayon` scope that, once built, decides its fate and spawns
-/// its halves: no interval waits for others of a batch (the former batches of `2 × threads`
-/// intervals left a core idle while the batch's slowest interval finished,
-/// docs/benchmarks.md §28.4). A worker takes its own newest task first, so the build stays
-/// depth first on each worker (a split parent's node values are released once its children
-/// are built). The set does not depend on the order: each interval's build reads only its own
-/// job and what its parent handed down. On an error no further interval is started, and the
-/// error of the first failing interval in the order of [`assemble_cells`] is returned.
+/// their cells (in the order they were built).
 fn run_jobs(
     brdf: &Arc<dyn Brdf>,
     options: &ExactOptions,
@@ -292,136 +259,86 @@ fn run_jobs(
     progress: Option<crate::Progress<'_>>,
     phases: &mut BuildPhases,
 ) -> Result<Vec<(usize, Placed)>, ExactError> {
-    let jobs = plan.initial_jobs();
-    let shared = JobShared {
-        brdf,
-        options,
-        plan,
-        progress,
-        state: Mutex::new(JobState {
-            done: Vec::new(),
-            phases,
-            built: 0,
-            queued: jobs.len(),
-            error: None,
-        }),
-        failed: AtomicBool::new(false),
-    };
-    rayon::scope(|s| {
-        // The last one first on this worker, the first ones taken by the others.
-        for job in jobs.into_iter().rev() {
-            spawn_job(s, &shared, job);
-        }
-    });
-    let state = shared.state.into_inner().unwrap_or_else(|e| e.into_inner());
-    match state.error {
-        Some((_, e)) => Err(e),
-        None => Ok(state.done),
-    }
-}
-
-/// Spawns `job`'s build on `s`; the task then records its fate and spawns its halves.
-fn spawn_job<'s>(s: &rayon::Scope<'s>, shared: &'s JobShared<'s, '_>, job: Job) {
-    s.spawn(move |s| {
-        if shared.failed.load(Ordering::Relaxed) {
-            return;
-        }
-        let plan = shared.plan;
-        let built = build_interval(shared.brdf, shared.options, &job, &plan.context(&job));
-        match built {
-            Ok(b) => {
-                // Children on top of this worker's stack, the left one taken first.
-                for child in job_done(shared, job, b).into_iter().rev() {
-                    spawn_job(s, shared, child);
+    let mut jobs = plan.initial_jobs();
+    let mut done: Vec<(usize, Placed)> = Vec::new();
+    let (mut built, mut queued) = (0usize, jobs.len());
+    // Depth first, a few intervals at a time: a split parent's node values are released
+    // once its children are built (the set does not depend on the order).
+    jobs.reverse();
+    let batch_len = 2 * rayon::current_num_threads().max(1);
+    while !jobs.is_empty() {
+        let batch = jobs.split_off(jobs.len().saturating_sub(batch_len));
+        let results: Vec<Result<(Job, Built), ExactError>> = batch
+            .par_iter()
+            .map(|job| {
+                build_interval(brdf, options, job, &plan.context(job)).map(|b| (job.clone(), b))
+            })
+            .collect();
+        let mut next = Vec::new();
+        for r in results {
+            let (
+                job,
+                Built {
+                    interval: iv,
+                    inheritance,
+                    axis: trials_axis,
+                    phases: counts,
+                    envelope,
+                },
+            ) = r?;
+            built += 1;
+            phases.built += 1;
+            if let Some(delta) = next_axis(options, plan, &job, iv.as_ref(), trials_axis) {
+                // Too many trials (found early, or at a node of the full table), or a
+                // table's interpolation tail.
+                let by_trials = iv
+                    .as_ref()
+                    .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
+                if by_trials {
+                    phases.split.add(&counts);
+                } else {
+                    phases.split_tail.add(&counts);
                 }
-            }
-            Err(e) => {
-                shared.failed.store(true, Ordering::Relaxed);
-                let key = (job.cell, job.num, job.dnum);
-                let mut state = shared.state.lock().unwrap_or_else(|e| e.into_inner());
-                if state.error.as_ref().is_none_or(|(k, _)| key < *k) {
-                    state.error = Some((key, e));
+                phases.record(
+                    &plan.grid,
+                    &job,
+                    iv.as_ref(),
+                    &counts,
+                    Some((by_trials, delta)),
+                );
+                // Split for its tail: its tree bounds the halves too (`Inheritance`).
+                let mut inheritance = inheritance;
+                if let Some(envelope) = envelope {
+                    inheritance.nodes = values_of(envelope);
                 }
+                if let (false, Some(iv)) = (by_trials, iv) {
+                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
+                }
+                let inheritance = Arc::new(inheritance);
+                for (num, dnum) in job.halves(delta) {
+                    next.push(Job {
+                        cell: job.cell,
+                        num,
+                        dnum,
+                        inherited: Arc::clone(&inheritance),
+                    });
+                }
+                queued += 2;
+            } else if let Some(iv) = iv {
+                phases.kept.add(&counts);
+                phases.kept_intervals += 1;
+                phases.record(&plan.grid, &job, Some(&iv), &counts, None);
+                // Only the edges are kept (the node values go with `job`).
+                done.push((job.cell, (job.num, job.dnum, iv)));
+            }
+            if let Some(p) = progress {
+                p(built, queued);
             }
         }
-    });
-}
-
-/// Decides the fate of `job`, built as `b`: kept (recorded) or halved (its two halves
-/// returned, the left one first).
-fn job_done(shared: &JobShared<'_, '_>, job: Job, b: Built) -> Vec<Job> {
-    let (options, plan) = (shared.options, shared.plan);
-    let Built {
-        interval: iv,
-        inheritance,
-        axis: trials_axis,
-        phases: counts,
-        envelope,
-    } = b;
-    let mut next = Vec::new();
-    let split = next_axis(options, plan, &job, iv.as_ref(), trials_axis);
-    if let Some(delta) = split {
-        // Too many trials (found early, or at a node of the full table), or a table's
-        // interpolation tail.
-        let by_trials = iv
-            .as_ref()
-            .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
-        // Split for its tail: its tree bounds the halves too (`Inheritance`). The node
-        // values are gathered on this worker, outside the lock.
-        let mut inheritance = inheritance;
-        if let Some(envelope) = envelope {
-            inheritance.nodes = values_of(envelope);
-        }
-        let mut state = shared.state.lock().unwrap_or_else(|e| e.into_inner());
-        state.built += 1;
-        state.phases.built += 1;
-        if by_trials {
-            state.phases.split.add(&counts);
-        } else {
-            state.phases.split_tail.add(&counts);
-        }
-        state.phases.record(
-            &plan.grid,
-            &job,
-            iv.as_ref(),
-            &counts,
-            Some((by_trials, delta)),
-        );
-        state.queued += 2;
-        if let Some(p) = shared.progress {
-            p(state.built, state.queued);
-        }
-        drop(state);
-        if let (false, Some(iv)) = (by_trials, iv) {
-            inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
-        }
-        let inheritance = Arc::new(inheritance);
-        for (num, dnum) in job.halves(delta) {
-            next.push(Job {
-                cell: job.cell,
-                num,
-                dnum,
-                inherited: Arc::clone(&inheritance),
-            });
-        }
-    } else {
-        let mut state = shared.state.lock().unwrap_or_else(|e| e.into_inner());
-        state.built += 1;
-        state.phases.built += 1;
-        if let Some(iv) = iv {
-            state.phases.kept.add(&counts);
-            state.phases.kept_intervals += 1;
-            state
-                .phases
-                .record(&plan.grid, &job, Some(&iv), &counts, None);
-            // Only the edges are kept (the node values go with `job`).
-            state.done.push((job.cell, (job.num, job.dnum, iv)));
-        }
-        if let Some(p) = shared.progress {
-            p(state.built, state.queued);
-        }
+        // Children on top of the stack, the left one first.
+        jobs.extend(next.into_iter().rev());
     }
-    next
+    Ok(done)
 }
 
 /// The axis to halve (`Some(true)`: δ), if any: too many trials (either axis, `trials_axis`
