@@ -166,11 +166,10 @@ fn the_node_cache_changes_nothing_but_the_cost() {
     }
 }
 
-/// The intervals are tasks that spawn their halves when built (`build::run_jobs`): the order
-/// they are built and kept in depends on the threads, the set does not. Phong built on pools
-/// of 1 and 3 threads: the same layout and the same samples bit for bit. Fails when the kept
-/// intervals are not sorted by place before the cells are assembled (tried: sample 0
-/// differs).
+/// The intervals are built in batches of `2 × threads` (`build::run_jobs`): the order they are
+/// kept in depends on the threads, the set does not. Phong built on pools of 1 and 3 threads:
+/// the same layout and the same samples bit for bit. Fails when the kept intervals are not
+/// sorted by place before the cells are assembled (tried: sample 0 differs).
 #[test]
 fn the_set_does_not_depend_on_the_thread_count() {
     let (phong, opts) = small("phong:n=200");
