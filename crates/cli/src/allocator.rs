@@ -45,8 +45,8 @@ mod tests {
     /// back to the kernel every round and rounds 3–5 fault in ≈ 3 · 6 · 1024 pages again;
     /// primed, they are reused. Fails with `PRIMING_BYTES = 33 << 20` (above glibc's 32 MiB
     /// ceiling, the threshold then stays dynamic; tried: 18 336 faults), and without the
-    /// priming call (tried: 18 336). (The process's other tests may raise the thresholds too: the break
-    /// shows when this test runs alone.)
+    /// priming call (tried: 18 336). (The process's other tests may raise the thresholds too:
+    /// the break shows when this test runs alone.)
     #[test]
     fn freed_blocks_are_reused_without_faults() {
         super::raise_thresholds();
