@@ -3,6 +3,7 @@
 //! Exit codes: 0 success (all tests passed), 1 a statistical test failed, 2 bad usage or input,
 //! 3 `validate` ran no test (every case skipped).
 
+mod allocator;
 mod baseline_args;
 mod bench_cmd;
 mod brdf_args;
@@ -53,6 +54,9 @@ enum Command {
 }
 
 fn main() {
+    // Freed blocks of a build stay in the heaps for reuse instead of being handed back to the
+    // kernel and faulted in again (glibc; docs/benchmarks.md §28.4).
+    allocator::raise_thresholds();
     // Usage errors: clap's full message (missing arguments by name, possible values, "similar
     // argument" tips, the usage line) on stderr, exit 2. No subcommand: the help on stderr,
     // exit 2 (`arg_required_else_help`). `--help` / `--version`: stdout, exit 0.

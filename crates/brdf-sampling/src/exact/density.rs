@@ -94,11 +94,109 @@ impl Density for QueryDensity<'_> {
 type ValueMap = FxHashMap<[u64; 3], f64>;
 
 /// Every value known for one bound node: the maps of the builds that evaluated it, largest
-/// first, shared (not copied) between an interval and its descendants.
+/// first, shared (not copied) between an interval and its descendants. A map no other
+/// `NodeValues` shares goes back to [`MAP_POOL`] when this one is dropped.
 #[derive(Clone, Default)]
 pub(crate) struct NodeValues {
     layers: Vec<Arc<ValueMap>>,
 }
+
+impl Drop for NodeValues {
+    fn drop(&mut self) {
+        for layer in self.layers.drain(..) {
+            if let Ok(map) = Arc::try_unwrap(layer) {
+                MAP_POOL.give(map);
+            }
+        }
+    }
+}
+
+/// Freed storage kept for the next interval's nodes, instead of handing it back to the
+/// allocator (which returned the pages of a freed heap top to the kernel: the next interval's
+/// buffers and maps then faulted in zero-filled pages again, ≈ 7·10⁴ minor faults and
+/// 0.2–0.3 s of system time on `cc_ibiza_sunset`'s build, docs/benchmarks.md §28.4). Holds
+/// at most `max` items, emptied (their capacity kept); an item taken is the smallest one of
+/// at least the capacity asked for, else the largest (which then grows). Only storage is
+/// reused: an item is empty when taken, so no value passes from one build to another.
+struct Pool<T> {
+    items: Mutex<Vec<T>>,
+    max: usize,
+}
+
+/// Storage [`Pool`] can keep: emptied, and its capacity read.
+trait Reusable: Default {
+    fn empty(&mut self);
+    fn room(&self) -> usize;
+}
+
+impl<T> Reusable for Vec<T> {
+    fn empty(&mut self) {
+        self.clear();
+    }
+    fn room(&self) -> usize {
+        self.capacity()
+    }
+}
+
+impl Reusable for ValueMap {
+    fn empty(&mut self) {
+        self.clear();
+    }
+    fn room(&self) -> usize {
+        self.capacity()
+    }
+}
+
+impl<T: Reusable> Pool<T> {
+    const fn new(max: usize) -> Self {
+        Self {
+            items: Mutex::new(Vec::new()),
+            max,
+        }
+    }
+
+    /// An empty item, of capacity at least `room` when the pool has one (the smallest such),
+    /// else the pool's largest, else a new one.
+    fn take(&self, room: usize) -> T {
+        let Ok(mut items) = self.items.lock() else {
+            return T::default();
+        };
+        let pick = items
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.room() >= room)
+            .min_by_key(|(_, t)| t.room())
+            .or_else(|| items.iter().enumerate().max_by_key(|(_, t)| t.room()))
+            .map(|(k, _)| k);
+        pick.map(|k| items.swap_remove(k)).unwrap_or_default()
+    }
+
+    /// The empty item of largest capacity the pool has, else a new one.
+    fn take_largest(&self) -> T {
+        self.take(usize::MAX)
+    }
+
+    /// Keeps `item`'s storage (emptied) unless it has none or the pool is full.
+    fn give(&self, mut item: T) {
+        if item.room() == 0 {
+            return;
+        }
+        item.empty();
+        if let Ok(mut items) = self.items.lock()
+            && items.len() < self.max
+        {
+            items.push(item);
+        }
+    }
+}
+
+/// The caching nodes' per-worker buffers ([`FreshBuffer`]): an interval of ≈ 5–9 caching
+/// nodes holds `threads + 1` buffers each.
+static BUFFER_POOL: Pool<Vec<([u64; 3], f64)>> = Pool::new(48);
+
+/// The nodes' value maps ([`EnvelopeNode::into_values`]), freed with the last
+/// [`NodeValues`] that shares them.
+static MAP_POOL: Pool<ValueMap> = Pool::new(32);
 
 impl NodeValues {
     #[inline]
@@ -133,9 +231,35 @@ const LANES_MIN_TAIL: usize = 8;
 
 /// One thread's fresh values, on a cache line of its own (the image map evaluates in
 /// parallel; each worker appends to its own buffer, uncontended).
+/// Its storage comes from [`BUFFER_POOL`] at the first value ([`FreshBuffer::keep`]) and goes
+/// back there.
 #[repr(align(128))]
 #[derive(Default)]
 struct FreshBuffer(Mutex<Vec<([u64; 3], f64)>>);
+
+impl FreshBuffer {
+    /// Appends `values` to the buffer of this worker (the pool's largest storage when it has
+    /// none yet).
+    fn keep(&self, values: impl Iterator<Item = ([u64; 3], f64)>) {
+        if let Ok(mut b) = self.0.lock() {
+            if b.capacity() == 0 {
+                *b = BUFFER_POOL.take_largest();
+            }
+            b.extend(values);
+        }
+    }
+
+    /// Its values, leaving it empty.
+    fn take(&mut self) -> Vec<([u64; 3], f64)> {
+        std::mem::take(self.0.get_mut().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+impl Drop for FreshBuffer {
+    fn drop(&mut self) {
+        BUFFER_POOL.give(self.take());
+    }
+}
 
 /// One bound node of an [`IntervalEnvelope`].
 pub(crate) struct EnvelopeNode {
@@ -193,8 +317,8 @@ impl EnvelopeNode {
         };
         if let Some(buffers) = &self.fresh {
             let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
-            if let Some(Ok(mut b)) = buffers.get(worker).map(|b| b.0.lock()) {
-                b.push((key, v));
+            if let Some(b) = buffers.get(worker) {
+                b.keep(std::iter::once((key, v)));
             }
         }
         v
@@ -250,8 +374,8 @@ impl EnvelopeNode {
         }
         if let Some(buffers) = &self.fresh {
             let worker = rayon::current_thread_index().map_or(0, |i| i + 1);
-            if let Some(Ok(mut b)) = buffers.get(worker).map(|b| b.0.lock()) {
-                b.extend(slot[..m].iter().zip(&fresh[..m]).map(|(&k, &v)| {
+            if let Some(b) = buffers.get(worker) {
+                b.keep(slot[..m].iter().zip(&fresh[..m]).map(|(&k, &v)| {
                     let w = &wi[k];
                     ([w.x.to_bits(), w.y.to_bits(), w.z.to_bits()], v)
                 }));
@@ -278,22 +402,26 @@ impl EnvelopeNode {
     /// Every value known for this node (inherited and fresh), for the children.
     pub(crate) fn into_values(self) -> (NodeKey, Arc<NodeValues>) {
         let mut values = self.inherited.map(Arc::unwrap_or_clone).unwrap_or_default();
-        let buffers: Vec<Vec<([u64; 3], f64)>> = self
-            .fresh
-            .unwrap_or_default()
-            .into_iter()
-            .filter_map(|b| b.0.into_inner().ok())
-            .collect();
-        let mut fresh = ValueMap::with_capacity_and_hasher(
-            buffers.iter().map(Vec::len).sum(),
-            Default::default(),
-        );
-        for b in buffers {
-            fresh.extend(b);
+        let mut buffers: Vec<FreshBuffer> = self.fresh.unwrap_or_default();
+        let len = buffers
+            .iter_mut()
+            .map(|b| b.0.get_mut().map_or(0, |v| v.len()))
+            .sum();
+        // A map from the pool (emptied; its capacity grown to `len` if short).
+        let mut fresh = MAP_POOL.take(len);
+        fresh.reserve(len);
+        for b in &mut buffers {
+            // The buffer's storage goes back to the pool when `buffers` is dropped.
+            if let Ok(v) = b.0.get_mut() {
+                fresh.extend(v.drain(..));
+            }
         }
+        drop(buffers);
         if !fresh.is_empty() {
             values.layers.push(Arc::new(fresh));
             values.layers.sort_by_key(|m| std::cmp::Reverse(m.len()));
+        } else {
+            MAP_POOL.give(fresh);
         }
         (self.key, Arc::new(values))
     }
@@ -421,6 +549,38 @@ mod tests {
         fn name(&self) -> &str {
             "tally"
         }
+    }
+
+    /// The storage pools of the node buffers and maps (docs/benchmarks.md §28.4): an item
+    /// taken is empty whatever was given back, the smallest of at least the room asked for
+    /// (else the largest), and a full pool keeps no more. Fails when `give` keeps an item
+    /// without emptying it (tried: the taken buffer holds the given values).
+    #[test]
+    fn pooled_storage_comes_back_empty_and_best_fitting() {
+        let pool: Pool<Vec<([u64; 3], f64)>> = Pool::new(2);
+        let filled = |n: usize| -> Vec<([u64; 3], f64)> {
+            let mut v = Vec::with_capacity(n);
+            v.extend((0..n as u64).map(|k| ([k, k, k], k as f64)));
+            v
+        };
+        pool.give(filled(100));
+        pool.give(filled(1000));
+        pool.give(filled(10)); // full: not kept
+        pool.give(Vec::new()); // no storage: not kept
+        let a = pool.take(50);
+        assert!(a.is_empty() && a.capacity() >= 100 && a.capacity() < 1000);
+        let b = pool.take_largest();
+        assert!(b.is_empty() && b.capacity() >= 1000);
+        assert_eq!(pool.take(1).capacity(), 0, "the pool is empty");
+        let mut maps: Pool<ValueMap> = Pool::new(1);
+        let mut m = ValueMap::default();
+        m.insert([1, 2, 3], 4.0);
+        maps.give(m);
+        let m = maps.take(0);
+        assert!(m.is_empty() && m.capacity() >= 1);
+        maps.max = 0;
+        maps.give(m);
+        assert_eq!(maps.take(0).capacity(), 0, "a pool of 0 keeps nothing");
     }
 
     /// Issue 29 (docs/benchmarks.md §26.5): [`IntervalEnvelope::evaluations`], counted from the
