@@ -85,13 +85,40 @@ fn equal_area(x: f64, y: f64) -> Vec3 {
 /// Trials per structure-of-arrays group of [`pass`].
 const LANES: usize = 16;
 
-/// The pass of [`trials`] for one disc map's direction `to_dir`, in groups of [`LANES`]:
-/// the uniforms (vector lanes), the leaf records read lane by lane
+/// The next trial's four uniforms of a SplitMix64 stream at `state` (advanced by four steps):
+/// `u_k = unit(mix64(state + (k + 1)·γ))`, `k = 0..3`, as [`LeafTable::draw`] reads them from
+/// a generator's four outputs.
+///
+/// [`LeafTable::draw`]: super::table::LeafTable::draw
+#[inline(always)]
+fn four_outputs(state: &mut u64) -> [f64; 4] {
+    let s1 = state.wrapping_add(GOLDEN_GAMMA);
+    let s2 = s1.wrapping_add(GOLDEN_GAMMA);
+    let s3 = s2.wrapping_add(GOLDEN_GAMMA);
+    let s4 = s3.wrapping_add(GOLDEN_GAMMA);
+    *state = s4;
+    [
+        unit(mix64(s1)),
+        unit(mix64(s2)),
+        unit(mix64(s3)),
+        unit(mix64(s4)),
+    ]
+}
+
+/// The pass of [`trials`] / [`trials_split`] for one trial's uniforms `uniforms` (advancing a
+/// stream state: [`four_outputs`] or [`split_trial`]) and one disc map's direction `to_dir`,
+/// in groups of [`LANES`]: the uniforms (vector lanes), the leaf records read lane by lane
 /// ([`LeafTable::leaf_of`]), then the points, thresholds and directions (vector lanes),
 /// written in place (`t`'s room is a multiple of [`LANES`]; a last, partial group fills its
 /// group whole, the entries past `state.len()` meaning nothing).
 #[inline(always)]
-fn pass<D: Fn(f64, f64) -> Vec3>(table: &LeafTable, state: &mut [u64], t: &mut Trials, to_dir: D) {
+fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
+    table: &LeafTable,
+    state: &mut [u64],
+    t: &mut Trials,
+    uniforms: U,
+    to_dir: D,
+) {
     let z = [0.0; LANES];
     let groups = state
         .chunks_mut(LANES)
@@ -109,15 +136,11 @@ fn pass<D: Fn(f64, f64) -> Vec3>(table: &LeafTable, state: &mut [u64], t: &mut T
         }
         let (mut u0, mut u1, mut u2, mut u3) = (z, z, z, z);
         for j in 0..LANES {
-            let s1 = s0[j].wrapping_add(GOLDEN_GAMMA);
-            let s2 = s1.wrapping_add(GOLDEN_GAMMA);
-            let s3 = s2.wrapping_add(GOLDEN_GAMMA);
-            let s4 = s3.wrapping_add(GOLDEN_GAMMA);
-            u0[j] = unit(mix64(s1));
-            u1[j] = unit(mix64(s2));
-            u2[j] = unit(mix64(s3));
-            u3[j] = unit(mix64(s4));
-            s0[j] = s4;
+            let [a, b, c, d] = uniforms(&mut s0[j]);
+            u0[j] = a;
+            u1[j] = b;
+            u2[j] = c;
+            u3[j] = d;
         }
         st.copy_from_slice(&s0[..n]);
         let mut leaf = [[0.0; 5]; LANES];
@@ -138,10 +161,12 @@ fn pass<D: Fn(f64, f64) -> Vec3>(table: &LeafTable, state: &mut [u64], t: &mut T
     }
 }
 
-/// [`pass`] as a `pulp` operation (inlined into, and compiled for, each instruction set).
+/// [`pass`] as a `pulp` operation (inlined into, and compiled for, each instruction set):
+/// split trials ([`split_trial`]) when `split`, else [`four_outputs`].
 struct Pass<'a> {
     table: &'a LeafTable,
     map: DiscMap,
+    split: bool,
     state: &'a mut [u64],
     t: &'a mut Trials,
 }
@@ -150,9 +175,18 @@ impl pulp::WithSimd for Pass<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        match self.map {
-            DiscMap::Projected => pass(self.table, self.state, self.t, projected),
-            DiscMap::EqualArea => pass(self.table, self.state, self.t, equal_area),
+        let Self {
+            table,
+            map,
+            split,
+            state,
+            t,
+        } = self;
+        match (map, split) {
+            (DiscMap::Projected, false) => pass(table, state, t, four_outputs, projected),
+            (DiscMap::EqualArea, false) => pass(table, state, t, four_outputs, equal_area),
+            (DiscMap::Projected, true) => pass(table, state, t, split_trial, projected),
+            (DiscMap::EqualArea, true) => pass(table, state, t, split_trial, equal_area),
         }
     }
 }
@@ -175,6 +209,7 @@ pub(super) fn trials(
     arch.dispatch(Pass {
         table,
         map,
+        split: false,
         state,
         t,
     });
@@ -236,77 +271,6 @@ pub(super) fn split_trial(state: &mut u64) -> [f64; 4] {
     ]
 }
 
-/// [`pass`] with split trials ([`split_trial`]: two SplitMix64 outputs per trial instead of
-/// four), for the random-ωo wavefront: the same leaf pick, point, bound, threshold and
-/// direction arithmetic.
-#[inline(always)]
-fn pass_split<D: Fn(f64, f64) -> Vec3>(
-    table: &LeafTable,
-    state: &mut [u64],
-    t: &mut Trials,
-    to_dir: D,
-) {
-    let z = [0.0; LANES];
-    let groups = state
-        .chunks_mut(LANES)
-        .zip(t.x.chunks_exact_mut(LANES))
-        .zip(t.y.chunks_exact_mut(LANES))
-        .zip(t.bound.chunks_exact_mut(LANES))
-        .zip(t.threshold.chunks_exact_mut(LANES))
-        .zip(t.inside.chunks_exact_mut(LANES))
-        .zip(t.dir.chunks_exact_mut(LANES));
-    for ((((((st, xs), ys), ms), th), ok), dir) in groups {
-        let n = st.len();
-        let mut s0 = [0u64; LANES];
-        for (a, b) in s0.iter_mut().zip(st.iter()) {
-            *a = *b;
-        }
-        let (mut u0, mut u1, mut u2, mut u3) = (z, z, z, z);
-        for j in 0..LANES {
-            let [a, b, c, d] = split_trial(&mut s0[j]);
-            u0[j] = a;
-            u1[j] = b;
-            u2[j] = c;
-            u3[j] = d;
-        }
-        st.copy_from_slice(&s0[..n]);
-        let mut leaf = [[0.0; 5]; LANES];
-        for j in 0..LANES {
-            leaf[j] = table.leaf_of(u0[j]);
-        }
-        for j in 0..LANES {
-            let [x0, dx, y0, dy, m] = leaf[j];
-            let x = x0 + u1[j] * dx;
-            let y = y0 + u2[j] * dy;
-            xs[j] = x;
-            ys[j] = y;
-            ms[j] = m;
-            th[j] = u3[j] * m;
-            ok[j] = x * x + y * y < 1.0;
-            dir[j] = to_dir(x, y);
-        }
-    }
-}
-
-/// [`pass_split`] as a `pulp` operation.
-struct PassSplit<'a> {
-    table: &'a LeafTable,
-    map: DiscMap,
-    state: &'a mut [u64],
-    t: &'a mut Trials,
-}
-
-impl pulp::WithSimd for PassSplit<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        match self.map {
-            DiscMap::Projected => pass_split(self.table, self.state, self.t, projected),
-            DiscMap::EqualArea => pass_split(self.table, self.state, self.t, equal_area),
-        }
-    }
-}
-
 /// [`trials`] with split trials: entry `j`'s uniforms are [`split_trial`] of `state[j]`
 /// (advanced by two steps), as [`LeafTable::draw`] reads them from the stream through
 /// `next_uniform4_split`; the point and bound [`LeafTable::propose`]'s. Dispatched at run time
@@ -321,9 +285,10 @@ pub(super) fn trials_split(
     state: &mut [u64],
     t: &mut Trials,
 ) {
-    arch.dispatch(PassSplit {
+    arch.dispatch(Pass {
         table,
         map,
+        split: true,
         state,
         t,
     });
