@@ -21,21 +21,9 @@ use partition_sampler::{Audit, UniformSource};
 use super::ExactSet;
 use super::density::QueryDensity;
 use super::fused::accepted;
-use super::wave_aniso::AnisoWave;
+use super::wave_aniso::{AnisoWave, Located};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
-
-/// A located anisotropic query, as its draw reads it: the normaliser grid's keys
-/// `w = √(1 − cos θo)` and the strip key (`tan δ` or `δ`), `cos θo`, the rotation from the
-/// interval's frame to the world's, and the interval (its cell and index in the cell).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Located {
-    pub(super) keys: [f64; 2],
-    pub(super) cos: f64,
-    pub(super) turn: Turn,
-    pub(super) cell: u32,
-    pub(super) interval: u32,
-}
 
 /// The group of a query that is not served (at or below the horizon, not finite).
 const UNSERVED: u32 = u32::MAX;

@@ -24,13 +24,24 @@ use brdf::{Brdf, Outgoing, Vec3};
 use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE};
 
 use super::ExactSet;
-use super::batch_aniso::Located;
 use super::fused::accepted_at;
 use super::lanes::{self, Trials};
 use super::wave_iso::stream_key;
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
+
+/// A located anisotropic query, as its draw reads it: the normaliser grid's keys
+/// `w = √(1 − cos θo)` and the strip key (`tan δ` or `δ`), `cos θo`, the rotation from the
+/// interval's frame to the world's, and the interval (its cell and index in the cell).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Located {
+    pub(super) keys: [f64; 2],
+    pub(super) cos: f64,
+    pub(super) turn: Turn,
+    pub(super) cell: u32,
+    pub(super) interval: u32,
+}
 
 /// Pending queries per block of [`ExactSet::serve_aniso_wave`]: at most this many trials are
 /// made in lanes and evaluated per block.
