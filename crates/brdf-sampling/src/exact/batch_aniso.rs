@@ -21,20 +21,9 @@ use partition_sampler::{Audit, UniformSource};
 use super::ExactSet;
 use super::density::QueryDensity;
 use super::fused::accepted;
+use super::wave_aniso::{AnisoWave, Located};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
-
-/// A located anisotropic query, as its draw reads it: the normaliser grid's keys
-/// `w = √(1 − cos θo)` and the strip key (`tan δ` or `δ`), `cos θo`, the rotation from the
-/// interval's frame to the world's, and the interval (its cell and index in the cell).
-#[derive(Debug, Clone, Copy)]
-struct Located {
-    keys: [f64; 2],
-    cos: f64,
-    turn: Turn,
-    cell: u32,
-    interval: u32,
-}
 
 /// The group of a query that is not served (at or below the horizon, not finite).
 const UNSERVED: u32 = u32::MAX;
@@ -61,6 +50,40 @@ struct Scratch {
     count: Vec<u32>,
     /// The serving order: query indices with their run flags.
     order: Vec<u32>,
+    /// Per group, whether it is drawn as a random-`ωo` wavefront
+    /// ([`ExactSet::serve_aniso_wave`]).
+    wave: Vec<bool>,
+    /// One wave group's queries served at their own `ωo`, and the wavefront's working arrays.
+    members: Vec<u32>,
+    aniso_wave: AnisoWave,
+}
+
+/// The key of a wavefront's streams: one 64-bit word made of two uniforms of `u` (their 53-bit
+/// integers, the second shifted by 11) — `batch.rs`'s `wave_seed`, the isotropic wavefront's.
+fn wave_seed(u: &mut dyn UniformSource) -> u64 {
+    let [a, b] = [u.next_uniform(), u.next_uniform()];
+    let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
+    bits(a) ^ (bits(b) << 11)
+}
+
+/// Whether groups may be drawn as random-`ωo` wavefronts (always, but for tests that compare
+/// the run-by-run path's bits).
+#[inline]
+fn wave_on() -> bool {
+    #[cfg(test)]
+    {
+        !NO_WAVE.with(std::cell::Cell::get)
+    }
+    #[cfg(not(test))]
+    {
+        true
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test support: `true` turns the random-ωo wavefront off (every group served run by run).
+    static NO_WAVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 thread_local! {
@@ -107,6 +130,9 @@ impl ExactSet {
             group,
             count,
             order,
+            wave,
+            members,
+            aniso_wave,
         } = &mut *scratch;
         // The first group of each cell: groups are the set's intervals in one list.
         let mut base = [0u32; MAX_CELLS];
@@ -178,22 +204,90 @@ impl ExactSet {
                 *at += 1;
             }
         }
+        // `count[g]` is now group `g`'s end in `order`. A group of the caller's random `ωo` (no
+        // run of one `ωo`) whose interval has a table is drawn as one wavefront.
+        wave.clear();
+        wave.resize(groups as usize, false);
+        let mut waves = false;
+        if wave_on() {
+            let mut s = 0;
+            for (g, w) in wave.iter_mut().enumerate() {
+                let e = count[g] as usize;
+                let span = &order[s..e];
+                if let Some(&first) = span.first() {
+                    let q = &located[first as usize];
+                    let cell = &self.cells[q.cell as usize];
+                    *w = cell.tables[q.interval as usize].is_some()
+                        && span.iter().all(|&k| k & FOLLOWS == 0);
+                    waves |= *w;
+                }
+                s = e;
+            }
+        }
+        // The wave groups' streams are keyed by one word of `u`, drawn before any other draw of
+        // the pass.
+        let seed = if waves { wave_seed(u) } else { 0 };
+        let arch = pulp::Arch::new();
         let mut audit = Audit::default();
-        // Runs of one `ωo` of the caller's order stay runs in the serving order (they share
-        // their interval, and the sort is stable): the density and normaliser made once.
-        let mut a = 0;
-        while a < order.len() {
-            let k = (order[a] & !FOLLOWS) as usize;
-            let mut b = a + 1;
-            while b < order.len() && order[b] & FOLLOWS != 0 {
-                b += 1;
+        let mut s = 0;
+        for (g, &is_wave) in wave.iter().enumerate() {
+            let e = count[g] as usize;
+            let span = &order[s..e];
+            s = e;
+            if is_wave {
+                // Its queries served at their own `ωo` as one wavefront; the others (served at
+                // the top angle) one by one from `u`.
+                members.clear();
+                for &k in span {
+                    let wo = &wos[k as usize];
+                    if wo.z >= self.top_cos {
+                        members.push(k);
+                    } else {
+                        let k = k as usize;
+                        out[k] = self.draw_aniso(brdf, wo, &located[k], u, &mut audit);
+                    }
+                }
+                let q = &located[span[0] as usize];
+                self.serve_aniso_wave(
+                    brdf,
+                    wos,
+                    located,
+                    q.cell as usize,
+                    q.interval as usize,
+                    members,
+                    seed,
+                    arch,
+                    aniso_wave,
+                    &mut audit,
+                    out,
+                );
+                continue;
             }
-            if b == a + 1 {
-                out[k] = self.draw_aniso(brdf, &wos[k], &located[k], u, &mut audit);
-            } else {
-                self.serve_aniso_run(brdf, &wos[k], &located[k], &order[a..b], u, &mut audit, out);
+            // Runs of one `ωo` of the caller's order stay runs in the serving order (they
+            // share their interval, and the sort is stable): the density and normaliser made
+            // once.
+            let mut a = 0;
+            while a < span.len() {
+                let k = (span[a] & !FOLLOWS) as usize;
+                let mut b = a + 1;
+                while b < span.len() && span[b] & FOLLOWS != 0 {
+                    b += 1;
+                }
+                if b == a + 1 {
+                    out[k] = self.draw_aniso(brdf, &wos[k], &located[k], u, &mut audit);
+                } else {
+                    self.serve_aniso_run(
+                        brdf,
+                        &wos[k],
+                        &located[k],
+                        &span[a..b],
+                        u,
+                        &mut audit,
+                        out,
+                    );
+                }
+                a = b;
             }
-            a = b;
         }
         SCRATCH.with(|s| s.set(Some(scratch)));
         self.counters.record(&audit);
@@ -351,6 +445,8 @@ mod tests {
     /// and below the horizon, and a non-finite one twice in a row.
     #[test]
     fn aniso_batch_draws_the_one_query_paths_bits_in_serving_order() {
+        // The run-by-run path (the random-ωo wavefront is tested below).
+        super::NO_WAVE.with(|c| c.set(true));
         let spec = "ward:alpha_x=0.12,alpha_y=0.3";
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
         let other: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
@@ -440,6 +536,166 @@ mod tests {
                 "{who}: {drawn} of {}",
                 order.len()
             );
+        }
+        super::NO_WAVE.with(|c| c.set(false));
+    }
+
+    /// SplitMix64 as a `rand` generator (its outputs `mix64(state + k·γ)`, `k ≥ 1`): a
+    /// wavefront query's stream as a caller's uniform source.
+    struct SplitMix(u64);
+    impl rand::TryRng for SplitMix {
+        type Error = std::convert::Infallible;
+        fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
+            self.try_next_u64().map(|w| (w >> 32) as u32)
+        }
+        fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
+            self.0 = self.0.wrapping_add(super::super::lanes::GOLDEN_GAMMA);
+            Ok(super::super::lanes::mix64(self.0))
+        }
+        fn try_fill_bytes(&mut self, _: &mut [u8]) -> Result<(), Self::Error> {
+            unimplemented!("not used")
+        }
+    }
+
+    /// The random-ωo wavefront of the anisotropic batch path (anisotropic Ward, 4000 random
+    /// ωo with grazing, horizon, below-horizon and non-finite ones, no two alike): each query
+    /// served at its own ωo in an interval with a table is, bit for bit (`ωi`, pdf, `f`), the
+    /// one-query anisotropic draw (`draw_aniso`) from its own stream `stream_key(seed, i)`,
+    /// `seed` the word of the caller's first two uniforms — with the set's own BRDF object and
+    /// with another one; the grazing ones (served at the top angle) are samples of the set's
+    /// pdf with the BRDF's `f`; the others empty. Then other ωo put around them leave the
+    /// wavefront samples of the queries kept unchanged (a function of the seed and the index
+    /// only, not of the grouping).
+    #[test]
+    fn random_wo_groups_draw_draw_anisos_samples_from_their_own_streams() {
+        use super::super::wave_iso::stream_key;
+        use super::wave_seed;
+        use partition_sampler::Audit;
+        let spec = "ward:alpha_x=0.12,alpha_y=0.3";
+        let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
+        let other: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
+        let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let mut qr = Xoshiro256PlusPlus::seed_from_u64(51);
+        let mut wos: Vec<Vec3> = (0..4000)
+            .map(|k| {
+                let phi = 360.0 * qr.next_uniform();
+                let theta = match k % 97 {
+                    0 => 89.995,
+                    1 => 90.0,
+                    2 => 97.0,
+                    _ => 89.999 * qr.next_uniform(),
+                };
+                brdf::direction_from_angles(theta, phi)
+            })
+            .collect();
+        wos[500] = Vec3::new(f64::NAN, 0.0, 1.0);
+        wos[501] = Vec3::new(0.3, f64::INFINITY, 0.5);
+        let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
+        let rng = Xoshiro256PlusPlus::seed_from_u64(19);
+        let seed = wave_seed(&mut rng.clone());
+        let mut audit = Audit::default();
+        for by in [&brdf, &other] {
+            let mut out = Vec::new();
+            set.sample_eval_batch(by.as_ref(), &wos, &mut rng.clone(), &mut out);
+            let (mut wave, mut top, mut none) = (0, 0, 0);
+            for (i, (wo, o)) in wos.iter().zip(&out).enumerate() {
+                let Some(q) = set.locate_aniso(wo) else {
+                    assert_eq!(*o, EvalSample::NONE, "query {i}");
+                    none += 1;
+                    continue;
+                };
+                let table = set.cells[q.cell as usize].tables[q.interval as usize].is_some();
+                if wo.z >= set.top_cos && table {
+                    let mut s = SplitMix(stream_key(seed, i as u64));
+                    let want = set.draw_aniso(by.as_ref(), wo, &q, &mut s, &mut audit);
+                    assert_eq!(key(o), key(&want), "query {i}: {o:?} vs {want:?}");
+                    wave += 1;
+                } else {
+                    assert!(o.pdf > 0.0 && o.wi.z > 0.0, "query {i}: {o:?}");
+                    approx::assert_relative_eq!(o.pdf, set.pdf(wo, &o.wi), max_relative = 1e-9);
+                    approx::assert_relative_eq!(o.f, brdf.eval(wo, &o.wi), max_relative = 1e-12);
+                    top += 1;
+                }
+            }
+            assert!(
+                wave > 3800 && top >= 40 && none >= 40,
+                "{wave} wave, {top} top, {none} none"
+            );
+        }
+        assert!(audit.trials > audit.samples, "some trials rejected");
+        let mut out = Vec::new();
+        set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng.clone(), &mut out);
+        let before = out.clone();
+        for k in (0..wos.len()).filter(|k| k % 3 == 2) {
+            wos[k] =
+                brdf::direction_from_angles(80.0 * qr.next_uniform(), 360.0 * qr.next_uniform());
+        }
+        set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng.clone(), &mut out);
+        let mut same = 0;
+        for (k, (a, b)) in before.iter().zip(&out).enumerate() {
+            if k % 3 != 2 && wos[k].z >= set.top_cos {
+                assert_eq!(key(a), key(b), "query {k}");
+                same += 1;
+            }
+        }
+        assert!(same > 2500, "{same}");
+    }
+
+    /// The anisotropic random-ωo wavefront's law by χ² (α = 10⁻⁴, 16 × 32 `(cos θ, φ)` bins,
+    /// 4·10⁴ samples per angle): a batch alternating two ωo of anisotropic Ward (no two
+    /// consecutive alike, so both groups are wavefronts) at θo = 30° and 75° passes against
+    /// the set's pdf at each, and two deliberately broken wavefronts are rejected at both —
+    /// one that misreports each candidate's `f` by the factor `0.6 + 0.8 cos θi`, one that
+    /// accepts every candidate (the envelope's law).
+    #[test]
+    fn random_wo_aniso_wavefront_passes_chi_square_and_broken_ones_fail() {
+        use super::super::wave_aniso::SKEW;
+        let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.12,alpha_y=0.3").unwrap());
+        let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
+        let quad = stats::QuadratureOptions {
+            min_depth: 2,
+            ..stats::QuadratureOptions::default()
+        };
+        let dirs = [30.0, 75.0].map(|t: f64| brdf::direction_from_angles(t, 20.0 + t));
+        let p_values = |skew: f64| -> Vec<f64> {
+            SKEW.with(|c| c.set(skew));
+            let wos: Vec<Vec3> = (0..80_000).map(|k| dirs[k % 2]).collect();
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
+            let mut out = Vec::new();
+            set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng, &mut out);
+            SKEW.with(|c| c.set(0.0));
+            dirs.iter()
+                .enumerate()
+                .map(|(j, wo)| {
+                    let pts: Vec<[f64; 3]> = out
+                        .iter()
+                        .skip(j)
+                        .step_by(2)
+                        .map(|s| [s.wi.x, s.wi.y, s.wi.z])
+                        .collect();
+                    let pdf = |d: [f64; 3]| set.pdf(wo, &Vec3::new(d[0], d[1], d[2]));
+                    stats::chi_square_test(&bins, &pdf, &pts, &quad)
+                        .unwrap()
+                        .p_value
+                })
+                .collect()
+        };
+        for (j, p) in p_values(0.0).into_iter().enumerate() {
+            assert!(
+                p >= 1e-4,
+                "honest wavefront rejected at ωo {:?}: p = {p}",
+                dirs[j]
+            );
+        }
+        for skew in [0.4, -1.0] {
+            for (j, p) in p_values(skew).into_iter().enumerate() {
+                assert!(
+                    p < 1e-4,
+                    "broken wavefront ({skew}) passed at ωo {:?}: p = {p}",
+                    dirs[j]
+                );
+            }
         }
     }
 }

@@ -91,6 +91,7 @@ mod set_table;
 mod table;
 mod tabulated;
 mod walk;
+mod wave_aniso;
 mod wave_iso;
 
 pub use error::ExactError;
