@@ -15,7 +15,9 @@ use super::lanes::{self, Trials};
 #[cfg(test)]
 use super::lanes::{GOLDEN_GAMMA, mix64, unit};
 use super::table::LeafTable;
-use super::wave_iso::IsoWave;
+#[cfg(test)]
+use super::wave_iso::NO_WAVE;
+use super::wave_iso::{IsoWave, wave_on, wave_seed};
 use super::{ExactSet, Query};
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
@@ -46,14 +48,6 @@ impl Stream {
     fn of(seed: u64, i: usize) -> Self {
         Self(mix64(seed ^ mix64(i as u64)))
     }
-}
-
-/// The key of a wavefront's streams: one 64-bit word made of two uniforms of `u` (their 53-bit
-/// integers, the second shifted by 11).
-fn wave_seed(u: &mut dyn UniformSource) -> u64 {
-    let [a, b] = [u.next_uniform(), u.next_uniform()];
-    let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
-    bits(a) ^ (bits(b) << 11)
 }
 
 /// A sample's stream as a caller's uniform source (test support: [`LeafTable::draw`] from it
@@ -240,26 +234,6 @@ struct Waves<'a> {
     end: &'a [u32],
     members: &'a mut Vec<u32>,
     w: &'a mut IsoWave,
-}
-
-/// Whether groups may be drawn as random-`ωo` wavefronts (always, but for tests that compare
-/// the other paths' bits).
-#[inline]
-fn wave_on() -> bool {
-    #[cfg(test)]
-    {
-        !NO_WAVE.with(std::cell::Cell::get)
-    }
-    #[cfg(not(test))]
-    {
-        true
-    }
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Test support: `true` turns the random-ωo wavefront off (every group served run by run).
-    static NO_WAVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 thread_local! {

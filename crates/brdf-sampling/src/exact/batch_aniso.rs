@@ -22,6 +22,9 @@ use super::ExactSet;
 use super::density::QueryDensity;
 use super::fused::accepted;
 use super::wave_aniso::{AnisoWave, Located};
+#[cfg(test)]
+use super::wave_iso::NO_WAVE;
+use super::wave_iso::{wave_on, wave_seed};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
 
@@ -56,34 +59,6 @@ struct Scratch {
     /// One wave group's queries served at their own `ωo`, and the wavefront's working arrays.
     members: Vec<u32>,
     aniso_wave: AnisoWave,
-}
-
-/// The key of a wavefront's streams: one 64-bit word made of two uniforms of `u` (their 53-bit
-/// integers, the second shifted by 11) — `batch.rs`'s `wave_seed`, the isotropic wavefront's.
-fn wave_seed(u: &mut dyn UniformSource) -> u64 {
-    let [a, b] = [u.next_uniform(), u.next_uniform()];
-    let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
-    bits(a) ^ (bits(b) << 11)
-}
-
-/// Whether groups may be drawn as random-`ωo` wavefronts (always, but for tests that compare
-/// the run-by-run path's bits).
-#[inline]
-fn wave_on() -> bool {
-    #[cfg(test)]
-    {
-        !NO_WAVE.with(std::cell::Cell::get)
-    }
-    #[cfg(not(test))]
-    {
-        true
-    }
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Test support: `true` turns the random-ωo wavefront off (every group served run by run).
-    static NO_WAVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 thread_local! {

@@ -19,7 +19,7 @@
 //! seed (same law).
 
 use brdf::{Brdf, Outgoing, Vec3};
-use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE};
+use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, UniformSource};
 
 use super::ExactSet;
 use super::fused::accepted_at;
@@ -78,6 +78,34 @@ impl Default for IsoWave {
 #[inline(always)]
 pub(super) fn stream_key(seed: u64, i: u64) -> u64 {
     mix64(seed ^ mix64(i))
+}
+
+/// The key of a wavefront's streams (the isotropic and the anisotropic ones): one 64-bit word
+/// made of two uniforms of `u` (their 53-bit integers, the second shifted by 11).
+pub(super) fn wave_seed(u: &mut dyn UniformSource) -> u64 {
+    let [a, b] = [u.next_uniform(), u.next_uniform()];
+    let bits = |x: f64| (x * (1u64 << 53) as f64) as u64;
+    bits(a) ^ (bits(b) << 11)
+}
+
+/// Whether batch groups may be drawn as random-`ωo` wavefronts (always, but for tests that
+/// compare the other paths' bits).
+#[inline]
+pub(super) fn wave_on() -> bool {
+    #[cfg(test)]
+    {
+        !NO_WAVE.with(std::cell::Cell::get)
+    }
+    #[cfg(not(test))]
+    {
+        true
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test support: `true` turns the random-ωo wavefronts off (every group served run by run).
+    pub(super) static NO_WAVE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 impl ExactSet {
@@ -153,6 +181,7 @@ impl ExactSet {
                     let i = members[k as usize] as usize;
                     out[i] = self.finish_iso(brdf, &wos[i], DirSample::NONE, f64::NAN);
                 }
+                pending = 0;
                 break;
             }
             pass += 1;
