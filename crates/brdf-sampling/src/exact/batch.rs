@@ -881,7 +881,7 @@ impl ExactSet {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use std::sync::Arc;
 
     use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
@@ -1349,17 +1349,33 @@ mod tests {
         use super::super::wave_iso::SKEW;
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("phong:n=50").unwrap());
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let dirs = [35.0, 85.0].map(|t: f64| brdf::direction_from_angles(t, 30.0 + t));
+        assert_wavefront_chi_square(&set, dirs, |skew, wos| {
+            SKEW.with(|c| c.set(skew));
+            let out = batch(&set, brdf.as_ref(), wos, 29);
+            SKEW.with(|c| c.set(0.0));
+            out
+        });
+    }
+
+    /// A random-ωo wavefront's law by χ² (α = 10⁻⁴, 16 × 32 `(cos θ, φ)` bins, 4·10⁴ samples
+    /// per angle; the isotropic and the anisotropic wavefronts' tests): `draw(skew, wos)` is
+    /// the batch's samples for 80 000 queries alternating the two `dirs`, drawn with the
+    /// wavefront's test break `skew` (0: honest); the honest batch passes against the set's pdf
+    /// at both ωo, the broken ones (`0.4`, `−1.0`) are rejected at both.
+    pub(in crate::exact) fn assert_wavefront_chi_square(
+        set: &ExactSet,
+        dirs: [Vec3; 2],
+        draw: impl Fn(f64, &[Vec3]) -> Vec<EvalSample>,
+    ) {
         let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
         let quad = stats::QuadratureOptions {
             min_depth: 2,
             ..stats::QuadratureOptions::default()
         };
-        let dirs = [35.0, 85.0].map(|t: f64| brdf::direction_from_angles(t, 30.0 + t));
         let p_values = |skew: f64| -> Vec<f64> {
-            SKEW.with(|c| c.set(skew));
             let wos: Vec<Vec3> = (0..80_000).map(|k| dirs[k % 2]).collect();
-            let out = batch(&set, brdf.as_ref(), &wos, 29);
-            SKEW.with(|c| c.set(0.0));
+            let out = draw(skew, &wos);
             dirs.iter()
                 .enumerate()
                 .map(|(j, wo)| {

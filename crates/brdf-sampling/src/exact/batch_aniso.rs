@@ -624,53 +624,18 @@ mod tests {
     /// accepts every candidate (the envelope's law).
     #[test]
     fn random_wo_aniso_wavefront_passes_chi_square_and_broken_ones_fail() {
+        use super::super::batch::tests::assert_wavefront_chi_square;
         use super::super::wave_aniso::SKEW;
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.12,alpha_y=0.3").unwrap());
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
-        let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
-        let quad = stats::QuadratureOptions {
-            min_depth: 2,
-            ..stats::QuadratureOptions::default()
-        };
         let dirs = [30.0, 75.0].map(|t: f64| brdf::direction_from_angles(t, 20.0 + t));
-        let p_values = |skew: f64| -> Vec<f64> {
+        assert_wavefront_chi_square(&set, dirs, |skew, wos| {
             SKEW.with(|c| c.set(skew));
-            let wos: Vec<Vec3> = (0..80_000).map(|k| dirs[k % 2]).collect();
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
             let mut out = Vec::new();
-            set.sample_eval_batch(brdf.as_ref(), &wos, &mut rng, &mut out);
+            set.sample_eval_batch(brdf.as_ref(), wos, &mut rng, &mut out);
             SKEW.with(|c| c.set(0.0));
-            dirs.iter()
-                .enumerate()
-                .map(|(j, wo)| {
-                    let pts: Vec<[f64; 3]> = out
-                        .iter()
-                        .skip(j)
-                        .step_by(2)
-                        .map(|s| [s.wi.x, s.wi.y, s.wi.z])
-                        .collect();
-                    let pdf = |d: [f64; 3]| set.pdf(wo, &Vec3::new(d[0], d[1], d[2]));
-                    stats::chi_square_test(&bins, &pdf, &pts, &quad)
-                        .unwrap()
-                        .p_value
-                })
-                .collect()
-        };
-        for (j, p) in p_values(0.0).into_iter().enumerate() {
-            assert!(
-                p >= 1e-4,
-                "honest wavefront rejected at ωo {:?}: p = {p}",
-                dirs[j]
-            );
-        }
-        for skew in [0.4, -1.0] {
-            for (j, p) in p_values(skew).into_iter().enumerate() {
-                assert!(
-                    p < 1e-4,
-                    "broken wavefront ({skew}) passed at ωo {:?}: p = {p}",
-                    dirs[j]
-                );
-            }
-        }
+            out
+        });
     }
 }
