@@ -145,6 +145,88 @@ pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)
     Some((value, rel))
 }
 
+/// Evaluations of a Cornell node's coarse stage in the set table (issue 29, docs/benchmarks.md
+/// §29.3; the full stage is [`CORNELL_NODE_BUDGET`]): the disc rule's first pass over its
+/// initial partition takes ≈ 45 600 of them, so the coarse stage is that pass and a little
+/// refinement.
+pub(crate) const CORNELL_COARSE_BUDGET: u64 = 50_000;
+
+/// The set table's Cornell nodes (kNN interpolant) in two stages
+/// ([`super::set_table::TableNodes`]): the disc rule of [`table_normaliser`] run to a coarse
+/// budget, then resumed to [`CORNELL_NODE_BUDGET`] (not restarted: the final value, estimate
+/// and evaluations are [`table_normaliser`]'s bit for bit, [`crate::reference`]'s
+/// `AlbedoRun`). Evaluations are counted as the build's when made.
+pub(crate) struct ProgressiveCornellNodes<'a> {
+    brdf: &'a dyn Brdf,
+    cornell: &'a CornellBrdf,
+    coarse_budget: u64,
+}
+
+impl<'a> ProgressiveCornellNodes<'a> {
+    /// The nodes of `brdf` when it is a Cornell material with the kNN interpolant (the other
+    /// materials' nodes are one stage).
+    pub(crate) fn new(brdf: &'a dyn Brdf) -> Option<Self> {
+        let cornell = brdf
+            .as_any()?
+            .downcast_ref::<CornellBrdf>()
+            .filter(|c| c.interpolation() != Interpolation::Grid)?;
+        Some(Self {
+            brdf,
+            cornell,
+            coarse_budget: CORNELL_COARSE_BUDGET,
+        })
+    }
+
+    /// The same with another coarse budget (at most the full one).
+    #[cfg(test)]
+    pub(crate) fn with_coarse_budget(mut self, budget: u64) -> Self {
+        self.coarse_budget = budget;
+        self
+    }
+}
+
+/// `(A, relative error estimate)` of an albedo estimate (`None` unless finite).
+fn relative(a: &crate::AlbedoEstimate) -> (f64, f64) {
+    let rel = if a.value > 0.0 {
+        a.abs_err / a.value
+    } else {
+        f64::INFINITY
+    };
+    (a.value, rel)
+}
+
+impl super::set_table::TableNodes for ProgressiveCornellNodes<'_> {
+    /// The disc rule's state and the evaluations counted so far.
+    type Run = Option<(crate::reference::AlbedoRun, u64)>;
+    const EARLY: bool = true;
+
+    fn coarse(&self, theta: f64) -> (Option<(f64, f64)>, Self::Run) {
+        let wo = direction_from_radians(theta, 0.0);
+        let budget = self.coarse_budget.min(CORNELL_NODE_BUDGET);
+        match crate::reference::cornell_node_start(self.cornell, &wo, budget) {
+            Ok((a, run)) => {
+                count_evaluations(a.evaluations);
+                (Some(relative(&a)), Some((run, a.evaluations)))
+            }
+            Err(_) => (None, None),
+        }
+    }
+
+    fn finish(&self, theta: f64, run: Self::Run) -> Option<(f64, f64)> {
+        let Some((mut run, counted)) = run else {
+            // The coarse stage failed: the one-stage node (the same value, or none).
+            return table_normaliser(self.brdf, theta);
+        };
+        match crate::reference::cornell_node_resume(self.cornell, &mut run, CORNELL_NODE_BUDGET) {
+            Ok(a) => {
+                count_evaluations(a.evaluations.saturating_sub(counted));
+                Some(relative(&a))
+            }
+            Err(_) => Some((f64::NAN, f64::INFINITY)),
+        }
+    }
+}
+
 /// Whether [`table_normaliser`] serves `brdf`.
 pub(crate) fn table_normaliser_exists(brdf: &dyn Brdf) -> bool {
     brdf.as_any()
