@@ -197,8 +197,6 @@ pub(crate) fn per_leaf_quadrature(
 
 /// The rule of [`per_leaf_quadrature`] with an absolute target `abs_tol` for the summed
 /// disagreement and an evaluation `budget` (the albedo reference uses a larger one).
-/// The same as [`AdaptiveRule::new`], [`AdaptiveRule::run`] to `budget` and
-/// [`AdaptiveRule::result`].
 pub(crate) fn adaptive_quadrature(
     f: &dyn Density,
     leaves: impl Iterator<Item = LeafInfo>,
@@ -207,95 +205,24 @@ pub(crate) fn adaptive_quadrature(
     budget: u64,
     grading: Grading,
 ) -> LeafIntegrals {
-    let mut rule = AdaptiveRule::new(f, leaves, abs_tol, mirror, grading);
-    rule.run(f, budget);
-    rule.result()
-}
-
-/// The state of [`adaptive_quadrature`]'s globally adaptive rule, resumable (issue 29,
-/// docs/benchmarks.md §29.3): [`AdaptiveRule::run`] to a budget `B₁` and then to `B₂ ≥ B₁`
-/// makes the same calls of `f` in the same order, and reaches the same state bit for bit, as
-/// one run to `B₂` (the loop's test `factor · Σ|I_h − I_l| > abs_tol ∧ evaluations < B` only
-/// stops earlier at `B₁`; nothing else depends on the budget). [`AdaptiveRule::result`] reads
-/// the pieces without changing them, so a checkpoint is free.
-///
-/// The density is passed to every call instead of being held, so the state is `Send` and
-/// `'static`: every call must be given the same `f` (the same function of the point).
-pub(crate) struct AdaptiveRule {
-    factor: f64,
-    abs_tol: f64,
-    rules: [GaussLegendre; 3],
-    heap: std::collections::BinaryHeap<WorstFirst<Piece>>,
-    /// The running `Σ |I_h − I_l|` (updated as the loop goes, as before the refactor).
-    err: f64,
-    evaluations: u64,
-    n_leaves: usize,
-    grading: Grading,
-}
-
-impl AdaptiveRule {
-    /// The rule's first pieces: every leaf (cut at `y = 0`; with `mirror`, its part in
-    /// `y ≤ 0` only) integrated by the first pair of orders of `grading`.
-    pub(crate) fn new(
-        f: &dyn Density,
-        leaves: impl Iterator<Item = LeafInfo>,
-        abs_tol: f64,
-        mirror: bool,
-        grading: Grading,
-    ) -> Self {
-        let mut rule = Self {
-            factor: if mirror { 2.0 } else { 1.0 },
-            abs_tol,
-            rules: [
-                GaussLegendre::new(HIGH_ORDER),
-                GaussLegendre::new(LOW_ORDER),
-                GaussLegendre::new(FIRST_ORDER),
-            ],
-            heap: std::collections::BinaryHeap::new(),
-            err: 0.0,
-            evaluations: 0,
-            n_leaves: 0,
-            grading,
-        };
-        let mut n_leaves = 0;
-        // Leaves crossing the plane of incidence y = 0 are cut there: isotropic models have
-        // kinks in the azimuth difference (functions of |φi − φo|) exactly on it, where a Gauss
-        // rule converges slowly and its two orders can agree on a wrong value (schlick-diffuse
-        // at θo = 0.5°: 1e-4 off with an estimate of 1e-6 on the uncut single leaf).
-        let pieces: Vec<(usize, Rect)> = leaves
-            .enumerate()
-            .inspect(|_| n_leaves += 1)
-            .flat_map(|(i, l)| {
-                let r = l.rect;
-                let lower = (r.y0 < 0.0).then(|| Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0)));
-                let upper =
-                    (!mirror && r.y1 > 0.0).then(|| Rect::new(r.x0, r.y0.max(0.0), r.x1, r.y1));
-                [lower, upper].into_iter().flatten().map(move |q| (i, q))
-            })
-            .collect();
-        let first: Vec<WorstFirst<Piece>> = pieces
-            .into_iter()
-            .map(|(i, r)| rule.piece(f, i, r))
-            .collect();
-        rule.heap = first.into();
-        rule.n_leaves = n_leaves;
-        rule.err = rule.heap.iter().map(|p| p.err).sum();
-        rule
-    }
-
-    /// `∫_rect f` by rule `k` of [`AdaptiveRule::rules`], its evaluations counted.
-    fn counted(&mut self, f: &dyn Density, rect: &Rect, k: usize) -> f64 {
-        let (value, n) = integrate_leaf_counted(f, rect, &self.rules[k]);
-        self.evaluations += n;
+    let factor = if mirror { 2.0 } else { 1.0 };
+    let (hi, lo, first) = (
+        GaussLegendre::new(HIGH_ORDER),
+        GaussLegendre::new(LOW_ORDER),
+        GaussLegendre::new(FIRST_ORDER),
+    );
+    let evals = std::sync::atomic::AtomicU64::new(0);
+    // Evaluations counted per piece (one atomic add per piece, not per evaluation).
+    let counted = |rect: &Rect, rule: &GaussLegendre| {
+        let (value, n) = integrate_leaf_counted(f, rect, rule);
+        evals.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
         value
-    }
-
-    /// A new piece by the first pair of orders of the grading.
-    fn piece(&mut self, f: &dyn Density, leaf: usize, rect: Rect) -> WorstFirst<Piece> {
-        let low = self.counted(f, &rect, 1);
-        let (value, other, high) = match self.grading {
-            Grading::Fixed => (self.counted(f, &rect, 0), low, true),
-            Grading::Graded => (low, self.counted(f, &rect, 2), false),
+    };
+    let piece = |leaf: usize, rect: Rect| {
+        let low = counted(&rect, &lo);
+        let (value, other, high) = match grading {
+            Grading::Fixed => (counted(&rect, &hi), low, true),
+            Grading::Graded => (low, counted(&rect, &first), false),
         };
         WorstFirst(Piece {
             leaf,
@@ -304,63 +231,69 @@ impl AdaptiveRule {
             err: (value - other).abs(),
             high,
         })
-    }
-
-    /// Refine (the worst piece first) while `factor · Σ |I_h − I_l| > abs_tol` and fewer than
-    /// `budget` evaluations were spent in all (this call and the earlier ones).
-    pub(crate) fn run(&mut self, f: &dyn Density, budget: u64) {
-        while self.factor * self.err > self.abs_tol && self.evaluations < budget {
-            let Some(WorstFirst(worst)) = self.heap.pop() else {
-                break;
-            };
-            self.err -= worst.err;
-            if !worst.high {
-                // Raise the order before splitting: the order-5 value becomes the comparison.
-                let value = self.counted(f, &worst.rect, 0);
-                let p = Piece {
-                    value,
-                    err: (value - worst.value).abs(),
-                    high: true,
-                    ..worst
-                };
-                self.err += p.err;
-                self.heap.push(WorstFirst(p));
-                continue;
-            }
-            for q in worst.rect.quadrants() {
-                let p = self.piece(f, worst.leaf, q);
-                self.err += p.err;
-                self.heap.push(p);
-            }
-        }
-    }
-
-    /// The integral and its estimates at this state (the rule can go on afterwards).
-    pub(crate) fn result(&self) -> LeafIntegrals {
-        // The heap's storage order depends only on the sequence of pushes: a fixed summation
-        // order.
-        let pieces = self.heap.as_slice();
-        let factor = self.factor;
-        let total: f64 = factor * pieces.iter().map(|p| p.value).sum::<f64>();
-        let err: f64 = factor * pieces.iter().map(|p| p.err).sum::<f64>();
-        let rms_err = factor * pieces.iter().map(|p| p.err * p.err).sum::<f64>().sqrt();
-        let rel_err = if total > 0.0 {
-            err / total
-        } else {
-            f64::INFINITY
+    };
+    let mut n_leaves = 0;
+    // Leaves crossing the plane of incidence y = 0 are cut there: isotropic models have kinks
+    // in the azimuth difference (functions of |φi − φo|) exactly on it, where a Gauss rule
+    // converges slowly and its two orders can agree on a wrong value (schlick-diffuse at
+    // θo = 0.5°: 1e-4 off with an estimate of 1e-6 on the uncut single leaf).
+    let mut heap: std::collections::BinaryHeap<WorstFirst<Piece>> = leaves
+        .enumerate()
+        .inspect(|_| n_leaves += 1)
+        .flat_map(|(i, l)| {
+            let r = l.rect;
+            let lower = (r.y0 < 0.0).then(|| Rect::new(r.x0, r.y0, r.x1, r.y1.min(0.0)));
+            let upper = (!mirror && r.y1 > 0.0).then(|| Rect::new(r.x0, r.y0.max(0.0), r.x1, r.y1));
+            [lower, upper].into_iter().flatten().map(move |q| (i, q))
+        })
+        .map(|(i, r)| piece(i, r))
+        .collect();
+    let mut err: f64 = heap.iter().map(|p| p.err).sum();
+    while factor * err > abs_tol && evals.load(std::sync::atomic::Ordering::Relaxed) < budget {
+        let Some(WorstFirst(worst)) = heap.pop() else {
+            break;
         };
-        let mut per_leaf = vec![0.0; self.n_leaves];
-        for p in pieces {
-            per_leaf[p.leaf] += p.value;
+        err -= worst.err;
+        if !worst.high {
+            // Raise the order before splitting: the order-5 value becomes the comparison.
+            let value = counted(&worst.rect, &hi);
+            let p = Piece {
+                value,
+                err: (value - worst.value).abs(),
+                high: true,
+                ..worst
+            };
+            err += p.err;
+            heap.push(WorstFirst(p));
+            continue;
         }
-        LeafIntegrals {
-            total,
-            rel_err,
-            abs_err: err,
-            rms_err,
-            per_leaf,
-            evaluations: self.evaluations,
+        for q in worst.rect.quadrants() {
+            let p = piece(worst.leaf, q);
+            err += p.err;
+            heap.push(p);
         }
+    }
+    // The heap's storage order depends only on the sequence of pushes: a fixed summation order.
+    let pieces = heap.into_vec();
+    let total: f64 = factor * pieces.iter().map(|p| p.value).sum::<f64>();
+    let err: f64 = factor * pieces.iter().map(|p| p.err).sum::<f64>();
+    let rms_err = factor * pieces.iter().map(|p| p.err * p.err).sum::<f64>().sqrt();
+    let rel_err = if total > 0.0 {
+        err / total
+    } else {
+        f64::INFINITY
+    };
+    let mut per_leaf = vec![0.0; n_leaves];
+    for p in &pieces {
+        per_leaf[p.leaf] += p.value;
+    }
+    LeafIntegrals {
+        total,
+        rel_err,
+        abs_err: err,
+        rms_err,
+        per_leaf,
+        evaluations: evals.into_inner(),
     }
 }
 

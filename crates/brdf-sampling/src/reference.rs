@@ -29,15 +29,15 @@ use partition_sampler::{LeafInfo, Rect};
 
 mod cornell;
 mod rgl;
+pub(crate) use cornell::cornell_node_albedo;
 pub use cornell::{CORNELL_REFERENCE_REL_TOL, cornell_reference_albedo};
-pub(crate) use cornell::{cornell_node_albedo, cornell_node_resume, cornell_node_start};
 pub(crate) use rgl::albedo_in_cells_of;
 #[cfg(test)]
 pub(crate) use rgl::tests::ibiza as rgl_tests_ibiza;
 pub use rgl::{RGL_CELL_ORDER, rgl_albedo_in_cells, rgl_reference_albedo};
 
 use crate::disc::DiscMap;
-use crate::normalisation::{AdaptiveRule, Grading};
+use crate::normalisation::{Grading, adaptive_quadrature};
 
 /// Evaluation budget of [`reference_albedo`] (about 0.1–0.3 s for an analytic model).
 pub const REFERENCE_BUDGET: u64 = 4_000_000;
@@ -120,49 +120,6 @@ pub(crate) fn albedo_of(
     wo: &Vec3,
     budget: u64,
 ) -> Result<AlbedoEstimate, ReferenceError> {
-    albedo_start(f, brdf, wo, budget).map(|(a, _)| a)
-}
-
-/// A resumable run of [`albedo_of`]'s disc rule (issue 29, docs/benchmarks.md §29.3): the
-/// rule's state ([`AdaptiveRule`]) and the rotated `ωo`. [`albedo_resume`] to a budget `B₂`
-/// after [`albedo_start`] at `B₁ ≤ B₂` gives [`albedo_of`] at `B₂` bit for bit (same value,
-/// estimate and evaluations), given the same `f`.
-pub(crate) struct AlbedoRun {
-    rule: AdaptiveRule,
-    wo: Vec3,
-}
-
-/// `2 f(ωo, ωi) cos θi` at the equal-area disc point `p` (zero off the disc): the density
-/// [`albedo_of`] integrates (`dσ = 2 dA`).
-fn disc_density(f: &(impl Fn(&Vec3, &Vec3) -> f64 + Sync), wo: &Vec3, p: [f64; 2]) -> f64 {
-    let r2 = p[0] * p[0] + p[1] * p[1];
-    if !(r2 < 1.0) {
-        return 0.0;
-    }
-    let wi = DiscMap::EqualArea.to_direction(p);
-    2.0 * wi.z * f(wo, &wi)
-}
-
-/// The estimate at a state of the rule, or the error [`albedo_of`] reports.
-fn estimate_of(rule: &AdaptiveRule, brdf: &dyn Brdf) -> Result<AlbedoEstimate, ReferenceError> {
-    let q = rule.result();
-    if !(q.total.is_finite() && q.abs_err.is_finite()) {
-        return Err(ReferenceError::NotFinite(brdf.name().to_string()));
-    }
-    Ok(AlbedoEstimate {
-        value: q.total,
-        abs_err: q.abs_err,
-        evaluations: q.evaluations,
-    })
-}
-
-/// [`albedo_of`] at `budget`, and the rule's state to go on from (see [`AlbedoRun`]).
-pub(crate) fn albedo_start(
-    f: impl Fn(&Vec3, &Vec3) -> f64 + Sync,
-    brdf: &dyn Brdf,
-    wo: &Vec3,
-    budget: u64,
-) -> Result<(AlbedoEstimate, AlbedoRun), ReferenceError> {
     let unit = wo.iter().all(|c| c.is_finite()) && (wo.norm() - 1.0).abs() <= 1e-9;
     if !(unit && wo.z > 0.0) {
         return Err(ReferenceError::InvalidDirection {
@@ -178,8 +135,17 @@ pub(crate) fn albedo_start(
         *wo
     };
     let mirror = brdf.is_isotropic() && brdf.is_mirror_symmetric();
-    let density = |p: [f64; 2]| disc_density(&f, &wo, p);
-    let peak = DiscMap::EqualArea.to_disc(&brdf::mirror(&wo));
+    let map = DiscMap::EqualArea;
+    let density = |p: [f64; 2]| {
+        let r2 = p[0] * p[0] + p[1] * p[1];
+        if !(r2 < 1.0) {
+            return 0.0;
+        }
+        let wi = map.to_direction(p);
+        // 2 f cos θi: the equal-area density (dσ = 2 dA).
+        2.0 * wi.z * f(&wo, &wi)
+    };
+    let peak = map.to_disc(&brdf::mirror(&wo));
     let mut leaves = Vec::new();
     initial_partition(
         Rect::new(-1.0, -1.0, 1.0, 1.0),
@@ -188,30 +154,22 @@ pub(crate) fn albedo_start(
         mirror,
         &mut leaves,
     );
-    let mut rule = AdaptiveRule::new(
+    let q = adaptive_quadrature(
         &density,
         leaves.into_iter(),
         REFERENCE_TOL,
         mirror,
+        budget,
         Grading::Fixed,
     );
-    rule.run(&density, budget);
-    let a = estimate_of(&rule, brdf)?;
-    Ok((a, AlbedoRun { rule, wo }))
-}
-
-/// Continue `run` (from [`albedo_start`] with the same `f` and `brdf`) to `budget`
-/// evaluations in all: [`albedo_of`] at `budget`, bit for bit.
-pub(crate) fn albedo_resume(
-    f: impl Fn(&Vec3, &Vec3) -> f64 + Sync,
-    brdf: &dyn Brdf,
-    run: &mut AlbedoRun,
-    budget: u64,
-) -> Result<AlbedoEstimate, ReferenceError> {
-    let wo = run.wo;
-    let density = |p: [f64; 2]| disc_density(&f, &wo, p);
-    run.rule.run(&density, budget);
-    estimate_of(&run.rule, brdf)
+    if !(q.total.is_finite() && q.abs_err.is_finite()) {
+        return Err(ReferenceError::NotFinite(brdf.name().to_string()));
+    }
+    Ok(AlbedoEstimate {
+        value: q.total,
+        abs_err: q.abs_err,
+        evaluations: q.evaluations,
+    })
 }
 
 /// The uniform `2^INITIAL_DEPTH` grid, with the cells near `peak` (within one cell size)

@@ -68,139 +68,6 @@ fn split_count(excess: f64, room: f64) -> usize {
     1 << (wanted.min(allowed).min(16.0) as u32)
 }
 
-/// How far above the final test's thresholds a piece's coarse 9-versus-5 difference, less its
-/// possible change, must be for the piece to be cut on coarse values ([`early_split`]).
-const EARLY_MARGIN: f64 = 2.0;
-
-/// The nodes of a table, integrated in two stages (issue 29, docs/benchmarks.md §29.3): a
-/// coarse stage first, for every node a round asks for, then the final stage only for the
-/// nodes of pieces that may be accepted. The final value must not depend on whether or when
-/// the coarse stage was run (a resumed rule, or one run to the full budget).
-pub(crate) trait TableNodes: Sync {
-    /// The state kept between the stages.
-    type Run: Send;
-    /// Whether the coarse values differ from the final ones (`false`: the coarse stage is
-    /// final, and no piece is cut on it).
-    const EARLY: bool;
-    /// `(A, relative error estimate)` at `θo` at the coarse stage (`None`: not finite) and
-    /// the state to finish from.
-    fn coarse(&self, theta: f64) -> (Option<(f64, f64)>, Self::Run);
-    /// The final `(A, relative error estimate)` at `θo` from its coarse state.
-    fn finish(&self, theta: f64, run: Self::Run) -> Option<(f64, f64)>;
-}
-
-/// A node at the coarse stage: its value (`None`: not finite) and the run to finish.
-type Coarse<R> = (Option<(f64, f64)>, R);
-
-/// Nodes of one stage: the coarse value is the final one.
-struct OneStage<'a>(&'a (dyn Fn(f64) -> Option<(f64, f64)> + Sync));
-
-impl TableNodes for OneStage<'_> {
-    type Run = Option<(f64, f64)>;
-    const EARLY: bool = false;
-    fn coarse(&self, theta: f64) -> (Option<(f64, f64)>, Self::Run) {
-        let v = (self.0)(theta);
-        (v, v)
-    }
-    fn finish(&self, _theta: f64, run: Self::Run) -> Option<(f64, f64)> {
-        run
-    }
-}
-
-/// Nodes a table build integrated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct NodeCounts {
-    /// Nodes integrated to the final stage (the full budget).
-    pub(crate) finished: usize,
-    /// Nodes left at the coarse stage (their pieces were cut on coarse values).
-    pub(crate) coarse_only: usize,
-}
-
-/// `max_t Σ_i |ℓ⁹_i(t) − ℓ⁵_i(t)|` over the test points of a piece (`ℓ⁹`, `ℓ⁵`: the Lagrange
-/// bases of the piece's 9 and nested 5 Lobatto nodes, `ℓ⁵_i = 0` at odd `i`): node values
-/// that move by at most `δ` move the 9-versus-5 difference by at most this times `δ`.
-fn difference_spread() -> f64 {
-    let nodes = lobatto_nodes(0.0, 1.0, PIECE_NODES);
-    let even: Vec<f64> = nodes.iter().step_by(2).copied().collect();
-    (0..CHECKS)
-        .map(|k| {
-            let t = (k as f64 + 0.5) / CHECKS as f64;
-            (0..PIECE_NODES)
-                .map(|i| {
-                    let unit: Vec<f64> = (0..PIECE_NODES)
-                        .map(|j| f64::from(u8::from(i == j)))
-                        .collect();
-                    let five: Vec<f64> = unit.iter().step_by(2).copied().collect();
-                    (interpolate(&nodes, &unit, t) - interpolate(&even, &five, t)).abs()
-                })
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max)
-}
-
-/// Into how many parts a 9-node piece with nodes `ts` and values `got` (some coarse;
-/// `(A, relative error estimate)`) is cut without finishing its nodes, or `None` (finish
-/// them; the final test decides). With `e` the largest relative estimate among the nodes,
-/// `d` the 9-versus-5 difference of the given values and `s` the [`difference_spread`], the
-/// final values are taken within `2e` of these (each node's coarse estimate, plus a final one
-/// no larger), so the final difference is at least `d_lo = d − 2 s e · max|A_i| / min|A|`,
-/// and the final tolerance `max(PIECE_TOL, e_final)` at most `t_hi = max(PIECE_TOL, e)`.
-/// The piece is cut when `d_lo > EARLY_MARGIN · m · t_hi` (`m` the nesting threshold, 1
-/// without nesting): the final test would neither accept nor refine it in place; into
-/// [`split_count`]`(d_lo / t_hi, room)` parts (at most as many as the final test would
-/// choose; a part that still misses is cut again).
-fn early_split(
-    ts: &[f64],
-    got: &[(f64, f64)],
-    spread: f64,
-    nested: Option<f64>,
-    room: f64,
-) -> Option<usize> {
-    if room < 2.0 {
-        return None;
-    }
-    let values: Vec<f64> = got.iter().map(|v| v.0).collect();
-    let e = got.iter().map(|v| v.1).fold(0.0, f64::max);
-    if !(e.is_finite() && values.iter().all(|v| v.is_finite())) {
-        return None;
-    }
-    let (a, b) = (ts[0], ts[ts.len() - 1]);
-    let even: Vec<f64> = ts.iter().step_by(2).copied().collect();
-    let five: Vec<f64> = values.iter().step_by(2).copied().collect();
-    let fine = ChebyshevTable::new(ts.to_vec(), vec![0.0], values.clone());
-    let coarse = ChebyshevTable::new(even, vec![0.0], five);
-    let (mut diff, mut f_min) = (0.0f64, f64::INFINITY);
-    for k in 0..CHECKS {
-        let t = a + (b - a) * (k as f64 + 0.5) / CHECKS as f64;
-        let f = fine.eval(t, 0.0);
-        diff = diff.max((f - coarse.eval(t, 0.0)).abs() / f.abs());
-        f_min = f_min.min(f.abs());
-    }
-    let v_max = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let d_lo = diff - 2.0 * spread * e * v_max / f_min;
-    let t_hi = PIECE_TOL.max(e);
-    (d_lo > EARLY_MARGIN * nested.unwrap_or(1.0) * t_hi).then(|| split_count(d_lo / t_hi, room))
-}
-
-/// The polynomial through `values` at the Lobatto `nodes`, at `t` (the tables' own evaluation).
-fn interpolate(nodes: &[f64], values: &[f64], t: f64) -> f64 {
-    ChebyshevTable::new(nodes.to_vec(), vec![0.0], values.to_vec()).eval(t, 0.0)
-}
-
-/// `[a, b]` cut into `parts` equal pieces of [`PIECE_NODES`] nodes, pushed to `next`.
-fn push_parts(next: &mut Vec<(f64, f64, usize, f64)>, a: f64, b: f64, parts: usize) {
-    let step = (b - a) / parts as f64;
-    for k in 0..parts {
-        let lo = if k == 0 { a } else { a + step * k as f64 };
-        let hi = if k + 1 == parts {
-            b
-        } else {
-            a + step * (k + 1) as f64
-        };
-        next.push((lo, hi, PIECE_NODES, 0.0));
-    }
-}
-
 /// One piece `[lo, hi]` of θo (radians) and its 9-node table of `A` (over θo).
 struct Piece {
     lo: f64,
@@ -224,34 +91,23 @@ impl SetTable {
     }
 
     /// [`SetTable::build`] with the nested refinement ([`NESTED_NODES`]) up to the given
-    /// excess (`None`: none), and the nodes integrated.
+    /// excess (`None`: none), and the number of nodes integrated.
     pub(crate) fn build_with(
         brdf: &dyn Brdf,
         lo: f64,
         top: f64,
         breaks: &[f64],
         nested: Option<f64>,
-    ) -> Option<(Self, NodeCounts)> {
+    ) -> Option<(Self, usize)> {
         if !tabulated::table_normaliser_exists(brdf) {
             return None;
         }
-        if let Some(nodes) = tabulated::ProgressiveCornellNodes::new(brdf) {
-            return Some(Self::build_progressive(&nodes, lo, top, breaks, nested));
-        }
         let value = |t: f64| tabulated::table_normaliser(brdf, t);
-        let (table, n) = Self::build_from(&value, lo, top, breaks, nested);
-        Some((
-            table,
-            NodeCounts {
-                finished: n,
-                coarse_only: 0,
-            },
-        ))
+        Some(Self::build_from(&value, lo, top, breaks, nested))
     }
 
     /// The table of the nodes `value(θo) = Some((A, relative error estimate))` (`None`: not
     /// finite) over `[lo, top]`, cut first at `breaks`; and the number of nodes integrated.
-    /// Every node is integrated in one stage (no early decisions).
     pub(crate) fn build_from(
         value: &(dyn Fn(f64) -> Option<(f64, f64)> + Sync),
         lo: f64,
@@ -259,29 +115,6 @@ impl SetTable {
         breaks: &[f64],
         nested: Option<f64>,
     ) -> (Self, usize) {
-        let (table, counts) = Self::build_progressive(&OneStage(value), lo, top, breaks, nested);
-        (table, counts.finished)
-    }
-
-    /// The table of `nodes` over `[lo, top]`, cut first at `breaks` (see the module docs and
-    /// [`TableNodes`]), and the nodes integrated.
-    ///
-    /// Each round integrates the new nodes of its pieces to the coarse stage first. A piece of
-    /// 9 nodes some of which are coarse is halved (cut) at once, its coarse nodes left
-    /// unfinished, when its 9-versus-5 difference is far above what the final test could
-    /// accept ([`early_split`]); every other piece has its nodes finished, and is decided by
-    /// the one-stage test on finished values only. So every accepted piece, its table and its
-    /// declared error are what that test gives at the full budget; only which pieces are
-    /// tried changes (a piece cut early is one the final test would have cut, unless the
-    /// coarse estimates are short by a factor of more than [`EARLY_MARGIN`]: then the table is
-    /// finer than needed, never less accurate).
-    pub(crate) fn build_progressive<N: TableNodes>(
-        nodes: &N,
-        lo: f64,
-        top: f64,
-        breaks: &[f64],
-        nested: Option<f64>,
-    ) -> (Self, NodeCounts) {
         let mut edges = vec![lo];
         edges.extend(breaks.iter().copied().filter(|&b| b > lo && b < top));
         edges.push(top);
@@ -292,83 +125,24 @@ impl SetTable {
             .map(|w| (w[0], w[1], PIECE_NODES, 0.0))
             .collect();
         let mut known: HashMap<u64, (f64, f64)> = HashMap::new();
-        // Nodes at the coarse stage: the value (`None`: not finite) and the run to finish.
-        let mut coarse: HashMap<u64, Coarse<N::Run>> = HashMap::new();
         let mut pieces = Vec::new();
         let min_width = MIN_PIECE_DEG.to_radians();
-        let spread = difference_spread();
-        let not_finite = (f64::NAN, f64::INFINITY);
         while !todo.is_empty() {
-            // Every new node of this round to the coarse stage at once (in parallel; each
-            // depends on θo alone).
+            // Every node of this round at once (in parallel; each depends on θo alone).
             let mut wanted: Vec<f64> = todo
                 .iter()
                 .flat_map(|&(a, b, n, _)| lobatto_nodes(a, b, n))
-                .filter(|t| !known.contains_key(&t.to_bits()) && !coarse.contains_key(&t.to_bits()))
+                .filter(|t| !known.contains_key(&t.to_bits()))
                 .collect();
             wanted.sort_by(f64::total_cmp);
             wanted.dedup_by(|a, b| a.to_bits() == b.to_bits());
-            let started: Vec<(f64, Coarse<N::Run>)> =
-                wanted.par_iter().map(|&t| (t, nodes.coarse(t))).collect();
-            coarse.extend(started.into_iter().map(|(t, c)| (t.to_bits(), c)));
-            // Pieces cut on coarse values; the others wait for their nodes to be finished.
+            let values: Vec<(f64, (f64, f64))> = wanted
+                .par_iter()
+                .map(|&t| (t, value(t).unwrap_or((f64::NAN, f64::INFINITY))))
+                .collect();
+            known.extend(values.into_iter().map(|(t, v)| (t.to_bits(), v)));
             let mut next = Vec::new();
-            let mut ready = Vec::new();
-            let mut finish: Vec<f64> = Vec::new();
             for (a, b, n, excess_before) in todo {
-                let ts = lobatto_nodes(a, b, n);
-                let unfinished: Vec<f64> = ts
-                    .iter()
-                    .copied()
-                    .filter(|t| !known.contains_key(&t.to_bits()))
-                    .collect();
-                if !unfinished.is_empty() && N::EARLY && n == PIECE_NODES {
-                    let got: Option<Vec<(f64, f64)>> = ts
-                        .iter()
-                        .map(|t| {
-                            known
-                                .get(&t.to_bits())
-                                .copied()
-                                .or_else(|| coarse[&t.to_bits()].0)
-                        })
-                        .collect();
-                    #[cfg(test)]
-                    if let (Ok(_), Some(g)) = (std::env::var("SET_TABLE_TRACE"), &got) {
-                        {
-                            let e = g.iter().map(|v| v.1).fold(0.0, f64::max);
-                            let es: Vec<String> =
-                                g.iter().map(|v| format!("{:.1e}", v.1)).collect();
-                            eprintln!(
-                                "TRACE coarse {:.4}-{:.4}°: early {:?} e_c {e:.3e} [{}]",
-                                a.to_degrees(),
-                                b.to_degrees(),
-                                early_split(&ts, g, spread, nested, (b - a) / min_width),
-                                es.join(" ")
-                            );
-                        }
-                    }
-                    if let Some(parts) = got
-                        .and_then(|got| early_split(&ts, &got, spread, nested, (b - a) / min_width))
-                    {
-                        push_parts(&mut next, a, b, parts);
-                        continue;
-                    }
-                }
-                finish.extend(unfinished);
-                ready.push((a, b, n, excess_before));
-            }
-            finish.sort_by(f64::total_cmp);
-            finish.dedup_by(|a, b| a.to_bits() == b.to_bits());
-            let runs: Vec<(f64, N::Run)> = finish
-                .iter()
-                .map(|t| (*t, coarse.remove(&t.to_bits()).expect("a coarse node").1))
-                .collect();
-            let done: Vec<(f64, (f64, f64))> = runs
-                .into_par_iter()
-                .map(|(t, run)| (t, nodes.finish(t, run).unwrap_or(not_finite)))
-                .collect();
-            known.extend(done.into_iter().map(|(t, v)| (t.to_bits(), v)));
-            for (a, b, n, excess_before) in ready {
                 let nodes = lobatto_nodes(a, b, n);
                 let got: Vec<(f64, f64)> = nodes.iter().map(|t| known[&t.to_bits()]).collect();
                 let values: Vec<f64> = got.iter().map(|v| v.0).collect();
@@ -391,15 +165,6 @@ impl SetTable {
                 // to the narrowest with the tolerance alone).
                 let tol = PIECE_TOL.max(node_err);
                 let room = (b - a) / min_width;
-                #[cfg(test)]
-                if std::env::var("SET_TABLE_TRACE").is_ok() {
-                    eprintln!(
-                        "TRACE piece {:.4}-{:.4}° n {n}: diff {diff:.3e} node_err {node_err:.3e} excess {:.2}",
-                        a.to_degrees(),
-                        b.to_degrees(),
-                        diff / tol
-                    );
-                }
                 if !(diff <= tol) && 0.5 * (b - a) >= min_width {
                     if nested.is_some_and(|m| diff <= m * tol)
                         && n == PIECE_NODES
@@ -415,7 +180,17 @@ impl SetTable {
                     } else {
                         excess_before
                     };
-                    push_parts(&mut next, a, b, split_count(excess, room));
+                    let parts = split_count(excess, room);
+                    let step = (b - a) / parts as f64;
+                    for k in 0..parts {
+                        let lo = if k == 0 { a } else { a + step * k as f64 };
+                        let hi = if k + 1 == parts {
+                            b
+                        } else {
+                            a + step * (k + 1) as f64
+                        };
+                        next.push((lo, hi, PIECE_NODES, 0.0));
+                    }
                 } else {
                     pieces.push(Piece {
                         lo: a,
@@ -428,11 +203,7 @@ impl SetTable {
             todo = next;
         }
         pieces.sort_by(|p, q| p.lo.total_cmp(&q.lo));
-        let counts = NodeCounts {
-            finished: known.len(),
-            coarse_only: coarse.len(),
-        };
-        (Self { pieces }, counts)
+        (Self { pieces }, known.len())
     }
 
     /// `(A, relative error estimate)` at `theta` (radians; clamped to the table).
@@ -443,19 +214,6 @@ impl SetTable {
             .min(self.pieces.len() - 1);
         let p = &self.pieces[i];
         (p.table.eval(theta.clamp(p.lo, p.hi), 0.0), p.rel_err)
-    }
-
-    /// The distinct nodes the pieces' tables use.
-    #[cfg(test)]
-    pub(crate) fn used_nodes(&self) -> usize {
-        let mut bits: Vec<u64> = self
-            .pieces
-            .iter()
-            .flat_map(|p| p.table.theta.iter().map(|t| t.to_bits()))
-            .collect();
-        bits.sort_unstable();
-        bits.dedup();
-        bits.len()
     }
 
     /// The pieces' edges (radians).
@@ -527,89 +285,6 @@ mod tests {
             counts.push(nodes);
         }
         assert!(counts[1] < counts[0], "nodes {counts:?}");
-    }
-
-    /// The Cornell set table built in two stages (coarse nodes, then finished ones:
-    /// [`SetTable::build_progressive`]) against the one-stage build (every node at the full
-    /// budget), for the record (docs/benchmarks.md §29.3): nodes finished and left coarse,
-    /// pieces, whether the pieces' edges are the same, the largest `|A₂/A₁ − 1|` at 601 angles
-    /// and the worst declared error. `CORNELL_FILES` (default the three shared files),
-    /// `COARSE_BUDGETS` (default 50000), `ONE_STAGE=0` skips the one-stage build.
-    /// `cargo test --release -p brdf-sampling --lib set_table_progressive_survey -- --ignored --nocapture`
-    #[test]
-    #[ignore = "a survey for the record (minutes)"]
-    fn set_table_progressive_survey() {
-        use crate::exact::tabulated::{ProgressiveCornellNodes, table_normaliser};
-        let files = std::env::var("CORNELL_FILES")
-            .unwrap_or_else(|_| "krylon_blue,cayman,acryl_blue".into());
-        let budgets: Vec<u64> = std::env::var("COARSE_BUDGETS")
-            .unwrap_or_else(|_| "50000".into())
-            .split(',')
-            .filter_map(|s| s.parse().ok())
-            .collect();
-        let one_stage = std::env::var("ONE_STAGE").map_or(true, |v| v != "0");
-        for name in files.split(',') {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
-            let Ok(b) = brdf::CornellBrdf::load(&path) else {
-                eprintln!("skipped {name}");
-                continue;
-            };
-            let b = b.with_interpolation(brdf::measured::cornell::Interpolation::Knn);
-            let options = crate::ExactOptions::default();
-            let plan = crate::exact::build::Plan::new(&b, &options, None, true);
-            let breaks: Vec<f64> = (1..plan.n0)
-                .map(|i| plan.grid.edge(i << crate::exact::grid::EDGE_BITS))
-                .collect();
-            let top = crate::exact::options::THETA_TOP_DEG.to_radians();
-            let nest = Some(super::NEST_MAX_EXCESS);
-            let worst = |t: &SetTable| {
-                let e = t.edges();
-                (0..e.len() - 1)
-                    .map(|i| t.at(0.5 * (e[i] + e[i + 1])).1)
-                    .fold(0.0, f64::max)
-            };
-            let reference = one_stage.then(|| {
-                let start = std::time::Instant::now();
-                let value = |t: f64| table_normaliser(&b, t);
-                let (t, n) = SetTable::build_from(&value, 0.0, top, &breaks, nest);
-                eprintln!(
-                    "{name} one stage: {n} nodes ({} used), {} pieces, worst declared {:.3e}, {:.1} s",
-                    t.used_nodes(),
-                    t.edges().len() - 1,
-                    worst(&t),
-                    start.elapsed().as_secs_f64()
-                );
-                t
-            });
-            for &budget in &budgets {
-                let start = std::time::Instant::now();
-                let nodes = ProgressiveCornellNodes::new(&b)
-                    .unwrap()
-                    .with_coarse_budget(budget);
-                let (t, counts) = SetTable::build_progressive(&nodes, 0.0, top, &breaks, nest);
-                let full_price = counts.finished as f64
-                    + counts.coarse_only as f64 * budget as f64
-                        / crate::exact::tabulated::CORNELL_NODE_BUDGET as f64;
-                let mut line = format!(
-                    "{name} coarse {budget}: {counts:?} (≈ {full_price:.0} full-price, {} used), {} pieces, worst declared {:.3e}, {:.1} s",
-                    t.used_nodes(),
-                    t.edges().len() - 1,
-                    worst(&t),
-                    start.elapsed().as_secs_f64()
-                );
-                if let Some(r) = &reference {
-                    let same = r.edges() == t.edges();
-                    let mut gap = 0.0f64;
-                    for k in 0..=600 {
-                        let th = top * k as f64 / 600.0;
-                        gap = gap.max((t.at(th).0 / r.at(th).0 - 1.0).abs());
-                    }
-                    line += &format!("; same edges {same}, max |A₂/A₁ − 1| {gap:.2e}");
-                }
-                eprintln!("{line}");
-            }
-        }
     }
 
     /// A piece is cut into a power of two of parts, at least 2, never narrower than the

@@ -696,7 +696,7 @@ fn set_table_nesting_survey() {
                 .map(|i| t.at(0.5 * (edges[i] + edges[i + 1])).1)
                 .fold(0.0, f64::max);
             eprintln!(
-                "{name} nested {nested:?}: {nodes:?}, {} pieces, worst declared {worst:.2e}, {:.1} s",
+                "{name} nested {nested:?}: {nodes} nodes, {} pieces, worst declared {worst:.2e}, {:.1} s",
                 edges.len() - 1,
                 start.elapsed().as_secs_f64()
             );

@@ -210,33 +210,6 @@ pub(crate) fn cornell_node_albedo(
     Ok(a)
 }
 
-/// [`cornell_node_albedo`] at `budget`, and the disc rule's state to finish it from
-/// ([`cornell_node_resume`]; issue 29, docs/benchmarks.md §29.3).
-pub(crate) fn cornell_node_start(
-    brdf: &CornellBrdf,
-    wo: &brdf::Vec3,
-    budget: u64,
-) -> Result<(AlbedoEstimate, super::AlbedoRun), ReferenceError> {
-    let q = brdf.quadrature_eval();
-    let (mut a, run) = super::albedo_start(|wo, wi| q.eval(wo, wi), brdf, wo, budget)?;
-    a.abs_err += brdf::measured::cornell::QUADRATURE_REL_BOUND * 1.001 * a.value.abs();
-    Ok((a, run))
-}
-
-/// Continue a [`cornell_node_start`] run of `brdf` to `budget` evaluations in all:
-/// [`cornell_node_albedo`] at `budget`, bit for bit (the disc rule is resumed, not restarted:
-/// [`super::AlbedoRun`]).
-pub(crate) fn cornell_node_resume(
-    brdf: &CornellBrdf,
-    run: &mut super::AlbedoRun,
-    budget: u64,
-) -> Result<AlbedoEstimate, ReferenceError> {
-    let q = brdf.quadrature_eval();
-    let mut a = super::albedo_resume(|wo, wi| q.eval(wo, wi), brdf, run, budget)?;
-    a.abs_err += brdf::measured::cornell::QUADRATURE_REL_BOUND * 1.001 * a.value.abs();
-    Ok(a)
-}
-
 /// The Cornell node probes' workload (`reference::tests::cornell_node_cost_probe`, and this
 /// module's with the quadrature evaluator): env `CORNELL_FILE` (default the shared `cayman`),
 /// `NODE_THETA` (degrees, 30.5), `NODE_BUDGET` (1.5·10⁵ evaluations), `NODE_REPEAT` (1) nodes
