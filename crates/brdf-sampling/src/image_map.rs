@@ -389,12 +389,6 @@ impl<'a> SliceImageMap<'a> {
 
     /// `safety ·` the density at the point of `cell` nearest to `at`, when that point is
     /// within the peak reach of `at` (the point itself when `cell` holds it); 0 otherwise.
-    /// The largest image-map sample over `cell` (the grid's bound without the safety factor,
-    /// dilation, peaks or rim band): values of the density, so at most its supremum there.
-    pub(crate) fn largest_sample(&self, cell: &Rect) -> f64 {
-        self.grid.region(cell).max_bound / self.safety
-    }
-
     fn near_peak(&self, cell: &Rect, at: Point2, density: impl Fn(Point2) -> f64) -> f64 {
         let near = [at[0].clamp(cell.x0, cell.x1), at[1].clamp(cell.y0, cell.y1)];
         if (near[0] - at[0]).hypot(near[1] - at[1]) <= self.peak_reach {

@@ -23,7 +23,6 @@ use super::options::{
     ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_tree_params,
 };
 use super::phases::{Lap, PhaseCounts};
-use super::rgl_bound::RglBoundedMap;
 use super::tabulated;
 
 /// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
@@ -268,25 +267,15 @@ fn envelope_tree(
         leaf_choice: LeafChoice::Alias,
         ..envelope_tree_params(set, brdf)
     };
-    let tree_error = |source| SetError::Tree {
-        slice,
-        theta_deg,
-        phi_deg,
-        source,
-    };
-    let builder = QuadTreeBuilder::from_params(params);
-    // An RGL material in an isotropic interval of the outgoing frame at azimuth 0: rigorous
-    // leaf bounds (`rgl_bound.rs`) instead of the sampled rule.
-    let rgl = brdf
-        .as_any()
-        .and_then(|a| a.downcast_ref::<brdf::RglBrdf>());
-    let tree = match rgl {
-        Some(rgl) if span.isotropic && ctx.phi_k == 0.0 && ctx.delta == [0.0, 0.0] => {
-            let bounded = RglBoundedMap::new(image, rgl.clone(), span.ta, span.tb, span.map);
-            builder.build_tree(&bounded).map_err(tree_error)?
-        }
-        _ => builder.build_tree(&image).map_err(tree_error)?,
-    };
+    let tree = QuadTreeBuilder::from_params(params)
+        .build_tree(&image)
+        .map_err(|source| SetError::Tree {
+            slice,
+            theta_deg,
+            phi_deg,
+            source,
+        })?;
+    drop(image);
     Ok((tree, counter.total()))
 }
 

@@ -85,7 +85,6 @@ mod persist;
 mod phases;
 mod probe;
 mod report;
-mod rgl_bound;
 mod sampler;
 mod set;
 mod set_table;
