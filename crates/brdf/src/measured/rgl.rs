@@ -44,10 +44,12 @@ use crate::geometry::Vec3;
 pub use super::rgl_error::RglError;
 
 mod angles;
+mod bound;
 mod lanes;
 
 use angles::fast;
 pub use angles::{elevation, phi_to_u, theta_to_u, u_to_phi, u_to_theta};
+pub use bound::{DirectionBox, MARGIN as BOUND_MARGIN, PAD as BOUND_PAD};
 
 /// How many negative `rgb` entries were clamped to zero when reading.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -279,6 +279,28 @@ impl Warp2D {
         16 * (self.cells.len() + self.rows.len()) + 8 * self.axis.values.len()
     }
 
+    /// Number of rows `ny` of the grid (grid points along `y`).
+    pub(crate) fn rows(&self) -> usize {
+        self.ny
+    }
+
+    /// Whether the blend of slices `s` and `s + 1` at some weight of `[w0, w1]` has a row
+    /// whose total `T(y_r) = ∫ ρ(x, y_r) dx` is not positive (the blended total is affine in
+    /// the weight: checked at both ends with [`invert_located`](Self::invert_located)'s
+    /// expression). There the conditional CDF `C(x, y)/T(y)` is set to 0 instead of its limit,
+    /// so it is not monotone in `y` near that row (the RGL leaf bound, `measured/rgl/bound.rs`,
+    /// then takes the whole `[0, 1]` range of `x`). `s` is clamped to the last pair.
+    pub(crate) fn has_empty_row(&self, s: usize, w: [f64; 2]) -> bool {
+        let ny = self.ny;
+        let slices = self.rows.len() / ny;
+        let (s, w) = if slices < 2 {
+            (0, [0.0, 0.0])
+        } else {
+            (s.min(slices - 2), w)
+        };
+        (0..ny).any(|y| w.iter().any(|&wk| !(self.row_at(s, wk, y)[1] > 0.0)))
+    }
+
     fn area_scale(&self) -> f64 {
         ((self.nx - 1) * (self.ny - 1)) as f64
     }
