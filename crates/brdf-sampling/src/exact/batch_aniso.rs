@@ -47,7 +47,8 @@ const MAX_CELLS: usize = 64;
 struct Scratch {
     /// Per query, its location (written before it is read; never cleared).
     located: Vec<Located>,
-    /// Per query, its group with its run flag (see [`FOLLOWS`]), or [`UNSERVED`].
+    /// Per query, its group with its run flag (see [`FOLLOWS`]), or [`UNSERVED`] (grown, never
+    /// cleared: entry `k` is written before it is read).
     group: Vec<u32>,
     /// The counting sort's bucket starts (then ends) per group.
     count: Vec<u32>,
@@ -132,8 +133,10 @@ impl ExactSet {
         if located.len() < wos.len() {
             located.resize(wos.len(), dummy);
         }
-        group.clear();
-        group.reserve(wos.len());
+        if group.len() < wos.len() {
+            group.resize(wos.len(), UNSERVED);
+        }
+        let group = &mut group[..wos.len()];
         count.clear();
         count.resize(groups as usize + 1, 0);
         // `group[k]`: the query's group, with `FOLLOWS` when it continues its predecessor's
@@ -141,7 +144,7 @@ impl ExactSet {
         // `UNSERVED`.
         let mut prev = [u64::MAX; 3];
         let mut prev_group = UNSERVED;
-        for (k, wo) in wos.iter().enumerate() {
+        for ((k, wo), gk) in wos.iter().enumerate().zip(group.iter_mut()) {
             let now = bits(wo);
             let g = if k > 0 && now == prev {
                 if prev_group != UNSERVED {
@@ -161,7 +164,7 @@ impl ExactSet {
                 prev_group = UNSERVED;
                 UNSERVED
             };
-            group.push(g);
+            *gk = g;
             prev = now;
         }
         // Counting sort by group (stable: the caller's order within a group); each entry of

@@ -101,20 +101,26 @@ impl ExactSet {
         };
         let map = iv.map;
         // Per query: the one-query draw's preparation (`QueryDensity::in_frame` for an
-        // anisotropic BRDF, the record's normaliser).
-        w.lists.clear();
-        w.rot.clear();
-        for &i in members {
+        // anisotropic BRDF, the record's normaliser), written through slices.
+        let n = members.len();
+        if w.rot.len() < n {
+            w.rot.resize(n, None);
+        }
+        let s = w.lists.slots(n);
+        let lists = s
+            .prep
+            .iter_mut()
+            .zip(s.norm.iter_mut())
+            .zip(s.turn.iter_mut());
+        let per_query = lists.zip(s.state.iter_mut()).zip(w.rot[..n].iter_mut());
+        for (&i, ((((p, a), t), st), r)) in members.iter().zip(per_query) {
             let wo = &wos[i as usize];
             let q = &located[i as usize];
-            w.lists.push(
-                self.brdf.prepare(wo),
-                rec.normaliser(q.keys[0], q.keys[1], q.cos, &c.patches),
-                q.turn,
-                stream_key(seed, u64::from(i)),
-            );
-            w.rot
-                .push((q.turn != Turn::IDENTITY).then_some((q.turn.sin, q.turn.cos)));
+            *p = self.brdf.prepare(wo);
+            *a = rec.normaliser(q.keys[0], q.keys[1], q.cos, &c.patches);
+            *t = q.turn;
+            *st = stream_key(seed, u64::from(i));
+            *r = (q.turn != Turn::IDENTITY).then_some((q.turn.sin, q.turn.cos));
         }
         let AnisoWave { lists, rot } = w;
         self.run_wave(

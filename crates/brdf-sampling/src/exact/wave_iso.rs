@@ -75,26 +75,45 @@ impl Default for WaveLists {
 }
 
 impl WaveLists {
-    /// Empties the per-query lists for a new group.
-    #[inline]
-    pub(super) fn clear(&mut self) {
-        self.prep.clear();
-        self.norm.clear();
-        self.turn.clear();
-        self.idx.clear();
-        self.state.clear();
-    }
-
-    /// Appends the group's next query: its prepared `ωo`, normaliser `A`, rotation back to
-    /// the world and first stream state (its place in the group is the list's length).
+    /// The per-query lists of a new group of `n` queries, grown to `n` (never shrunk; every
+    /// entry `0..n` is written by the caller before [`ExactSet::run_wave`] reads it), as
+    /// slices of length `n`: prepared `ωo`, normaliser `A`, rotation back to the world, first
+    /// stream state; the pending list is set to the group's places `0..n`. Written through
+    /// slices, not pushed: no capacity check and no reload of a list's length per query.
     #[inline(always)]
-    pub(super) fn push(&mut self, prep: Outgoing, norm: f64, turn: Turn, state: u64) {
-        self.idx.push(self.prep.len() as u32);
-        self.prep.push(prep);
-        self.norm.push(norm);
-        self.turn.push(turn);
-        self.state.push(state);
+    pub(super) fn slots(&mut self, n: usize) -> Slots<'_> {
+        if self.prep.len() < n {
+            self.prep.resize(n, Outgoing::new(Vec3::new(0.0, 0.0, 1.0)));
+            self.norm.resize(n, 0.0);
+            self.turn.resize(n, Turn::IDENTITY);
+        }
+        // Each on its own: a pass swaps the pending lists with the next pass's.
+        if self.idx.len() < n {
+            self.idx.resize(n, 0);
+        }
+        if self.state.len() < n {
+            self.state.resize(n, 0);
+        }
+        for (k, i) in self.idx[..n].iter_mut().enumerate() {
+            *i = k as u32;
+        }
+        Slots {
+            prep: &mut self.prep[..n],
+            norm: &mut self.norm[..n],
+            turn: &mut self.turn[..n],
+            state: &mut self.state[..n],
+        }
     }
+}
+
+/// The per-query lists of a group as [`WaveLists::slots`] hands them out (each of the group's
+/// length): query `k`'s prepared `ωo`, normaliser `A`, rotation back to the world and first
+/// stream state.
+pub(super) struct Slots<'a> {
+    pub(super) prep: &'a mut [Outgoing],
+    pub(super) norm: &'a mut [f64],
+    pub(super) turn: &'a mut [Turn],
+    pub(super) state: &'a mut [u64],
 }
 
 /// The isotropic wavefront's working arrays ([`WaveLists`]; its queries need no rotation).
@@ -203,17 +222,20 @@ impl ExactSet {
         };
         let map = rec.map;
         // Per query: `draw_iso`'s preparation, in the interval's frame `(r, 0, cos θo)`.
-        w.clear();
-        for &i in members {
+        let s = w.slots(members.len());
+        let lists = s
+            .prep
+            .iter_mut()
+            .zip(s.norm.iter_mut())
+            .zip(s.turn.iter_mut());
+        for ((&i, ((p, a), t)), st) in members.iter().zip(lists).zip(s.state.iter_mut()) {
             let wo = &wos[i as usize];
             let cos = wo.z.min(1.0);
             let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
-            w.push(
-                self.brdf.prepare(&Vec3::new(r, 0.0, cos)),
-                rec.normaliser(cos, iv),
-                Turn::of_azimuth(wo, r),
-                stream_key(seed, u64::from(i)),
-            );
+            *p = self.brdf.prepare(&Vec3::new(r, 0.0, cos));
+            *a = rec.normaliser(cos, iv);
+            *t = Turn::of_azimuth(wo, r);
+            *st = stream_key(seed, u64::from(i));
         }
         self.run_wave(
             brdf, wos, members, table, map, &Unrotated, arch, w, audit, out,
@@ -250,6 +272,8 @@ impl ExactSet {
         // Room for the next pass's list (its entries are written before they are read).
         if w.idx2.len() < n {
             w.idx2.resize(n, 0);
+        }
+        if w.state2.len() < n {
             w.state2.resize(n, 0);
         }
         let WaveLists {
