@@ -47,7 +47,8 @@ const MAX_CELLS: usize = 64;
 struct Scratch {
     /// Per query, its location (written before it is read; never cleared).
     located: Vec<Located>,
-    /// Per query, its group with its run flag (see [`FOLLOWS`]), or [`UNSERVED`].
+    /// Per query, its group with its run flag (see [`FOLLOWS`]), or [`UNSERVED`] (grown, never
+    /// cleared: entry `k` is written before it is read).
     group: Vec<u32>,
     /// The counting sort's bucket starts (then ends) per group.
     count: Vec<u32>,
@@ -132,8 +133,10 @@ impl ExactSet {
         if located.len() < wos.len() {
             located.resize(wos.len(), dummy);
         }
-        group.clear();
-        group.reserve(wos.len());
+        if group.len() < wos.len() {
+            group.resize(wos.len(), UNSERVED);
+        }
+        let group = &mut group[..wos.len()];
         count.clear();
         count.resize(groups as usize + 1, 0);
         // `group[k]`: the query's group, with `FOLLOWS` when it continues its predecessor's
@@ -141,7 +144,7 @@ impl ExactSet {
         // `UNSERVED`.
         let mut prev = [u64::MAX; 3];
         let mut prev_group = UNSERVED;
-        for (k, wo) in wos.iter().enumerate() {
+        for ((k, wo), gk) in wos.iter().enumerate().zip(group.iter_mut()) {
             let now = bits(wo);
             let g = if k > 0 && now == prev {
                 if prev_group != UNSERVED {
@@ -161,7 +164,7 @@ impl ExactSet {
                 prev_group = UNSERVED;
                 UNSERVED
             };
-            group.push(g);
+            *gk = g;
             prev = now;
         }
         // Counting sort by group (stable: the caller's order within a group); each entry of
@@ -409,6 +412,24 @@ mod tests {
 
     use crate::{DirectionSampler, EvalSample, ExactOptions, ExactSet};
 
+    /// `n` outgoing directions drawn from `qr`: `φ` uniform in [0°, 360°), and `θo` uniform
+    /// in [0°, 89.999°) but for every 97th from `k = 0, 1, 2` on: 89.995° (grazing), 90°
+    /// (the horizon) and 97° (below it).
+    fn random_wos(qr: &mut Xoshiro256PlusPlus, n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|k| {
+                let phi = 360.0 * qr.next_uniform();
+                let theta = match k % 97 {
+                    0 => 89.995,
+                    1 => 90.0,
+                    2 => 97.0,
+                    _ => 89.999 * qr.next_uniform(),
+                };
+                brdf::direction_from_angles(theta, phi)
+            })
+            .collect()
+    }
+
     /// The anisotropic batch path on narrow azimuth cells (`tan δ` keys, the default layout of
     /// anisotropic Ward) at random `ωo`: the batch returns, bit for bit, what the one-query
     /// path (`sample_eval`) returns when called in the batch's serving order (intervals in the
@@ -438,18 +459,7 @@ mod tests {
             "some cells hold several intervals"
         );
         let mut qr = Xoshiro256PlusPlus::seed_from_u64(12);
-        let mut wos: Vec<Vec3> = (0..3000)
-            .map(|k| {
-                let phi = 360.0 * qr.next_uniform();
-                let theta = match k % 97 {
-                    0 => 89.995,
-                    1 => 90.0,
-                    2 => 97.0,
-                    _ => 89.999 * qr.next_uniform(),
-                };
-                brdf::direction_from_angles(theta, phi)
-            })
-            .collect();
+        let mut wos = random_wos(&mut qr, 3000);
         let run = brdf::direction_from_angles(41.0, 123.0);
         wos.extend(std::iter::repeat_n(run, 50));
         wos.push(Vec3::new(f64::NAN, 0.0, 1.0));
@@ -551,18 +561,7 @@ mod tests {
         let other: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
         let mut qr = Xoshiro256PlusPlus::seed_from_u64(51);
-        let mut wos: Vec<Vec3> = (0..4000)
-            .map(|k| {
-                let phi = 360.0 * qr.next_uniform();
-                let theta = match k % 97 {
-                    0 => 89.995,
-                    1 => 90.0,
-                    2 => 97.0,
-                    _ => 89.999 * qr.next_uniform(),
-                };
-                brdf::direction_from_angles(theta, phi)
-            })
-            .collect();
+        let mut wos = random_wos(&mut qr, 4000);
         wos[500] = Vec3::new(f64::NAN, 0.0, 1.0);
         wos[501] = Vec3::new(0.3, f64::INFINITY, 0.5);
         let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
@@ -625,7 +624,7 @@ mod tests {
     #[test]
     fn random_wo_aniso_wavefront_passes_chi_square_and_broken_ones_fail() {
         use super::super::batch::tests::assert_wavefront_chi_square;
-        use super::super::wave_aniso::SKEW;
+        use super::super::wave_iso::SKEW;
         let brdf: Arc<dyn Brdf> = Arc::from(parse_spec("ward:alpha_x=0.12,alpha_y=0.3").unwrap());
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
         let dirs = [30.0, 75.0].map(|t: f64| brdf::direction_from_angles(t, 20.0 + t));

@@ -24,24 +24,25 @@ use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, UniformSource};
 use super::ExactSet;
 use super::fused::accepted_at;
 use super::lanes::{self, Trials, mix64};
+use super::table::LeafTable;
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
 
-/// Pending queries per block of [`ExactSet::serve_iso_wave`]: at most this many trials are
-/// made in lanes and evaluated per block.
-const WAVE_ISO: usize = 256;
+/// Pending queries per block of a wavefront ([`ExactSet::run_wave`]): at most this many trials
+/// are made in lanes and evaluated per block.
+const WAVE_BLOCK: usize = 256;
 
-/// Pending queries below which [`ExactSet::serve_iso_wave`] finishes them one by one (a lane
+/// Pending queries below which [`ExactSet::run_wave`] finishes them one by one (a lane
 /// group's 16 trials would be mostly padding).
 const WAVE_TAIL: usize = 16;
 
-/// The working arrays of [`ExactSet::serve_iso_wave`], kept by the caller between groups (and
-/// per thread between batches): per query of the group its prepared `ωo`, normaliser and
-/// rotation back to the world; the pending queries and their stream states (this pass's and
-/// the next one's); one block's trials, the candidates inside the disc, their values, and the
-/// accepted ones.
-pub(super) struct IsoWave {
+/// The working arrays of a wavefront (the isotropic and the anisotropic one), kept by the
+/// caller between groups (and per thread between batches): per query of the group its
+/// prepared `ωo`, normaliser `A` and rotation back to the world; the pending queries (their
+/// places in the group) and their stream states (this pass's and the next one's); one
+/// block's trials, the candidates inside the disc, their values `g`, and the accepted ones.
+pub(super) struct WaveLists {
     prep: Vec<Outgoing>,
     norm: Vec<f64>,
     turn: Vec<Turn>,
@@ -55,7 +56,7 @@ pub(super) struct IsoWave {
     acc: Vec<u32>,
 }
 
-impl Default for IsoWave {
+impl Default for WaveLists {
     fn default() -> Self {
         Self {
             prep: Vec::new(),
@@ -65,11 +66,95 @@ impl Default for IsoWave {
             state: Vec::new(),
             idx2: Vec::new(),
             state2: Vec::new(),
-            t: Trials::new(WAVE_ISO),
-            lane: vec![0; WAVE_ISO],
-            g: vec![0.0; WAVE_ISO],
-            acc: vec![0; WAVE_ISO],
+            t: Trials::new(WAVE_BLOCK),
+            lane: vec![0; WAVE_BLOCK],
+            g: vec![0.0; WAVE_BLOCK],
+            acc: vec![0; WAVE_BLOCK],
         }
+    }
+}
+
+impl WaveLists {
+    /// The per-query lists of a new group of `n` queries, grown to `n` (never shrunk; every
+    /// entry `0..n` is written by the caller before [`ExactSet::run_wave`] reads it), as
+    /// slices of length `n`: prepared `ωo`, normaliser `A`, rotation back to the world, first
+    /// stream state; the pending list is set to the group's places `0..n`. Written through
+    /// slices, not pushed: no capacity check and no reload of a list's length per query.
+    #[inline(always)]
+    pub(super) fn slots(&mut self, n: usize) -> Slots<'_> {
+        if self.prep.len() < n {
+            self.prep.resize(n, Outgoing::new(Vec3::new(0.0, 0.0, 1.0)));
+            self.norm.resize(n, 0.0);
+            self.turn.resize(n, Turn::IDENTITY);
+        }
+        // Each on its own: a pass swaps the pending lists with the next pass's.
+        if self.idx.len() < n {
+            self.idx.resize(n, 0);
+        }
+        if self.state.len() < n {
+            self.state.resize(n, 0);
+        }
+        for (k, i) in self.idx[..n].iter_mut().enumerate() {
+            *i = k as u32;
+        }
+        Slots {
+            prep: &mut self.prep[..n],
+            norm: &mut self.norm[..n],
+            turn: &mut self.turn[..n],
+            state: &mut self.state[..n],
+        }
+    }
+}
+
+/// The per-query lists of a group as [`WaveLists::slots`] hands them out (each of the group's
+/// length): query `k`'s prepared `ωo`, normaliser `A`, rotation back to the world and first
+/// stream state.
+pub(super) struct Slots<'a> {
+    pub(super) prep: &'a mut [Outgoing],
+    pub(super) norm: &'a mut [f64],
+    pub(super) turn: &'a mut [Turn],
+    pub(super) state: &'a mut [u64],
+}
+
+/// The isotropic wavefront's working arrays ([`WaveLists`]; its queries need no rotation).
+pub(super) type IsoWave = WaveLists;
+
+/// How a wavefront evaluates the BRDF at a trial direction: `f(ωo_q, ω)` with `ω` the trial
+/// direction `v` (in the interval's frame) taken to the BRDF's frame — the identity for an
+/// isotropic set, the query's rotation `R_δ` for an anisotropic one (`wave_aniso.rs`).
+pub(super) trait WaveFrame {
+    /// `f(prep, ω(q, v))` by `model`, `prep` query `q`'s prepared `ωo`.
+    fn eval(&self, model: &dyn Brdf, prep: &Outgoing, q: usize, v: &Vec3) -> f64;
+}
+
+/// The isotropic [`WaveFrame`]: `ω = v` (the interval's frame is the BRDF's, `ωo` in the
+/// plane `φ = 0`).
+pub(super) struct Unrotated;
+
+impl WaveFrame for Unrotated {
+    #[inline(always)]
+    fn eval(&self, model: &dyn Brdf, prep: &Outgoing, _q: usize, v: &Vec3) -> f64 {
+        model.eval_prepared(prep, v)
+    }
+}
+
+/// `g` of trial direction `v` (on the map `map`) for query `q` of a wavefront: `f(ωo_q, ω)`
+/// (see [`WaveFrame`]) on the projected map, `2 v_z f` on the equal-area one.
+#[inline(always)]
+fn density<F: WaveFrame>(
+    frame: &F,
+    model: &dyn Brdf,
+    map: DiscMap,
+    prep: &Outgoing,
+    q: usize,
+    v: &Vec3,
+) -> f64 {
+    let f = frame.eval(model, prep, q, v);
+    #[cfg(test)]
+    let f = skewed(f, v);
+    match map {
+        DiscMap::Projected => f,
+        DiscMap::EqualArea => 2.0 * v.z * f,
     }
 }
 
@@ -136,29 +221,62 @@ impl ExactSet {
             return;
         };
         let map = rec.map;
-        let n = members.len();
         // Per query: `draw_iso`'s preparation, in the interval's frame `(r, 0, cos θo)`.
-        w.prep.clear();
-        w.norm.clear();
-        w.turn.clear();
-        w.idx.clear();
-        w.state.clear();
-        for (k, &i) in members.iter().enumerate() {
+        let s = w.slots(members.len());
+        let lists = s
+            .prep
+            .iter_mut()
+            .zip(s.norm.iter_mut())
+            .zip(s.turn.iter_mut());
+        for ((&i, ((p, a), t)), st) in members.iter().zip(lists).zip(s.state.iter_mut()) {
             let wo = &wos[i as usize];
             let cos = wo.z.min(1.0);
             let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
-            w.prep.push(self.brdf.prepare(&Vec3::new(r, 0.0, cos)));
-            w.norm.push(rec.normaliser(cos, iv));
-            w.turn.push(Turn::of_azimuth(wo, r));
-            w.idx.push(k as u32);
-            w.state.push(stream_key(seed, u64::from(i)));
+            *p = self.brdf.prepare(&Vec3::new(r, 0.0, cos));
+            *a = rec.normaliser(cos, iv);
+            *t = Turn::of_azimuth(wo, r);
+            *st = stream_key(seed, u64::from(i));
         }
+        self.run_wave(
+            brdf, wos, members, table, map, &Unrotated, arch, w, audit, out,
+        );
+    }
+
+    /// The passes of a wavefront (the isotropic and the anisotropic one) over the group's
+    /// queries `members` (indices into `wos` and `out`), prepared in `w` (per query its
+    /// prepared `ωo`, normaliser, turn and first stream state, in `members`' order): per pass
+    /// every pending query's next trial from `table` in lanes ([`lanes::trials_split`]), the
+    /// candidates inside the disc valued `g` at their own query ([`WaveFrame`], times `2 v_z`
+    /// on the equal-area map), acceptance `u₃·M_i < g` and the next pass's list without
+    /// branches; below [`WAVE_TAIL`] pending queries, one by one from the same streams. An
+    /// accepted trial `(v, g)` gives `accepted_at`'s sample (pdf `g / A` on the map, the turn
+    /// applied), finished by [`ExactSet::finish_iso`]; after [`MAX_TRIALS_PER_SAMPLE`]
+    /// trials the empty sample (counted as exhausted). Trials, violations (`g > M_i`) and
+    /// samples are counted in `audit` as `LeafTable::draw` counts them.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(super) fn run_wave<F: WaveFrame>(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        members: &[u32],
+        table: &LeafTable,
+        map: DiscMap,
+        frame: &F,
+        arch: pulp::Arch,
+        w: &mut WaveLists,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
+        let n = members.len();
         // Room for the next pass's list (its entries are written before they are read).
         if w.idx2.len() < n {
             w.idx2.resize(n, 0);
+        }
+        if w.state2.len() < n {
             w.state2.resize(n, 0);
         }
-        let IsoWave {
+        let WaveLists {
             prep,
             norm,
             turn,
@@ -190,8 +308,8 @@ impl ExactSet {
             // the rejected ones).
             let mut np = 0;
             for (ib, sb) in idx[..pending]
-                .chunks(WAVE_ISO)
-                .zip(state[..pending].chunks_mut(WAVE_ISO))
+                .chunks(WAVE_BLOCK)
+                .zip(state[..pending].chunks_mut(WAVE_BLOCK))
             {
                 let len = ib.len();
                 lanes::trials_split(arch, table, map, sb, t);
@@ -212,14 +330,8 @@ impl ExactSet {
                 count_evaluations(c as u64);
                 for (gj, &k) in g[..c].iter_mut().zip(&lane[..c]) {
                     let k = k as usize;
-                    let v = &t.dir[k];
-                    let f = model.eval_prepared(&prep[ib[k] as usize], v);
-                    #[cfg(test)]
-                    let f = skewed(f, v);
-                    *gj = match map {
-                        DiscMap::Projected => f,
-                        DiscMap::EqualArea => 2.0 * v.z * f,
-                    };
+                    let q = ib[k] as usize;
+                    *gj = density(frame, model, map, &prep[q], q, &t.dir[k]);
                 }
                 // Acceptance (`u₃·M_i < g`, `draw`'s test) without branches: the accepted
                 // candidates' entries gathered in `acc`, the rejected queries in the next
@@ -267,13 +379,7 @@ impl ExactSet {
                 };
                 count_evaluations(1);
                 let v = map.to_direction(x);
-                let f = model.eval_prepared(&prep[q], &v);
-                #[cfg(test)]
-                let f = skewed(f, &v);
-                let gx = match map {
-                    DiscMap::Projected => f,
-                    DiscMap::EqualArea => 2.0 * v.z * f,
-                };
+                let gx = density(frame, model, map, &prep[q], q, &v);
                 violations += u64::from(gx > m);
                 if us[3] * m < gx {
                     break Some((v, gx));
@@ -302,7 +408,7 @@ thread_local! {
 
 /// [`SKEW`]'s break applied to a candidate's `f` at `v` (test support).
 #[cfg(test)]
-fn skewed(f: f64, v: &Vec3) -> f64 {
+pub(super) fn skewed(f: f64, v: &Vec3) -> f64 {
     let k = SKEW.with(std::cell::Cell::get);
     if k < 0.0 {
         f64::MAX
