@@ -365,27 +365,12 @@ mod tests {
         use crate::exact::tabulated::table_normaliser;
         use std::collections::HashMap;
         use std::sync::Mutex;
-        let files = std::env::var("CORNELL_FILES")
-            .unwrap_or_else(|_| "krylon_blue,cayman,acryl_blue".into());
         let widths: Vec<f64> = std::env::var("FIRST_MAX_DEG")
             .unwrap_or_else(|_| "inf,7.5,3.75".into())
             .split(',')
             .filter_map(|s| s.parse().ok())
             .collect();
-        for name in files.split(',') {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
-            let Ok(b) = brdf::CornellBrdf::load(&path) else {
-                eprintln!("skipped {name}");
-                continue;
-            };
-            let b = b.with_interpolation(brdf::measured::cornell::Interpolation::Knn);
-            let options = crate::ExactOptions::default();
-            let plan = crate::exact::build::Plan::new(&b, &options, None, true);
-            let breaks: Vec<f64> = (1..plan.n0)
-                .map(|i| plan.grid.edge(i << crate::exact::grid::EDGE_BITS))
-                .collect();
-            let top = crate::exact::options::THETA_TOP_DEG.to_radians();
+        for (name, b, breaks, top) in crate::exact::tests::cornell_survey_inputs() {
             let cache: Mutex<HashMap<u64, Option<(f64, f64)>>> = Mutex::new(HashMap::new());
             let value = |t: f64| {
                 if let Some(v) = cache.lock().unwrap().get(&t.to_bits()) {

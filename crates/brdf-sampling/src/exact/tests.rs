@@ -656,16 +656,13 @@ pub(super) fn paper_white_fixture() -> Option<brdf::RglBrdf> {
     }
 }
 
-/// The Cornell set table with and without the nested refinement of `set_table.rs`
-/// (`NESTED_NODES`), for the record (docs/benchmarks.md §26.4): nodes integrated, pieces,
-/// the worst declared error, and the two tables against each other at 601 angles.
-/// `CORNELL_FILES` (default the three shared files);
-/// `cargo test --release -p brdf-sampling --lib set_table_nesting_survey -- --ignored --nocapture`
-#[test]
-#[ignore = "a survey for the record (minutes)"]
-fn set_table_nesting_survey() {
+/// The shared Cornell files named by `CORNELL_FILES` (default the three), each with the kNN
+/// interpolant, the build's first interval edges (the set table's breaks) and the top θo
+/// (radians): the inputs of the ignored set-table surveys. Missing files are skipped.
+pub(super) fn cornell_survey_inputs() -> Vec<(String, brdf::CornellBrdf, Vec<f64>, f64)> {
     let files =
         std::env::var("CORNELL_FILES").unwrap_or_else(|_| "krylon_blue,cayman,acryl_blue".into());
+    let mut inputs = Vec::new();
     for name in files.split(',') {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
@@ -674,12 +671,29 @@ fn set_table_nesting_survey() {
             continue;
         };
         let b = b.with_interpolation(brdf::measured::cornell::Interpolation::Knn);
-        let options = ExactOptions::default();
-        let plan = super::build::Plan::new(&b, &options, None, true);
+        let plan = super::build::Plan::new(&b, &ExactOptions::default(), None, true);
         let breaks: Vec<f64> = (1..plan.n0)
             .map(|i| plan.grid.edge(i << super::grid::EDGE_BITS))
             .collect();
-        let top = super::options::THETA_TOP_DEG.to_radians();
+        inputs.push((
+            name.to_string(),
+            b,
+            breaks,
+            super::options::THETA_TOP_DEG.to_radians(),
+        ));
+    }
+    inputs
+}
+
+/// The Cornell set table with and without the nested refinement of `set_table.rs`
+/// (`NESTED_NODES`), for the record (docs/benchmarks.md §26.4): nodes integrated, pieces,
+/// the worst declared error, and the two tables against each other at 601 angles.
+/// `CORNELL_FILES` (default the three shared files);
+/// `cargo test --release -p brdf-sampling --lib set_table_nesting_survey -- --ignored --nocapture`
+#[test]
+#[ignore = "a survey for the record (minutes)"]
+fn set_table_nesting_survey() {
+    for (name, b, breaks, top) in cornell_survey_inputs() {
         let mut tables = Vec::new();
         let excess: Vec<Option<f64>> = std::env::var("NEST_EXCESS")
             .unwrap_or_else(|_| "0,32".into())
