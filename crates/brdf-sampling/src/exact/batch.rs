@@ -9,7 +9,7 @@ use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
-use super::fused::{IsoQuery, accepted, accepted_at};
+use super::fused::{IsoQuery, accepted, accepted_at, same_brdf};
 use super::grid::TableVar;
 use super::lanes::{self, Trials};
 #[cfg(test)]
@@ -875,12 +875,15 @@ impl ExactSet {
         match prepared {
             Some(p) if p.prefers_blocks() && cell.tables[q.interval].is_some() => {
                 let table = cell.tables[q.interval].as_ref().expect("checked");
+                // `finish_iso`'s test of the caller's BRDF, made once for the run.
+                let same = same_brdf(brdf, self.brdf.as_ref());
                 let emit = |i: usize, d: Option<Drawn>| {
                     let (s, f) = match d {
                         Some((_, v, gx)) => accepted_at(rec.map, &at.turn, v, gx, at.a),
                         None => (DirSample::NONE, f64::NAN),
                     };
-                    out[run[i] as usize] = self.finish_iso(brdf, at.wo, s, f);
+                    let f = f.is_finite().then_some(f);
+                    out[run[i] as usize] = self.finish_known(brdf, at.wo, s, f, same);
                 };
                 wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
             }
@@ -958,13 +961,16 @@ impl ExactSet {
             if let Some(p) = self.brdf.prepare_run(&frame).filter(|p| p.prefers_blocks()) {
                 let a = self.normaliser_of(q);
                 let served = q.wo == *wo;
+                // `finish`'s test of the caller's BRDF, made once for the run.
+                let same = same_brdf(brdf, self.brdf.as_ref());
                 let emit = |i: usize, d: Option<Drawn>| {
                     out[run[i] as usize] = match d {
                         Some((_, v, gx)) => {
                             let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
-                            self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
+                            let f = (served && f.is_finite()).then_some(f);
+                            self.finish_known(brdf, wo, s, f, same)
                         }
-                        None => self.finish(brdf, wo, DirSample::NONE, None),
+                        None => self.finish_known(brdf, wo, DirSample::NONE, None, same),
                     };
                 };
                 wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
