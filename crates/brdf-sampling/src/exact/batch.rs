@@ -192,18 +192,25 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     audit.trials += trials;
     audit.violations += violations;
     audit.samples += n as u64;
-    *kept = WaveArrays {
-        idx,
-        state,
-        idx2,
-        state2,
-        t: kept_t,
-        lane,
-        dirs,
-        f,
-    };
-    let _ = WAVE_ARRAYS.try_with(|s| s.set(Some(kept)));
+    // Kept for the next call unless they grew past `WAVE_KEEP_MAX` samples (then freed).
+    if idx.capacity().max(idx2.capacity()) <= WAVE_KEEP_MAX {
+        *kept = WaveArrays {
+            idx,
+            state,
+            idx2,
+            state2,
+            t: kept_t,
+            lane,
+            dirs,
+            f,
+        };
+        let _ = WAVE_ARRAYS.try_with(|s| s.set(Some(kept)));
+    }
 }
+
+/// Most samples whose [`WaveArrays`] a thread keeps after a wavefront (32 bytes each, 2 MiB
+/// here); a longer wavefront's arrays are freed when it ends.
+const WAVE_KEEP_MAX: usize = 1 << 16;
 
 /// [`wavefront_with`]'s working arrays, kept per thread between calls (no allocation and no
 /// zero-filled buffer per call once a thread has drawn a wavefront of the size): the pending
@@ -1665,6 +1672,53 @@ pub(super) mod tests {
             "{what}: mean {mean}, exact {}, z = {z}",
             cos2 / a
         );
+    }
+
+    /// The wavefront's working arrays ([`WaveArrays`]) are kept by the thread after a
+    /// wavefront of at most [`WAVE_KEEP_MAX`] samples and freed after a longer one; a
+    /// wavefront drawn on kept arrays (after a longer and a shorter one) gives the same
+    /// points, values and counts as on fresh ones (Phong through a block-preferring run).
+    #[test]
+    fn wavefront_keeps_its_arrays_only_up_to_a_size_and_they_change_nothing() {
+        use super::{WAVE_ARRAYS, WAVE_KEEP_MAX, wavefront};
+        use partition_sampler::Audit;
+        let phong: Arc<dyn Brdf> = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks: true,
+        });
+        let set = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
+        let wo = brdf::direction_from_angles(35.0, 0.0);
+        let q = set.locate_iso(&wo).expect("the isotropic path");
+        let table = set.cells[0].tables[q.interval].as_ref().unwrap();
+        let map = set.cells[0].iso[q.interval].map;
+        let run = phong.prepare_run(&Vec3::new(q.r, 0.0, q.cos)).unwrap();
+        let draw = |n: usize| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+            let mut audit = Audit::default();
+            let d = wavefront(run.as_ref(), table, map, n, 256, &mut rng, &mut audit);
+            let bits: Vec<_> = d
+                .iter()
+                .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
+                .collect();
+            (bits, audit.trials, audit.violations, audit.exhausted)
+        };
+        let kept = || {
+            WAVE_ARRAYS.with(|s| {
+                let k = s.take();
+                let room = k.as_ref().map(|k| k.idx.capacity());
+                s.set(k);
+                room
+            })
+        };
+        WAVE_ARRAYS.with(|s| s.set(None));
+        let fresh = draw(3000);
+        assert!(kept().is_some_and(|c| c >= 3000), "kept after 3000");
+        let _ = draw(WAVE_KEEP_MAX + 1);
+        assert_eq!(kept(), None, "freed after {}", WAVE_KEEP_MAX + 1);
+        let _ = draw(5000);
+        assert_eq!(draw(3000), fresh);
+        assert!(kept().is_some_and(|c| c <= WAVE_KEEP_MAX));
     }
 
     /// The wavefront (long runs of one `ωo` whose prepared run prefers blocks): each sample is

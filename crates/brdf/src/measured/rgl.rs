@@ -838,8 +838,9 @@ std::thread_local! {
 }
 
 impl RglBrdf {
-    /// The [`PreparedSlice`] of `wo` (whose prepared form is `q`, blend `(i, w)`): this thread's
-    /// last one when it is this material's at the same blend bits, else
+    /// The [`PreparedSlice`] of `wo`, `(i, w)` the θo blend its prepared form locates
+    /// ([`prepared_slice`](Self::prepared_slice)): this thread's last one when it is this
+    /// material's at the same blend bits, else
     /// [`prepare_slice`](Self::prepare_slice)`(wo)`, kept as the thread's last when it holds
     /// `(i, w)`. `None` when the made slice does not hold `(i, w)` (as before the cache).
     fn run_slice(&self, wo: &Vec3, i: usize, w: f64) -> Option<Arc<PreparedSlice>> {
