@@ -9,7 +9,7 @@ use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, Point2, UniformSource};
 
 use super::density::QueryDensity;
-use super::fused::{IsoQuery, accepted, accepted_at};
+use super::fused::{IsoQuery, accepted, accepted_at, same_brdf};
 use super::grid::TableVar;
 use super::lanes::{self, Trials};
 #[cfg(test)]
@@ -101,22 +101,49 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     let seed = wave_seed(u);
     let wave = wave.max(1).min(n.max(1));
     let arch = pulp::Arch::new();
+    // This thread's kept arrays (`try_with`: during the thread's teardown, fresh ones; a
+    // nested call finds none and makes its own).
+    let mut kept = WAVE_ARRAYS
+        .try_with(|s| s.take())
+        .ok()
+        .flatten()
+        .unwrap_or_default();
+    // Taken out by value: locals the compiler keeps in registers across `emit` (through the
+    // box, each push would reload the vector's length: ≈ 13 instructions per sample, §29.1).
+    let WaveArrays {
+        mut idx,
+        mut state,
+        mut idx2,
+        mut state2,
+        t: mut kept_t,
+        mut lane,
+        mut dirs,
+        mut f,
+    } = std::mem::take(&mut *kept);
     // The pending samples: index and stream state (and the next pass's). Every pending sample
     // makes one trial per pass, so after `pass` passes each has made `pass` trials.
-    let mut idx: Vec<usize> = (0..n).collect();
-    let mut state: Vec<u64> = vec![0; n];
+    idx.clear();
+    idx.extend(0..n);
+    state.clear();
+    state.resize(n, 0);
     lanes::keys(arch, seed, &mut state);
-    let (mut idx2, mut state2) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    idx2.clear();
+    state2.clear();
     // One block's trials (`lanes.rs`), and its candidates inside the disc: the trial's entry
     // in the block, direction, value.
-    let mut t = Trials::new(wave);
-    let mut lane: Vec<usize> = vec![0; wave];
-    let mut dirs: Vec<Vec3> = vec![Vec3::zeros(); wave];
-    let mut f = vec![0.0; wave];
+    if kept_t.as_ref().is_none_or(|t| t.room() < wave) {
+        kept_t = Some(Trials::new(wave));
+    }
+    let t = kept_t.as_mut().expect("made above");
+    if lane.len() < wave {
+        lane.resize(wave, 0);
+        dirs.resize(wave, Vec3::zeros());
+        f.resize(wave, 0.0);
+    }
     let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
     while !idx.is_empty() {
         if pass >= MAX_TRIALS_PER_SAMPLE {
-            for &i in &idx {
+            for &i in idx.iter() {
                 audit.exhausted += 1;
                 emit(i, None);
             }
@@ -128,7 +155,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         state2.clear();
         for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
             let len = ib.len();
-            lanes::trials(arch, table, map, sb, &mut t);
+            lanes::trials(arch, table, map, sb, t);
             // The candidates inside the disc, compacted without branches; the others (a few
             // per cent) propose again next pass.
             let mut c = 0;
@@ -165,6 +192,47 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     audit.trials += trials;
     audit.violations += violations;
     audit.samples += n as u64;
+    // Kept for the next call unless they grew past `WAVE_KEEP_MAX` samples (then freed).
+    if idx.capacity().max(idx2.capacity()) <= WAVE_KEEP_MAX {
+        *kept = WaveArrays {
+            idx,
+            state,
+            idx2,
+            state2,
+            t: kept_t,
+            lane,
+            dirs,
+            f,
+        };
+        let _ = WAVE_ARRAYS.try_with(|s| s.set(Some(kept)));
+    }
+}
+
+/// Most samples whose [`WaveArrays`] a thread keeps after a wavefront (32 bytes each, 2 MiB
+/// here); a longer wavefront's arrays are freed when it ends.
+const WAVE_KEEP_MAX: usize = 1 << 16;
+
+/// [`wavefront_with`]'s working arrays, kept per thread between calls (no allocation and no
+/// zero-filled buffer per call once a thread has drawn a wavefront of the size): the pending
+/// samples' indices and stream states (this pass's and the next's), one block's trials, and
+/// its candidates inside the disc (entry in the block, direction, value). Their contents are
+/// set by each call before they are read: nothing carries over but the room.
+#[derive(Default)]
+struct WaveArrays {
+    idx: Vec<usize>,
+    state: Vec<u64>,
+    idx2: Vec<usize>,
+    state2: Vec<u64>,
+    t: Option<Trials>,
+    lane: Vec<usize>,
+    dirs: Vec<Vec3>,
+    f: Vec<f64>,
+}
+
+thread_local! {
+    /// This thread's [`WaveArrays`], taken for the length of a wavefront.
+    static WAVE_ARRAYS: std::cell::Cell<Option<Box<WaveArrays>>> =
+        const { std::cell::Cell::new(None) };
 }
 
 /// [`wavefront_with`]'s samples in index order (test support).
@@ -333,6 +401,9 @@ impl Source for Ahead<'_> {
 thread_local! {
     /// Test support: `true` makes [`Ahead`] pass every call through (the reference).
     static NO_FILL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Test support: `true` turns [`ExactSet::one_wo`] off (every pass located, counted and
+    /// sorted: the reference).
+    static NO_ONE_WO: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 impl UniformSource for Ahead<'_> {
@@ -398,6 +469,13 @@ fn run_density(run: &dyn PreparedRun, map: DiscMap, p: Point2) -> f64 {
     }
 }
 
+/// A pass's one `ωo` located ([`ExactSet::one_wo`]): by the isotropic fast path or the general
+/// one.
+enum OneWo {
+    Iso(IsoQuery),
+    General(Query),
+}
+
 /// The per-run part of an isotropic query ([`ExactSet::draw_iso`]'s, made once).
 struct IsoRun<'a> {
     q: &'a IsoQuery,
@@ -428,6 +506,29 @@ impl ExactSet {
         match self.locate_iso(wo) {
             Some(q) => Some(q.interval),
             None => self.locate_keys(wo).map(|q| offsets[q.cell] + q.interval),
+        }
+    }
+
+    /// The query of `wos[0]` — the isotropic fast path's ([`ExactSet::locate_iso`]), else the
+    /// general one ([`ExactSet::locate_keys`]), as the locate pass finds it — when `wos` is one
+    /// run of at least [`PREPARED_RUN_MIN`] queries (every query with `wos[0]`'s bits) that
+    /// the set serves; else `None`. At most one pass over `wos` (stops at the first other
+    /// `ωo`).
+    fn one_wo(&self, wos: &[Vec3]) -> Option<OneWo> {
+        #[cfg(test)]
+        if NO_ONE_WO.with(std::cell::Cell::get) {
+            return None;
+        }
+        if wos.len() < PREPARED_RUN_MIN {
+            return None;
+        }
+        let b0 = bits(&wos[0]);
+        if !wos.iter().all(|wo| bits(wo) == b0) {
+            return None;
+        }
+        match self.locate_iso(&wos[0]) {
+            Some(q) => Some(OneWo::Iso(q)),
+            None => self.locate_keys(&wos[0]).map(OneWo::General),
         }
     }
 
@@ -518,6 +619,25 @@ impl ExactSet {
             members,
             iso_wave,
         } = scratch;
+        // A pass of one served `ωo` (a fixed-ωo benchmark's chunk, a pixel's samples) long
+        // enough for a prepared run: the locate, count and sort below would find one group
+        // holding one run, in the caller's order, drawn from the caller's stream (no group
+        // fills ahead: it is no span; none is a wavefront group: it repeats). That run is
+        // served directly by the call `serve_order` makes for it: the same samples bit for
+        // bit, without the per-query bookkeeping.
+        if let Some(one) = self.one_wo(wos) {
+            order.clear();
+            order.extend(0..wos.len() as u32);
+            let mut audit = Audit::default();
+            match one {
+                OneWo::Iso(q) => self.serve_iso_run(brdf, &q, &wos[0], order, u, &mut audit, out),
+                OneWo::General(q) => {
+                    self.serve_general_run(brdf, &q, &wos[0], order, u, &mut audit, out)
+                }
+            }
+            self.counters.record(&audit);
+            return;
+        }
         let offsets = self.interval_offsets();
         let groups = offsets[offsets.len() - 1];
         if groups >= MAX_PASS {
@@ -762,12 +882,15 @@ impl ExactSet {
         match prepared {
             Some(p) if p.prefers_blocks() && cell.tables[q.interval].is_some() => {
                 let table = cell.tables[q.interval].as_ref().expect("checked");
+                // `finish_iso`'s test of the caller's BRDF, made once for the run.
+                let same = same_brdf(brdf, self.brdf.as_ref());
                 let emit = |i: usize, d: Option<Drawn>| {
                     let (s, f) = match d {
                         Some((_, v, gx)) => accepted_at(rec.map, &at.turn, v, gx, at.a),
                         None => (DirSample::NONE, f64::NAN),
                     };
-                    out[run[i] as usize] = self.finish_iso(brdf, at.wo, s, f);
+                    let f = f.is_finite().then_some(f);
+                    out[run[i] as usize] = self.finish_known(brdf, at.wo, s, f, same);
                 };
                 wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
             }
@@ -845,13 +968,16 @@ impl ExactSet {
             if let Some(p) = self.brdf.prepare_run(&frame).filter(|p| p.prefers_blocks()) {
                 let a = self.normaliser_of(q);
                 let served = q.wo == *wo;
+                // `finish`'s test of the caller's BRDF, made once for the run.
+                let same = same_brdf(brdf, self.brdf.as_ref());
                 let emit = |i: usize, d: Option<Drawn>| {
                     out[run[i] as usize] = match d {
                         Some((_, v, gx)) => {
                             let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
-                            self.finish(brdf, wo, s, (served && f.is_finite()).then_some(f))
+                            let f = (served && f.is_finite()).then_some(f);
+                            self.finish_known(brdf, wo, s, f, same)
                         }
-                        None => self.finish(brdf, wo, DirSample::NONE, None),
+                        None => self.finish_known(brdf, wo, DirSample::NONE, None, same),
                     };
                 };
                 wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
@@ -1136,6 +1262,66 @@ pub(super) mod tests {
             }
         }
         NO_WAVE.with(|c| c.set(false));
+    }
+
+    /// A pass of one `ωo` served without the locate pass ([`ExactSet::one_wo`]) draws the
+    /// grouped path's samples bit for bit and leaves the caller's generator in the same state:
+    /// Phong with a block-preferring run (the isotropic fast path's wavefront), anisotropic
+    /// Ward (the general path, one query at a time) and the RGL fixture (the general path's
+    /// wavefront), at θo 0°, 35°, 85°, grazing (89.995°) and below the horizon, in batches of
+    /// 511, 512 and 4096 copies of one `ωo` and of 4096 with a last query at another `ωo` —
+    /// against the same batches with `one_wo` off. The short, mixed and unserved batches
+    /// do not take it; every other does (checked).
+    #[test]
+    fn one_wo_passes_draw_the_grouped_paths_bits() {
+        use super::NO_ONE_WO;
+        let (_, [phong, ward]) = phong_and_small_ward(true);
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
+        let mut taken = 0;
+        for (brdf, opts) in [phong, ward, (rgl, ExactOptions::default())] {
+            let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+            for theta in [0.0, 35.0, 85.0, 89.995, 95.0] {
+                let wo = brdf::direction_from_angles(theta, 40.0);
+                let other = brdf::direction_from_angles(20.0, 300.0);
+                for (len, mixed) in [(511, false), (512, false), (4096, false), (4096, true)] {
+                    let mut wos = vec![wo; len];
+                    if mixed {
+                        wos[len - 1] = other;
+                    }
+                    let takes = set.one_wo(&wos).is_some();
+                    let served = theta < 90.0 && set.locate_keys(&wo).is_some();
+                    assert_eq!(
+                        takes,
+                        len >= 512 && !mixed && served,
+                        "{} θo {theta}",
+                        brdf.name()
+                    );
+                    taken += usize::from(takes);
+                    let mut draws = [0, 1].map(|off| {
+                        NO_ONE_WO.with(|c| c.set(off == 1));
+                        let mut r = Xoshiro256PlusPlus::seed_from_u64(17 + len as u64);
+                        let mut out = Vec::new();
+                        set.sample_eval_batch(brdf.as_ref(), &wos, &mut r, &mut out);
+                        (out, r)
+                    });
+                    NO_ONE_WO.with(|c| c.set(false));
+                    let [(a, ra), (b, rb)] = &mut draws;
+                    assert_eq!(a.len(), len);
+                    for (k, (x, y)) in a.iter().zip(b.iter()).enumerate() {
+                        assert_eq!(key(x), key(y), "{} θo {theta} query {k}", brdf.name());
+                    }
+                    assert_eq!(ra.next_uniform(), rb.next_uniform(), "{}", brdf.name());
+                    if served && !mixed {
+                        assert!(a.iter().all(|s| s.pdf > 0.0), "{} θo {theta}", brdf.name());
+                    }
+                }
+            }
+        }
+        // Two per material at each of four served θo.
+        assert_eq!(taken, 3 * 4 * 2);
     }
 
     /// The uniforms filled ahead (`Ahead`) are the trials one call each would draw: random-ωo
@@ -1486,6 +1672,53 @@ pub(super) mod tests {
             "{what}: mean {mean}, exact {}, z = {z}",
             cos2 / a
         );
+    }
+
+    /// The wavefront's working arrays ([`WaveArrays`]) are kept by the thread after a
+    /// wavefront of at most [`WAVE_KEEP_MAX`] samples and freed after a longer one; a
+    /// wavefront drawn on kept arrays (after a longer and a shorter one) gives the same
+    /// points, values and counts as on fresh ones (Phong through a block-preferring run).
+    #[test]
+    fn wavefront_keeps_its_arrays_only_up_to_a_size_and_they_change_nothing() {
+        use super::{WAVE_ARRAYS, WAVE_KEEP_MAX, wavefront};
+        use partition_sampler::Audit;
+        let phong: Arc<dyn Brdf> = Arc::new(WithRun {
+            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+            run_evals: AtomicU64::new(0),
+            blocks: true,
+        });
+        let set = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
+        let wo = brdf::direction_from_angles(35.0, 0.0);
+        let q = set.locate_iso(&wo).expect("the isotropic path");
+        let table = set.cells[0].tables[q.interval].as_ref().unwrap();
+        let map = set.cells[0].iso[q.interval].map;
+        let run = phong.prepare_run(&Vec3::new(q.r, 0.0, q.cos)).unwrap();
+        let draw = |n: usize| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+            let mut audit = Audit::default();
+            let d = wavefront(run.as_ref(), table, map, n, 256, &mut rng, &mut audit);
+            let bits: Vec<_> = d
+                .iter()
+                .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
+                .collect();
+            (bits, audit.trials, audit.violations, audit.exhausted)
+        };
+        let kept = || {
+            WAVE_ARRAYS.with(|s| {
+                let k = s.take();
+                let room = k.as_ref().map(|k| k.idx.capacity());
+                s.set(k);
+                room
+            })
+        };
+        WAVE_ARRAYS.with(|s| s.set(None));
+        let fresh = draw(3000);
+        assert!(kept().is_some_and(|c| c >= 3000), "kept after 3000");
+        let _ = draw(WAVE_KEEP_MAX + 1);
+        assert_eq!(kept(), None, "freed after {}", WAVE_KEEP_MAX + 1);
+        let _ = draw(5000);
+        assert_eq!(draw(3000), fresh);
+        assert!(kept().is_some_and(|c| c <= WAVE_KEEP_MAX));
     }
 
     /// The wavefront (long runs of one `ωo` whose prepared run prefers blocks): each sample is

@@ -112,11 +112,27 @@ impl ExactSet {
         s: DirSample,
         f: Option<f64>,
     ) -> EvalSample {
+        self.finish_known(brdf, wo, s, f, same_brdf(brdf, self.brdf.as_ref()))
+    }
+
+    /// [`ExactSet::finish`] with `same = same_brdf(brdf, set's BRDF)` decided once by the
+    /// caller for many samples (a run's; the batch path): the same [`EvalSample`] —
+    /// `(s.wi, s.pdf, f)` with `f = 0` unless `s.pdf > 0` and `s.wi.z > 0`, else the given `f`
+    /// when `same`, else `brdf.eval(wo, s.wi)`.
+    #[inline(always)]
+    pub(super) fn finish_known(
+        &self,
+        brdf: &dyn Brdf,
+        wo: &Vec3,
+        s: DirSample,
+        f: Option<f64>,
+        same: bool,
+    ) -> EvalSample {
         let f = if !(s.pdf > 0.0 && s.wi.z > 0.0) {
             0.0
         } else {
             match f {
-                Some(f) if same_brdf(brdf, self.brdf.as_ref()) => f,
+                Some(f) if same => f,
                 _ => brdf.eval(wo, &s.wi),
             }
         };

@@ -63,6 +63,11 @@ impl Trials {
             dir: vec![Vec3::zeros(); wave],
         }
     }
+
+    /// The largest block these arrays take (a multiple of [`LANES`]).
+    pub(super) fn room(&self) -> usize {
+        self.x.len()
+    }
 }
 
 /// `DiscMap::Projected.to_direction`'s arithmetic: `(x, y, √(1 − x² − y²))` (0 where the

@@ -34,7 +34,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, Weak};
 
 use super::tensor::TensorFile;
 use super::warp::{BilinearTable, ParamAxis, Warp2D, Warp2DSlice};
@@ -824,7 +824,53 @@ impl RglBrdf {
 struct RglRun<'a> {
     brdf: &'a RglBrdf,
     q: Outgoing,
-    slice: PreparedSlice,
+    slice: Arc<PreparedSlice>,
+}
+
+std::thread_local! {
+    /// This thread's last slice made by [`Brdf::prepare_run`], with the material it belongs
+    /// to (a `Weak` of its tables: the tables' allocation outlives the entry, so no other
+    /// material can take its address while the entry names it). A run at a θo of the same
+    /// blend `(i, w)` — the same bits — of the same material takes it instead of blending
+    /// again (≈ 2·10⁵ instructions, docs/benchmarks.md §29.1): consecutive batches at one `ωo`
+    /// (a fixed-ωo benchmark's chunks, a pixel's samples called in pieces). Holds one slice
+    /// (≈ 3.4·10⁴ `f64`) per thread until the thread ends or another blend replaces it.
+    static LAST_SLICE: std::cell::RefCell<Option<(Weak<Tables>, Arc<PreparedSlice>)>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+impl RglBrdf {
+    /// The [`PreparedSlice`] of `wo`, `(i, w)` the θo blend its prepared form locates
+    /// ([`prepared_slice`](Self::prepared_slice)): this thread's last one when it is this
+    /// material's at the same blend bits, else
+    /// [`prepare_slice`](Self::prepare_slice)`(wo)`, kept as the thread's last when it holds
+    /// `(i, w)`. `None` when the made slice does not hold `(i, w)` (as before the cache).
+    fn run_slice(&self, wo: &Vec3, i: usize, w: f64) -> Option<Arc<PreparedSlice>> {
+        let owner = self.owner();
+        let hit = LAST_SLICE
+            .try_with(|c| {
+                c.borrow().as_ref().and_then(|(m, p)| {
+                    (Weak::as_ptr(m) as usize == owner && p.matches(owner, i, w))
+                        .then(|| Arc::clone(p))
+                })
+            })
+            .ok()
+            .flatten();
+        if hit.is_some() {
+            return hit;
+        }
+        let slice = self.prepare_slice(wo);
+        if !slice.matches(owner, i, w) {
+            return None;
+        }
+        let slice = Arc::new(slice);
+        let _ = LAST_SLICE.try_with(|c| {
+            if let Ok(mut c) = c.try_borrow_mut() {
+                *c = Some((Arc::downgrade(&self.tables), Arc::clone(&slice)));
+            }
+        });
+        Some(slice)
+    }
 }
 
 impl RglRun<'_> {
@@ -944,15 +990,13 @@ impl Brdf for RglBrdf {
             return None;
         }
         let q = self.prepare(wo);
-        let slice = self.prepare_slice(wo);
         let (i, w) = self.prepared_slice(&q);
-        slice.matches(self.owner(), i, w).then(|| {
-            Box::new(RglRun {
-                brdf: self,
-                q,
-                slice,
-            }) as Box<dyn crate::brdf::PreparedRun + '_>
-        })
+        let slice = self.run_slice(wo, i, w)?;
+        Some(Box::new(RglRun {
+            brdf: self,
+            q,
+            slice,
+        }) as Box<dyn crate::brdf::PreparedRun + '_>)
     }
 
     /// True when the file's `ndf` and `sigma` do not depend on the azimuth (checked when read):
@@ -1197,7 +1241,7 @@ mod tests {
                 let rgl = RglRun {
                     brdf: b,
                     q: b.prepare(&wo),
-                    slice: b.prepare_slice(&wo),
+                    slice: Arc::new(b.prepare_slice(&wo)),
                 };
                 let wis: Vec<Vec3> = (0..820)
                     .map(|j| match j % 41 {
@@ -1292,5 +1336,66 @@ mod tests {
             assert!(10 * positive > 9 * compared, "{positive} positive values");
             assert!(on_slice * 20 >= n_wo, "{on_slice} ωo on a slice");
         }
+    }
+
+    /// [`Brdf::prepare_run`]'s per-thread slice ([`RglBrdf::run_slice`]): a run at another `ωo`
+    /// of the same blend bits of the same material takes the thread's last slice (the same
+    /// allocation); another weight of the same slice `i`, or another material at the same `ωo`,
+    /// gets its own; every run's values are `eval`'s bit for bit, in any order of runs.
+    #[test]
+    fn runs_share_the_threads_last_slice_only_at_the_same_material_and_blend() {
+        let b = fixture();
+        let c = fixture();
+        assert_ne!(b.owner(), c.owner());
+        let at = |deg: f64, phi: f64| {
+            let t = deg.to_radians();
+            Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
+        };
+        let blend = |m: &RglBrdf, wo: &Vec3| m.prepared_slice(&m.prepare(wo));
+        let (w1, w2) = (at(30.0, 0.3), at(30.0, 2.1));
+        // Another weight of the same slice `i`: a θo 0.4° away.
+        let w3 = at(30.4, 0.3);
+        let (b1, b3) = (blend(&b, &w1), blend(&b, &w3));
+        assert_eq!(b1, blend(&b, &w2));
+        assert_eq!(b1.0, b3.0, "the test needs one slice i");
+        assert_ne!(b1.1.to_bits(), b3.1.to_bits());
+        let s1 = b.run_slice(&w1, b1.0, b1.1).expect("a slice");
+        let s2 = b.run_slice(&w2, b1.0, b1.1).expect("a slice");
+        assert!(Arc::ptr_eq(&s1, &s2), "the same blend takes the kept slice");
+        let s3 = b.run_slice(&w3, b3.0, b3.1).expect("a slice");
+        assert!(s3.matches(b.owner(), b3.0, b3.1));
+        let s4 = c.run_slice(&w3, b3.0, b3.1).expect("a slice");
+        assert!(!Arc::ptr_eq(&s3, &s4), "another material makes its own");
+        assert!(s4.matches(c.owner(), b3.0, b3.1));
+        // Runs' values in an order that alternates blends and materials.
+        let mut uniform = crate::test_support::splitmix_uniforms(0x51ce_cace);
+        let wis: Vec<Vec3> = (0..400)
+            .map(|_| direction(uniform(), uniform(), false))
+            .collect();
+        let mut positive = 0;
+        for (m, wo) in [
+            (&b, w1),
+            (&b, w3),
+            (&c, w3),
+            (&b, w1),
+            (&c, w2),
+            (&b, w2),
+            (&b, w3),
+        ] {
+            let run = m.prepare_run(&wo).expect("a run above the horizon");
+            let mut block = vec![0.0; wis.len()];
+            run.eval_block(&wis, &mut block);
+            for (wi, v) in wis.iter().zip(&block) {
+                let want = m.eval(&wo, wi);
+                assert_eq!(
+                    run.eval(wi).to_bits(),
+                    want.to_bits(),
+                    "ωo {wo:?} ωi {wi:?}"
+                );
+                assert_eq!(v.to_bits(), want.to_bits(), "block, ωo {wo:?} ωi {wi:?}");
+                positive += usize::from(want > 0.0);
+            }
+        }
+        assert!(positive > 7 * 300, "{positive} positive values");
     }
 }
