@@ -141,6 +141,20 @@ pub(super) fn asin_lane(x: f64) -> (f64, bool) {
     (v, special)
 }
 
+/// [`asin_lane`] for `x < 0.5` (or NaN, flagged): its `small` and below-half ranges only,
+/// the same operations, so the same bits where `x ∈ [0, 0.5)`. A block whose lanes all have
+/// `x < 0.5` (half vectors within 60° of the normal) skips the above-half range's square
+/// root and division.
+#[inline(always)]
+pub(super) fn asin_lane_below_half(x: f64) -> (f64, bool) {
+    let special = !(0.0..1.0).contains(&x);
+    let small = x < high(0x3e50_0000);
+    let r = comp_r(x * x);
+    let below_half = x + x * r;
+    let v = if small { x } else { below_half };
+    (v, special)
+}
+
 /// `atan(t)` for `t ∈ [0, 2^66)`, bit for bit `libm::atan`, branch-free; flagged outside.
 #[inline(always)]
 fn atan_pos(t: f64) -> (f64, bool) {
@@ -221,11 +235,45 @@ fn bilinear(v: [f64; 4], fx: f64, fy: f64) -> f64 {
     (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
 }
 
-/// The four corners of cell `(cx, cy)` of a row-major grid of `nx` columns.
+/// The index `cy·nx + cx` of cell `(cx, cy)` of a row-major grid of `nx` columns, from
+/// [`axis_cell`]'s cells (non-negative integers): computed in `f64`, exact while the grid has
+/// at most 2⁵³ points, so `cy as usize * nx + cx as usize` — one conversion per lane, which
+/// the compiler keeps in vector lanes, instead of two scalar saturating ones in the gathers.
 #[inline(always)]
-fn corners(d: &[f64], nx: usize, cx: f64, cy: f64) -> [f64; 4] {
-    let k = cy as usize * nx + cx as usize;
+fn cell_index(cx: f64, cy: f64, nx: usize) -> usize {
+    (cy * nx as f64 + cx) as usize
+}
+
+/// The four corners of the cell at index `k` (see [`cell_index`]) of a row-major grid of
+/// `nx` columns.
+#[inline(always)]
+fn corners(d: &[f64], nx: usize, k: usize) -> [f64; 4] {
     [d[k], d[k + 1], d[k + nx], d[k + nx + 1]]
+}
+
+/// Pass 1b of [`block`]: `u_m = (√(2θm/π), frac((φm − φo + π)/2π))` from `half = |m − n|/2`
+/// (`θm = 2 asin(half)`, through `asin`, [`asin_lane`] or [`asin_lane_below_half`]) and
+/// `(ay, ax)` (`φm − φo = atan2(ay, ax)`); `special` flags the lanes left to the scalar path.
+#[inline(always)]
+fn angles<A: Fn(f64) -> (f64, bool)>(
+    half: &[f64; LANES],
+    ay: &[f64; LANES],
+    ax: &[f64; LANES],
+    asin: A,
+    u0: &mut [f64; LANES],
+    u1: &mut [f64; LANES],
+    special: &mut [u64; LANES],
+) {
+    for j in 0..LANES {
+        let (a, bad_a) = asin(half[j]);
+        let theta: f64 = 2.0 * a;
+        u0[j] = (theta.max(0.0) / FRAC_PI_2).sqrt();
+        let (rel, bad_r) = atan2_lane(ay[j], ax[j]);
+        let u = (rel + PI) / TAU;
+        let in_range = (0.0..1.0).contains(&u);
+        u1[j] = if in_range { u } else { 0.0 };
+        special[j] = u64::from(bad_a | bad_r | !in_range);
+    }
 }
 
 /// One block of at most [`LANES`] directions (see the module docs).
@@ -242,23 +290,33 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
     for j in 0..n {
         (xs[j], ys[j], zs[j]) = (wi[j].x, wi[j].y, wi[j].z);
     }
+    // Pass 1a: the half vector, `|m − n|/2` (the `asin` argument) and `atan2`'s arguments.
+    let (mut half, mut ay, mut ax) = (z0, z0, z0);
     for j in 0..LANES {
         let s = [wox + xs[j], woy + ys[j], woz + zs[j]];
         let norm = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
         let h = [s[0] / norm, s[1] / norm, s[2] / norm];
-        let y = cos_o * s[1] - sin_o * s[0];
-        let x = cos_o * s[0] + sin_o * s[1];
+        ay[j] = cos_o * s[1] - sin_o * s[0];
+        ax[j] = cos_o * s[0] + sin_o * s[1];
         let dist = (h[0] * h[0] + h[1] * h[1] + (h[2] - 1.0) * (h[2] - 1.0)).sqrt();
-        let (a, bad_a) = asin_lane((0.5 * dist).clamp(-1.0, 1.0));
-        let theta: f64 = 2.0 * a;
-        u0[j] = (theta.max(0.0) / FRAC_PI_2).sqrt();
-        let (rel, bad_r) = atan2_lane(y, x);
-        let u = (rel + PI) / TAU;
-        let in_range = (0.0..1.0).contains(&u);
-        u1[j] = if in_range { u } else { 0.0 };
-        special[j] = u64::from(bad_a | bad_r | !in_range);
+        half[j] = (0.5 * dist).clamp(-1.0, 1.0);
         wz[j] = zs[j];
         norms[j] = norm;
+    }
+    // Pass 1b: the angles; `asin`'s above-half range only when a lane of the block needs it
+    // (the padded lanes' values are not returned).
+    if half[..n].iter().all(|&x| x < 0.5) {
+        angles(
+            &half,
+            &ay,
+            &ax,
+            asin_lane_below_half,
+            &mut u0,
+            &mut u1,
+            &mut special,
+        );
+    } else {
+        angles(&half, &ay, &ax, asin_lane, &mut u0, &mut u1, &mut special);
     }
     let valid = |j: usize| run.valid && wz[j] > 0.0 && norms[j] > 1e-12;
     // msun's special cases, one lane at a time, by the scalar path's functions.
@@ -278,34 +336,39 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
     let (nnx, nny, ndf) = run.ndf.parts();
     let (mut cx, mut cy, mut fx, mut fy) = (z0, z0, z0, z0);
     let (mut ncx, mut ncy, mut nfx, mut nfy) = (z0, z0, z0, z0);
+    let (mut vk, mut vy, mut nk) = ([0usize; LANES], [0usize; LANES], [0usize; LANES]);
     for j in 0..LANES {
         (cx[j], fx[j]) = axis_cell(u0[j], vnx);
         (cy[j], fy[j]) = axis_cell(u1[j], vny);
         (ncx[j], nfx[j]) = axis_cell(u0[j], nnx);
         (ncy[j], nfy[j]) = axis_cell(u1[j], nny);
+        vk[j] = cell_index(cx[j], cy[j], vnx);
+        vy[j] = cy[j] as usize;
+        nk[j] = cell_index(ncx[j], ncy[j], nnx);
     }
     // Gather: the inversion's grid points and rows, ndf's corners.
     let mut v = [[0.0; 4]; LANES];
     let mut along = [[0.0; 2]; LANES];
     let mut row = [[0.0; 3]; LANES];
     let mut nd = [[0.0; 4]; LANES];
+    let jacobian = run.jacobian;
     for j in 0..LANES {
-        let (x, y) = (cx[j] as usize, cy[j] as usize);
-        let k = y * vnx + x;
+        let (k, y) = (vk[j], vy[j]);
         let [v00, a0] = cells[k];
         let [v01, a1] = cells[k + vnx];
         v[j] = [v00, cells[k + 1][0], v01, cells[k + vnx + 1][0]];
         along[j] = [a0, a1];
         let [m0, r0] = rows[y];
         row[j] = [m0, r0, rows[y + 1][1]];
-        if run.jacobian {
-            nd[j] = corners(ndf, nnx, ncx[j], ncy[j]);
+        if jacobian {
+            nd[j] = corners(ndf, nnx, nk[j]);
         }
     }
     // Pass 3: the inversion, D/(4σ), the cell of s on the luminance slice.
     let (lnx, lny, lum) = run.lum.parts();
     let mut factor = z0;
     let (mut lcx, mut lcy, mut lfx, mut lfy) = (z0, z0, z0, z0);
+    let mut lk = [0usize; LANES];
     for j in 0..LANES {
         let (fx, fy) = (fx[j], fy[j]);
         let [v00, v10, v01, v11] = v[j];
@@ -324,11 +387,12 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
         };
         (lcx[j], lfx[j]) = axis_cell(ux, lnx);
         (lcy[j], lfy[j]) = axis_cell(uy, lny);
+        lk[j] = cell_index(lcx[j], lcy[j], lnx);
     }
     // Gather: the luminance corners; pass 4: the value.
     let mut lc = [[0.0; 4]; LANES];
     for j in 0..LANES {
-        lc[j] = corners(lum, lnx, lcx[j], lcy[j]);
+        lc[j] = corners(lum, lnx, lk[j]);
     }
     let mut f = z0;
     for j in 0..LANES {
