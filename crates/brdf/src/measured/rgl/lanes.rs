@@ -141,20 +141,6 @@ pub(super) fn asin_lane(x: f64) -> (f64, bool) {
     (v, special)
 }
 
-/// [`asin_lane`] for `x < 0.5` (or NaN, flagged): its `small` and below-half ranges only,
-/// the same operations, so the same bits where `x ∈ [0, 0.5)`. A block whose lanes all have
-/// `x < 0.5` (half vectors within 60° of the normal) skips the above-half range's square
-/// root and division.
-#[inline(always)]
-pub(super) fn asin_lane_below_half(x: f64) -> (f64, bool) {
-    let special = !(0.0..1.0).contains(&x);
-    let small = x < high(0x3e50_0000);
-    let r = comp_r(x * x);
-    let below_half = x + x * r;
-    let v = if small { x } else { below_half };
-    (v, special)
-}
-
 /// `atan(t)` for `t ∈ [0, 2^66)`, bit for bit `libm::atan`, branch-free; flagged outside.
 #[inline(always)]
 fn atan_pos(t: f64) -> (f64, bool) {
@@ -253,31 +239,6 @@ fn corners(d: &[f64], nx: usize, k: usize) -> [f64; 4] {
     [w[0], w[1], w[nx], w[nx + 1]]
 }
 
-/// Pass 1b of [`block`]: `u_m = (√(2θm/π), frac((φm − φo + π)/2π))` from `half = |m − n|/2`
-/// (`θm = 2 asin(half)`, through `asin`, [`asin_lane`] or [`asin_lane_below_half`]) and
-/// `(ay, ax)` (`φm − φo = atan2(ay, ax)`); `special` flags the lanes left to the scalar path.
-#[inline(always)]
-fn angles<A: Fn(f64) -> (f64, bool)>(
-    half: &[f64; LANES],
-    ay: &[f64; LANES],
-    ax: &[f64; LANES],
-    asin: A,
-    u0: &mut [f64; LANES],
-    u1: &mut [f64; LANES],
-    special: &mut [u64; LANES],
-) {
-    for j in 0..LANES {
-        let (a, bad_a) = asin(half[j]);
-        let theta: f64 = 2.0 * a;
-        u0[j] = (theta.max(0.0) / FRAC_PI_2).sqrt();
-        let (rel, bad_r) = atan2_lane(ay[j], ax[j]);
-        let u = (rel + PI) / TAU;
-        let in_range = (0.0..1.0).contains(&u);
-        u1[j] = if in_range { u } else { 0.0 };
-        special[j] = u64::from(bad_a | bad_r | !in_range);
-    }
-}
-
 /// One block of at most [`LANES`] directions (see the module docs).
 #[inline(always)]
 fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
@@ -292,33 +253,23 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
     for j in 0..n {
         (xs[j], ys[j], zs[j]) = (wi[j].x, wi[j].y, wi[j].z);
     }
-    // Pass 1a: the half vector, `|m − n|/2` (the `asin` argument) and `atan2`'s arguments.
-    let (mut half, mut ay, mut ax) = (z0, z0, z0);
     for j in 0..LANES {
         let s = [wox + xs[j], woy + ys[j], woz + zs[j]];
         let norm = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
         let h = [s[0] / norm, s[1] / norm, s[2] / norm];
-        ay[j] = cos_o * s[1] - sin_o * s[0];
-        ax[j] = cos_o * s[0] + sin_o * s[1];
+        let y = cos_o * s[1] - sin_o * s[0];
+        let x = cos_o * s[0] + sin_o * s[1];
         let dist = (h[0] * h[0] + h[1] * h[1] + (h[2] - 1.0) * (h[2] - 1.0)).sqrt();
-        half[j] = (0.5 * dist).clamp(-1.0, 1.0);
+        let (a, bad_a) = asin_lane((0.5 * dist).clamp(-1.0, 1.0));
+        let theta: f64 = 2.0 * a;
+        u0[j] = (theta.max(0.0) / FRAC_PI_2).sqrt();
+        let (rel, bad_r) = atan2_lane(y, x);
+        let u = (rel + PI) / TAU;
+        let in_range = (0.0..1.0).contains(&u);
+        u1[j] = if in_range { u } else { 0.0 };
+        special[j] = u64::from(bad_a | bad_r | !in_range);
         wz[j] = zs[j];
         norms[j] = norm;
-    }
-    // Pass 1b: the angles; `asin`'s above-half range only when a lane of the block needs it
-    // (the padded lanes' values are not returned).
-    if half[..n].iter().all(|&x| x < 0.5) {
-        angles(
-            &half,
-            &ay,
-            &ax,
-            asin_lane_below_half,
-            &mut u0,
-            &mut u1,
-            &mut special,
-        );
-    } else {
-        angles(&half, &ay, &ax, asin_lane, &mut u0, &mut u1, &mut special);
     }
     let valid = |j: usize| run.valid && wz[j] > 0.0 && norms[j] > 1e-12;
     // msun's special cases, one lane at a time, by the scalar path's functions.
