@@ -221,22 +221,11 @@ fn bilinear(v: [f64; 4], fx: f64, fy: f64) -> f64 {
     (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
 }
 
-/// The index `cy·nx + cx` of cell `(cx, cy)` of a row-major grid of `nx` columns, from
-/// [`axis_cell`]'s cells (non-negative integers): computed in `f64`, exact while the grid has
-/// at most 2⁵³ points, so `cy as usize * nx + cx as usize` — one conversion per lane, which
-/// the compiler keeps in vector lanes, instead of two scalar saturating ones in the gathers.
+/// The four corners of cell `(cx, cy)` of a row-major grid of `nx` columns.
 #[inline(always)]
-fn cell_index(cx: f64, cy: f64, nx: usize) -> usize {
-    (cy * nx as f64 + cx) as usize
-}
-
-/// The four corners of the cell at index `k` (see [`cell_index`]) of a row-major grid of
-/// `nx` columns.
-#[inline(always)]
-fn corners(d: &[f64], nx: usize, k: usize) -> [f64; 4] {
-    // One slice over both rows: two bounds checks instead of four.
-    let w = &d[k..][..nx + 2];
-    [w[0], w[1], w[nx], w[nx + 1]]
+fn corners(d: &[f64], nx: usize, cx: f64, cy: f64) -> [f64; 4] {
+    let k = cy as usize * nx + cx as usize;
+    [d[k], d[k + 1], d[k + nx], d[k + nx + 1]]
 }
 
 /// One block of at most [`LANES`] directions (see the module docs).
@@ -289,41 +278,34 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
     let (nnx, nny, ndf) = run.ndf.parts();
     let (mut cx, mut cy, mut fx, mut fy) = (z0, z0, z0, z0);
     let (mut ncx, mut ncy, mut nfx, mut nfy) = (z0, z0, z0, z0);
-    let (mut vk, mut vy, mut nk) = ([0usize; LANES], [0usize; LANES], [0usize; LANES]);
     for j in 0..LANES {
         (cx[j], fx[j]) = axis_cell(u0[j], vnx);
         (cy[j], fy[j]) = axis_cell(u1[j], vny);
         (ncx[j], nfx[j]) = axis_cell(u0[j], nnx);
         (ncy[j], nfy[j]) = axis_cell(u1[j], nny);
-        vk[j] = cell_index(cx[j], cy[j], vnx);
-        vy[j] = cy[j] as usize;
-        nk[j] = cell_index(ncx[j], ncy[j], nnx);
     }
     // Gather: the inversion's grid points and rows, ndf's corners.
     let mut v = [[0.0; 4]; LANES];
     let mut along = [[0.0; 2]; LANES];
     let mut row = [[0.0; 3]; LANES];
     let mut nd = [[0.0; 4]; LANES];
-    let jacobian = run.jacobian;
     for j in 0..LANES {
-        let (k, y) = (vk[j], vy[j]);
-        // One slice over both rows: two bounds checks instead of four.
-        let w = &cells[k..][..vnx + 2];
-        let [v00, a0] = w[0];
-        let [v01, a1] = w[vnx];
-        v[j] = [v00, w[1][0], v01, w[vnx + 1][0]];
+        let (x, y) = (cx[j] as usize, cy[j] as usize);
+        let k = y * vnx + x;
+        let [v00, a0] = cells[k];
+        let [v01, a1] = cells[k + vnx];
+        v[j] = [v00, cells[k + 1][0], v01, cells[k + vnx + 1][0]];
         along[j] = [a0, a1];
         let [m0, r0] = rows[y];
         row[j] = [m0, r0, rows[y + 1][1]];
-        if jacobian {
-            nd[j] = corners(ndf, nnx, nk[j]);
+        if run.jacobian {
+            nd[j] = corners(ndf, nnx, ncx[j], ncy[j]);
         }
     }
     // Pass 3: the inversion, D/(4σ), the cell of s on the luminance slice.
     let (lnx, lny, lum) = run.lum.parts();
     let mut factor = z0;
     let (mut lcx, mut lcy, mut lfx, mut lfy) = (z0, z0, z0, z0);
-    let mut lk = [0usize; LANES];
     for j in 0..LANES {
         let (fx, fy) = (fx[j], fy[j]);
         let [v00, v10, v01, v11] = v[j];
@@ -342,12 +324,11 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
         };
         (lcx[j], lfx[j]) = axis_cell(ux, lnx);
         (lcy[j], lfy[j]) = axis_cell(uy, lny);
-        lk[j] = cell_index(lcx[j], lcy[j], lnx);
     }
     // Gather: the luminance corners; pass 4: the value.
     let mut lc = [[0.0; 4]; LANES];
     for j in 0..LANES {
-        lc[j] = corners(lum, lnx, lk[j]);
+        lc[j] = corners(lum, lnx, lcx[j], lcy[j]);
     }
     let mut f = z0;
     for j in 0..LANES {
