@@ -1092,6 +1092,17 @@ pub(super) mod tests {
         blocks: bool,
     }
 
+    impl WithRun {
+        /// Phong (`n = 50`) with a fresh run counter; `blocks` as the field.
+        fn phong(blocks: bool) -> Self {
+            Self {
+                inner: Arc::from(parse_spec("phong:n=50").unwrap()),
+                run_evals: AtomicU64::new(0),
+                blocks,
+            }
+        }
+    }
+
     /// `n` outgoing directions from `qr`: uniform in θo ∈ [0°, 89°) and φo, except every 97th
     /// grazing (89.995°) and the next below the horizon (95°).
     fn mixed_wos(qr: &mut Xoshiro256PlusPlus, n: usize) -> Vec<Vec3> {
@@ -1123,11 +1134,7 @@ pub(super) mod tests {
     /// the two cases of the run tests: that Phong with the default options, [`small_ward`].
     #[allow(clippy::type_complexity)]
     fn phong_and_small_ward(blocks: bool) -> (Arc<WithRun>, [(Arc<dyn Brdf>, ExactOptions); 2]) {
-        let phong = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks,
-        });
+        let phong = Arc::new(WithRun::phong(blocks));
         let (ward, small) = small_ward();
         let cases: [(Arc<dyn Brdf>, ExactOptions); 2] =
             [(phong.clone(), ExactOptions::default()), (ward, small)];
@@ -1682,11 +1689,7 @@ pub(super) mod tests {
     fn wavefront_keeps_its_arrays_only_up_to_a_size_and_they_change_nothing() {
         use super::{WAVE_ARRAYS, WAVE_KEEP_MAX, wavefront};
         use partition_sampler::Audit;
-        let phong: Arc<dyn Brdf> = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: true,
-        });
+        let phong: Arc<dyn Brdf> = Arc::new(WithRun::phong(true));
         let set = ExactSet::build(Arc::clone(&phong), &ExactOptions::default(), None).unwrap();
         let wo = brdf::direction_from_angles(35.0, 0.0);
         let q = set.locate_iso(&wo).expect("the isotropic path");
@@ -1731,11 +1734,7 @@ pub(super) mod tests {
     fn wavefront_draws_depend_on_the_seed_and_index_only_with_the_exact_law() {
         use super::{PREPARED_RUN_MIN, wavefront};
         use partition_sampler::Audit;
-        let phong = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: true,
-        });
+        let phong = Arc::new(WithRun::phong(true));
         let brdf: Arc<dyn Brdf> = phong.clone();
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
         // The wavefront itself, block sizes apart.
@@ -1819,11 +1818,7 @@ pub(super) mod tests {
                 self.0.eval(wi) * (1.0 - self.1 + 2.0 * self.1 * wi.z)
             }
         }
-        let brdf: Arc<dyn Brdf> = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: true,
-        });
+        let brdf: Arc<dyn Brdf> = Arc::new(WithRun::phong(true));
         let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
         let bins = stats::SphereBinning::hemisphere(16, 32).unwrap();
         let quad = stats::QuadratureOptions {
@@ -1908,11 +1903,7 @@ pub(super) mod tests {
     fn wavefront_samples_are_draws_from_their_own_streams() {
         use super::{Stream, run_density, wave_seed, wavefront};
         use partition_sampler::Audit;
-        let phong: Arc<dyn Brdf> = Arc::new(WithRun {
-            inner: Arc::from(parse_spec("phong:n=50").unwrap()),
-            run_evals: AtomicU64::new(0),
-            blocks: true,
-        });
+        let phong: Arc<dyn Brdf> = Arc::new(WithRun::phong(true));
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../data/measured/rgl/paper_white_rgb.bsdf");
         let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
