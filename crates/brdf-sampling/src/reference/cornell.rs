@@ -271,35 +271,49 @@ impl Ord for GmCell {
     }
 }
 
-/// The Genz–Malik pair and split axis of `g` over `[t0, t1] × [y0, y1]`.
-fn gm_cell(g: &impl Fn(f64, f64) -> f64, t0: f64, t1: f64, y0: f64, y1: f64, seq: u64) -> GmCell {
+/// The Genz–Malik pair and split axis of `g` over `[t0, t1] × [y0, y1]`; `g` takes
+/// `(sin θi, cos θi)` and `y` (the 17 points have 7 distinct `θi`: one `sin_cos` each).
+fn gm_cell(
+    g: &impl Fn((f64, f64), f64) -> f64,
+    t0: f64,
+    t1: f64,
+    y0: f64,
+    y1: f64,
+    seq: u64,
+) -> GmCell {
     let r = SCRATCH_RULE.with(|r| r.get());
     if r != 7 {
-        return low_cell(g, t0, t1, y0, y1, seq, r);
+        let g1 = |t: f64, y: f64| g(t.sin_cos(), y);
+        return low_cell(&g1, t0, t1, y0, y1, seq, r);
     }
     use genz_malik::*;
-    let (ct, cy, ht, hy) = (0.5 * (t0 + t1), 0.5 * (y0 + y1), 0.5 * (t1 - t0), 0.5 * (y1 - y0));
-    let c = g(ct, cy);
+    let (ct, cy, ht, hy) = (
+        0.5 * (t0 + t1),
+        0.5 * (y0 + y1),
+        0.5 * (t1 - t0),
+        0.5 * (y1 - y0),
+    );
+    let c0 = ct.sin_cos();
+    let (p2, m2) = ((ct + L2 * ht).sin_cos(), (ct - L2 * ht).sin_cos());
+    let (p3, m3) = ((ct + L3 * ht).sin_cos(), (ct - L3 * ht).sin_cos());
+    let (p5, m5) = ((ct + L5 * ht).sin_cos(), (ct - L5 * ht).sin_cos());
+    // L4 = L3: the λ₄ points share the λ₃ abscissae.
+    let (p4, m4) = (p3, m3);
+    let c = g(c0, cy);
     let (t2p, t2m, y2p, y2m) = (
-        g(ct + L2 * ht, cy),
-        g(ct - L2 * ht, cy),
-        g(ct, cy + L2 * hy),
-        g(ct, cy - L2 * hy),
+        g(p2, cy),
+        g(m2, cy),
+        g(c0, cy + L2 * hy),
+        g(c0, cy - L2 * hy),
     );
     let (t3p, t3m, y3p, y3m) = (
-        g(ct + L3 * ht, cy),
-        g(ct - L3 * ht, cy),
-        g(ct, cy + L3 * hy),
-        g(ct, cy - L3 * hy),
+        g(p3, cy),
+        g(m3, cy),
+        g(c0, cy + L3 * hy),
+        g(c0, cy - L3 * hy),
     );
-    let s4 = g(ct + L4 * ht, cy + L4 * hy)
-        + g(ct + L4 * ht, cy - L4 * hy)
-        + g(ct - L4 * ht, cy + L4 * hy)
-        + g(ct - L4 * ht, cy - L4 * hy);
-    let s5 = g(ct + L5 * ht, cy + L5 * hy)
-        + g(ct + L5 * ht, cy - L5 * hy)
-        + g(ct - L5 * ht, cy + L5 * hy)
-        + g(ct - L5 * ht, cy - L5 * hy);
+    let s4 = g(p4, cy + L4 * hy) + g(p4, cy - L4 * hy) + g(m4, cy + L4 * hy) + g(m4, cy - L4 * hy);
+    let s5 = g(p5, cy + L5 * hy) + g(p5, cy - L5 * hy) + g(m5, cy + L5 * hy) + g(m5, cy - L5 * hy);
     let (s2, s3) = (t2p + t2m + y2p + y2m, t3p + t3m + y3p + y3m);
     let area = (t1 - t0) * (y1 - y0);
     let i7 = area * (W7[0] * c + W7[1] * s2 + W7[2] * s3 + W7[3] * s4 + W7[4] * s5);
@@ -335,9 +349,22 @@ pub(crate) fn scratch_points() -> u64 {
 }
 
 /// scratch: lower-degree fully symmetric pairs on Genz–Malik's points.
-fn low_cell(g: &impl Fn(f64, f64) -> f64, t0: f64, t1: f64, y0: f64, y1: f64, seq: u64, r: u8) -> GmCell {
+fn low_cell(
+    g: &impl Fn(f64, f64) -> f64,
+    t0: f64,
+    t1: f64,
+    y0: f64,
+    y1: f64,
+    seq: u64,
+    r: u8,
+) -> GmCell {
     use genz_malik::*;
-    let (ct, cy, ht, hy) = (0.5 * (t0 + t1), 0.5 * (y0 + y1), 0.5 * (t1 - t0), 0.5 * (y1 - y0));
+    let (ct, cy, ht, hy) = (
+        0.5 * (t0 + t1),
+        0.5 * (y0 + y1),
+        0.5 * (t1 - t0),
+        0.5 * (y1 - y0),
+    );
     let area = (t1 - t0) * (y1 - y0);
     let c = g(ct, cy);
     let (t3p, t3m, y3p, y3m) = (
@@ -352,7 +379,16 @@ fn low_cell(g: &impl Fn(f64, f64) -> f64, t0: f64, t1: f64, y0: f64, y1: f64, se
     if r == 3 {
         let dt = (t3p + t3m - 2.0 * c).abs();
         let dy = (y3p + y3m - 2.0 * c).abs();
-        return GmCell { t0, t1, y0, y1, value: i3, err: (i3 - area * c).abs(), axis: u8::from(dy > dt), seq };
+        return GmCell {
+            t0,
+            t1,
+            y0,
+            y1,
+            value: i3,
+            err: (i3 - area * c).abs(),
+            axis: u8::from(dy > dt),
+            seq,
+        };
     }
     let (t2p, t2m, y2p, y2m) = (
         g(ct + L2 * ht, cy),
@@ -368,7 +404,16 @@ fn low_cell(g: &impl Fn(f64, f64) -> f64, t0: f64, t1: f64, y0: f64, y1: f64, se
     let i5 = area * (W5[0] * c + W5[1] * s2 + W5[2] * s3 + W5[3] * s4);
     let dt = ((t2p + t2m - 2.0 * c) - RATIO * (t3p + t3m - 2.0 * c)).abs();
     let dy = ((y2p + y2m - 2.0 * c) - RATIO * (y3p + y3m - 2.0 * c)).abs();
-    GmCell { t0, t1, y0, y1, value: i5, err: (i5 - i3).abs(), axis: u8::from(dy > dt), seq }
+    GmCell {
+        t0,
+        t1,
+        y0,
+        y1,
+        value: i5,
+        err: (i5 - i3).abs(),
+        axis: u8::from(dy > dt),
+        seq,
+    }
 }
 
 /// The initial cells of [`cornell_node_remapped`]: `θi` and `y` cut into this many equal parts.
@@ -414,8 +459,7 @@ pub(crate) fn cornell_node_remapped_with(
     let not_finite = || ReferenceError::NotFinite(brdf.name().to_string());
     let q = brdf.quadrature_eval();
     let (so, co) = theta_o.sin_cos();
-    let g = |t: f64, y: f64| {
-        let (si, ci) = t.sin_cos();
+    let g = |(si, ci): (f64, f64), y: f64| {
         let p = [(si * so).clamp(0.0, 1.0), y, (ci * co).clamp(0.0, 1.0)];
         TAU * si * ci * q.eval_remapped(p)
     };
@@ -428,7 +472,11 @@ pub(crate) fn cornell_node_remapped_with(
         }
     };
     let ys: Vec<f64> = SCRATCH_Y.with(|e| e.borrow().clone());
-    let ys = if ys.is_empty() { (0..=ny).map(|j| edge(j, ny, 1.0)).collect() } else { ys };
+    let ys = if ys.is_empty() {
+        (0..=ny).map(|j| edge(j, ny, 1.0)).collect()
+    } else {
+        ys
+    };
     let ny = ys.len() - 1;
     let edge_y = |j: usize| ys[j];
     let mut heap = std::collections::BinaryHeap::with_capacity((budget / GM_POINTS) as usize + 1);
@@ -493,13 +541,23 @@ pub(crate) fn cornell_node_remapped_with(
         let tot: f64 = cells.iter().map(|c| c.err).sum();
         for (k, v) in by {
             if v.1 > 0.01 * tot {
-                eprintln!("   level θ {} y {}: {} cells, {:.1} % of the error", k.0, k.1, v.0, 100.0 * v.1 / tot);
+                eprintln!(
+                    "   level θ {} y {}: {} cells, {:.1} % of the error",
+                    k.0,
+                    k.1,
+                    v.0,
+                    100.0 * v.1 / tot
+                );
             }
         }
         let mut errs: Vec<f64> = cells.iter().map(|c| c.err).collect();
         errs.sort_by(|a, b| b.total_cmp(a));
         let top: f64 = errs.iter().take(errs.len() / 10).sum();
-        eprintln!("   {} cells; top 10 % hold {:.1} % of the error", cells.len(), 100.0 * top / tot);
+        eprintln!(
+            "   {} cells; top 10 % hold {:.1} % of the error",
+            cells.len(),
+            100.0 * top / tot
+        );
         // error by θ band (16) and y band (16)
         let mut tb = [0.0; 16];
         let mut yb = [0.0; 16];
@@ -635,7 +693,9 @@ mod tests {
         let (so, co) = theta_o.sin_cos();
         let g = |t: f64, y: f64| {
             let (si, ci) = t.sin_cos();
-            TAU * si * ci * q.eval_remapped([(si * so).clamp(0.0, 1.0), y, (ci * co).clamp(0.0, 1.0)])
+            TAU * si
+                * ci
+                * q.eval_remapped([(si * so).clamp(0.0, 1.0), y, (ci * co).clamp(0.0, 1.0)])
         };
         let per = budget / shifts as u64;
         let (mut f0, mut f1) = (1u64, 2u64);
@@ -693,7 +753,9 @@ mod tests {
         };
         let angles = list("NODE_ANGLES", "2.8,30.5,62.4,89.5");
         let budgets = list("BUDGETS", "10000,20000,40000,80000,150000");
-        let judge_tol: f64 = env("JUDGE_TOL").and_then(|s| s.parse().ok()).unwrap_or(2e-6);
+        let judge_tol: f64 = env("JUDGE_TOL")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(2e-6);
         let disc = env("DISC").is_none_or(|s| s != "0");
         let initial: Vec<(usize, usize)> = env("INITIAL")
             .unwrap_or("4x4".into())
@@ -712,14 +774,22 @@ mod tests {
                 let mut ys: Vec<f64> = text
                     .lines()
                     .filter_map(|l| {
-                        let v: Vec<f64> = l.split_whitespace().filter_map(|t| t.parse().ok()).collect();
-                        (v.len() > 10).then(|| brdf::measured::cornell::remap(v[0], v[1], v[2], v[3])[1])
+                        let v: Vec<f64> = l
+                            .split_whitespace()
+                            .filter_map(|t| t.parse().ok())
+                            .collect();
+                        (v.len() > 10)
+                            .then(|| brdf::measured::cornell::remap(v[0], v[1], v[2], v[3])[1])
                     })
                     .collect();
                 ys.sort_by(f64::total_cmp);
                 ys.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
                 let mut edges = vec![0.0];
-                edges.extend(ys.windows(2).map(|w| 0.5 * (w[0] + w[1])).filter(|&m| m > 0.0 && m < 1.0));
+                edges.extend(
+                    ys.windows(2)
+                        .map(|w| 0.5 * (w[0] + w[1]))
+                        .filter(|&m| m > 0.0 && m < 1.0),
+                );
                 edges.push(1.0);
                 eprintln!("{name}: {} y edges", edges.len());
                 SCRATCH_Y.with(|e| *e.borrow_mut() = edges);
@@ -746,18 +816,22 @@ mod tests {
                         );
                     }
                     for &ini in &initial {
-                      for rule in env("RULES").unwrap_or("7".into()).split(',').filter_map(|s| s.parse::<u8>().ok()) {
-                        SCRATCH_RULE.with(|r| r.set(rule));
-                        let a = cornell_node_remapped_with(&b, th, n, 0.0, ini).unwrap();
-                        line += &format!(
-                            " r{rule} gm{}x{} decl {:.2e} act {:+.2e} ({} ev);",
-                            ini.0,
-                            ini.1,
-                            a.abs_err / a.value,
-                            a.value / j.value - 1.0,
-                            a.evaluations
-                        );
-                      }
+                        for rule in env("RULES")
+                            .unwrap_or("7".into())
+                            .split(',')
+                            .filter_map(|s| s.parse::<u8>().ok())
+                        {
+                            SCRATCH_RULE.with(|r| r.set(rule));
+                            let a = cornell_node_remapped_with(&b, th, n, 0.0, ini).unwrap();
+                            line += &format!(
+                                " r{rule} gm{}x{} decl {:.2e} act {:+.2e} ({} ev);",
+                                ini.0,
+                                ini.1,
+                                a.abs_err / a.value,
+                                a.value / j.value - 1.0,
+                                a.evaluations
+                            );
+                        }
                     }
                     if let Some(m) = env("LATTICE").and_then(|s| s.parse::<usize>().ok()) {
                         let (v, se, ev) = lattice_node(&b, th, n, m);
@@ -780,9 +854,7 @@ mod tests {
     #[test]
     #[ignore = "a cachegrind probe"]
     fn cornell_remapped_node_cost_probe() {
-        node_cost_probe(|b, wo, budget| {
-            cornell_node_remapped(b, wo.z.acos(), budget, 0.0)
-        });
+        node_cost_probe(|b, wo, budget| cornell_node_remapped(b, wo.z.acos(), budget, 0.0));
     }
 
     /// The node rule against the reference rule over the disc, for the record
