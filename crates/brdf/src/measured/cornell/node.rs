@@ -118,31 +118,6 @@ impl QuadratureEval<'_> {
     }
 }
 
-impl QuadratureEval<'_> {
-    /// The luminance interpolant at a point `p = (x, y, z)` of the remapped cube given directly
-    /// (`x = sin θi sin θo`, `y = Δφ/π`, `z = cos θi cos θo`; docs/benchmarks.md §30.2): for
-    /// [`Interpolation::Knn`] the lanes blend of [`QuadratureEval::eval`] at `p` — the same
-    /// value bit for bit as `eval(ωo, ωi)` when `p` is the point `eval` computes from the pair —
-    /// so within [`QUADRATURE_REL_BOUND`] relative of [`CornellBrdf::luminance_at`]`(p)`; where
-    /// the lanes path declines (a cell of fewer than `K` candidates, every blended sample as far
-    /// as the cut one, `p` off the grid) and for other interpolations, `luminance_at(p)` itself.
-    /// No trigonometry: rules that integrate in the remapped coordinates call this.
-    #[inline]
-    pub fn eval_remapped(&self, p: [f64; 3]) -> f64 {
-        if self.brdf.interp != Interpolation::Knn {
-            return self.brdf.luminance_at(&p);
-        }
-        let data = &*self.brdf.data;
-        self.arch
-            .dispatch(Blend {
-                tree: &data.tree,
-                lum: &data.lum,
-                p,
-            })
-            .unwrap_or_else(|| self.brdf.luminance_at(&p))
-    }
-}
-
 /// One point's blend as a `pulp` operation.
 struct Blend<'a> {
     tree: &'a search::Tree,
