@@ -5,7 +5,7 @@
 use std::sync::{Arc, Mutex};
 
 use brdf::measured::rgl::PreparedSlice;
-use brdf::{Brdf, CornellBrdf, Outgoing, RglBrdf, Vec3, rotate_z};
+use brdf::{Brdf, Outgoing, RglBrdf, Vec3, rotate_z};
 use partition_sampler::{Density, Point2};
 use rustc_hash::FxHashMap;
 
@@ -363,18 +363,11 @@ impl EnvelopeNode {
                     *v = rgl.eval_in_slice(slice, &self.wo, w);
                 }
             }
-            _ => match cornell_itself(brdf) {
-                // `eval`'s values bit for bit (`eval_prepared` is `eval` for this format), the
-                // nearest samples found in vector lanes.
-                Some(cornell) => {
-                    cornell.eval_block_at(self.wo.wo(), &turned[..m], &mut fresh[..m]);
+            _ => {
+                for (v, w) in fresh[..m].iter_mut().zip(&turned[..m]) {
+                    *v = brdf.eval_prepared(&self.wo, w);
                 }
-                None => {
-                    for (v, w) in fresh[..m].iter_mut().zip(&turned[..m]) {
-                        *v = brdf.eval_prepared(&self.wo, w);
-                    }
-                }
-            },
+            }
         }
         for (&k, &v) in slot[..m].iter().zip(&fresh[..m]) {
             out[k] = v;
@@ -510,14 +503,6 @@ pub(crate) fn rgl_itself(brdf: &Arc<dyn Brdf>) -> Option<RglBrdf> {
     let rgl = brdf.as_any()?.downcast_ref::<RglBrdf>()?;
     let same = std::ptr::addr_eq(Arc::as_ptr(brdf), rgl as *const RglBrdf);
     same.then(|| rgl.clone())
-}
-
-/// The Cornell material `brdf` is, when it is one itself (not a wrapper that forwards `as_any`,
-/// such as [`brdf::CountingBrdf`], whose evaluations must go through it to be counted): its
-/// bound nodes then evaluate their blocks by [`CornellBrdf::eval_block_at`], `eval` bit for bit.
-fn cornell_itself(brdf: &dyn Brdf) -> Option<&CornellBrdf> {
-    let cornell = brdf.as_any()?.downcast_ref::<CornellBrdf>()?;
-    std::ptr::addr_eq(brdf as *const dyn Brdf, cornell as *const CornellBrdf).then_some(cornell)
 }
 
 impl Brdf for IntervalEnvelope {

@@ -128,7 +128,6 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
-mod block;
 mod grid;
 mod line;
 mod node;
@@ -479,14 +478,6 @@ impl Brdf for CornellBrdf {
         self.rgb_at(&remap_dirs(wo, wi))
     }
 
-    /// With the kNN interpolant and `ωo` above the horizon: a run whose block evaluation finds
-    /// the nearest samples in vector lanes, `eval`'s values bit for bit (`cornell/block.rs`);
-    /// `None` otherwise.
-    fn prepare_run(&self, wo: &Vec3) -> Option<Box<dyn crate::brdf::PreparedRun + '_>> {
-        block::CornellRun::new(self, wo)
-            .map(|run| Box::new(run) as Box<dyn crate::brdf::PreparedRun + '_>)
-    }
-
     fn is_isotropic(&self) -> bool {
         true
     }
@@ -617,12 +608,12 @@ mod tests {
     }
 
     /// A file of 567 samples of a glossy lobe on a regular grid (many equidistant samples).
-    pub(super) fn synthetic() -> String {
+    fn synthetic() -> String {
         super::lobe_grid_text(|f| [0.7 * f, f, 0.2 + f])
     }
 
     /// The team's Cornell files when the data repository sits beside this one.
-    pub(super) fn shared_files() -> Vec<(String, String)> {
+    fn shared_files() -> Vec<(String, String)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../../shared/data/measured/cornell");
         let mut out = Vec::new();
