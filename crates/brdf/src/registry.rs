@@ -460,7 +460,7 @@ static MODELS: &[ModelInfo] = &[
     ModelInfo::argument(
         "cornell",
         Build::File,
-        "measured spectral material of Cornell PCG, spec `cornell:PATH[,interp=knn|grid]` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space; `interp=grid` tabulates it on a 64³ grid)",
+        "measured spectral material of Cornell PCG, spec `cornell:PATH[,interp=grid|knn]` (pbrt-v2 `.brdf` samples, CIE 1931 to RGB, k-nearest-neighbour interpolation in a reciprocal remapped space tabulated on a 64³ grid, trilinear between vertices (exact albedo); `interp=knn` evaluates the kNN interpolant at every query)",
     ),
     ModelInfo::argument(
         "sgd",
@@ -587,7 +587,7 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Brdf>, SpecError> {
     }
     if name.eq_ignore_ascii_case("cornell") {
         let path = file_path(rest, SpecError::MissingFile { model: "cornell" })?;
-        // `cornell:PATH,interp=knn|grid` (the kNN interpolant by default).
+        // `cornell:PATH,interp=grid|knn` (the tabulated interpolant by default).
         let (path, interp) = match path.rsplit_once(",interp=") {
             Some((p, "knn")) => (p, Some(Interpolation::Knn)),
             Some((p, "grid")) => (p, Some(Interpolation::Grid)),

@@ -229,6 +229,7 @@ pub(crate) fn node_cost_probe(
         eprintln!("skipped: {} is not readable", path.display());
         return;
     };
+    let b = b.with_interpolation(brdf::measured::cornell::Interpolation::Knn);
     let theta: f64 = env("NODE_THETA")
         .and_then(|s| s.parse().ok())
         .unwrap_or(30.5);
@@ -287,12 +288,13 @@ mod tests {
         }
     }
 
-    /// The team's Cornell file `name` when the data repository sits beside this one.
+    /// The team's Cornell file `name` (its kNN interpolant) when the data repository sits
+    /// beside this one.
     fn shared(name: &str) -> Option<CornellBrdf> {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("../../../shared/data/measured/cornell/{name}.brdf"));
         match CornellBrdf::load(&path) {
-            Ok(b) => Some(b),
+            Ok(b) => Some(b.with_interpolation(brdf::measured::cornell::Interpolation::Knn)),
             Err(e) => {
                 eprintln!("skipped {name}: {e}");
                 None

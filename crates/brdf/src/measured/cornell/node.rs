@@ -311,16 +311,21 @@ mod tests {
 
     /// The team's Cornell files when the data repository sits beside this one, and the
     /// synthetic grid file (many equidistant samples).
+    /// The kNN materials the evaluator serves (the default interpolation is the grid).
     fn files() -> Vec<(String, CornellBrdf)> {
+        let knn = |b: CornellBrdf| b.with_interpolation(Interpolation::Knn);
         let mut out = vec![(
             "synthetic".to_string(),
-            CornellBrdf::parse(&super::super::lobe_grid_text(|f| [0.7 * f, f, 0.2 + f])).unwrap(),
+            knn(
+                CornellBrdf::parse(&super::super::lobe_grid_text(|f| [0.7 * f, f, 0.2 + f]))
+                    .unwrap(),
+            ),
         )];
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../../shared/data/measured/cornell");
         for name in ["acryl_blue", "cayman", "krylon_blue"] {
             match CornellBrdf::load(&dir.join(format!("{name}.brdf"))) {
-                Ok(b) => out.push((name.to_string(), b)),
+                Ok(b) => out.push((name.to_string(), knn(b))),
                 Err(_) => eprintln!("skipped {name}: {} is absent", dir.display()),
             }
         }
