@@ -128,6 +128,8 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
+#[cfg(test)]
+mod fidelity;
 mod grid;
 mod line;
 mod node;
