@@ -345,6 +345,57 @@ fn knn_albedo(b: &CornellBrdf, theta_o: f64, rel_tol: f64) -> (f64, f64) {
     }
 }
 
+/// [`CornellBrdf::grid_albedo`]'s exact sum for a regular `n³` grid of the kNN interpolant
+/// (any `n`, vertex columns made on demand): `2π ∫ sin θi cos θi J(θi) dθi` with `J` the
+/// bilinear interpolant of the columns' trapezoid sums over `y`, 8 Gauss–Legendre points
+/// between the angles where `sin θi sin θo` or `cos θi cos θo` crosses a grid plane.
+fn grid_albedo_n(b: &CornellBrdf, n: usize, theta_o: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    let (so, co) = theta_o.sin_cos();
+    let nf = n as f64;
+    let mut breaks = vec![0.0, FRAC_PI_2];
+    for i in 1..n {
+        let v = i as f64 / nf;
+        if v < so {
+            breaks.push((v / so).asin());
+        }
+        if v < co {
+            breaks.push((v / co).acos());
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    let h = 1.0 / nf;
+    let columns = std::cell::RefCell::new(HashMap::<(usize, usize), f64>::new());
+    let column = |i: usize, k: usize| {
+        if let Some(&c) = columns.borrow().get(&(i, k)) {
+            return c;
+        }
+        let at = |j: usize| b.knn_luminance_at(&[i as f64 * h, j as f64 * h, k as f64 * h]);
+        let inner: f64 = (1..n).map(at).sum();
+        let c = (inner + 0.5 * (at(0) + at(n))) / nf;
+        columns.borrow_mut().insert((i, k), c);
+        c
+    };
+    let j_at = |t: f64| {
+        let (si, ci) = t.sin_cos();
+        let (x, z) = (
+            (si * so).clamp(0.0, 1.0) * nf,
+            (ci * co).clamp(0.0, 1.0) * nf,
+        );
+        let (i, k) = ((x as usize).min(n - 1), (z as usize).min(n - 1));
+        let (fx, fz) = (x - i as f64, z - k as f64);
+        let j = (1.0 - fx) * ((1.0 - fz) * column(i, k) + fz * column(i, k + 1))
+            + fx * ((1.0 - fz) * column(i + 1, k) + fz * column(i + 1, k + 1));
+        TAU * si * ci * j
+    };
+    let g8 = crate::quadrature::GaussLegendre::new(8);
+    breaks
+        .windows(2)
+        .map(|w| g8.integrate(w[0], w[1], j_at))
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -415,6 +466,15 @@ mod tests {
         assert!(s.abs[3] <= 1e-15 && s.rel_count == flat.len(), "{s:?}");
         for v in e.grid[0].1.iter().chain(&e.grid[0].2).chain(&e.pbrt_loo) {
             assert!((v - 0.25).abs() <= 1e-15, "{v}");
+        }
+        // The survey's grid albedo for any `n` is the reader's at `GRID_CELLS`.
+        for deg in [0.0f64, 37.0, 80.0] {
+            let (want, _) = grid.grid_albedo(deg.to_radians()).unwrap();
+            let got = grid_albedo_n(&b, GRID_CELLS, deg.to_radians());
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "{deg}°: {got} vs {want}"
+            );
         }
         // The percentiles by nearest rank.
         let f = five((1..=100).map(f64::from).collect());
@@ -541,6 +601,26 @@ mod tests {
                     "check: grid helper vs Interpolation::Grid at the samples: max |Δ| {worst:e}"
                 );
             }
+            // The CPU time of the kNN luminance at every vertex of each grid (one thread; the
+            // reader makes luminance and RGB per vertex, by blocks, with one search).
+            for &c in &cells {
+                let t = std::time::Instant::now();
+                let h = 1.0 / c as f64;
+                let mut sum = 0.0;
+                for k in 0..=c {
+                    for j in 0..=c {
+                        for i in 0..=c {
+                            sum += b.knn_luminance_at(&[i as f64 * h, j as f64 * h, k as f64 * h]);
+                        }
+                    }
+                }
+                let secs = t.elapsed().as_secs_f64();
+                let count = (c + 1).pow(3);
+                eprintln!(
+                    "vertices {c}³: {count} kNN evaluations in {secs:.2} s ({:.0} ns each; sum {sum:.3e})",
+                    1e9 * secs / count as f64
+                );
+            }
             // RGB channels: relative median / p99 (values above 1 % of the channel's peak).
             for ch in 0..3 {
                 let v: Vec<f64> = b.data.rgb.iter().map(|c| c[ch]).collect();
@@ -566,9 +646,17 @@ mod tests {
                 continue;
             }
             eprintln!(
-                "| θo | A_knn (± est.) | A_grid {GRID_CELLS}³ | (A_grid − A_knn)/A_knn | ÷ LOO kNN rel (v>0) median | s (kNN) |"
+                "| θo | A_knn (± est.) | A_grid {GRID_CELLS}³ | (A_grid − A_knn)/A_knn | ÷ LOO kNN rel (v>0) median | s (kNN) | {} |",
+                cells
+                    .iter()
+                    .map(|c| format!("(A_grid {c}³ − A_knn)/A_knn"))
+                    .collect::<Vec<_>>()
+                    .join(" | ")
             );
-            eprintln!("|---:|---:|---:|---:|---:|---:|");
+            eprintln!(
+                "|---:|---:|---:|---:|---:|---:|{}",
+                "---:|".repeat(cells.len())
+            );
             for deg in &angles {
                 let to = deg.to_radians();
                 let t = std::time::Instant::now();
@@ -576,10 +664,15 @@ mod tests {
                 let secs = t.elapsed().as_secs_f64();
                 let (ag, _) = b.grid_albedo(to).unwrap_or((f64::NAN, 0.0));
                 let d = (ag - ak) / ak;
+                let finer: Vec<String> = cells
+                    .iter()
+                    .map(|&c| format!("{:+.2e}", (grid_albedo_n(&b, c, to) - ak) / ak))
+                    .collect();
                 eprintln!(
-                    "| {deg}° | {ak:.6} (± {:.1e}) | {ag:.6} | {d:+.2e} | {:.2} | {secs:.1} |",
+                    "| {deg}° | {ak:.6} (± {:.1e}) | {ag:.6} | {d:+.2e} | {:.2} | {secs:.1} | {} |",
                     ek / ak,
-                    d.abs() / knn_loo.rel_all[0]
+                    d.abs() / knn_loo.rel_all[0],
+                    finer.join(" | ")
                 );
             }
         }
