@@ -27,7 +27,9 @@
 //!
 //! `cargo test --release -p brdf --lib fidelity_survey -- --ignored --nocapture`, knobs
 //! `FIDELITY_FILES=krylon_blue,cayman,acryl_blue`, `FIDELITY_CELLS=64,128`,
-//! `FIDELITY_ANGLES=0,15,30,45,60,75,85` (empty: no albedo), `FIDELITY_ALBEDO_TOL=1e-5`.
+//! `FIDELITY_ANGLES=0,15,30,45,60,75,85` (empty: no albedo), `FIDELITY_ALBEDO_TOL=1e-5`,
+//! `FIDELITY_PBRT_M=256,512` (the albedo of pbrt's rule and, as a check, of the kNN one by
+//! a midpoint rule of `m²` points; none by default).
 
 use std::collections::HashMap;
 
@@ -396,6 +398,26 @@ fn grid_albedo_n(b: &CornellBrdf, n: usize, theta_o: f64) -> f64 {
         .sum()
 }
 
+/// The albedo at `theta_o` of an interpolant `f` of the remapped point (pbrt-v2's rule,
+/// [`pbrt_rule`], or the kNN one as a check): the midpoint rule with `m` points in
+/// `θi ∈ [0, π/2]` and `m` in `t = Δφ/π ∈ [0, 1]` of
+/// `2π ∫ sin θi cos θi ∫₀¹ f(sin θi sin θo, t, cos θi cos θo) dt dθi` (pbrt's rule jumps where
+/// its sample set changes, so this converges slowly: compare two `m`).
+fn midpoint_albedo(f: impl Fn(&[f64; 3]) -> f64, theta_o: f64, m: usize) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    let (so, co) = theta_o.sin_cos();
+    let (ht, hy) = (FRAC_PI_2 / m as f64, 1.0 / m as f64);
+    let mut total = 0.0;
+    for a in 0..m {
+        let (si, ci) = ((a as f64 + 0.5) * ht).sin_cos();
+        let line: f64 = (0..m)
+            .map(|c| f(&[si * so, (c as f64 + 0.5) * hy, ci * co]))
+            .sum();
+        total += TAU * si * ci * line * hy * ht;
+    }
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -420,8 +442,9 @@ mod tests {
     /// helper at `GRID_CELLS` equal `knn_luminance_at` and `Interpolation::Grid` bit for bit at
     /// every sample; left out, `kNN₋ᵢ(p_i)` and `grid₋ᵢ(p_i)` equal the reader's interpolants
     /// of the file re-read without line `i`, and so does pbrt's rule; and on a fixture whose
-    /// samples all have one value every estimate is that value. Fails when the exclusion is
-    /// forgotten in `knn_from` (`Some(j) == exclude` never skipping).
+    /// samples all have one value every estimate is that value (and the midpoint albedo `π c`);
+    /// the grid albedo for any `n` is `grid_albedo` at `GRID_CELLS`. Fails when the exclusion
+    /// is forgotten in `knn_from` or in `pbrt_rule` (`Some(j) == exclude` never skipping).
     #[test]
     fn survey_rules_are_the_readers_with_sample_left_out() {
         let text = fixture();
@@ -476,6 +499,11 @@ mod tests {
                 "{deg}°: {got} vs {want}"
             );
         }
+        // The midpoint albedo of a constant `c` is `π c` (up to the rule's O(h²) error).
+        let pb = |p: &[f64; 3]| pbrt_rule(&lists.points, p, None, &flat);
+        let a = midpoint_albedo(pb, 0.7, 64);
+        let want = std::f64::consts::PI * 0.25;
+        assert!((a - want).abs() <= 1e-3 * want, "{a} vs {want}");
         // The percentiles by nearest rank.
         let f = five((1..=100).map(f64::from).collect());
         assert_eq!(&f[..4], &[50.0, 90.0, 99.0, 100.0]);
@@ -507,13 +535,14 @@ mod tests {
 
     /// The survey of docs/benchmarks.md §30.4 (see the module docs for the command and knobs).
     #[test]
-    #[ignore = "a survey for the record (about a minute per file with the albedo)"]
+    #[ignore = "a survey for the record (≈ 6 s per file; ≈ 17 s with FIDELITY_PBRT_M=256,512)"]
     fn fidelity_survey() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../../shared/data/measured/cornell");
         let files: Vec<String> = env_list("FIDELITY_FILES", "krylon_blue,cayman,acryl_blue");
         let cells: Vec<usize> = env_list("FIDELITY_CELLS", "64,128");
         let angles: Vec<f64> = env_list("FIDELITY_ANGLES", "0,15,30,45,60,75,85");
+        let pbrt_m: Vec<usize> = env_list("FIDELITY_PBRT_M", "");
         let tol: f64 = std::env::var("FIDELITY_ALBEDO_TOL")
             .ok()
             .and_then(|s| s.parse().ok())
@@ -664,6 +693,23 @@ mod tests {
                 let secs = t.elapsed().as_secs_f64();
                 let (ag, _) = b.grid_albedo(to).unwrap_or((f64::NAN, 0.0));
                 let d = (ag - ak) / ak;
+                let pbrt: Vec<String> = pbrt_m
+                    .iter()
+                    .map(|&m| {
+                        let pb = |p: &[f64; 3]| pbrt_rule(&lists.points, p, None, &lum);
+                        let a = midpoint_albedo(pb, to, m);
+                        let k = midpoint_albedo(|p: &[f64; 3]| b.knn_luminance_at(p), to, m);
+                        format!(
+                            "m {m}: {:+.2e} (the same rule on kNN: {:+.2e})",
+                            (a - ak) / ak,
+                            (k - ak) / ak
+                        )
+                    })
+                    .collect();
+                eprintln!(
+                    "pbrt-v2 rule albedo at {deg}°, midpoint rule of m² points, (A_pbrt − A_knn)/A_knn: {}",
+                    pbrt.join(", ")
+                );
                 let finer: Vec<String> = cells
                     .iter()
                     .map(|&c| format!("{:+.2e}", (grid_albedo_n(&b, c, to) - ak) / ak))
