@@ -135,6 +135,8 @@ pub struct NegativeValues {
     pub min: f64,
 }
 
+#[cfg(test)]
+mod fidelity;
 mod grid;
 mod line;
 mod node;
