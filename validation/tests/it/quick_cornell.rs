@@ -1,30 +1,32 @@
 //! The quick tier's Cornell material (`validation::QUICK_CORNELL`, `acryl_blue.brdf` of the
-//! project's shared data beside the repository, which has no licence to be copied into it) at
-//! θo = 45°, for every direction sampler that applies to it at a CI-sized cost: the adaptive
-//! sets (`adaptive`, `adaptive-mixture`) and the baselines (`uniform`, `cosine`, the two cosine
-//! lobes, `tabulated-cdf`, `cascade-cdf`, `factored`, `srbf`); 105 tests, ≈ 150 s wall (299 CPU-s) on 2
-//! cores, most of it the adaptive sets' builds on the interpolant.
-//! Left out, with the figures in docs/validation.md: `adaptive-paper` (normalisation 1.6e-3
-//! against the tier's 1e-3: its leaf probabilities need per-leaf integrals that the leaf
-//! quadrature's budget does not resolve on the scattered-data interpolant),
-//! `adaptive-paper-mixture` (passes, but 104 s wall on its own), `quadtree-disc` (2–3 bound
-//! violations per 3·10⁵ samples: its bounds are the maxima of a 512² sampled grid × 1.25, and
-//! the interpolant peaks between grid points), `adaptive-exact` (28 s build, normaliser error
-//! 6e-3 on it); `analytic` and `rgl-native` do not apply (no model sampler, not an RGL file).
-//! Without the shared data (a user's clone) the test says so and does nothing; CI has it.
+//! project's shared data beside the repository, which has no licence to be copied into it; its
+//! default interpolation, the kNN interpolant tabulated on a 64³ grid) at θo = 45°, for every
+//! direction sampler that applies to it: the adaptive sets (`adaptive`, `adaptive-mixture`,
+//! `adaptive-paper`, `adaptive-paper-mixture`, `adaptive-exact`), `quadtree-disc` and the
+//! baselines (`uniform`, `cosine`, the two cosine lobes, `tabulated-cdf`, `cascade-cdf`,
+//! `factored`, `srbf`); 149 tests, ≈ 35 s wall on 2 cores (2026-11-28). On the kNN interpolant
+//! (`interp=knn`) the adaptive sets' builds made the ten samplers of the earlier list take
+//! ≈ 150 s, and `adaptive-paper`, `quadtree-disc` and `adaptive-exact` were left out
+//! (docs/validation.md); `analytic` and `rgl-native` do not apply (no model sampler, not an
+//! RGL file). Without the shared data (a user's clone) the test says so and does nothing; CI
+//! has it.
 //!
 //! Not in the README's test command: CI runs the same configuration with the binary the tests
 //! built (`brdf-lab validate --quick --theta-o 45 --brdf cornell:… --sampler …` in `.ci/run`,
-//! the ten samplers below); run this test with `cargo test --release -p validation --test it
+//! the samplers below); run this test with `cargo test --release -p validation --test it
 //! quick_cornell -- --ignored` (docs/validation.md, "What the test command runs and what moved
 //! to validate runs").
 
 use validation::{QUICK_CORNELL, ValidateConfig, run};
 
 /// The samplers run on the Cornell material (see the module docs for the others).
-const SAMPLERS: [&str; 10] = [
+const SAMPLERS: [&str; 14] = [
     "adaptive",
     "adaptive-mixture",
+    "adaptive-paper",
+    "adaptive-paper-mixture",
+    "adaptive-exact",
+    "quadtree-disc",
     "uniform",
     "cosine",
     "lobe-sphere",
@@ -36,7 +38,7 @@ const SAMPLERS: [&str; 10] = [
 ];
 
 #[test]
-#[ignore = "≈ 300 CPU-s: CI runs it as `brdf-lab validate` (.ci/run); run with --release -- --ignored"]
+#[ignore = "≈ 35 s wall: CI runs it as `brdf-lab validate` (.ci/run); run with --release -- --ignored"]
 fn quick_tier_cornell_material_passes_for_every_applicable_sampler() {
     let path = QUICK_CORNELL.trim_start_matches("cornell:");
     if !std::path::Path::new(path).is_file() {
