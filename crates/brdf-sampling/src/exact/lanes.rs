@@ -38,13 +38,16 @@ pub(super) fn unit(z: u64) -> f64 {
 }
 
 /// One block's trials, entry `j` for the pending sample `j` of the block: the point `(x, y)`
-/// on the disc's square, its leaf's bound `M_i`, the acceptance threshold `u₃·M_i`, whether
-/// the point lies inside the unit circle (`x² + y² < 1`: else the trial evaluates nothing)
-/// and, inside, its direction `map.to_direction((x, y))`.
+/// on the disc's square, its leaf's bound `M_i`, the thinning bound `M_is ≤ M_i` of its
+/// sub-cell ([`LeafTable::cap`]; written by a thinning pass only, [`trials`] on a table with
+/// thinning bounds), the acceptance threshold `u₃·M_i`, whether the point lies inside the unit
+/// circle (`x² + y² < 1`: else the trial evaluates nothing) and, inside, its direction
+/// `map.to_direction((x, y))`.
 pub(super) struct Trials {
     pub(super) x: Vec<f64>,
     pub(super) y: Vec<f64>,
     pub(super) bound: Vec<f64>,
+    pub(super) cap: Vec<f64>,
     pub(super) threshold: Vec<f64>,
     pub(super) inside: Vec<bool>,
     pub(super) dir: Vec<Vec3>,
@@ -58,6 +61,7 @@ impl Trials {
             x: vec![0.0; wave],
             y: vec![0.0; wave],
             bound: vec![0.0; wave],
+            cap: vec![0.0; wave],
             threshold: vec![0.0; wave],
             inside: vec![false; wave],
             dir: vec![Vec3::zeros(); wave],
@@ -115,9 +119,10 @@ fn four_outputs(state: &mut u64) -> [f64; 4] {
 /// in groups of [`LANES`]: the uniforms (vector lanes), the leaf records read lane by lane
 /// ([`LeafTable::leaf_of`]), then the points, thresholds and directions (vector lanes),
 /// written in place (`t`'s room is a multiple of [`LANES`]; a last, partial group fills its
-/// group whole, the entries past `state.len()` meaning nothing).
+/// group whole, the entries past `state.len()` meaning nothing). With `THIN`, also each
+/// trial's thinning bound ([`LeafTable::cap`]) in `t.cap`.
 #[inline(always)]
-fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
+fn pass<const THIN: bool, U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
     table: &LeafTable,
     state: &mut [u64],
     t: &mut Trials,
@@ -130,10 +135,11 @@ fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
         .zip(t.x.chunks_exact_mut(LANES))
         .zip(t.y.chunks_exact_mut(LANES))
         .zip(t.bound.chunks_exact_mut(LANES))
+        .zip(t.cap.chunks_exact_mut(LANES))
         .zip(t.threshold.chunks_exact_mut(LANES))
         .zip(t.inside.chunks_exact_mut(LANES))
         .zip(t.dir.chunks_exact_mut(LANES));
-    for ((((((st, xs), ys), ms), th), ok), dir) in groups {
+    for (((((((st, xs), ys), ms), cs), th), ok), dir) in groups {
         let n = st.len();
         let mut s0 = [0u64; LANES];
         for (a, b) in s0.iter_mut().zip(st.iter()) {
@@ -149,8 +155,16 @@ fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
         }
         st.copy_from_slice(&s0[..n]);
         let mut leaf = [[0.0; 5]; LANES];
-        for j in 0..LANES {
-            leaf[j] = table.leaf_of(u0[j]);
+        if THIN {
+            for j in 0..LANES {
+                let (k, l) = table.leaf_at(u0[j]);
+                leaf[j] = l;
+                cs[j] = table.cap(k, u1[j], u2[j], l[4]);
+            }
+        } else {
+            for j in 0..LANES {
+                leaf[j] = table.leaf_of(u0[j]);
+            }
         }
         for j in 0..LANES {
             let [x0, dx, y0, dy, m] = leaf[j];
@@ -167,11 +181,13 @@ fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
 }
 
 /// [`pass`] as a `pulp` operation (inlined into, and compiled for, each instruction set):
-/// split trials ([`split_trial`]) when `split`, else [`four_outputs`].
+/// split trials ([`split_trial`]) when `split`, else [`four_outputs`]; thinning bounds when
+/// `thin` (with [`four_outputs`] only).
 struct Pass<'a> {
     table: &'a LeafTable,
     map: DiscMap,
     split: bool,
+    thin: bool,
     state: &'a mut [u64],
     t: &'a mut Trials,
 }
@@ -184,14 +200,29 @@ impl pulp::WithSimd for Pass<'_> {
             table,
             map,
             split,
+            thin,
             state,
             t,
         } = self;
-        match (map, split) {
-            (DiscMap::Projected, false) => pass(table, state, t, four_outputs, projected),
-            (DiscMap::EqualArea, false) => pass(table, state, t, four_outputs, equal_area),
-            (DiscMap::Projected, true) => pass(table, state, t, split_trial, projected),
-            (DiscMap::EqualArea, true) => pass(table, state, t, split_trial, equal_area),
+        match (map, split, thin) {
+            (DiscMap::Projected, false, false) => {
+                pass::<false, _, _>(table, state, t, four_outputs, projected)
+            }
+            (DiscMap::EqualArea, false, false) => {
+                pass::<false, _, _>(table, state, t, four_outputs, equal_area)
+            }
+            (DiscMap::Projected, false, true) => {
+                pass::<true, _, _>(table, state, t, four_outputs, projected)
+            }
+            (DiscMap::EqualArea, false, true) => {
+                pass::<true, _, _>(table, state, t, four_outputs, equal_area)
+            }
+            (DiscMap::Projected, true, _) => {
+                pass::<false, _, _>(table, state, t, split_trial, projected)
+            }
+            (DiscMap::EqualArea, true, _) => {
+                pass::<false, _, _>(table, state, t, split_trial, equal_area)
+            }
         }
     }
 }
@@ -200,7 +231,9 @@ impl pulp::WithSimd for Pass<'_> {
 /// most `t`'s room; each advances by four steps): `t`'s entries `0..state.len()`, the
 /// uniforms of trial `u_k = unit(mix64(state + (k + 1)·γ))`, `k = 0..3`, as
 /// [`LeafTable::draw`] reads them from the sample's stream, the point and bound
-/// [`LeafTable::propose`]'s. Dispatched at run time (`pulp`); the same bits on every level.
+/// [`LeafTable::propose`]'s; when the table has thinning bounds, each trial's
+/// [`LeafTable::cap`] in `t.cap` too. Dispatched at run time (`pulp`); the same bits on every
+/// level.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`LeafTable::propose`]: super::table::LeafTable::propose
@@ -215,6 +248,7 @@ pub(super) fn trials(
         table,
         map,
         split: false,
+        thin: table.thins(),
         state,
         t,
     });
@@ -294,6 +328,7 @@ pub(super) fn trials_split(
         table,
         map,
         split: true,
+        thin: false,
         state,
         t,
     });

@@ -75,6 +75,12 @@ pub struct ExactOptions {
     pub normaliser_tol: f64,
     /// Narrowest interval, in θ and in azimuth (degrees, > 0).
     pub min_width_deg: f64,
+    /// Store the leaves' thinning bounds for RGL materials (docs/benchmarks.md §30.1): per
+    /// leaf `i` and each of its 4 × 4 sub-cells `s`, `M_is ≥` the leaf rule's bound over `s`
+    /// (`safety ×` the image map's largest sample there, the peak track, the rim band), `≤ M_i`;
+    /// the fixed-`ωo` wavefront rejects a trial whose threshold `u₃·M_i ≥ M_is` without
+    /// evaluating `f` (the same samples; fewer evaluations). Other BRDFs: unused.
+    pub thinning: bool,
 }
 
 impl ExactOptions {
@@ -110,6 +116,7 @@ impl ExactOptions {
             max_trials: Self::DEFAULT_MAX_TRIALS,
             normaliser_tol: Self::DEFAULT_NORMALISER_TOL,
             min_width_deg: Self::DEFAULT_MIN_WIDTH_DEG,
+            thinning: true,
         }
     }
 
