@@ -117,6 +117,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         mut state2,
         t: mut kept_t,
         mut lane,
+        mut rest,
         mut dirs,
         mut f,
     } = std::mem::take(&mut *kept);
@@ -137,6 +138,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     let t = kept_t.as_mut().expect("made above");
     if lane.len() < wave {
         lane.resize(wave, 0);
+        rest.resize(wave, 0);
         dirs.resize(wave, Vec3::zeros());
         f.resize(wave, 0.0);
     }
@@ -156,23 +158,27 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         state2.clear();
         for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
             let len = ib.len();
-            lanes::trials(arch, table, map, sb, t);
+            lanes::trials(arch, table, map, thin, sb, t);
             // The candidates inside the disc (and, with thinning bounds, whose threshold
             // `u₃·M_i` is below their sub-cell's bound `M_is ≥ g`: the others would be
             // rejected by `g` too), compacted without branches; the others propose again next
             // pass.
             let mut c = 0;
             if thin {
+                // Both lists without branches: candidates in `lane`, the others in `rest`
+                // (`inside` is the candidate flag: inside the disc, below the sub-cell bound).
+                let mut r = 0;
                 for k in 0..len {
+                    let go = t.inside[k];
                     lane[c] = k;
                     dirs[c] = t.dir[k];
-                    c += usize::from(t.inside[k] & (t.threshold[k] < t.cap[k]));
+                    rest[r] = k;
+                    c += usize::from(go);
+                    r += usize::from(!go);
                 }
-                if c < len {
-                    for k in (0..len).filter(|&k| !(t.inside[k] & (t.threshold[k] < t.cap[k]))) {
-                        idx2.push(ib[k]);
-                        state2.push(sb[k]);
-                    }
+                for &k in &rest[..r] {
+                    idx2.push(ib[k]);
+                    state2.push(sb[k]);
                 }
             } else {
                 for k in 0..len {
@@ -220,6 +226,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
             state2,
             t: kept_t,
             lane,
+            rest,
             dirs,
             f,
         };
@@ -234,7 +241,8 @@ const WAVE_KEEP_MAX: usize = 1 << 16;
 /// [`wavefront_with`]'s working arrays, kept per thread between calls (no allocation and no
 /// zero-filled buffer per call once a thread has drawn a wavefront of the size): the pending
 /// samples' indices and stream states (this pass's and the next's), one block's trials, and
-/// its candidates inside the disc (entry in the block, direction, value). Their contents are
+/// its candidates inside the disc (entry in the block, direction, value) and, with thinning bounds,
+/// the block entries that are not candidates. Their contents are
 /// set by each call before they are read: nothing carries over but the room.
 #[derive(Default)]
 struct WaveArrays {
@@ -244,6 +252,7 @@ struct WaveArrays {
     state2: Vec<u64>,
     t: Option<Trials>,
     lane: Vec<usize>,
+    rest: Vec<usize>,
     dirs: Vec<Vec3>,
     f: Vec<f64>,
 }

@@ -40,11 +40,18 @@ pub(super) const SUB: usize = 4;
 pub(super) const SUB_CELLS: usize = SUB * SUB;
 
 /// The thinning bound of a sub-cell whose code is `q` in a leaf of bound `m`:
-/// `m · q / 255` (`m` itself at `q = 255`). The build stores the smallest `q` whose value is at
-/// least the sub-cell's image-map bound ([`sub_code`]), so this, as computed here, is the bound.
+/// `m · (q · fl(1/255))` (`m` itself at `q = 255`: `255 · fl(1/255) = 1` exactly). The build
+/// stores the smallest `q` whose value is at least the sub-cell's image-map bound
+/// ([`sub_code`]), so this, as computed here, is the bound.
 #[inline(always)]
 pub(super) fn sub_bound(m: f64, q: u8) -> f64 {
-    m * f64::from(q) / 255.0
+    m * sub_factor(q)
+}
+
+/// `q · fl(1/255)`: the factor of [`sub_bound`].
+#[inline(always)]
+pub(super) fn sub_factor(q: u8) -> f64 {
+    f64::from(q) * (1.0 / 255.0)
 }
 
 /// The code of a sub-cell bound `b` in a leaf of bound `m`: the smallest `q` with
@@ -79,8 +86,8 @@ pub(super) struct LeafTable {
     entries: Box<[Entry]>,
     /// `entries.len()` as `f64`.
     n: f64,
-    /// The leaves' thinning bounds, if any (one per entry).
-    sub: Option<SubBounds>,
+    /// The leaves' thinning bound codes, [`SUB_CELLS`] per entry in order (empty: none).
+    sub: Box<[u8]>,
 }
 
 impl LeafTable {
@@ -127,7 +134,7 @@ impl LeafTable {
         Some(Self {
             n: index_to_f64(entries.len()),
             entries: entries.into_boxed_slice(),
-            sub: None,
+            sub: Box::new([]),
         })
     }
 
@@ -136,20 +143,21 @@ impl LeafTable {
     pub(super) fn with_sub_bounds(mut self, sub: Option<&[[u8; SUB_CELLS]]>) -> Self {
         self.sub = sub
             .filter(|s| s.len() == self.entries.len())
-            .map(|s| s.to_vec().into_boxed_slice());
+            .map_or_else(Vec::new, |s| s.as_flattened().to_vec())
+            .into_boxed_slice();
         self
     }
 
     /// Whether the table has thinning bounds.
     pub(super) fn thins(&self) -> bool {
-        self.sub.is_some()
+        !self.sub.is_empty()
     }
 
     /// Bytes of the records.
     pub(super) fn bytes_used(&self) -> usize {
         std::mem::size_of::<Self>()
             + std::mem::size_of_val(&*self.entries)
-            + self.sub.as_ref().map_or(0, |s| std::mem::size_of_val(&**s))
+            + std::mem::size_of_val(&*self.sub)
     }
 
     /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds
@@ -242,21 +250,14 @@ impl LeafTable {
         (k, [e.x0, e.dx, e.y0, e.dy, e.m].map(f64::from))
     }
 
-    /// The thinning bound of a trial in leaf `k` (of bound `m`, [`LeafTable::leaf_at`]) at the
-    /// point's uniforms `(u₁, u₂)`: sub-cell `(⌊SUB·u₁⌋, ⌊SUB·u₂⌋)`'s [`sub_bound`], or `m`
-    /// without thinning bounds. (The point `x0 + u₁·dx` lies in that sub-cell up to the
-    /// rounding of its sum.)
+    /// The thinning factor of a trial in leaf `k` ([`LeafTable::leaf_at`]) whose point's
+    /// uniforms `(u₁, u₂)` fall in sub-cell `sub = ⌊SUB·u₂⌋·SUB + ⌊SUB·u₁⌋`: [`sub_factor`] of
+    /// its code (1 without thinning bounds), so that `M_i ·` it is the trial's thinning bound
+    /// [`sub_bound`]. (The point `x0 + u₁·dx` lies in that sub-cell up to the rounding of its
+    /// sum.)
     #[inline(always)]
-    pub(super) fn cap(&self, k: usize, u1: f64, u2: f64, m: f64) -> f64 {
-        match &self.sub {
-            None => m,
-            Some(sub) => {
-                let sx = ((u1 * SUB as f64) as usize).min(SUB - 1);
-                let sy = ((u2 * SUB as f64) as usize).min(SUB - 1);
-                let q = sub.get(k).map_or(255, |c| c[sy * SUB + sx]);
-                sub_bound(m, q)
-            }
-        }
+    pub(super) fn code_factor(&self, k: usize, sub: usize) -> f64 {
+        sub_factor(self.sub.get(k * SUB_CELLS + sub).copied().unwrap_or(255))
     }
 }
 
