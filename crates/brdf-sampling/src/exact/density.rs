@@ -859,7 +859,10 @@ mod survey {
     /// safety factor 1.1 and the image map's own maxima), (b) the θo range (`max F` against
     /// `max g` over each leaf, `g` at this θo), (a) the leaf resolution (`Σ max_leaf g · a / ∫g`),
     /// and (d) the limits that stopped the leaves (depth, volume floor); and predicts the
-    /// evaluations with sub-cell bounds `min(M_i, 1.1 · max F over the sub-cell)` (s × s per leaf).
+    /// evaluations with sub-cell bounds `min(M_i, 1.1 · max F over the sub-cell)` (s × s per leaf),
+    /// and with θo layers: the interval cut into L equal θo layers, `F_L` the max of `f` at the
+    /// layer's two ends, leaf bounds `min(M_i, 1.1 · max F_L)` (`L` leaf tables: trials and
+    /// evaluations) and 4 × 4 sub-cell bounds per layer (thinning: evaluations).
     /// Points: a k × k midpoint grid per leaf (k = 16).
     #[test]
     #[ignore = "survey: needs RGL_FILE"]
@@ -903,6 +906,21 @@ mod survey {
             let (mut evals, mut m_f, mut m_g, mut int_g, mut int_f) = (0.0, 0.0, 0.0, 0.0, 0.0);
             let (mut v_deep, mut v_floor) = (0.0, 0.0);
             let mut sub_evals = [0.0f64; 3];
+            // θo layers: L = 2 and 4; the query's layer and its two ends.
+            let layers = [2usize, 4];
+            let ends: Vec<[QueryDensity; 2]> = layers
+                .iter()
+                .map(|&l| {
+                    let j = (((t.to_radians() - ta) / (tb - ta) * l as f64).floor() as usize)
+                        .min(l - 1);
+                    [j, j + 1].map(|e| {
+                        let th = ta + (tb - ta) * e as f64 / l as f64;
+                        let w = brdf::direction_from_radians(th, 0.0);
+                        QueryDensity::new(brdf.as_ref(), w, 0.0, iv.map)
+                    })
+                })
+                .collect();
+            let (mut layer_leaf, mut layer_sub) = ([0.0f64; 2], [0.0f64; 2]);
             let mut above = 0u64;
             let leaves: Vec<_> = iv.tree.tree().leaves().collect();
             let root_w = 2.0f64;
@@ -912,6 +930,7 @@ mod survey {
                 let (w, h) = (r.x1 - r.x0, r.y1 - r.y0);
                 let area = w * h;
                 let mut fv = vec![0.0f64; k * k];
+                let mut fl = vec![[0.0f64; 2]; k * k];
                 let (mut mf, mut mg, mut sf, mut sg, mut inside) = (0.0f64, 0.0f64, 0.0, 0.0, 0);
                 for i in 0..k {
                     for j in 0..k {
@@ -925,6 +944,9 @@ mod survey {
                         let ge = nodes.iter().map(|n| n.at([x, y])).fold(0.0, f64::max);
                         above += u64::from(gq > l.max_bound);
                         fv[i * k + j] = ge;
+                        for (li, e) in ends.iter().enumerate() {
+                            fl[i * k + j][li] = e[0].at([x, y]).max(e[1].at([x, y]));
+                        }
                         mf = mf.max(ge);
                         mg = mg.max(gq);
                         sf += ge;
@@ -943,6 +965,29 @@ mod survey {
                     v_deep += vol;
                 } else if l.volume <= floor {
                     v_floor += vol;
+                }
+                for li in 0..layers.len() {
+                    let ml = fl.iter().map(|v| v[li]).fold(0.0, f64::max);
+                    layer_leaf[li] += (safety * ml).min(l.max_bound) * area * frac;
+                    let per = k / 4;
+                    for sx in 0..4 {
+                        for sy in 0..4 {
+                            let (mut ms, mut ins) = (0.0f64, 0);
+                            for i in sx * per..(sx + 1) * per {
+                                for j in sy * per..(sy + 1) * per {
+                                    let x = r.x0 + w * (i as f64 + 0.5) / k as f64;
+                                    let y = r.y0 + h * (j as f64 + 0.5) / k as f64;
+                                    if x * x + y * y < 1.0 {
+                                        ins += 1;
+                                        ms = ms.max(fl[i * k + j][li]);
+                                    }
+                                }
+                            }
+                            layer_sub[li] += (safety * ms).min(l.max_bound) * area / 16.0
+                                * ins as f64
+                                / (per * per) as f64;
+                        }
+                    }
                 }
                 for (si, &s) in subs.iter().enumerate() {
                     let per = k / s;
@@ -988,6 +1033,13 @@ mod survey {
                 sub_evals[0] / a,
                 sub_evals[1] / a,
                 sub_evals[2] / a,
+            );
+            println!(
+                "    θo layers 2 / 4: leaf bounds per layer {:.3} / {:.3}; 4 × 4 sub-cell bounds per layer {:.3} / {:.3}",
+                layer_leaf[0] / a,
+                layer_leaf[1] / a,
+                layer_sub[0] / a,
+                layer_sub[1] / a,
             );
         }
     }
