@@ -1978,8 +1978,10 @@ pub(super) mod tests {
     /// under) — while evaluating `f` at least 5 % less often over the set. So the sub-cell bounds
     /// are above `g` wherever a trial was decided by them, and they pay. Fails with the bounds
     /// shrunk by 12 % (`sub_bound`'s `m · q / 255 · 0.88`: other samples and violations) and
-    /// with the sub-cell index transposed (`c[sx · SUB + sy]`: other samples); passes with
-    /// thinning off only through its evaluation clause.
+    /// with the sub-cell index transposed (`c[sx · SUB + sy]`, and later the top bits of `u₁`
+    /// and `u₂` swapped in `four_outputs`: other samples); with thinning off it fails only
+    /// through its evaluation clause. A saved and loaded set keeps the bounds (the tables
+    /// compare equal).
     #[test]
     fn thinning_bounds_change_no_sample_and_save_evaluations() {
         use super::wavefront;
@@ -1988,6 +1990,13 @@ pub(super) mod tests {
             .join("../../data/measured/rgl/paper_white_rgb.bsdf");
         let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
         let set = ExactSet::build(Arc::clone(&rgl), &ExactOptions::default(), None).unwrap();
+        // Saved and loaded, the tables keep their thinning bounds (format version 2).
+        let spec = format!("rgl:{}", path.display());
+        let back = ExactSet::from_bytes(&set.to_bytes(&spec), Arc::clone(&rgl), &spec).unwrap();
+        assert!(
+            back.cells[0].tables == set.cells[0].tables,
+            "thinning bounds saved"
+        );
         let (mut evals_thin, mut evals_plain, mut thinned) = (0u64, 0u64, 0usize);
         for iv in &set.cells[0].intervals {
             let t = 0.5 * (iv.theta[0] + iv.theta[1]);
