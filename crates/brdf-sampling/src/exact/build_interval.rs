@@ -20,7 +20,7 @@ use super::jobs::{
     INHERITED_TAIL_CAP, Inheritance, InheritedTable, Job, Normaliser, NormaliserKey,
 };
 use super::options::{
-    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_tree_params,
+    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_grid, envelope_tree_params,
 };
 use super::phases::{Lap, PhaseCounts};
 use super::table::{SUB, SUB_CELLS, SubBounds, sub_code};
@@ -267,7 +267,7 @@ fn envelope_tree(
             f,
             counter: &counter,
         },
-        set.grid,
+        envelope_grid(set, brdf),
         set.safety_factor,
         set.dilation_for(brdf),
         &grid_options,
