@@ -312,7 +312,7 @@ fn run_jobs(
                     inheritance.nodes = values_of(envelope);
                 }
                 if let (false, Some(iv)) = (by_trials, iv) {
-                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map));
+                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map, iv.sub_bounds));
                 }
                 let inheritance = Arc::new(inheritance);
                 for (num, dnum) in job.halves(delta) {

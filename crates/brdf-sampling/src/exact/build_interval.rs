@@ -20,9 +20,10 @@ use super::jobs::{
     INHERITED_TAIL_CAP, Inheritance, InheritedTable, Job, Normaliser, NormaliserKey,
 };
 use super::options::{
-    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_tree_params,
+    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, THETA_TOP_DEG, envelope_grid, envelope_tree_params,
 };
 use super::phases::{Lap, PhaseCounts};
+use super::table::{SUB, SUB_CELLS, SubBounds, sub_code};
 use super::tabulated;
 
 /// Outgoing polar angles per interval whose peaks bound the interval's envelope near its
@@ -217,9 +218,34 @@ fn bound_nodes(
     nodes
 }
 
+/// The thinning bounds of `tree`'s leaves from the image map it was built on (see
+/// [`SubBounds`]): sub-cell `s` of leaf `i` gets the code of `min(M_i, region(s).max_bound)`,
+/// the leaf rule's bound over the sub-cell's rectangle, rounded up ([`sub_code`]).
+fn sub_bounds(tree: &QuadTree, image: &SliceImageMap<'_>) -> SubBounds {
+    use partition_sampler::{Rect, RegionStats};
+    tree.leaves()
+        .map(|l| {
+            let r = l.rect;
+            let (w, h) = ((r.x1 - r.x0) / SUB as f64, (r.y1 - r.y0) / SUB as f64);
+            let mut codes = [255u8; SUB_CELLS];
+            for sy in 0..SUB {
+                for sx in 0..SUB {
+                    let (x0, y0) = (r.x0 + w * sx as f64, r.y0 + h * sy as f64);
+                    let x1 = if sx + 1 == SUB { r.x1 } else { x0 + w };
+                    let y1 = if sy + 1 == SUB { r.y1 } else { y0 + h };
+                    let b = image.region(&Rect::new(x0, y0, x1, y1)).max_bound;
+                    codes[sy * SUB + sx] = sub_code(l.max_bound, b);
+                }
+            }
+            codes
+        })
+        .collect()
+}
+
 /// The envelope tree of an interval: the image map of the envelope `f` (with the peak track
 /// of the members' mirror directions at the azimuth offsets `track_deltas`) and the tree built
-/// on it. Returns the tree and the points the image map evaluated.
+/// on it, with its leaves' thinning bounds for an RGL material ([`sub_bounds`]). Returns the
+/// tree, the points the image map evaluated and the thinning bounds.
 fn envelope_tree(
     brdf: &dyn Brdf,
     options: &ExactOptions,
@@ -227,7 +253,7 @@ fn envelope_tree(
     span: &Span,
     f: &DiscBrdf,
     track_deltas: &[f64],
-) -> Result<(QuadTree, u64), ExactError> {
+) -> Result<(QuadTree, u64, Option<SubBounds>), ExactError> {
     let set = &options.set;
     let (slice, theta_deg, phi_deg) = (span.slice, span.theta_deg, span.phi_deg);
     let counter = EvalCounter::new();
@@ -241,7 +267,7 @@ fn envelope_tree(
             f,
             counter: &counter,
         },
-        set.grid,
+        envelope_grid(set, brdf),
         set.safety_factor,
         set.dilation_for(brdf),
         &grid_options,
@@ -275,8 +301,10 @@ fn envelope_tree(
             phi_deg,
             source,
         })?;
+    let thin = options.thinning && brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>());
+    let sub = thin.then(|| sub_bounds(&tree, &image));
     drop(image);
-    Ok((tree, counter.total()))
+    Ok((tree, counter.total(), sub))
 }
 
 /// The normaliser table of an interval, or the verdict that it is to be split.
@@ -551,8 +579,8 @@ pub(super) fn build_interval(
     );
     // A parent split for its tail hands down its tree (on the same disc map: its bounds hold
     // over the parent's interval, so over this one too); otherwise the envelope's own.
-    let (tree, points) = match &job.inherited.tree {
-        Some((tree, map)) if *map == span.map => (tree.clone(), 0),
+    let (tree, points, sub) = match &job.inherited.tree {
+        Some((tree, map, sub)) if *map == span.map => (tree.clone(), 0, sub.clone()),
         _ => envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?,
     };
     drop(f);
@@ -596,7 +624,7 @@ pub(super) fn build_interval(
                 ctx,
                 &span,
                 &envelope,
-                tree,
+                (tree, sub),
                 table,
                 quad_err,
                 build_evals + axis_evals + quad_evals,
@@ -635,7 +663,7 @@ fn finish_interval(
     ctx: &IntervalContext,
     span: &Span,
     envelope: &IntervalEnvelope,
-    tree: QuadTree,
+    (tree, sub_bounds): (QuadTree, Option<SubBounds>),
     table: ChebyshevTable,
     quad_err: f64,
     evaluations: u64,
@@ -663,6 +691,7 @@ fn finish_interval(
         norm_err,
         quad_err,
         evaluations,
+        sub_bounds,
     })
 }
 

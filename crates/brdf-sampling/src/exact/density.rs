@@ -841,3 +841,206 @@ mod tests {
         assert_eq!(maps(block), maps(pointwise));
     }
 }
+
+/// The rejection-volume survey of an RGL set at a fixed θo (issue 29, docs/benchmarks.md
+/// §30.1): `RGL_FILE=… [THETAS="30 60"] cargo test --release -p brdf-sampling --lib
+/// rejection_volume_survey -- --ignored --nocapture`.
+#[cfg(test)]
+mod survey {
+    use std::sync::Arc;
+
+    use brdf::Brdf;
+
+    use super::QueryDensity;
+    use crate::exact::{ExactOptions, ExactSet};
+
+    /// Splits the evaluations per sample of the interval serving θo, `Σ M_i·|leaf_i ∩ disc| / A`,
+    /// into (c) the bound rule (`M_i` against the largest sampled envelope `F` over the leaf: the
+    /// safety factor 1.1 and the image map's own maxima), (b) the θo range (`max F` against
+    /// `max g` over each leaf, `g` at this θo), (a) the leaf resolution (`Σ max_leaf g · a / ∫g`),
+    /// and (d) the limits that stopped the leaves (depth, volume floor); and predicts the
+    /// evaluations with sub-cell bounds `min(M_i, 1.1 · max F over the sub-cell)` (s × s per leaf),
+    /// and with θo layers: the interval cut into L equal θo layers, `F_L` the max of `f` at the
+    /// layer's two ends, leaf bounds `min(M_i, 1.1 · max F_L)` (`L` leaf tables: trials and
+    /// evaluations) and 4 × 4 sub-cell bounds per layer (thinning: evaluations).
+    /// Points: a k × k midpoint grid per leaf (k = 16).
+    #[test]
+    #[ignore = "survey: needs RGL_FILE"]
+    fn rejection_volume_survey() {
+        let path = std::env::var("RGL_FILE").expect("RGL_FILE");
+        let brdf: Arc<dyn Brdf> =
+            Arc::new(brdf::RglBrdf::load(std::path::Path::new(&path)).expect("an RGL file"));
+        let opts = ExactOptions::default();
+        let set = ExactSet::build(Arc::clone(&brdf), &opts, None).expect("a set");
+        let r = set.report();
+        println!(
+            "{path}: {} intervals, {} leaves, worst trials {:.3}",
+            set.len(),
+            r.leaves,
+            r.worst_trials
+        );
+        let thetas: Vec<f64> = std::env::var("THETAS")
+            .unwrap_or_else(|_| "30 60".into())
+            .split_whitespace()
+            .map(|s| s.parse().expect("a number"))
+            .collect();
+        let k = 16usize;
+        let subs = [2usize, 4, 8];
+        let safety = opts.set.safety_factor;
+        let params = crate::exact::envelope_tree_params(&opts.set, brdf.as_ref());
+        let max_depth = params.max_depth;
+        for t in thetas {
+            let wo = brdf::direction_from_angles(t, 0.0);
+            let q = set.locate(&wo).expect("served");
+            let iv = set.interval(&q);
+            let a = set.normaliser_of(&q);
+            let g = QueryDensity::new(brdf.as_ref(), wo, 0.0, iv.map);
+            let [ta, tb] = iv.theta;
+            let nodes: Vec<QueryDensity> = (0..=2)
+                .map(|n| {
+                    let th = ta + (tb - ta) * f64::from(n) / 2.0;
+                    let w = brdf::direction_from_radians(th, 0.0);
+                    QueryDensity::new(brdf.as_ref(), w, 0.0, iv.map)
+                })
+                .collect();
+            let (mut evals, mut m_f, mut m_g, mut int_g, mut int_f) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            let (mut v_deep, mut v_floor) = (0.0, 0.0);
+            let mut sub_evals = [0.0f64; 3];
+            // θo layers: L = 2 and 4; the query's layer and its two ends.
+            let layers = [2usize, 4];
+            let ends: Vec<[QueryDensity; 2]> = layers
+                .iter()
+                .map(|&l| {
+                    let j = (((t.to_radians() - ta) / (tb - ta) * l as f64).floor() as usize)
+                        .min(l - 1);
+                    [j, j + 1].map(|e| {
+                        let th = ta + (tb - ta) * e as f64 / l as f64;
+                        let w = brdf::direction_from_radians(th, 0.0);
+                        QueryDensity::new(brdf.as_ref(), w, 0.0, iv.map)
+                    })
+                })
+                .collect();
+            let (mut layer_leaf, mut layer_sub) = ([0.0f64; 2], [0.0f64; 2]);
+            let mut above = 0u64;
+            let leaves: Vec<_> = iv.tree.tree().leaves().collect();
+            let root_w = 2.0f64;
+            let floor = params.volume_tolerance * leaves.iter().map(|l| l.integral).sum::<f64>();
+            for l in &leaves {
+                let r = l.rect;
+                let (w, h) = (r.x1 - r.x0, r.y1 - r.y0);
+                let area = w * h;
+                let mut fv = vec![0.0f64; k * k];
+                let mut fl = vec![[0.0f64; 2]; k * k];
+                let (mut mf, mut mg, mut sf, mut sg, mut inside) = (0.0f64, 0.0f64, 0.0, 0.0, 0);
+                for i in 0..k {
+                    for j in 0..k {
+                        let x = r.x0 + w * (i as f64 + 0.5) / k as f64;
+                        let y = r.y0 + h * (j as f64 + 0.5) / k as f64;
+                        if x * x + y * y >= 1.0 {
+                            continue;
+                        }
+                        inside += 1;
+                        let gq = g.at([x, y]);
+                        let ge = nodes.iter().map(|n| n.at([x, y])).fold(0.0, f64::max);
+                        above += u64::from(gq > l.max_bound);
+                        fv[i * k + j] = ge;
+                        for (li, e) in ends.iter().enumerate() {
+                            fl[i * k + j][li] = e[0].at([x, y]).max(e[1].at([x, y]));
+                        }
+                        mf = mf.max(ge);
+                        mg = mg.max(gq);
+                        sf += ge;
+                        sg += gq;
+                    }
+                }
+                let frac = inside as f64 / (k * k) as f64;
+                let vol = l.max_bound * area * frac;
+                evals += vol;
+                m_f += mf * area * frac;
+                m_g += mg * area * frac;
+                int_f += sf / (k * k) as f64 * area;
+                int_g += sg / (k * k) as f64 * area;
+                let depth = (root_w / w).log2().round() as u32;
+                if depth >= max_depth {
+                    v_deep += vol;
+                } else if l.volume <= floor {
+                    v_floor += vol;
+                }
+                for li in 0..layers.len() {
+                    let ml = fl.iter().map(|v| v[li]).fold(0.0, f64::max);
+                    layer_leaf[li] += (safety * ml).min(l.max_bound) * area * frac;
+                    let per = k / 4;
+                    for sx in 0..4 {
+                        for sy in 0..4 {
+                            let (mut ms, mut ins) = (0.0f64, 0);
+                            for i in sx * per..(sx + 1) * per {
+                                for j in sy * per..(sy + 1) * per {
+                                    let x = r.x0 + w * (i as f64 + 0.5) / k as f64;
+                                    let y = r.y0 + h * (j as f64 + 0.5) / k as f64;
+                                    if x * x + y * y < 1.0 {
+                                        ins += 1;
+                                        ms = ms.max(fl[i * k + j][li]);
+                                    }
+                                }
+                            }
+                            layer_sub[li] += (safety * ms).min(l.max_bound) * area / 16.0
+                                * ins as f64
+                                / (per * per) as f64;
+                        }
+                    }
+                }
+                for (si, &s) in subs.iter().enumerate() {
+                    let per = k / s;
+                    for sx in 0..s {
+                        for sy in 0..s {
+                            let mut ms = 0.0f64;
+                            let mut ins = 0;
+                            for i in sx * per..(sx + 1) * per {
+                                for j in sy * per..(sy + 1) * per {
+                                    let x = r.x0 + w * (i as f64 + 0.5) / k as f64;
+                                    let y = r.y0 + h * (j as f64 + 0.5) / k as f64;
+                                    if x * x + y * y < 1.0 {
+                                        ins += 1;
+                                        ms = ms.max(fv[i * k + j]);
+                                    }
+                                }
+                            }
+                            let bound = (safety * ms).min(l.max_bound);
+                            sub_evals[si] +=
+                                bound * area / (s * s) as f64 * ins as f64 / (per * per) as f64;
+                        }
+                    }
+                }
+            }
+            println!(
+                "θo {t}: interval [{:.2}, {:.2}]°, {} leaves; evaluations/sample ΣMa/A {:.3} = \
+                 (c) bound/maxF {:.3} × (b) maxF/maxg {:.3} × (a) Σmaxg·a/∫g {:.3} × ∫g/A {:.3}; \
+                 ∫F/∫g {:.3}; Σmax F·a/∫F {:.3}; volume share at max depth {} {:.3}, at the \
+                 volume floor {:.3}; sub-cell bounds 2²/4²/8²: {:.3} / {:.3} / {:.3}; points above M_i {above}",
+                ta.to_degrees(),
+                tb.to_degrees(),
+                leaves.len(),
+                evals / a,
+                evals / m_f,
+                m_f / m_g,
+                m_g / int_g,
+                int_g / a,
+                int_f / int_g,
+                m_f / int_f,
+                max_depth,
+                v_deep / evals,
+                v_floor / evals,
+                sub_evals[0] / a,
+                sub_evals[1] / a,
+                sub_evals[2] / a,
+            );
+            println!(
+                "    θo layers 2 / 4: leaf bounds per layer {:.3} / {:.3}; 4 × 4 sub-cell bounds per layer {:.3} / {:.3}",
+                layer_leaf[0] / a,
+                layer_leaf[1] / a,
+                layer_sub[0] / a,
+                layer_sub[1] / a,
+            );
+        }
+    }
+}

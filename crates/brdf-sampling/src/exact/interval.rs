@@ -8,6 +8,7 @@ use crate::layout::Turn;
 
 use super::chebyshev::ChebyshevTable;
 use super::grid::TableVar;
+use super::table::SubBounds;
 
 /// One built interval.
 pub(super) struct Interval {
@@ -30,6 +31,8 @@ pub(super) struct Interval {
     /// The quadrature's part of it.
     pub(super) quad_err: f64,
     pub(super) evaluations: u64,
+    /// The leaves' thinning bounds (RGL materials; [`SubBounds`]), in the tree's leaf order.
+    pub(super) sub_bounds: Option<SubBounds>,
 }
 
 impl Interval {

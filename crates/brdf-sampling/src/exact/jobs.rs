@@ -34,8 +34,9 @@ pub(super) struct Job {
 pub(super) struct Inheritance {
     pub(super) nodes: Vec<(NodeKey, Arc<NodeValues>)>,
     pub(super) normalisers: Vec<(NormaliserKey, Normaliser)>,
-    /// The tree of an interval split for its tail, and its disc map.
-    pub(super) tree: Option<(QuadTree, DiscMap)>,
+    /// The tree of an interval split for its tail, its disc map and its leaves' thinning
+    /// bounds (they hold over the halves as the tree's bounds do).
+    pub(super) tree: Option<(QuadTree, DiscMap, Option<super::table::SubBounds>)>,
     /// An ancestor's normaliser table whose interpolation tail met the inheritance test (see
     /// [`InheritedTable`]): the descendants take their nodes from it.
     pub(super) table: Option<Arc<InheritedTable>>,

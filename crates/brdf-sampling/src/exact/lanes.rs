@@ -38,13 +38,16 @@ pub(super) fn unit(z: u64) -> f64 {
 }
 
 /// One block's trials, entry `j` for the pending sample `j` of the block: the point `(x, y)`
-/// on the disc's square, its leaf's bound `M_i`, the acceptance threshold `u₃·M_i`, whether
-/// the point lies inside the unit circle (`x² + y² < 1`: else the trial evaluates nothing)
-/// and, inside, its direction `map.to_direction((x, y))`.
+/// on the disc's square, its leaf's bound `M_i`, the thinning bound `M_is ≤ M_i` of its
+/// sub-cell (`M_i ·` [`LeafTable::code_factor`]; written by a thinning pass only, [`trials`] on a table with
+/// thinning bounds), the acceptance threshold `u₃·M_i`, whether the point lies inside the unit
+/// circle (`x² + y² < 1`: else the trial evaluates nothing) and, inside, its direction
+/// `map.to_direction((x, y))`.
 pub(super) struct Trials {
     pub(super) x: Vec<f64>,
     pub(super) y: Vec<f64>,
     pub(super) bound: Vec<f64>,
+    pub(super) cap: Vec<f64>,
     pub(super) threshold: Vec<f64>,
     pub(super) inside: Vec<bool>,
     pub(super) dir: Vec<Vec3>,
@@ -58,6 +61,7 @@ impl Trials {
             x: vec![0.0; wave],
             y: vec![0.0; wave],
             bound: vec![0.0; wave],
+            cap: vec![0.0; wave],
             threshold: vec![0.0; wave],
             inside: vec![false; wave],
             dir: vec![Vec3::zeros(); wave],
@@ -95,19 +99,22 @@ const LANES: usize = 16;
 /// a generator's four outputs.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
+///
+/// Also the trial's thinning sub-cell `⌊SUB·u₂⌋·SUB + ⌊SUB·u₁⌋` ([`LeafTable::code_factor`])
+/// from the outputs' top bits: `u = (z >> 11)·2⁻⁵³`, so `⌊4u⌋ = z >> 62` (`SUB` = 4).
 #[inline(always)]
-fn four_outputs(state: &mut u64) -> [f64; 4] {
+fn four_outputs(state: &mut u64) -> ([f64; 4], usize) {
     let s1 = state.wrapping_add(GOLDEN_GAMMA);
     let s2 = s1.wrapping_add(GOLDEN_GAMMA);
     let s3 = s2.wrapping_add(GOLDEN_GAMMA);
     let s4 = s3.wrapping_add(GOLDEN_GAMMA);
     *state = s4;
-    [
-        unit(mix64(s1)),
-        unit(mix64(s2)),
-        unit(mix64(s3)),
-        unit(mix64(s4)),
-    ]
+    let (z1, z2) = (mix64(s2), mix64(s3));
+    let sub = (z1 >> 62) | ((z2 >> 62) << 2);
+    (
+        [unit(mix64(s1)), unit(z1), unit(z2), unit(mix64(s4))],
+        sub as usize,
+    )
 }
 
 /// The pass of [`trials`] / [`trials_split`] for one trial's uniforms `uniforms` (advancing a
@@ -115,9 +122,11 @@ fn four_outputs(state: &mut u64) -> [f64; 4] {
 /// in groups of [`LANES`]: the uniforms (vector lanes), the leaf records read lane by lane
 /// ([`LeafTable::leaf_of`]), then the points, thresholds and directions (vector lanes),
 /// written in place (`t`'s room is a multiple of [`LANES`]; a last, partial group fills its
-/// group whole, the entries past `state.len()` meaning nothing).
+/// group whole, the entries past `state.len()` meaning nothing). With `THIN`, also each
+/// trial's thinning bound (`M_i ·` [`LeafTable::code_factor`]) in `t.cap`, and `inside` then
+/// also requires the threshold below it (the trial's candidate flag).
 #[inline(always)]
-fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
+fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) -> Vec3>(
     table: &LeafTable,
     state: &mut [u64],
     t: &mut Trials,
@@ -130,27 +139,42 @@ fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
         .zip(t.x.chunks_exact_mut(LANES))
         .zip(t.y.chunks_exact_mut(LANES))
         .zip(t.bound.chunks_exact_mut(LANES))
+        .zip(t.cap.chunks_exact_mut(LANES))
         .zip(t.threshold.chunks_exact_mut(LANES))
         .zip(t.inside.chunks_exact_mut(LANES))
         .zip(t.dir.chunks_exact_mut(LANES));
-    for ((((((st, xs), ys), ms), th), ok), dir) in groups {
+    for (((((((st, xs), ys), ms), cs), th), ok), dir) in groups {
         let n = st.len();
         let mut s0 = [0u64; LANES];
         for (a, b) in s0.iter_mut().zip(st.iter()) {
             *a = *b;
         }
         let (mut u0, mut u1, mut u2, mut u3) = (z, z, z, z);
+        let mut sub = [0usize; LANES];
         for j in 0..LANES {
-            let [a, b, c, d] = uniforms(&mut s0[j]);
+            let ([a, b, c, d], s) = uniforms(&mut s0[j]);
             u0[j] = a;
             u1[j] = b;
             u2[j] = c;
             u3[j] = d;
+            sub[j] = s;
         }
         st.copy_from_slice(&s0[..n]);
         let mut leaf = [[0.0; 5]; LANES];
-        for j in 0..LANES {
-            leaf[j] = table.leaf_of(u0[j]);
+        if THIN {
+            let mut factor = [0.0; LANES];
+            for j in 0..LANES {
+                let (k, l) = table.leaf_at(u0[j]);
+                leaf[j] = l;
+                factor[j] = table.code_factor(k, sub[j]);
+            }
+            for j in 0..LANES {
+                cs[j] = leaf[j][4] * factor[j];
+            }
+        } else {
+            for j in 0..LANES {
+                leaf[j] = table.leaf_of(u0[j]);
+            }
         }
         for j in 0..LANES {
             let [x0, dx, y0, dy, m] = leaf[j];
@@ -160,18 +184,26 @@ fn pass<U: Fn(&mut u64) -> [f64; 4], D: Fn(f64, f64) -> Vec3>(
             ys[j] = y;
             ms[j] = m;
             th[j] = u3[j] * m;
-            ok[j] = x * x + y * y < 1.0;
+            let inside = x * x + y * y < 1.0;
+            // With thinning, a trial at or above its sub-cell's bound is no candidate.
+            ok[j] = if THIN {
+                inside & (th[j] < cs[j])
+            } else {
+                inside
+            };
             dir[j] = to_dir(x, y);
         }
     }
 }
 
 /// [`pass`] as a `pulp` operation (inlined into, and compiled for, each instruction set):
-/// split trials ([`split_trial`]) when `split`, else [`four_outputs`].
+/// split trials ([`split_trial`]) when `split`, else [`four_outputs`]; thinning bounds when
+/// `thin` (with [`four_outputs`] only).
 struct Pass<'a> {
     table: &'a LeafTable,
     map: DiscMap,
     split: bool,
+    thin: bool,
     state: &'a mut [u64],
     t: &'a mut Trials,
 }
@@ -184,14 +216,29 @@ impl pulp::WithSimd for Pass<'_> {
             table,
             map,
             split,
+            thin,
             state,
             t,
         } = self;
-        match (map, split) {
-            (DiscMap::Projected, false) => pass(table, state, t, four_outputs, projected),
-            (DiscMap::EqualArea, false) => pass(table, state, t, four_outputs, equal_area),
-            (DiscMap::Projected, true) => pass(table, state, t, split_trial, projected),
-            (DiscMap::EqualArea, true) => pass(table, state, t, split_trial, equal_area),
+        match (map, split, thin) {
+            (DiscMap::Projected, false, false) => {
+                pass::<false, _, _>(table, state, t, four_outputs, projected)
+            }
+            (DiscMap::EqualArea, false, false) => {
+                pass::<false, _, _>(table, state, t, four_outputs, equal_area)
+            }
+            (DiscMap::Projected, false, true) => {
+                pass::<true, _, _>(table, state, t, four_outputs, projected)
+            }
+            (DiscMap::EqualArea, false, true) => {
+                pass::<true, _, _>(table, state, t, four_outputs, equal_area)
+            }
+            (DiscMap::Projected, true, _) => {
+                pass::<false, _, _>(table, state, t, split_trial_pass, projected)
+            }
+            (DiscMap::EqualArea, true, _) => {
+                pass::<false, _, _>(table, state, t, split_trial_pass, equal_area)
+            }
         }
     }
 }
@@ -200,7 +247,9 @@ impl pulp::WithSimd for Pass<'_> {
 /// most `t`'s room; each advances by four steps): `t`'s entries `0..state.len()`, the
 /// uniforms of trial `u_k = unit(mix64(state + (k + 1)·γ))`, `k = 0..3`, as
 /// [`LeafTable::draw`] reads them from the sample's stream, the point and bound
-/// [`LeafTable::propose`]'s. Dispatched at run time (`pulp`); the same bits on every level.
+/// [`LeafTable::propose`]'s; when the table has thinning bounds, each trial's
+/// thinning bound in `t.cap` too (`inside`: the candidate flag). Dispatched at run time (`pulp`); the same bits on every
+/// level.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`LeafTable::propose`]: super::table::LeafTable::propose
@@ -208,6 +257,7 @@ pub(super) fn trials(
     arch: pulp::Arch,
     table: &LeafTable,
     map: DiscMap,
+    thin: bool,
     state: &mut [u64],
     t: &mut Trials,
 ) {
@@ -215,6 +265,7 @@ pub(super) fn trials(
         table,
         map,
         split: false,
+        thin: thin && table.thins(),
         state,
         t,
     });
@@ -276,6 +327,12 @@ pub(super) fn split_trial(state: &mut u64) -> [f64; 4] {
     ]
 }
 
+/// [`split_trial`] in [`pass`]'s form (no thinning sub-cell).
+#[inline(always)]
+fn split_trial_pass(state: &mut u64) -> ([f64; 4], usize) {
+    (split_trial(state), 0)
+}
+
 /// [`trials`] with split trials: entry `j`'s uniforms are [`split_trial`] of `state[j]`
 /// (advanced by two steps), as [`LeafTable::draw`] reads them from the stream through
 /// `next_uniform4_split`; the point and bound [`LeafTable::propose`]'s. Dispatched at run time
@@ -294,7 +351,32 @@ pub(super) fn trials_split(
         table,
         map,
         split: true,
+        thin: false,
         state,
         t,
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::table::SUB;
+
+    /// `four_outputs`' thinning sub-cell is `⌊SUB·u₂⌋·SUB + ⌊SUB·u₁⌋` of its own uniforms (the
+    /// top bits of the outputs), on 10⁵ stream states. Fails with the two halves swapped
+    /// (`(z2 >> 62) | ((z1 >> 62) << 2)`).
+    #[test]
+    fn thinning_sub_cell_is_the_uniforms_floor() {
+        assert_eq!(SUB, 4, "the top-two-bits rule is for 4 × 4 sub-cells");
+        let mut state = 0x1234_5678_9abc_def0u64;
+        let mut seen = [0u32; 16];
+        for _ in 0..100_000 {
+            let ([_, u1, u2, _], sub) = four_outputs(&mut state);
+            let want =
+                ((u2 * SUB as f64).floor() as usize) * SUB + (u1 * SUB as f64).floor() as usize;
+            assert_eq!(sub, want, "u1 {u1} u2 {u2}");
+            seen[sub] += 1;
+        }
+        assert!(seen.iter().all(|&n| n > 5_000), "{seen:?}");
+    }
 }

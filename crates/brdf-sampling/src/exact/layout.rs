@@ -155,7 +155,10 @@ impl Cell {
                 aniso.push(rec);
             }
         }
-        let tables = intervals.iter().map(|iv| LeafTable::of(&iv.tree)).collect();
+        let tables = intervals
+            .iter()
+            .map(|iv| LeafTable::of(&iv.tree).map(|t| t.with_sub_bounds(iv.sub_bounds.as_deref())))
+            .collect();
         let half_key = if by_tan { tan_half } else { grid.half };
         let iso = intervals
             .iter()

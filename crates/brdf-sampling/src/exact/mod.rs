@@ -96,8 +96,8 @@ mod wave_iso;
 
 pub use error::ExactError;
 pub use options::{
-    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, RGL_N_MAX, RGL_VOLUME_TOLERANCE, THETA_TOP_DEG,
-    envelope_tree_params,
+    ExactOptions, MAX_DELTA_NODE_SPACING_DEG, RGL_MAX_DEPTH, RGL_N_MAX, RGL_VOLUME_TOLERANCE,
+    THETA_TOP_DEG, envelope_grid, envelope_tree_params,
 };
 pub use persist::EXACT_FORMAT_VERSION;
 pub use phases::{BuildPhases, PhaseCounts};

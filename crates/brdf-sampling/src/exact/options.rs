@@ -31,6 +31,14 @@ pub const RGL_N_MAX: f64 = 1.2;
 /// default 2 % stopped the paper_white trees at ~65 leaves whatever `n_max`.
 pub const RGL_VOLUME_TOLERANCE: f64 = 2e-3;
 
+/// Smallest `max_depth` of an RGL material's envelope trees (issue 29, docs/benchmarks.md
+/// §30.1): at the sets' 7, 62–88 % of `cc_ibiza_sunset`'s bound volume lay in leaves stopped by
+/// the depth limit (2 × 2 image-map pixels each); at 8 (with the image map at
+/// [`envelope_grid`]'s 512 cells per axis) its evaluations per sample fell from 1.65 / 1.57 /
+/// 1.43 to 1.63 / 1.53 / 1.30 at θo 30 / 60 / 80° and its build got cheaper (fewer intervals
+/// split for their trials).
+pub const RGL_MAX_DEPTH: u32 = 8;
+
 /// The tree parameters of an interval's envelope tree for `brdf`: `set.tree`, with `n_max` and
 /// `volume_tolerance` at most [`RGL_N_MAX`] and [`RGL_VOLUME_TOLERANCE`] for an RGL material
 /// (finer leaves: fewer rejected trials, hence fewer evaluations of the costly interpolant
@@ -38,14 +46,35 @@ pub const RGL_VOLUME_TOLERANCE: f64 = 2e-3;
 /// sample over leaf `i` — so at every point the bound is still at least `safety_factor ×` the
 /// samples of the image-map cells around it, the margin the coarse leaves had at their
 /// maximum; finer leaves drop only the slack of a coarse leaf's maximum elsewhere in it. Other
-/// BRDFs get `set.tree` unchanged.
+/// BRDFs get `set.tree` unchanged. RGL materials also get `max_depth` at least
+/// [`RGL_MAX_DEPTH`] (their image map at least [`envelope_grid`]'s, so that
+/// `2^(max_depth + 1) ≤ grid` still holds).
 pub fn envelope_tree_params(set: &SetOptions, brdf: &dyn brdf::Brdf) -> TreeParams {
     let mut tree = set.tree;
-    if brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>()) {
+    if is_rgl(brdf) {
         tree.n_max = tree.n_max.min(RGL_N_MAX);
         tree.volume_tolerance = tree.volume_tolerance.min(RGL_VOLUME_TOLERANCE);
+        tree.max_depth = tree.max_depth.max(RGL_MAX_DEPTH);
     }
     tree
+}
+
+/// Cells per axis of an interval envelope's image map for `brdf`: `set.grid`, for an RGL
+/// material at least `2^(max_depth + 1)` of [`envelope_tree_params`]' depth (512 at
+/// [`RGL_MAX_DEPTH`]): the image map finer than the deepest leaf, as
+/// [`SetOptions::tree`]'s rule asks.
+pub fn envelope_grid(set: &SetOptions, brdf: &dyn brdf::Brdf) -> usize {
+    if is_rgl(brdf) {
+        let depth = envelope_tree_params(set, brdf).max_depth;
+        set.grid.max(1usize << (depth + 1).min(16))
+    } else {
+        set.grid
+    }
+}
+
+/// Whether `brdf` is an RGL material.
+fn is_rgl(brdf: &dyn brdf::Brdf) -> bool {
+    brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>())
 }
 
 /// Settings of [`ExactSet`](crate::ExactSet). `set` supplies the tree parameters, image map, safety factor,
@@ -75,6 +104,12 @@ pub struct ExactOptions {
     pub normaliser_tol: f64,
     /// Narrowest interval, in θ and in azimuth (degrees, > 0).
     pub min_width_deg: f64,
+    /// Store the leaves' thinning bounds for RGL materials (docs/benchmarks.md §30.1): per
+    /// leaf `i` and each of its 4 × 4 sub-cells `s`, `M_is ≥` the leaf rule's bound over `s`
+    /// (`safety ×` the image map's largest sample there, the peak track, the rim band), `≤ M_i`;
+    /// the fixed-`ωo` wavefront rejects a trial whose threshold `u₃·M_i ≥ M_is` without
+    /// evaluating `f` (the same samples; fewer evaluations). Other BRDFs: unused.
+    pub thinning: bool,
 }
 
 impl ExactOptions {
@@ -110,6 +145,7 @@ impl ExactOptions {
             max_trials: Self::DEFAULT_MAX_TRIALS,
             normaliser_tol: Self::DEFAULT_NORMALISER_TOL,
             min_width_deg: Self::DEFAULT_MIN_WIDTH_DEG,
+            thinning: true,
         }
     }
 
@@ -185,7 +221,12 @@ mod tests {
         let tree = envelope_tree_params(&set, &rgl);
         assert_eq!(tree.n_max, RGL_N_MAX);
         assert_eq!(tree.volume_tolerance, RGL_VOLUME_TOLERANCE);
-        assert_eq!(tree.max_depth, set.tree.max_depth);
+        assert_eq!(tree.max_depth, RGL_MAX_DEPTH);
+        assert_eq!(envelope_grid(&set, &rgl), 512);
+        assert_eq!(envelope_grid(&set, phong.as_ref()), set.grid);
+        let deep = set.with_depth(9);
+        assert_eq!(envelope_tree_params(&deep, &rgl).max_depth, 9);
+        assert_eq!(envelope_grid(&deep, &rgl), 1024);
         let mut tight = set;
         tight.tree.n_max = 1.1;
         tight.tree.volume_tolerance = 1e-4;

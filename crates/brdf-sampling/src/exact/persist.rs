@@ -5,8 +5,9 @@
 //! of: the BRDF spec and name, 32 probe values of the BRDF (as the quadtree sets,
 //! `crate::persist`), the options, the build's time, and per azimuth cell its intervals: θ and δ
 //! numerators (see `Grid`), normaliser table (nodes and values of `A · cos θo`), the
-//! quadrature's error estimate, the build's evaluation count and the tree in partition-sampler's
-//! own versioned format ([`partition_sampler::FORMAT_VERSION`]).
+//! quadrature's error estimate, the build's evaluation count, the tree in partition-sampler's
+//! own versioned format ([`partition_sampler::FORMAT_VERSION`]) and the leaves' thinning bounds
+//! (16 codes per leaf in the tree's leaf order, or none; version 2, §30.1).
 //!
 //! The BRDF is not stored: it is re-attached on load, which checks that the spec matches and
 //! that the BRDF reproduces the probes. The set's grid, cells, table variable and azimuth
@@ -39,9 +40,10 @@ use super::jobs::{Inheritance, Job};
 use super::layout::{Cell, Placed};
 use super::options::{ExactOptions, THETA_TOP_DEG};
 use super::set::ExactSet;
+use super::table::{SUB_CELLS, SubBounds};
 
 /// Version of the stored `adaptive-exact` format; bumped on any incompatible change.
-pub const EXACT_FORMAT_VERSION: u32 = 1;
+pub const EXACT_FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 4] = b"BRQE";
 
@@ -67,6 +69,8 @@ struct StoredInterval {
     quad_err: f64,
     evaluations: u64,
     tree: Vec<u8>,
+    /// The thinning bounds' codes, [`SUB_CELLS`] per leaf (empty: none).
+    sub_bounds: Vec<u8>,
 }
 
 impl StoredInterval {
@@ -80,6 +84,10 @@ impl StoredInterval {
             quad_err: iv.quad_err,
             evaluations: iv.evaluations,
             tree: iv.tree.tree().to_bytes(),
+            sub_bounds: iv
+                .sub_bounds
+                .as_deref()
+                .map_or_else(Vec::new, |s| s.as_flattened().to_vec()),
         }
     }
 }
@@ -277,6 +285,26 @@ fn load_interval(
     {
         return Err(bad("wrong domain or scheme".into()));
     }
+    let leaves = tree.leaves().len();
+    let sub_bounds: Option<SubBounds> = match iv.sub_bounds.len() {
+        0 => None,
+        n if n == leaves * SUB_CELLS => Some(
+            iv.sub_bounds
+                .chunks_exact(SUB_CELLS)
+                .map(|c| {
+                    let mut a = [0u8; SUB_CELLS];
+                    a.copy_from_slice(c);
+                    a
+                })
+                .collect(),
+        ),
+        n => {
+            return Err(bad(format!(
+                "{n} thinning bound codes for {leaves} leaves (want {})",
+                leaves * SUB_CELLS
+            )));
+        }
+    };
     let job = Job {
         cell: k,
         num: iv.num,
@@ -316,5 +344,6 @@ fn load_interval(
         worst_trials: worst,
         quad_err: iv.quad_err,
         evaluations: iv.evaluations,
+        sub_bounds,
     })
 }

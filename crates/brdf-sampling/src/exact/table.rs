@@ -33,12 +33,61 @@ struct Entry {
     prob: f64,
 }
 
+/// Sub-cells per axis of a leaf's thinning bounds ([`SubBounds`]).
+pub(super) const SUB: usize = 4;
+
+/// Sub-cells per leaf, `SUB²`.
+pub(super) const SUB_CELLS: usize = SUB * SUB;
+
+/// The thinning bound of a sub-cell whose code is `q` in a leaf of bound `m`:
+/// `m · (q · fl(1/255))` (`m` itself at `q = 255`: `255 · fl(1/255) = 1` exactly). The build
+/// stores the smallest `q` whose value is at least the sub-cell's image-map bound
+/// ([`sub_code`]), so this, as computed here, is the bound.
+#[inline(always)]
+pub(super) fn sub_bound(m: f64, q: u8) -> f64 {
+    m * sub_factor(q)
+}
+
+/// `q · fl(1/255)`: the factor of [`sub_bound`].
+#[inline(always)]
+pub(super) fn sub_factor(q: u8) -> f64 {
+    f64::from(q) * (1.0 / 255.0)
+}
+
+/// The code of a sub-cell bound `b` in a leaf of bound `m`: the smallest `q` with
+/// [`sub_bound`]`(m, q) ≥ b` (255, i.e. `m`, when `b ≥ m`, or `b` is not a number, or `m ≤ 0`).
+pub(super) fn sub_code(m: f64, b: f64) -> u8 {
+    if !(m > 0.0 && b < m) {
+        return 255;
+    }
+    let mut q = ((b.max(0.0) / m) * 255.0).ceil().clamp(0.0, 255.0) as u8;
+    while q < 255 && sub_bound(m, q) < b {
+        q += 1;
+    }
+    while q > 0 && sub_bound(m, q - 1) >= b {
+        q -= 1;
+    }
+    q
+}
+
+/// Per-leaf thinning bounds of one interval's tree (issue 29, docs/benchmarks.md §30.1): leaf
+/// `i`'s rectangle cut into `SUB × SUB` equal sub-cells, sub-cell `(sx, sy)` (row-major by
+/// `sy`) holding the code `q` of `M_is = m_i · q / 255` ([`sub_bound`]), at least the image
+/// map's bound over the sub-cell (the leaf rule's: `safety ×` the largest sample, the peak track
+/// and the rim band) and at most `M_i`. A trial at a point of sub-cell `s` whose acceptance
+/// threshold `u₃·M_i` is at least `M_is` is rejected without evaluating `g`: `g ≤ M_is` there,
+/// so it would have been rejected anyway — the same samples, the same law; only the
+/// evaluations fall. `SUB_CELLS` bytes per leaf, in the tree's leaf order.
+pub(super) type SubBounds = Box<[[u8; SUB_CELLS]]>;
+
 /// The compact table of one interval's tree (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct LeafTable {
     entries: Box<[Entry]>,
     /// `entries.len()` as `f64`.
     n: f64,
+    /// The leaves' thinning bound codes, [`SUB_CELLS`] per entry in order (empty: none).
+    sub: Box<[u8]>,
 }
 
 impl LeafTable {
@@ -85,12 +134,30 @@ impl LeafTable {
         Some(Self {
             n: index_to_f64(entries.len()),
             entries: entries.into_boxed_slice(),
+            sub: Box::new([]),
         })
+    }
+
+    /// The table with the leaves' thinning bounds `sub` (one per leaf in the tree's order);
+    /// ignored (no thinning) unless there is exactly one per entry.
+    pub(super) fn with_sub_bounds(mut self, sub: Option<&[[u8; SUB_CELLS]]>) -> Self {
+        self.sub = sub
+            .filter(|s| s.len() == self.entries.len())
+            .map_or_else(Vec::new, |s| s.as_flattened().to_vec())
+            .into_boxed_slice();
+        self
+    }
+
+    /// Whether the table has thinning bounds.
+    pub(super) fn thins(&self) -> bool {
+        !self.sub.is_empty()
     }
 
     /// Bytes of the records.
     pub(super) fn bytes_used(&self) -> usize {
-        std::mem::size_of::<Self>() + std::mem::size_of_val(&*self.entries)
+        std::mem::size_of::<Self>()
+            + std::mem::size_of_val(&*self.entries)
+            + std::mem::size_of_val(&*self.sub)
     }
 
     /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds
@@ -160,6 +227,12 @@ impl LeafTable {
     /// the alias fallback is a select.
     #[inline(always)]
     pub(super) fn leaf_of(&self, u0: f64) -> [f64; 5] {
+        self.leaf_at(u0).1
+    }
+
+    /// [`LeafTable::leaf_of`] with the leaf's index.
+    #[inline(always)]
+    pub(super) fn leaf_at(&self, u0: f64) -> (usize, [f64; 5]) {
         let entries = &*self.entries;
         let last = entries.len() - 1;
         let s = u0 * self.n;
@@ -172,8 +245,19 @@ impl LeafTable {
         } else {
             alias
         };
-        let e = &entries[k.min(last)];
-        [e.x0, e.dx, e.y0, e.dy, e.m].map(f64::from)
+        let k = k.min(last);
+        let e = &entries[k];
+        (k, [e.x0, e.dx, e.y0, e.dy, e.m].map(f64::from))
+    }
+
+    /// The thinning factor of a trial in leaf `k` ([`LeafTable::leaf_at`]) whose point's
+    /// uniforms `(u₁, u₂)` fall in sub-cell `sub = ⌊SUB·u₂⌋·SUB + ⌊SUB·u₁⌋`: [`sub_factor`] of
+    /// its code (1 without thinning bounds), so that `M_i ·` it is the trial's thinning bound
+    /// [`sub_bound`]. (The point `x0 + u₁·dx` lies in that sub-cell up to the rounding of its
+    /// sum.)
+    #[inline(always)]
+    pub(super) fn code_factor(&self, k: usize, sub: usize) -> f64 {
+        sub_factor(self.sub.get(k * SUB_CELLS + sub).copied().unwrap_or(255))
     }
 }
 
@@ -251,5 +335,40 @@ pub(super) mod walks {
             }
         }
         checked
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thinning codes: `sub_bound(m, sub_code(m, b))` is at least `b` and the smallest code
+    /// that is (so the stored bound is the image map's rounded up by at most `m / 255`); `m`
+    /// itself at 255, and 255 for `b ≥ m`, NaN or `m ≤ 0`. Fails with the code rounded to
+    /// nearest (`.round()` and no correction loops: values below `b`).
+    #[test]
+    fn sub_codes_round_the_bound_up_by_at_most_one_step() {
+        let mut checked = 0;
+        for &m in &[1e-6f64, 0.37, 1.0, 3.3, 1234.5] {
+            assert_eq!(sub_bound(m, 255), m);
+            for k in 0..=2000 {
+                let b = m * f64::from(k) / 2000.0;
+                let q = sub_code(m, b);
+                assert!(sub_bound(m, q) >= b, "m {m} b {b} q {q}");
+                if q > 0 {
+                    assert!(
+                        sub_bound(m, q - 1) < b,
+                        "m {m} b {b} q {q}: not the smallest"
+                    );
+                }
+                assert!(sub_bound(m, q) - b <= m / 255.0 * (1.0 + 1e-12));
+                checked += 1;
+            }
+            assert_eq!(sub_code(m, 2.0 * m), 255);
+            assert_eq!(sub_code(m, f64::NAN), 255);
+        }
+        assert_eq!(sub_code(0.0, 0.0), 255);
+        assert_eq!(sub_code(-1.0, 0.5), 255);
+        assert_eq!(checked, 5 * 2001);
     }
 }
