@@ -352,21 +352,10 @@ fn knn_albedo(b: &CornellBrdf, theta_o: f64, rel_tol: f64) -> (f64, f64) {
 /// bilinear interpolant of the columns' trapezoid sums over `y`, 8 Gauss–Legendre points
 /// between the angles where `sin θi sin θo` or `cos θi cos θo` crosses a grid plane.
 fn grid_albedo_n(b: &CornellBrdf, n: usize, theta_o: f64) -> f64 {
-    use std::f64::consts::{FRAC_PI_2, TAU};
+    use std::f64::consts::TAU;
     let (so, co) = theta_o.sin_cos();
     let nf = n as f64;
-    let mut breaks = vec![0.0, FRAC_PI_2];
-    for i in 1..n {
-        let v = i as f64 / nf;
-        if v < so {
-            breaks.push((v / so).asin());
-        }
-        if v < co {
-            breaks.push((v / co).acos());
-        }
-    }
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup();
+    let breaks = super::grid::grid_break_angles(n, so, co);
     let h = 1.0 / nf;
     let columns = std::cell::RefCell::new(HashMap::<(usize, usize), f64>::new());
     let column = |i: usize, k: usize| {

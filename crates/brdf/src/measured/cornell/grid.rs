@@ -117,20 +117,7 @@ impl CornellBrdf {
         }
         let (so, co) = theta_o.sin_cos();
         let n = GRID_CELLS as f64;
-        let half_pi = std::f64::consts::FRAC_PI_2;
-        // Break angles: x = sin θi sin θo = i/N, z = cos θi cos θo = k/N.
-        let mut breaks = vec![0.0, half_pi];
-        for i in 1..GRID_CELLS {
-            let v = i as f64 / n;
-            if v < so {
-                breaks.push((v / so).asin());
-            }
-            if v < co {
-                breaks.push((v / co).acos());
-            }
-        }
-        breaks.sort_by(f64::total_cmp);
-        breaks.dedup();
+        let breaks = grid_break_angles(GRID_CELLS, so, co);
         let j_at = |t: f64| {
             let (si, ci) = t.sin_cos();
             let (x, z) = ((si * so).clamp(0.0, 1.0) * n, (ci * co).clamp(0.0, 1.0) * n);
@@ -157,4 +144,24 @@ impl CornellBrdf {
         }
         Some((value, err))
     }
+}
+
+/// The polar angles `θi ∈ [0, π/2]` (sorted, without repeats, both ends included) where the
+/// path `x = sin θi sin θo`, `z = cos θi cos θo` (`so`, `co` = `sin θo`, `cos θo`) crosses a plane
+/// `x = i/n` or `z = k/n` of a regular `n³` grid of the remapped cube: between them the grid's
+/// trilinear interpolant integrated over `y` is smooth along the path.
+pub(super) fn grid_break_angles(n: usize, so: f64, co: f64) -> Vec<f64> {
+    let mut breaks = vec![0.0, std::f64::consts::FRAC_PI_2];
+    for i in 1..n {
+        let v = i as f64 / n as f64;
+        if v < so {
+            breaks.push((v / so).asin());
+        }
+        if v < co {
+            breaks.push((v / co).acos());
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    breaks
 }
