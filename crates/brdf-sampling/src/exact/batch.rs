@@ -92,6 +92,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     run: &dyn PreparedRun,
     table: &LeafTable,
     map: DiscMap,
+    theta: f64,
     n: usize,
     wave: usize,
     u: &mut dyn UniformSource,
@@ -143,6 +144,8 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         f.resize(wave, 0.0);
     }
     let thin = table.thins();
+    // The thinning layer serving θo, picked once for the run.
+    let base = table.layer_base(theta);
     let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
     while !idx.is_empty() {
         if pass >= MAX_TRIALS_PER_SAMPLE {
@@ -158,7 +161,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         state2.clear();
         for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
             let len = ib.len();
-            lanes::trials(arch, table, map, thin, sb, t);
+            lanes::trials(arch, table, map, thin, base, sb, t);
             // The candidates inside the disc (and, with thinning bounds, whose threshold
             // `u₃·M_i` is below their sub-cell's bound `M_is ≥ g`: the others would be
             // rejected by `g` too), compacted without branches; the others propose again next
@@ -269,13 +272,14 @@ fn wavefront(
     run: &dyn PreparedRun,
     table: &LeafTable,
     map: DiscMap,
+    theta: f64,
     n: usize,
     wave: usize,
     u: &mut dyn UniformSource,
     audit: &mut Audit,
 ) -> Vec<Option<(Point2, f64)>> {
     let mut drawn = vec![None; n];
-    wavefront_with(run, table, map, n, wave, u, audit, |i, d| {
+    wavefront_with(run, table, map, theta, n, wave, u, audit, |i, d| {
         drawn[i] = d.map(|(p, _, g)| (p, g));
     });
     drawn
@@ -920,7 +924,18 @@ impl ExactSet {
                     let f = f.is_finite().then_some(f);
                     out[run[i] as usize] = self.finish_known(brdf, at.wo, s, f, same);
                 };
-                wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
+                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                wavefront_with(
+                    p.as_ref(),
+                    table,
+                    rec.map,
+                    theta,
+                    run.len(),
+                    WAVE,
+                    u,
+                    audit,
+                    emit,
+                );
             }
             Some(p) => {
                 let g = |x| run_density(p.as_ref(), rec.map, x);
@@ -1008,7 +1023,18 @@ impl ExactSet {
                         None => self.finish_known(brdf, wo, DirSample::NONE, None, same),
                     };
                 };
-                wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
+                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                wavefront_with(
+                    p.as_ref(),
+                    table,
+                    iv.map,
+                    theta,
+                    run.len(),
+                    WAVE,
+                    u,
+                    audit,
+                    emit,
+                );
                 return;
             }
         }
@@ -1727,7 +1753,16 @@ pub(super) mod tests {
         let draw = |n: usize| {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
             let mut audit = Audit::default();
-            let d = wavefront(run.as_ref(), table, map, n, 256, &mut rng, &mut audit);
+            let d = wavefront(
+                run.as_ref(),
+                table,
+                map,
+                q.cos.acos(),
+                n,
+                256,
+                &mut rng,
+                &mut audit,
+            );
             let bits: Vec<_> = d
                 .iter()
                 .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
@@ -1776,7 +1811,16 @@ pub(super) mod tests {
         for wave in [1, 7, 64, 256, 10_000] {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
             let mut audit = Audit::default();
-            let drawn = wavefront(run.as_ref(), table, map, 3000, wave, &mut rng, &mut audit);
+            let drawn = wavefront(
+                run.as_ref(),
+                table,
+                map,
+                q.cos.acos(),
+                3000,
+                wave,
+                &mut rng,
+                &mut audit,
+            );
             let bits: Vec<_> = drawn
                 .iter()
                 .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
@@ -1870,13 +1914,22 @@ pub(super) mod tests {
             };
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
             let mut audit = Audit::default();
-            let pts: Vec<[f64; 3]> = wavefront(run, table, map, 40_000, 256, &mut rng, &mut audit)
-                .into_iter()
-                .map(|d| {
-                    let v = map.to_direction(d.expect("accepted").0);
-                    [v.x, v.y, v.z]
-                })
-                .collect();
+            let pts: Vec<[f64; 3]> = wavefront(
+                run,
+                table,
+                map,
+                q.cos.acos(),
+                40_000,
+                256,
+                &mut rng,
+                &mut audit,
+            )
+            .into_iter()
+            .map(|d| {
+                let v = map.to_direction(d.expect("accepted").0);
+                [v.x, v.y, v.z]
+            })
+            .collect();
             let pdf = |d: [f64; 3]| set.pdf(&frame, &Vec3::new(d[0], d[1], d[2]));
             stats::chi_square_test(&bins, &pdf, &pts, &quad)
                 .unwrap()
@@ -1952,7 +2005,16 @@ pub(super) mod tests {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(31);
                 let seed = wave_seed(&mut rng.clone());
                 let mut audit = Audit::default();
-                let drawn = wavefront(run.as_ref(), table, map, 3000, 256, &mut rng, &mut audit);
+                let drawn = wavefront(
+                    run.as_ref(),
+                    table,
+                    map,
+                    q.cos.acos(),
+                    3000,
+                    256,
+                    &mut rng,
+                    &mut audit,
+                );
                 let g = |p| run_density(run.as_ref(), map, p);
                 let mut want_audit = Audit::default();
                 for (i, d) in drawn.iter().enumerate() {
@@ -2018,7 +2080,16 @@ pub(super) mod tests {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(41);
                 let mut audit = Audit::default();
                 let e0 = crate::disc::thread_evaluations();
-                let d = wavefront(run.as_ref(), tb, map, 4000, 256, &mut rng, &mut audit);
+                let d = wavefront(
+                    run.as_ref(),
+                    tb,
+                    map,
+                    q.cos.acos(),
+                    4000,
+                    256,
+                    &mut rng,
+                    &mut audit,
+                );
                 let e = crate::disc::thread_evaluations() - e0;
                 let bits: Vec<_> = d
                     .iter()

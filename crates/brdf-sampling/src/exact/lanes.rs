@@ -128,6 +128,7 @@ fn four_outputs(state: &mut u64) -> ([f64; 4], usize) {
 #[inline(always)]
 fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) -> Vec3>(
     table: &LeafTable,
+    base: usize,
     state: &mut [u64],
     t: &mut Trials,
     uniforms: U,
@@ -166,7 +167,7 @@ fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) 
             for j in 0..LANES {
                 let (k, l) = table.leaf_at(u0[j]);
                 leaf[j] = l;
-                factor[j] = table.code_factor(k, sub[j]);
+                factor[j] = table.code_factor(base, k, sub[j]);
             }
             for j in 0..LANES {
                 cs[j] = leaf[j][4] * factor[j];
@@ -204,6 +205,8 @@ struct Pass<'a> {
     map: DiscMap,
     split: bool,
     thin: bool,
+    /// The serving layer's codes ([`LeafTable::layer_base`]).
+    base: usize,
     state: &'a mut [u64],
     t: &'a mut Trials,
 }
@@ -217,27 +220,28 @@ impl pulp::WithSimd for Pass<'_> {
             map,
             split,
             thin,
+            base,
             state,
             t,
         } = self;
         match (map, split, thin) {
             (DiscMap::Projected, false, false) => {
-                pass::<false, _, _>(table, state, t, four_outputs, projected)
+                pass::<false, _, _>(table, base, state, t, four_outputs, projected)
             }
             (DiscMap::EqualArea, false, false) => {
-                pass::<false, _, _>(table, state, t, four_outputs, equal_area)
+                pass::<false, _, _>(table, base, state, t, four_outputs, equal_area)
             }
             (DiscMap::Projected, false, true) => {
-                pass::<true, _, _>(table, state, t, four_outputs, projected)
+                pass::<true, _, _>(table, base, state, t, four_outputs, projected)
             }
             (DiscMap::EqualArea, false, true) => {
-                pass::<true, _, _>(table, state, t, four_outputs, equal_area)
+                pass::<true, _, _>(table, base, state, t, four_outputs, equal_area)
             }
             (DiscMap::Projected, true, _) => {
-                pass::<false, _, _>(table, state, t, split_trial_pass, projected)
+                pass::<false, _, _>(table, base, state, t, split_trial_pass, projected)
             }
             (DiscMap::EqualArea, true, _) => {
-                pass::<false, _, _>(table, state, t, split_trial_pass, equal_area)
+                pass::<false, _, _>(table, base, state, t, split_trial_pass, equal_area)
             }
         }
     }
@@ -258,6 +262,7 @@ pub(super) fn trials(
     table: &LeafTable,
     map: DiscMap,
     thin: bool,
+    base: usize,
     state: &mut [u64],
     t: &mut Trials,
 ) {
@@ -266,6 +271,7 @@ pub(super) fn trials(
         map,
         split: false,
         thin: thin && table.thins(),
+        base,
         state,
         t,
     });
@@ -352,6 +358,7 @@ pub(super) fn trials_split(
         map,
         split: true,
         thin: false,
+        base: 0,
         state,
         t,
     });
