@@ -2033,8 +2033,9 @@ pub(super) mod tests {
         assert_eq!(compared, 12_000);
     }
 
-    /// Thinning (docs/benchmarks.md §30.1): on the RGL fixture, at a θo inside every interval
-    /// (its midpoint), the wavefront under the interval's table with its leaves' thinning bounds
+    /// Thinning (docs/benchmarks.md §30.1, §30.6): on the RGL fixture built with up to 4 θo
+    /// layers of ≥ 0.5°, at a θo inside every interval (its midpoint) and, for a layered one,
+    /// at its ends and at and just above each layer edge, the wavefront under the interval's table with its leaves' thinning bounds
     /// draws, bit for bit, the samples of the same table without them — the same points and
     /// `g`, the same trial and sample counts, 0 violations (`g` above the bound it was drawn
     /// under) — while evaluating `f` at least 5 % less often over the set. So the sub-cell bounds
@@ -2042,8 +2043,8 @@ pub(super) mod tests {
     /// shrunk by 12 % (`sub_bound`'s `m · q / 255 · 0.88`: other samples and violations) and
     /// with the sub-cell index transposed (`c[sx · SUB + sy]`, and later the top bits of `u₁`
     /// and `u₂` swapped in `four_outputs`: other samples); with thinning off it fails only
-    /// through its evaluation clause. A saved and loaded set keeps the bounds (the tables
-    /// compare equal).
+    /// through its evaluation clause. A saved and loaded set keeps the bounds and layers (the
+    /// tables compare equal).
     #[test]
     fn thinning_bounds_change_no_sample_and_save_evaluations() {
         use super::wavefront;
@@ -2051,8 +2052,15 @@ pub(super) mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../data/measured/rgl/paper_white_rgb.bsdf");
         let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
-        let set = ExactSet::build(Arc::clone(&rgl), &ExactOptions::default(), None).unwrap();
-        // Saved and loaded, the tables keep their thinning bounds (format version 2).
+        // Up to 4 θo layers of ≥ 0.5° (the fixture's default intervals are too narrow for the
+        // default's 1.5°).
+        let opts = ExactOptions {
+            thinning_layers: 4,
+            thinning_layer_deg: 0.5,
+            ..ExactOptions::default()
+        };
+        let set = ExactSet::build(Arc::clone(&rgl), &opts, None).unwrap();
+        // Saved and loaded, the tables keep their thinning bounds and layers (format 3).
         let spec = format!("rgl:{}", path.display());
         let back = ExactSet::from_bytes(&set.to_bytes(&spec), Arc::clone(&rgl), &spec).unwrap();
         assert!(
@@ -2060,8 +2068,21 @@ pub(super) mod tests {
             "thinning bounds saved"
         );
         let (mut evals_thin, mut evals_plain, mut thinned) = (0u64, 0u64, 0usize);
+        let mut layered = 0;
+        // Every interval at its midpoint, and a layered one also at its ends and layer edges.
+        let mut thetas = Vec::new();
         for iv in &set.cells[0].intervals {
-            let t = 0.5 * (iv.theta[0] + iv.theta[1]);
+            thetas.push(0.5 * (iv.theta[0] + iv.theta[1]));
+            if let Some(sub) = iv.sub_bounds.as_ref().filter(|s| s.layers() > 1) {
+                layered += 1;
+                thetas.extend([iv.theta[0].next_up(), iv.theta[1]]);
+                for &e in &sub.edges {
+                    thetas.extend([e, e.next_up()]);
+                }
+            }
+        }
+        assert!(layered >= 4, "{layered} layered intervals");
+        for t in thetas {
             let wo = brdf::direction_from_radians(t.min(89.0f64.to_radians()), 0.0);
             let q = set.locate(&wo).expect("served");
             let frame = if q.turn == crate::layout::Turn::IDENTITY {
@@ -2112,7 +2133,7 @@ pub(super) mod tests {
             evals_thin += e_a;
             evals_plain += e_b;
         }
-        assert!(thinned >= 10, "{thinned} intervals");
+        assert!(thinned >= 40, "{thinned} angles");
         let ratio = evals_thin as f64 / evals_plain as f64;
         println!("thinning: {evals_thin} / {evals_plain} evaluations = {ratio:.4}");
         assert!(
