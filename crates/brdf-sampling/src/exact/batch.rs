@@ -268,6 +268,7 @@ thread_local! {
 
 /// [`wavefront_with`]'s samples in index order (test support).
 #[cfg(test)]
+#[allow(clippy::too_many_arguments)]
 fn wavefront(
     run: &dyn PreparedRun,
     table: &LeafTable,

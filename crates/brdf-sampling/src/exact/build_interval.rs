@@ -1071,7 +1071,7 @@ mod tests {
         // The same trees with the interval's own codes (one layer), for (d).
         let one = ExactOptions {
             thinning_layers: 1,
-            ..opts.clone()
+            ..opts
         };
         let single = super::super::ExactSet::build(Arc::clone(&brdf), &one, None).unwrap();
         let top = THETA_TOP_DEG.to_radians();

@@ -123,7 +123,8 @@ fn four_outputs(state: &mut u64) -> ([f64; 4], usize) {
 /// ([`LeafTable::leaf_of`]), then the points, thresholds and directions (vector lanes),
 /// written in place (`t`'s room is a multiple of [`LANES`]; a last, partial group fills its
 /// group whole, the entries past `state.len()` meaning nothing). With `THIN`, also each
-/// trial's thinning bound (`M_i ·` [`LeafTable::code_factor`]) in `t.cap`, and `inside` then
+/// trial's thinning bound (`M_i ·` [`LeafTable::code_factor`], the codes of the layer at offset
+/// `base`) in `t.cap`, and `inside` then
 /// also requires the threshold below it (the trial's candidate flag).
 #[inline(always)]
 fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) -> Vec3>(
@@ -252,8 +253,9 @@ impl pulp::WithSimd for Pass<'_> {
 /// uniforms of trial `u_k = unit(mix64(state + (k + 1)·γ))`, `k = 0..3`, as
 /// [`LeafTable::draw`] reads them from the sample's stream, the point and bound
 /// [`LeafTable::propose`]'s; when the table has thinning bounds, each trial's
-/// thinning bound in `t.cap` too (`inside`: the candidate flag). Dispatched at run time (`pulp`); the same bits on every
-/// level.
+/// thinning bound in `t.cap` too (`inside`: the candidate flag), from the codes of the θo layer
+/// at offset `base` ([`LeafTable::layer_base`]). Dispatched at run time (`pulp`); the same bits
+/// on every level.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`LeafTable::propose`]: super::table::LeafTable::propose

@@ -199,6 +199,7 @@ impl LeafTable {
     }
 
     /// The layer count of the thinning bounds (1 without any).
+    #[cfg(test)]
     pub(super) fn layers(&self) -> usize {
         self.edges.len() + 1
     }
