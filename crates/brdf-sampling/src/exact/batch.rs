@@ -92,6 +92,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
     run: &dyn PreparedRun,
     table: &LeafTable,
     map: DiscMap,
+    theta: f64,
     n: usize,
     wave: usize,
     u: &mut dyn UniformSource,
@@ -143,6 +144,8 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         f.resize(wave, 0.0);
     }
     let thin = table.thins();
+    // The thinning layer serving θo, picked once for the run.
+    let base = table.layer_base(theta);
     let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
     while !idx.is_empty() {
         if pass >= MAX_TRIALS_PER_SAMPLE {
@@ -158,7 +161,7 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         state2.clear();
         for (ib, sb) in idx.chunks(wave).zip(state.chunks_mut(wave)) {
             let len = ib.len();
-            lanes::trials(arch, table, map, thin, sb, t);
+            lanes::trials(arch, table, map, thin, base, sb, t);
             // The candidates inside the disc (and, with thinning bounds, whose threshold
             // `u₃·M_i` is below their sub-cell's bound `M_is ≥ g`: the others would be
             // rejected by `g` too), compacted without branches; the others propose again next
@@ -265,17 +268,19 @@ thread_local! {
 
 /// [`wavefront_with`]'s samples in index order (test support).
 #[cfg(test)]
+#[allow(clippy::too_many_arguments)]
 fn wavefront(
     run: &dyn PreparedRun,
     table: &LeafTable,
     map: DiscMap,
+    theta: f64,
     n: usize,
     wave: usize,
     u: &mut dyn UniformSource,
     audit: &mut Audit,
 ) -> Vec<Option<(Point2, f64)>> {
     let mut drawn = vec![None; n];
-    wavefront_with(run, table, map, n, wave, u, audit, |i, d| {
+    wavefront_with(run, table, map, theta, n, wave, u, audit, |i, d| {
         drawn[i] = d.map(|(p, _, g)| (p, g));
     });
     drawn
@@ -920,7 +925,18 @@ impl ExactSet {
                     let f = f.is_finite().then_some(f);
                     out[run[i] as usize] = self.finish_known(brdf, at.wo, s, f, same);
                 };
-                wavefront_with(p.as_ref(), table, rec.map, run.len(), WAVE, u, audit, emit);
+                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                wavefront_with(
+                    p.as_ref(),
+                    table,
+                    rec.map,
+                    theta,
+                    run.len(),
+                    WAVE,
+                    u,
+                    audit,
+                    emit,
+                );
             }
             Some(p) => {
                 let g = |x| run_density(p.as_ref(), rec.map, x);
@@ -1008,7 +1024,18 @@ impl ExactSet {
                         None => self.finish_known(brdf, wo, DirSample::NONE, None, same),
                     };
                 };
-                wavefront_with(p.as_ref(), table, iv.map, run.len(), WAVE, u, audit, emit);
+                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                wavefront_with(
+                    p.as_ref(),
+                    table,
+                    iv.map,
+                    theta,
+                    run.len(),
+                    WAVE,
+                    u,
+                    audit,
+                    emit,
+                );
                 return;
             }
         }
@@ -1727,7 +1754,16 @@ pub(super) mod tests {
         let draw = |n: usize| {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
             let mut audit = Audit::default();
-            let d = wavefront(run.as_ref(), table, map, n, 256, &mut rng, &mut audit);
+            let d = wavefront(
+                run.as_ref(),
+                table,
+                map,
+                q.cos.acos(),
+                n,
+                256,
+                &mut rng,
+                &mut audit,
+            );
             let bits: Vec<_> = d
                 .iter()
                 .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
@@ -1776,7 +1812,16 @@ pub(super) mod tests {
         for wave in [1, 7, 64, 256, 10_000] {
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
             let mut audit = Audit::default();
-            let drawn = wavefront(run.as_ref(), table, map, 3000, wave, &mut rng, &mut audit);
+            let drawn = wavefront(
+                run.as_ref(),
+                table,
+                map,
+                q.cos.acos(),
+                3000,
+                wave,
+                &mut rng,
+                &mut audit,
+            );
             let bits: Vec<_> = drawn
                 .iter()
                 .map(|d| d.map(|(p, g)| [p[0], p[1], g].map(f64::to_bits)))
@@ -1870,13 +1915,22 @@ pub(super) mod tests {
             };
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
             let mut audit = Audit::default();
-            let pts: Vec<[f64; 3]> = wavefront(run, table, map, 40_000, 256, &mut rng, &mut audit)
-                .into_iter()
-                .map(|d| {
-                    let v = map.to_direction(d.expect("accepted").0);
-                    [v.x, v.y, v.z]
-                })
-                .collect();
+            let pts: Vec<[f64; 3]> = wavefront(
+                run,
+                table,
+                map,
+                q.cos.acos(),
+                40_000,
+                256,
+                &mut rng,
+                &mut audit,
+            )
+            .into_iter()
+            .map(|d| {
+                let v = map.to_direction(d.expect("accepted").0);
+                [v.x, v.y, v.z]
+            })
+            .collect();
             let pdf = |d: [f64; 3]| set.pdf(&frame, &Vec3::new(d[0], d[1], d[2]));
             stats::chi_square_test(&bins, &pdf, &pts, &quad)
                 .unwrap()
@@ -1952,7 +2006,16 @@ pub(super) mod tests {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(31);
                 let seed = wave_seed(&mut rng.clone());
                 let mut audit = Audit::default();
-                let drawn = wavefront(run.as_ref(), table, map, 3000, 256, &mut rng, &mut audit);
+                let drawn = wavefront(
+                    run.as_ref(),
+                    table,
+                    map,
+                    q.cos.acos(),
+                    3000,
+                    256,
+                    &mut rng,
+                    &mut audit,
+                );
                 let g = |p| run_density(run.as_ref(), map, p);
                 let mut want_audit = Audit::default();
                 for (i, d) in drawn.iter().enumerate() {
@@ -1971,8 +2034,9 @@ pub(super) mod tests {
         assert_eq!(compared, 12_000);
     }
 
-    /// Thinning (docs/benchmarks.md §30.1): on the RGL fixture, at a θo inside every interval
-    /// (its midpoint), the wavefront under the interval's table with its leaves' thinning bounds
+    /// Thinning (docs/benchmarks.md §30.1, §30.6): on the RGL fixture built with up to 4 θo
+    /// layers of ≥ 0.5°, at a θo inside every interval (its midpoint) and, for a layered one,
+    /// at its ends and at and just above each layer edge, the wavefront under the interval's table with its leaves' thinning bounds
     /// draws, bit for bit, the samples of the same table without them — the same points and
     /// `g`, the same trial and sample counts, 0 violations (`g` above the bound it was drawn
     /// under) — while evaluating `f` at least 5 % less often over the set. So the sub-cell bounds
@@ -1980,8 +2044,8 @@ pub(super) mod tests {
     /// shrunk by 12 % (`sub_bound`'s `m · q / 255 · 0.88`: other samples and violations) and
     /// with the sub-cell index transposed (`c[sx · SUB + sy]`, and later the top bits of `u₁`
     /// and `u₂` swapped in `four_outputs`: other samples); with thinning off it fails only
-    /// through its evaluation clause. A saved and loaded set keeps the bounds (the tables
-    /// compare equal).
+    /// through its evaluation clause. A saved and loaded set keeps the bounds and layers (the
+    /// tables compare equal).
     #[test]
     fn thinning_bounds_change_no_sample_and_save_evaluations() {
         use super::wavefront;
@@ -1989,8 +2053,15 @@ pub(super) mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../data/measured/rgl/paper_white_rgb.bsdf");
         let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
-        let set = ExactSet::build(Arc::clone(&rgl), &ExactOptions::default(), None).unwrap();
-        // Saved and loaded, the tables keep their thinning bounds (format version 2).
+        // Up to 4 θo layers of ≥ 0.5° (the fixture's default intervals are too narrow for the
+        // default's 1.5°).
+        let opts = ExactOptions {
+            thinning_layers: 4,
+            thinning_layer_deg: 0.5,
+            ..ExactOptions::default()
+        };
+        let set = ExactSet::build(Arc::clone(&rgl), &opts, None).unwrap();
+        // Saved and loaded, the tables keep their thinning bounds and layers (format 3).
         let spec = format!("rgl:{}", path.display());
         let back = ExactSet::from_bytes(&set.to_bytes(&spec), Arc::clone(&rgl), &spec).unwrap();
         assert!(
@@ -1998,8 +2069,21 @@ pub(super) mod tests {
             "thinning bounds saved"
         );
         let (mut evals_thin, mut evals_plain, mut thinned) = (0u64, 0u64, 0usize);
+        let mut layered = 0;
+        // Every interval at its midpoint, and a layered one also at its ends and layer edges.
+        let mut thetas = Vec::new();
         for iv in &set.cells[0].intervals {
-            let t = 0.5 * (iv.theta[0] + iv.theta[1]);
+            thetas.push(0.5 * (iv.theta[0] + iv.theta[1]));
+            if let Some(sub) = iv.sub_bounds.as_ref().filter(|s| s.layers() > 1) {
+                layered += 1;
+                thetas.extend([iv.theta[0].next_up(), iv.theta[1]]);
+                for &e in &sub.edges {
+                    thetas.extend([e, e.next_up()]);
+                }
+            }
+        }
+        assert!(layered >= 4, "{layered} layered intervals");
+        for t in thetas {
             let wo = brdf::direction_from_radians(t.min(89.0f64.to_radians()), 0.0);
             let q = set.locate(&wo).expect("served");
             let frame = if q.turn == crate::layout::Turn::IDENTITY {
@@ -2018,7 +2102,16 @@ pub(super) mod tests {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(41);
                 let mut audit = Audit::default();
                 let e0 = crate::disc::thread_evaluations();
-                let d = wavefront(run.as_ref(), tb, map, 4000, 256, &mut rng, &mut audit);
+                let d = wavefront(
+                    run.as_ref(),
+                    tb,
+                    map,
+                    q.cos.acos(),
+                    4000,
+                    256,
+                    &mut rng,
+                    &mut audit,
+                );
                 let e = crate::disc::thread_evaluations() - e0;
                 let bits: Vec<_> = d
                     .iter()
@@ -2041,7 +2134,7 @@ pub(super) mod tests {
             evals_thin += e_a;
             evals_plain += e_b;
         }
-        assert!(thinned >= 10, "{thinned} intervals");
+        assert!(thinned >= 40, "{thinned} angles");
         let ratio = evals_thin as f64 / evals_plain as f64;
         println!("thinning: {evals_thin} / {evals_plain} evaluations = {ratio:.4}");
         assert!(

@@ -35,19 +35,20 @@ const PEAK_TRACK_THETAS: usize = 65;
 const PEAK_TRACK_DELTAS: usize = 9;
 
 /// The peak track of an interval `[ta, tb]` of cell `phi_k` (azimuth offsets `deltas`): for
-/// every outgoing direction `(θ, φ_k + δ)` of a fine grid, its mirror direction's point in the
-/// interval's frame and disc map, and the member density there (`QueryDensity`).
+/// every outgoing direction `(θ, φ_k + δ)` of a fine grid (`thetas` equally spaced θ, ends
+/// included), its mirror direction's point in the interval's frame and disc map, and the member
+/// density there (`QueryDensity`).
 fn peak_track<'a>(
     brdf: &'a dyn Brdf,
-    ta: f64,
-    tb: f64,
+    [ta, tb]: [f64; 2],
+    thetas: usize,
     phi_k: f64,
     deltas: &[f64],
     map: DiscMap,
 ) -> Vec<crate::image_map::TrackPoint<'a>> {
     let mut track = Vec::new();
-    for n in 0..PEAK_TRACK_THETAS {
-        let t = ta + (tb - ta) * n as f64 / (PEAK_TRACK_THETAS - 1) as f64;
+    for n in 0..thetas {
+        let t = ta + (tb - ta) * n as f64 / (thetas - 1) as f64;
         for &d in deltas {
             let wo = direction_from_radians(t, phi_k + d);
             let g = QueryDensity::new(brdf, wo, d, map);
@@ -221,7 +222,7 @@ fn bound_nodes(
 /// The thinning bounds of `tree`'s leaves from the image map it was built on (see
 /// [`SubBounds`]): sub-cell `s` of leaf `i` gets the code of `min(M_i, region(s).max_bound)`,
 /// the leaf rule's bound over the sub-cell's rectangle, rounded up ([`sub_code`]).
-fn sub_bounds(tree: &QuadTree, image: &SliceImageMap<'_>) -> SubBounds {
+fn sub_bounds(tree: &QuadTree, image: &SliceImageMap<'_>) -> Box<[[u8; SUB_CELLS]]> {
     use partition_sampler::{Rect, RegionStats};
     tree.leaves()
         .map(|l| {
@@ -240,6 +241,123 @@ fn sub_bounds(tree: &QuadTree, image: &SliceImageMap<'_>) -> SubBounds {
             codes
         })
         .collect()
+}
+
+/// Whether `brdf`'s intervals get thinning bounds: an RGL material with `options.thinning`.
+fn thins(options: &ExactOptions, brdf: &dyn Brdf) -> bool {
+    options.thinning && brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>())
+}
+
+/// The θo layers of an interval's thinning bounds: `L = ⌊(θ_b − θ_a) / w⌋` clamped to
+/// `[1, thinning_layers]`, `w` = [`ExactOptions::thinning_layer_deg`] (an interval narrower
+/// than `2w` keeps one layer: over a narrow θo range the envelope is close to `f` already,
+/// docs/benchmarks.md §30.1's factor (b), and its layers would cost image maps for little).
+fn layer_count(options: &ExactOptions, span: &Span) -> usize {
+    let w = (span.tb - span.ta).to_degrees() / options.thinning_layer_deg;
+    if !(w >= 2.0) {
+        return 1;
+    }
+    (w.floor() as usize).clamp(1, options.thinning_layers.max(1))
+}
+
+/// The thinning bounds of `tree`'s leaves in `L` θo layers ([`layer_count`]; see
+/// [`SubBounds`]): layer `l` spans `[θ_l, θ_{l+1}]`, `θ_l` the rational `(a·L + (b − a)·l) /
+/// (den·L)` of the interval `num = [a, b]` (clamped to the top angle as the interval's ends;
+/// at `L = bound_nodes − 1` these are the interval's own bound nodes, bit for bit). Each layer's
+/// codes come from an image map built as the interval's ([`envelope_tree`]: the same lattice,
+/// safety factor, dilation and rim band) on the envelope `max f(ωo_n, ·)` of its two end nodes
+/// `θ_l, θ_{l+1}` (and their δ nodes), with the members' peak track over `[θ_l, θ_{l+1}]` (at the
+/// interval's track spacing, `⌈64/L⌉ + 1` angles): the
+/// interval's own rule applied to the layer, whose end nodes are at most as far apart as the
+/// interval's bound nodes when `L ≥ bound_nodes − 1`. A code is capped at 255 (`M_i`), so
+/// each layer bound is also at most the interval's. Returns the bounds and the evaluations of
+/// the layers' image maps.
+#[allow(clippy::too_many_arguments)]
+fn layer_bounds(
+    brdf: &Arc<dyn Brdf>,
+    options: &ExactOptions,
+    job: &Job,
+    ctx: &IntervalContext,
+    span: &Span,
+    n_delta: usize,
+    track_deltas: &[f64],
+    tree: &QuadTree,
+) -> Result<(SubBounds, u64), ExactError> {
+    let layers = layer_count(options, span) as u64;
+    let top = THETA_TOP_DEG.to_radians();
+    let (grid, set) = (ctx.grid, &options.set);
+    let edge = |l: u64| {
+        let k = job.num[0] * layers + (job.num[1] - job.num[0]) * l;
+        (k, grid.angle(k, layers).min(top))
+    };
+    let grid_options = GridOptions {
+        refinement: set.grid_refinement,
+        mirror_y: span.mirror_y,
+        ..GridOptions::default()
+    };
+    // The layer's track at the interval's track spacing (or finer).
+    let layer_track = (PEAK_TRACK_THETAS - 1).div_ceil(layers as usize) + 1;
+    let counter = EvalCounter::new();
+    let mut codes = Vec::with_capacity(layers as usize * tree.leaves().len());
+    let mut edges = Vec::with_capacity(layers as usize - 1);
+    for l in 0..layers {
+        let ends = [edge(l), edge(l + 1)];
+        if l > 0 {
+            edges.push(ends[0].1);
+        }
+        let mut nodes = Vec::with_capacity(2 * n_delta);
+        for (num, t) in ends {
+            for d in delta_nodes(&grid, job, span.isotropic, n_delta) {
+                let wo = direction_from_radians(t, ctx.phi_k + d);
+                nodes.push(EnvelopeNode::new(
+                    (num, d.to_bits()),
+                    brdf.prepare(&wo),
+                    d,
+                    None,
+                    false,
+                ));
+            }
+        }
+        let envelope = Arc::new(IntervalEnvelope::new(Arc::clone(brdf), nodes, true));
+        let f = DiscBrdf::with_map(
+            Arc::clone(&envelope) as Arc<dyn Brdf>,
+            span.centre(ctx.phi_k),
+            span.map,
+        )
+        .with_blocks(Arc::clone(&envelope) as Arc<dyn crate::disc::DirectionBlock>);
+        let image = SliceImageMap::new(
+            Counted {
+                f: &f,
+                counter: &counter,
+            },
+            envelope_grid(set, brdf.as_ref()),
+            set.safety_factor,
+            set.dilation_for(brdf.as_ref()),
+            &grid_options,
+        )
+        .map_err(|source| SetError::Density {
+            slice: span.slice,
+            theta_deg: span.theta_deg,
+            phi_deg: span.phi_deg,
+            source,
+        })?
+        .with_track(peak_track(
+            brdf.as_ref(),
+            [ends[0].1, ends[1].1],
+            layer_track,
+            ctx.phi_k,
+            track_deltas,
+            span.map,
+        ));
+        codes.extend(sub_bounds(tree, &image));
+    }
+    Ok((
+        SubBounds {
+            codes: codes.into_boxed_slice(),
+            edges: edges.into_boxed_slice(),
+        },
+        counter.total() * 2 * n_delta as u64,
+    ))
 }
 
 /// The envelope tree of an interval: the image map of the envelope `f` (with the peak track
@@ -282,8 +400,8 @@ fn envelope_tree(
     // moves with θo (and δ), and a cusp there (Beard–Maxwell) falls between the bound nodes'.
     let image = image.with_track(peak_track(
         brdf,
-        span.ta,
-        span.tb,
+        [span.ta, span.tb],
+        PEAK_TRACK_THETAS,
         ctx.phi_k,
         track_deltas,
         span.map,
@@ -301,8 +419,9 @@ fn envelope_tree(
             phi_deg,
             source,
         })?;
-    let thin = options.thinning && brdf.as_any().is_some_and(|a| a.is::<brdf::RglBrdf>());
-    let sub = thin.then(|| sub_bounds(&tree, &image));
+    // One layer here; more are built by `layer_bounds` on other image maps.
+    let thin = thins(options, brdf) && layer_count(options, span) <= 1;
+    let sub = thin.then(|| SubBounds::single(sub_bounds(&tree, &image)));
     drop(image);
     Ok((tree, counter.total(), sub))
 }
@@ -579,9 +698,13 @@ pub(super) fn build_interval(
     );
     // A parent split for its tail hands down its tree (on the same disc map: its bounds hold
     // over the parent's interval, so over this one too); otherwise the envelope's own.
-    let (tree, points, sub) = match &job.inherited.tree {
-        Some((tree, map, sub)) if *map == span.map => (tree.clone(), 0, sub.clone()),
-        _ => envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?,
+    let (tree, points, sub, inherited) = match &job.inherited.tree {
+        Some((tree, map, sub)) if *map == span.map => (tree.clone(), 0, sub.clone(), true),
+        _ => {
+            let (tree, points, sub) =
+                envelope_tree(brdf.as_ref(), options, ctx, &span, &f, &track)?;
+            (tree, points, sub, false)
+        }
     };
     drop(f);
     phases.envelope = lap.take();
@@ -617,20 +740,33 @@ pub(super) fn build_interval(
     phases.nodes = normalisers.len() as u64;
     let (interval, table) = match outcome {
         TableOutcome::Split(table) => (None, table),
-        TableOutcome::Table(table, quad_err) => (
-            Some(finish_interval(
-                brdf,
-                job,
-                ctx,
-                &span,
-                &envelope,
-                (tree, sub),
-                table,
-                quad_err,
-                build_evals + axis_evals + quad_evals,
-            )?),
-            None,
-        ),
+        TableOutcome::Table(table, quad_err) => {
+            // Thinning layers, for a kept interval only, on its own tree (an inherited tree
+            // keeps its parent's bounds, which hold over the parent's layers, so over this
+            // interval's θo too).
+            let (sub, layer_evals) =
+                if !inherited && thins(options, brdf.as_ref()) && layer_count(options, &span) > 1 {
+                    let (b, e) =
+                        layer_bounds(brdf, options, job, ctx, &span, n_delta, &track, &tree)?;
+                    (Some(b), e)
+                } else {
+                    (sub, 0)
+                };
+            (
+                Some(finish_interval(
+                    brdf,
+                    job,
+                    ctx,
+                    &span,
+                    &envelope,
+                    (tree, sub),
+                    table,
+                    quad_err,
+                    build_evals + axis_evals + quad_evals + layer_evals,
+                )?),
+                None,
+            )
+        }
     };
     phases.finish = lap.take();
     // A kept interval's values are gathered for children only if the caller splits it for
@@ -903,5 +1039,177 @@ mod tests {
             "{worst9:e} vs {worst5:e}"
         );
         assert!(table.rel_tail_theta() < 0.01 * five.rel_tail_theta());
+    }
+
+    /// The θo layers of the thinning bounds (docs/benchmarks.md §30.6), on the RGL fixture built
+    /// with up to 4 layers of ≥ 0.5°: (a) each layered interval's edges cut `[θ_a, θ_b]` in `L`
+    /// equal parts (then clamped to the top angle); (b) the layer serving a θo at an interval's ends, at each
+    /// edge (the lower layer), just above it and inside is the one whose range holds it
+    /// (`LeafTable::layer_base`); (c) each layer's codes are those of an image map built here
+    /// independently from the envelope of **both** of the layer's end nodes and the peak track
+    /// of its θo range (the build's rule for a layer); (d) at 12 × 12 points of every 8th leaf,
+    /// `g(θo) ≤ M_ils` of the layer serving θo, at the layer's ends and middle, wherever `g` is
+    /// within the interval's own (one-layer) code there — the layers add no point above its
+    /// bound (the image-map rule has a few of its own: counted, docs §30.6). Fails (each
+    /// tried, docs §30.6): with the layer picked one too high (`layer_of` + 1, clamped): (b);
+    /// with `theta >= e` in `layer_of`: (b) at the edges; with a layer's image map from its
+    /// lower end node only: (c); with layer `l` built on layer `l + 1`'s nodes (clamped): (c).
+    #[test]
+    fn thinning_layers_are_picked_by_theta_and_bound_both_ends() {
+        use super::super::table::{LeafTable, SUB, layer_of};
+        use partition_sampler::{Point2, Rect};
+        let Some(rgl) = super::super::tests::paper_white_fixture() else {
+            return;
+        };
+        let brdf: Arc<dyn Brdf> = Arc::new(rgl);
+        let opts = ExactOptions {
+            thinning_layers: 4,
+            thinning_layer_deg: 0.5,
+            ..ExactOptions::default()
+        };
+        let set = super::super::ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
+        // The same trees with the interval's own codes (one layer), for (d).
+        let one = ExactOptions {
+            thinning_layers: 1,
+            ..opts
+        };
+        let single = super::super::ExactSet::build(Arc::clone(&brdf), &one, None).unwrap();
+        let top = THETA_TOP_DEG.to_radians();
+        let cell = &set.cells[0];
+        let (mut old, mut new) = (0, 0);
+        let (mut layered, mut checked, mut inherited) = (0, 0, 0);
+        for ((iv, table), plain) in cell
+            .intervals
+            .iter()
+            .zip(&cell.tables)
+            .zip(&single.cells[0].tables)
+        {
+            let plain = plain.as_ref().unwrap();
+            let (Some(sub), Some(table)) = (&iv.sub_bounds, table) else {
+                continue;
+            };
+            let l_count = sub.layers();
+            if l_count == 1 {
+                continue;
+            }
+            let (ta, tb) = (iv.theta[0].min(top), iv.theta[1].min(top));
+            let n = iv.tree.tree().leaves().len();
+            assert_eq!(sub.codes.len(), l_count * n);
+            assert_eq!(table.layers(), l_count);
+            // An interval that inherited its parent's tree (a split for its tail) keeps the
+            // parent's layers, over the parent's wider range.
+            if !(sub.edges[0] > ta && sub.edges[l_count - 2] < tb) {
+                inherited += 1;
+                continue;
+            }
+            layered += 1;
+            // (a) the edges.
+            let mut ends = vec![ta];
+            for (l, &e) in sub.edges.iter().enumerate() {
+                let (a, b) = (iv.theta[0], iv.theta[1]);
+                let want = (a + (b - a) * (l + 1) as f64 / l_count as f64).min(top);
+                assert!((e - want).abs() < 1e-12, "edge {l}: {e} vs {want}");
+                ends.push(e);
+            }
+            ends.push(tb);
+            // (b) the serving layer.
+            for l in 0..l_count {
+                let (a, b) = (ends[l], ends[l + 1]);
+                let base = l * n * SUB_CELLS;
+                for t in [a.next_up(), 0.5 * (a + b), b] {
+                    assert_eq!(layer_of(&sub.edges, t), Some(l), "θo {t} in layer {l}");
+                    assert_eq!(table.layer_base(t), base);
+                }
+            }
+            assert_eq!(table.layer_base(ta), 0);
+            assert_eq!(table.layer_base(f64::NAN), usize::MAX / 2);
+            // (c) each layer's codes from an image map of both end nodes, made here.
+            let tree = iv.tree.tree();
+            let mirror_y = opts.set.symmetries && brdf.is_mirror_symmetric();
+            let grid_options = GridOptions {
+                refinement: opts.set.grid_refinement,
+                mirror_y,
+                ..GridOptions::default()
+            };
+            let centre = direction_from_radians(0.5 * (ta + tb), 0.0);
+            for l in 0..l_count {
+                let nodes = [ends[l], ends[l + 1]]
+                    .iter()
+                    .map(|&t| {
+                        let wo = direction_from_radians(t, 0.0);
+                        EnvelopeNode::new((0, 0), brdf.prepare(&wo), 0.0, None, false)
+                    })
+                    .collect();
+                let env = Arc::new(IntervalEnvelope::new(Arc::clone(&brdf), nodes, false));
+                let f = DiscBrdf::with_map(env as Arc<dyn Brdf>, centre, iv.map);
+                let counter = EvalCounter::new();
+                let thetas = (PEAK_TRACK_THETAS - 1).div_ceil(l_count) + 1;
+                let image = SliceImageMap::new(
+                    Counted {
+                        f: &f,
+                        counter: &counter,
+                    },
+                    envelope_grid(&opts.set, brdf.as_ref()),
+                    opts.set.safety_factor,
+                    opts.set.dilation_for(brdf.as_ref()),
+                    &grid_options,
+                )
+                .unwrap()
+                .with_track(peak_track(
+                    brdf.as_ref(),
+                    [ends[l], ends[l + 1]],
+                    thetas,
+                    0.0,
+                    &[0.0],
+                    iv.map,
+                ));
+                let want = sub_bounds(tree, &image);
+                assert!(
+                    *want == sub.codes[l * n..(l + 1) * n],
+                    "layer {l} of [{ta}, {tb}]: codes not from both end nodes"
+                );
+            }
+            // (d) the layer bounds hold at sampled points.
+            let leaves: Vec<Rect> = tree.leaves().map(|l| l.rect).collect();
+            for l in 0..l_count {
+                for t in [ends[l], 0.5 * (ends[l] + ends[l + 1]), ends[l + 1]] {
+                    let wo = direction_from_radians(t, 0.0);
+                    let g = QueryDensity::new(brdf.as_ref(), wo, 0.0, iv.map);
+                    let base = table.layer_base(t);
+                    for (k, r) in leaves.iter().enumerate().step_by(8) {
+                        let m = tree.leaves().nth(k).map(|x| x.max_bound).unwrap();
+                        for j in 0..144 {
+                            let (u, v) = ((j % 12) as f64 + 0.5, (j / 12) as f64 + 0.5);
+                            let p: Point2 = [
+                                r.x0 + (r.x1 - r.x0) * u / 12.0,
+                                r.y0 + (r.y1 - r.y0) * v / 12.0,
+                            ];
+                            let s = ((v / 12.0 * SUB as f64) as usize) * SUB
+                                + (u / 12.0 * SUB as f64) as usize;
+                            let bound = m * table.code_factor(base, k, s);
+                            let gv = g.at(p);
+                            if gv > bound {
+                                // Above the interval's own code too: the image-map rule's
+                                // (§30.1), not the layer's.
+                                if gv > m * plain.code_factor(0, k, s) {
+                                    old += 1;
+                                } else {
+                                    new += 1;
+                                    println!("θo {t}: leaf {k} sub {s}: {gv} > {bound}, layer {l}");
+                                }
+                            }
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(layered >= 4, "{layered} layered intervals");
+        println!(
+            "{layered} layered intervals ({inherited} inherited), {checked} points checked: \
+             {new} above their layer's bound only, {old} above the interval's code too"
+        );
+        assert_eq!(new, 0, "points above their layer's bound only");
+        let _ = LeafTable::of::<crate::disc::SliceDensity>;
     }
 }

@@ -123,11 +123,13 @@ fn four_outputs(state: &mut u64) -> ([f64; 4], usize) {
 /// ([`LeafTable::leaf_of`]), then the points, thresholds and directions (vector lanes),
 /// written in place (`t`'s room is a multiple of [`LANES`]; a last, partial group fills its
 /// group whole, the entries past `state.len()` meaning nothing). With `THIN`, also each
-/// trial's thinning bound (`M_i ·` [`LeafTable::code_factor`]) in `t.cap`, and `inside` then
+/// trial's thinning bound (`M_i ·` [`LeafTable::code_factor`], the codes of the layer at offset
+/// `base`) in `t.cap`, and `inside` then
 /// also requires the threshold below it (the trial's candidate flag).
 #[inline(always)]
 fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) -> Vec3>(
     table: &LeafTable,
+    base: usize,
     state: &mut [u64],
     t: &mut Trials,
     uniforms: U,
@@ -166,7 +168,7 @@ fn pass<const THIN: bool, U: Fn(&mut u64) -> ([f64; 4], usize), D: Fn(f64, f64) 
             for j in 0..LANES {
                 let (k, l) = table.leaf_at(u0[j]);
                 leaf[j] = l;
-                factor[j] = table.code_factor(k, sub[j]);
+                factor[j] = table.code_factor(base, k, sub[j]);
             }
             for j in 0..LANES {
                 cs[j] = leaf[j][4] * factor[j];
@@ -204,6 +206,8 @@ struct Pass<'a> {
     map: DiscMap,
     split: bool,
     thin: bool,
+    /// The serving layer's codes ([`LeafTable::layer_base`]).
+    base: usize,
     state: &'a mut [u64],
     t: &'a mut Trials,
 }
@@ -217,27 +221,28 @@ impl pulp::WithSimd for Pass<'_> {
             map,
             split,
             thin,
+            base,
             state,
             t,
         } = self;
         match (map, split, thin) {
             (DiscMap::Projected, false, false) => {
-                pass::<false, _, _>(table, state, t, four_outputs, projected)
+                pass::<false, _, _>(table, base, state, t, four_outputs, projected)
             }
             (DiscMap::EqualArea, false, false) => {
-                pass::<false, _, _>(table, state, t, four_outputs, equal_area)
+                pass::<false, _, _>(table, base, state, t, four_outputs, equal_area)
             }
             (DiscMap::Projected, false, true) => {
-                pass::<true, _, _>(table, state, t, four_outputs, projected)
+                pass::<true, _, _>(table, base, state, t, four_outputs, projected)
             }
             (DiscMap::EqualArea, false, true) => {
-                pass::<true, _, _>(table, state, t, four_outputs, equal_area)
+                pass::<true, _, _>(table, base, state, t, four_outputs, equal_area)
             }
             (DiscMap::Projected, true, _) => {
-                pass::<false, _, _>(table, state, t, split_trial_pass, projected)
+                pass::<false, _, _>(table, base, state, t, split_trial_pass, projected)
             }
             (DiscMap::EqualArea, true, _) => {
-                pass::<false, _, _>(table, state, t, split_trial_pass, equal_area)
+                pass::<false, _, _>(table, base, state, t, split_trial_pass, equal_area)
             }
         }
     }
@@ -248,8 +253,9 @@ impl pulp::WithSimd for Pass<'_> {
 /// uniforms of trial `u_k = unit(mix64(state + (k + 1)·γ))`, `k = 0..3`, as
 /// [`LeafTable::draw`] reads them from the sample's stream, the point and bound
 /// [`LeafTable::propose`]'s; when the table has thinning bounds, each trial's
-/// thinning bound in `t.cap` too (`inside`: the candidate flag). Dispatched at run time (`pulp`); the same bits on every
-/// level.
+/// thinning bound in `t.cap` too (`inside`: the candidate flag), from the codes of the θo layer
+/// at offset `base` ([`LeafTable::layer_base`]). Dispatched at run time (`pulp`); the same bits
+/// on every level.
 ///
 /// [`LeafTable::draw`]: super::table::LeafTable::draw
 /// [`LeafTable::propose`]: super::table::LeafTable::propose
@@ -258,6 +264,7 @@ pub(super) fn trials(
     table: &LeafTable,
     map: DiscMap,
     thin: bool,
+    base: usize,
     state: &mut [u64],
     t: &mut Trials,
 ) {
@@ -266,6 +273,7 @@ pub(super) fn trials(
         map,
         split: false,
         thin: thin && table.thins(),
+        base,
         state,
         t,
     });
@@ -352,6 +360,7 @@ pub(super) fn trials_split(
         map,
         split: true,
         thin: false,
+        base: 0,
         state,
         t,
     });

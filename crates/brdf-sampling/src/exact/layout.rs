@@ -157,7 +157,7 @@ impl Cell {
         }
         let tables = intervals
             .iter()
-            .map(|iv| LeafTable::of(&iv.tree).map(|t| t.with_sub_bounds(iv.sub_bounds.as_deref())))
+            .map(|iv| LeafTable::of(&iv.tree).map(|t| t.with_sub_bounds(iv.sub_bounds.as_ref())))
             .collect();
         let half_key = if by_tan { tan_half } else { grid.half };
         let iso = intervals

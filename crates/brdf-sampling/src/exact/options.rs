@@ -110,6 +110,16 @@ pub struct ExactOptions {
     /// the fixed-`ωo` wavefront rejects a trial whose threshold `u₃·M_i ≥ M_is` without
     /// evaluating `f` (the same samples; fewer evaluations). Other BRDFs: unused.
     pub thinning: bool,
+    /// Most θo layers of the thinning bounds (docs/benchmarks.md §30.6; ≥ 1): an RGL interval's θo
+    /// range `[θ_a, θ_b]` is cut into `L = ⌊(θ_b − θ_a) / thinning_layer_deg⌋` equal layers (in
+    /// the grid's rationals; `L` clamped to `[1, thinning_layers]`), each with its own
+    /// codes over the same tree, leaf bounds and alias table, from the envelope of the layer's
+    /// end nodes and the peak track inside it; the fixed-`ωo` wavefront reads the layer of its
+    /// θo. 1: the interval's codes (§30.1).
+    pub thinning_layers: usize,
+    /// The narrowest θo layer of the thinning bounds (degrees, > 0), see
+    /// [`ExactOptions::thinning_layers`].
+    pub thinning_layer_deg: f64,
 }
 
 impl ExactOptions {
@@ -129,6 +139,10 @@ impl ExactOptions {
     pub const DEFAULT_MAX_TRIALS: f64 = 2.0;
     /// Default interpolation tolerance.
     pub const DEFAULT_NORMALISER_TOL: f64 = 1e-6;
+    /// Default θo layers of the thinning bounds (RGL materials).
+    pub const DEFAULT_THINNING_LAYERS: usize = 4;
+    /// Default narrowest θo layer of the thinning bounds (degrees).
+    pub const DEFAULT_THINNING_LAYER_DEG: f64 = 1.5;
     /// Default narrowest interval (degrees).
     pub const DEFAULT_MIN_WIDTH_DEG: f64 = 0.25;
 
@@ -146,6 +160,8 @@ impl ExactOptions {
             normaliser_tol: Self::DEFAULT_NORMALISER_TOL,
             min_width_deg: Self::DEFAULT_MIN_WIDTH_DEG,
             thinning: true,
+            thinning_layers: Self::DEFAULT_THINNING_LAYERS,
+            thinning_layer_deg: Self::DEFAULT_THINNING_LAYER_DEG,
         }
     }
 
@@ -188,6 +204,12 @@ impl ExactOptions {
         }
         if !(self.min_width_deg > 0.0 && self.min_width_deg <= 90.0) {
             return bad("min_width_deg (0, 90]", self.min_width_deg);
+        }
+        if !(1..=16).contains(&self.thinning_layers) {
+            return bad("thinning_layers (1 ..= 16)", self.thinning_layers as f64);
+        }
+        if !(self.thinning_layer_deg > 0.0 && self.thinning_layer_deg <= 90.0) {
+            return bad("thinning_layer_deg (0, 90]", self.thinning_layer_deg);
         }
         Ok(())
     }

@@ -7,7 +7,8 @@
 //! numerators (see `Grid`), normaliser table (nodes and values of `A · cos θo`), the
 //! quadrature's error estimate, the build's evaluation count, the tree in partition-sampler's
 //! own versioned format ([`partition_sampler::FORMAT_VERSION`]) and the leaves' thinning bounds
-//! (16 codes per leaf in the tree's leaf order, or none; version 2, §30.1).
+//! (16 codes per leaf in the tree's leaf order, per θo layer, and the layers' inner edges; or none;
+//! version 2, §30.1; version 3: the layers, §30.6).
 //!
 //! The BRDF is not stored: it is re-attached on load, which checks that the spec matches and
 //! that the BRDF reproduces the probes. The set's grid, cells, table variable and azimuth
@@ -43,7 +44,7 @@ use super::set::ExactSet;
 use super::table::{SUB_CELLS, SubBounds};
 
 /// Version of the stored `adaptive-exact` format; bumped on any incompatible change.
-pub const EXACT_FORMAT_VERSION: u32 = 2;
+pub const EXACT_FORMAT_VERSION: u32 = 3;
 
 const MAGIC: &[u8; 4] = b"BRQE";
 
@@ -69,8 +70,10 @@ struct StoredInterval {
     quad_err: f64,
     evaluations: u64,
     tree: Vec<u8>,
-    /// The thinning bounds' codes, [`SUB_CELLS`] per leaf (empty: none).
+    /// The thinning bounds' codes, [`SUB_CELLS`] per leaf, layer after layer (empty: none).
     sub_bounds: Vec<u8>,
+    /// The thinning layers' inner θo edges (radians; empty: one layer).
+    sub_edges: Vec<f64>,
 }
 
 impl StoredInterval {
@@ -86,8 +89,12 @@ impl StoredInterval {
             tree: iv.tree.tree().to_bytes(),
             sub_bounds: iv
                 .sub_bounds
-                .as_deref()
-                .map_or_else(Vec::new, |s| s.as_flattened().to_vec()),
+                .as_ref()
+                .map_or_else(Vec::new, |s| s.codes.as_flattened().to_vec()),
+            sub_edges: iv
+                .sub_bounds
+                .as_ref()
+                .map_or_else(Vec::new, |s| s.edges.to_vec()),
         }
     }
 }
@@ -286,10 +293,15 @@ fn load_interval(
         return Err(bad("wrong domain or scheme".into()));
     }
     let leaves = tree.leaves().len();
+    let layers = iv.sub_edges.len() + 1;
+    if !iv.sub_edges.is_sorted_by(|a, b| a < b) || iv.sub_edges.iter().any(|e| !e.is_finite()) {
+        return Err(bad("thinning layer edges not finite and increasing".into()));
+    }
     let sub_bounds: Option<SubBounds> = match iv.sub_bounds.len() {
         0 => None,
-        n if n == leaves * SUB_CELLS => Some(
-            iv.sub_bounds
+        n if n == layers * leaves * SUB_CELLS => Some(SubBounds {
+            codes: iv
+                .sub_bounds
                 .chunks_exact(SUB_CELLS)
                 .map(|c| {
                     let mut a = [0u8; SUB_CELLS];
@@ -297,11 +309,12 @@ fn load_interval(
                     a
                 })
                 .collect(),
-        ),
+            edges: iv.sub_edges.clone().into_boxed_slice(),
+        }),
         n => {
             return Err(bad(format!(
-                "{n} thinning bound codes for {leaves} leaves (want {})",
-                leaves * SUB_CELLS
+                "{n} thinning bound codes for {layers} layers of {leaves} leaves (want {})",
+                layers * leaves * SUB_CELLS
             )));
         }
     };

@@ -70,15 +70,50 @@ pub(super) fn sub_code(m: f64, b: f64) -> u8 {
     q
 }
 
-/// Per-leaf thinning bounds of one interval's tree (issue 29, docs/benchmarks.md §30.1): leaf
-/// `i`'s rectangle cut into `SUB × SUB` equal sub-cells, sub-cell `(sx, sy)` (row-major by
-/// `sy`) holding the code `q` of `M_is = m_i · q / 255` ([`sub_bound`]), at least the image
-/// map's bound over the sub-cell (the leaf rule's: `safety ×` the largest sample, the peak track
-/// and the rim band) and at most `M_i`. A trial at a point of sub-cell `s` whose acceptance
-/// threshold `u₃·M_i` is at least `M_is` is rejected without evaluating `g`: `g ≤ M_is` there,
-/// so it would have been rejected anyway — the same samples, the same law; only the
-/// evaluations fall. `SUB_CELLS` bytes per leaf, in the tree's leaf order.
-pub(super) type SubBounds = Box<[[u8; SUB_CELLS]]>;
+/// Per-leaf thinning bounds of one interval's tree (issue 29, docs/benchmarks.md §30.1, §30.6),
+/// in `L ≥ 1` θo layers: the layers cut the θo range the bounds serve at the inner edges
+/// `edges` (`L − 1` angles in radians, increasing); in layer `l` (`e_l ≤ θo ≤ e_{l+1}`, with the
+/// interval's ends outside), leaf `i`'s rectangle is cut into `SUB × SUB` equal sub-cells,
+/// sub-cell `(sx, sy)` (row-major by `sy`) holding the code `q` of `M_ils = m_i · q / 255`
+/// ([`sub_bound`]), at least the leaf rule's bound over the sub-cell for every θo of the layer
+/// (`safety ×` the largest image-map sample of the envelope of the layer's end nodes, the peak
+/// track of the layer's θo and the rim band) and at most `M_i`. A trial at a point of sub-cell
+/// `s` whose acceptance threshold `u₃·M_i` is at least `M_ils` is rejected without evaluating
+/// `g`: `g ≤ M_ils` there, so it would have been rejected anyway — the same samples, the same
+/// law; only the evaluations fall.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct SubBounds {
+    /// `L · leaves` code blocks, layer-major, each layer's in the tree's leaf order.
+    pub(super) codes: Box<[[u8; SUB_CELLS]]>,
+    /// The `L − 1` inner layer edges (radians, increasing; empty: one layer).
+    pub(super) edges: Box<[f64]>,
+}
+
+impl SubBounds {
+    /// One layer's codes (`L = 1`).
+    pub(super) fn single(codes: Box<[[u8; SUB_CELLS]]>) -> Self {
+        Self {
+            codes,
+            edges: Box::new([]),
+        }
+    }
+
+    /// The layer count `L = edges.len() + 1`.
+    pub(super) fn layers(&self) -> usize {
+        self.edges.len() + 1
+    }
+}
+
+/// The layer serving `theta` among the inner edges `edges`: the number of edges strictly
+/// below `theta` (at an edge, the lower layer: both layers' bounds hold there, each being
+/// valid at its closed range's ends). `None` for a `theta` that is not a number.
+#[inline]
+pub(super) fn layer_of(edges: &[f64], theta: f64) -> Option<usize> {
+    if theta.is_nan() {
+        return None;
+    }
+    Some(edges.iter().filter(|&&e| theta > e).count())
+}
 
 /// The compact table of one interval's tree (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -86,8 +121,11 @@ pub(super) struct LeafTable {
     entries: Box<[Entry]>,
     /// `entries.len()` as `f64`.
     n: f64,
-    /// The leaves' thinning bound codes, [`SUB_CELLS`] per entry in order (empty: none).
+    /// The leaves' thinning bound codes, [`SUB_CELLS`] per entry in order, layer after layer
+    /// (empty: none).
     sub: Box<[u8]>,
+    /// The inner θo edges of the layers ([`SubBounds::edges`]).
+    edges: Box<[f64]>,
 }
 
 impl LeafTable {
@@ -135,17 +173,35 @@ impl LeafTable {
             n: index_to_f64(entries.len()),
             entries: entries.into_boxed_slice(),
             sub: Box::new([]),
+            edges: Box::new([]),
         })
     }
 
     /// The table with the leaves' thinning bounds `sub` (one per leaf in the tree's order);
     /// ignored (no thinning) unless there is exactly one per entry.
-    pub(super) fn with_sub_bounds(mut self, sub: Option<&[[u8; SUB_CELLS]]>) -> Self {
+    pub(super) fn with_sub_bounds(mut self, sub: Option<&SubBounds>) -> Self {
+        let sub = sub.filter(|s| s.codes.len() == s.layers() * self.entries.len());
         self.sub = sub
-            .filter(|s| s.len() == self.entries.len())
-            .map_or_else(Vec::new, |s| s.as_flattened().to_vec())
+            .map_or_else(Vec::new, |s| s.codes.as_flattened().to_vec())
+            .into_boxed_slice();
+        self.edges = sub
+            .map_or_else(Vec::new, |s| s.edges.to_vec())
             .into_boxed_slice();
         self
+    }
+
+    /// The offset of the codes of the layer serving `theta` (θo, radians) in the table's codes
+    /// (`layer · entries · SUB_CELLS`, see [`layer_of`]); for a `theta` that is not a number,
+    /// an offset past every code: [`LeafTable::code_factor`] then reads 1 (`M_i` itself).
+    #[inline]
+    pub(super) fn layer_base(&self, theta: f64) -> usize {
+        layer_of(&self.edges, theta).map_or(usize::MAX / 2, |l| l * self.entries.len() * SUB_CELLS)
+    }
+
+    /// The layer count of the thinning bounds (1 without any).
+    #[cfg(test)]
+    pub(super) fn layers(&self) -> usize {
+        self.edges.len() + 1
     }
 
     /// Whether the table has thinning bounds.
@@ -158,6 +214,7 @@ impl LeafTable {
         std::mem::size_of::<Self>()
             + std::mem::size_of_val(&*self.entries)
             + std::mem::size_of_val(&*self.sub)
+            + std::mem::size_of_val(&*self.edges)
     }
 
     /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds
@@ -254,10 +311,15 @@ impl LeafTable {
     /// uniforms `(u₁, u₂)` fall in sub-cell `sub = ⌊SUB·u₂⌋·SUB + ⌊SUB·u₁⌋`: [`sub_factor`] of
     /// its code (1 without thinning bounds), so that `M_i ·` it is the trial's thinning bound
     /// [`sub_bound`]. (The point `x0 + u₁·dx` lies in that sub-cell up to the rounding of its
-    /// sum.)
+    /// sum.) `base`: the serving layer's offset, [`LeafTable::layer_base`].
     #[inline(always)]
-    pub(super) fn code_factor(&self, k: usize, sub: usize) -> f64 {
-        sub_factor(self.sub.get(k * SUB_CELLS + sub).copied().unwrap_or(255))
+    pub(super) fn code_factor(&self, base: usize, k: usize, sub: usize) -> f64 {
+        sub_factor(
+            self.sub
+                .get(base.wrapping_add(k * SUB_CELLS + sub))
+                .copied()
+                .unwrap_or(255),
+        )
     }
 }
 
