@@ -338,6 +338,8 @@ pub(crate) struct SliceImageMap<'a> {
     safety: f64,
     /// Bounds are taken over the cell grown by this many fine cells on every side.
     dilation: f64,
+    /// The width of one cell of the map on the disc (`2 / grid`).
+    cell: f64,
 }
 
 impl<'a> SliceImageMap<'a> {
@@ -374,11 +376,17 @@ impl<'a> SliceImageMap<'a> {
             track: Vec::new(),
             safety,
             dilation: f64::from(dilation) * h,
+            cell: h,
         })
     }
 }
 
 impl<'a> SliceImageMap<'a> {
+    /// The width of one cell of the map on the disc (`2 / grid`).
+    pub(crate) fn cell(&self) -> f64 {
+        self.cell
+    }
+
     /// Adds the peaks of an envelope's members: every cell holding a member's peak, or within
     /// the peak reach of it, gets that member's density at its point nearest to the peak (times
     /// the safety factor) as a lower limit of its bound.
