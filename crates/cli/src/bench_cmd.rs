@@ -23,7 +23,7 @@ use std::time::Instant;
 use brdf::{Brdf, Vec3};
 use brdf_sampling::{DirectionSampler, EvalSample};
 use clap::{Args, ValueEnum};
-use partition_sampler::chunk_seed;
+use partition_sampler::{chunk_seed, thread_trials};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
@@ -117,6 +117,9 @@ struct BenchRecord {
     ns_per_sample_runs: Vec<f64>,
     /// BRDF evaluations per sample, the estimator's one included (counted, not timed).
     evals_per_sample: f64,
+    /// Rejection trials (proposals, accepted or not) per sample, counted in the same untimed
+    /// pass; `null` for a sampler that records none (one proposal per sample).
+    trials_per_sample: Option<f64>,
     /// Samples per timed run.
     samples: usize,
     /// Threads of the timed runs.
@@ -151,7 +154,7 @@ fn query(queries: Queries, fixed: &Vec3, rng: &mut Xoshiro256PlusPlus) -> Vec3 {
 
 /// Draws `n` samples (and their `f`) in seeded chunks — one query at a time, or with `batch`
 /// a chunk's queries in one [`DirectionSampler::sample_eval_batch`] call; returns
-/// Σ f cos / pdf and the evaluations counted on the worker threads.
+/// Σ f cos / pdf and the evaluations and rejection trials counted on the worker threads.
 fn run_samples(
     sampler: &dyn DirectionSampler,
     brdf: &dyn Brdf,
@@ -160,7 +163,7 @@ fn run_samples(
     n: usize,
     seed: u64,
     batch: bool,
-) -> (f64, u64) {
+) -> (f64, u64, u64) {
     let chunks = n.div_ceil(CHUNK);
     (0..chunks)
         .into_par_iter()
@@ -168,6 +171,7 @@ fn run_samples(
             let len = CHUNK.min(n - c * CHUNK);
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(chunk_seed(seed, c as u64));
             let before = thread_evaluations();
+            let trials_before = thread_trials();
             let mut sum = 0.0;
             if batch {
                 // The chunk's queries first, then one batch call (the sampler may group them).
@@ -181,9 +185,13 @@ fn run_samples(
                     sum += sampler.sample_eval(brdf, &wo, &mut rng).weight();
                 }
             }
-            (sum, thread_evaluations() - before)
+            (
+                sum,
+                thread_evaluations() - before,
+                thread_trials() - trials_before,
+            )
         })
-        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+        .reduce(|| (0.0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2))
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -293,13 +301,13 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
         });
     }
 
-    // Evaluations per sample: an untimed pass on the worker threads.
+    // Evaluations and trials per sample: an untimed pass on the worker threads.
     let count_n = n.min(COUNT_SAMPLES);
-    let evals: Vec<f64> = pool.install(|| {
+    let counts: Vec<(f64, Option<f64>)> = pool.install(|| {
         subjects
             .iter()
             .map(|s| {
-                let (_, e) = run_samples(
+                let (_, e, t) = run_samples(
                     s.sampler.as_ref(),
                     counted.as_ref(),
                     args.queries,
@@ -308,7 +316,8 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
                     args.seed,
                     args.batch,
                 );
-                e as f64 / count_n as f64
+                let per = |c: u64| c as f64 / count_n as f64;
+                (per(e), (t > 0).then(|| per(t)))
             })
             .collect()
     });
@@ -321,7 +330,7 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
         for _ in 0..args.repeat {
             for (k, s) in subjects.iter().enumerate() {
                 let started = Instant::now();
-                let (sum, _) = run_samples(
+                let (sum, _, _) = run_samples(
                     s.sampler.as_ref(),
                     counted.as_ref(),
                     args.queries,
@@ -348,7 +357,8 @@ pub(crate) fn run(args: &BenchArgs, given: &Given) -> CliResult<()> {
             ns_per_sample_min: runs[k].iter().copied().fold(f64::INFINITY, f64::min),
             ns_per_sample_max: runs[k].iter().copied().fold(0.0, f64::max),
             ns_per_sample_runs: runs[k].clone(),
-            evals_per_sample: evals[k],
+            evals_per_sample: counts[k].0,
+            trials_per_sample: counts[k].1,
             samples: n,
             threads,
             queries: args.queries,
@@ -394,24 +404,27 @@ fn print_table(args: &BenchArgs, spec: &str, records: &[BenchRecord], threads: u
         .map(|r| r.ns_per_sample)
         .fold(f64::INFINITY, f64::min);
     println!(
-        "{:<24} {:>10} {:>17} {:>9} {:>10} {:>10} {:>12} {:>11}",
+        "{:<24} {:>10} {:>17} {:>9} {:>10} {:>10} {:>10} {:>12} {:>11}",
         "sampler",
         "ns/sample",
         "min–max",
         "× fastest",
         "evals/smp",
+        "trials/smp",
         "build s",
         "memory KiB",
         "mean f·c/p"
     );
     for r in records {
         println!(
-            "{:<24} {:>10.1} {:>17} {:>9.2} {:>10.3} {:>10.3} {:>12.1} {:>11.5}",
+            "{:<24} {:>10.1} {:>17} {:>9.2} {:>10.3} {:>10} {:>10.3} {:>12.1} {:>11.5}",
             r.sampler,
             r.ns_per_sample,
             format!("{:.1}–{:.1}", r.ns_per_sample_min, r.ns_per_sample_max),
             r.ns_per_sample / fastest,
             r.evals_per_sample,
+            r.trials_per_sample
+                .map_or_else(|| "–".to_string(), |t| format!("{t:.3}")),
             r.build_seconds,
             r.bytes_used as f64 / 1024.0,
             r.mean_weight,
@@ -462,13 +475,15 @@ mod tests {
                     )
                 })
         };
-        let (s1, e1) = on(1);
-        let (s2, e2) = on(2);
+        let (s1, e1, t1) = on(1);
+        let (s2, e2, t2) = on(2);
         // Chunk sums are added in a fixed tree order by rayon's reduce only up to
         // associativity: compare to rounding.
         approx::assert_relative_eq!(s1, s2, max_relative = 1e-12);
         assert_eq!(e1, e2);
         // Cosine sampling evaluates f once per sample above the horizon: the estimator's.
         assert!(e1 <= 20_000 && e1 > 19_000, "{e1}");
+        // Cosine sampling makes no rejection trial.
+        assert_eq!((t1, t2), (0, 0));
     }
 }

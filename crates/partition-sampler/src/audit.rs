@@ -38,6 +38,26 @@ impl Audit {
     }
 }
 
+thread_local! {
+    /// Rejection trials recorded on this thread (read by cost measurements).
+    static THREAD_TRIALS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Rejection trials (proposals, accepted or not) recorded on the calling thread so far by
+/// the samplers' counters: a monotone counter whose difference over a sequential run, divided
+/// by the samples returned, is the run's mean trials per sample. Samplers that make one
+/// proposal per sample record nothing.
+pub fn thread_trials() -> u64 {
+    THREAD_TRIALS.with(Cell::get)
+}
+
+/// Adds `n` trials to the calling thread's [`thread_trials`] (for a rejection sampler that
+/// keeps no [`Audit`]; this crate's samplers count through their audits).
+#[inline]
+pub fn count_trials(n: u64) {
+    THREAD_TRIALS.with(|c| c.set(c.get() + n));
+}
+
 /// Shared counters of one sampler.
 #[derive(Debug, Default)]
 pub(crate) struct Counters {
@@ -48,6 +68,12 @@ pub(crate) struct Counters {
 }
 
 impl Counters {
+    /// Adds a run's counts made on the calling thread, also into [`thread_trials`].
+    pub(crate) fn record(&self, a: &Audit) {
+        count_trials(a.trials);
+        self.add(a);
+    }
+
     pub(crate) fn add(&self, a: &Audit) {
         if a.trials > 0 {
             self.trials.fetch_add(a.trials, Relaxed);
@@ -122,6 +148,7 @@ thread_local! {
 /// Buffers one plain sample's counts (violations and exhaustion go straight to `counters`).
 #[inline]
 pub(crate) fn record_one(counters: &Arc<Counters>, a: &Audit) {
+    count_trials(a.trials);
     if a.violations > 0 || a.exhausted > 0 {
         counters.add(&Audit {
             trials: 0,

@@ -85,7 +85,7 @@ mod tree;
 mod user_bound;
 
 pub use allocate::{AllocationMode, allocate, stratum_weights};
-pub use audit::{Audit, AuditCounters, FLUSH_EVERY};
+pub use audit::{Audit, AuditCounters, FLUSH_EVERY, count_trials, thread_trials};
 pub use builder::{MAX_DEPTH_LIMIT, QuadTreeBuilder};
 pub use contract::{
     AsDistribution, InvertibleSampler2D, Point2, Sample2, Sampler2D, UniformSequence, UniformSource,

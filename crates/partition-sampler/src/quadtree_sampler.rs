@@ -221,7 +221,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
     /// Adds locally gathered counts to the sampler's statistics
     /// ([`crate::diagnostics::AuditedDraws::record_audit`]).
     pub(crate) fn add_audit(&self, audit: &Audit) {
-        self.counters.add(audit);
+        self.counters.record(audit);
     }
 
     /// Leaf selection probabilities `p_i = I_i / Î` of batch mode (leaf storage order).
@@ -261,7 +261,7 @@ impl<D: RegionStats> QuadTreeSampler<D> {
                 });
             }
         }
-        self.counters.add(&a);
+        self.counters.record(&a);
         let weights = match mode {
             AllocationMode::Hamilton => {
                 let w = stratum_weights(n, &self.tree.leaf_integral, &counts);
@@ -627,7 +627,7 @@ impl<D: RegionStats> Sampler2D for QuadTreeSampler<D> {
                 *s = self.draw(u, &mut a);
             }
         }
-        self.counters.add(&a);
+        self.counters.record(&a);
     }
 
     /// `f(p)/Î` when `p` is in the domain and in a sampleable leaf, else 0.

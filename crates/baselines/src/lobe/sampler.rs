@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use brdf::{Brdf, Vec3, direction_from_radians, mirror};
 use brdf_sampling::{DirSample, DirectionSampler, SamplerDiagnostics};
-use partition_sampler::UniformSource;
+use partition_sampler::{UniformSource, count_trials};
 use rayon::prelude::*;
 
 use super::LobeError;
@@ -204,6 +204,7 @@ impl DirectionSampler for LobeSampler {
         let u0 = u.next_uniform();
         let u1 = u.next_uniform();
         let fit = self.fit_at(wo);
+        count_trials(1);
         let wi = if !(wo.z > 0.0) || pick < fit.defensive {
             CosineHemisphere::sample_square([u0, u1]).wi
         } else {
@@ -218,6 +219,9 @@ impl DirectionSampler for LobeSampler {
                         w = sample_lobe(&r, fit.exponent, v);
                         trials += 1;
                     }
+                    // The retried lobe directions below the horizon (`bench`'s trials; the
+                    // other samples' one proposal is counted below).
+                    count_trials(trials as u64 - 1);
                     if w.z > 0.0 {
                         w
                     } else {

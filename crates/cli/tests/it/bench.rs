@@ -1,5 +1,6 @@
 //! End-to-end test of `brdf-lab bench`: several samplers in one run, the JSON contract
-//! (`sampler`, `ns_per_sample`, `evals_per_sample`, `samples`, `threads`, `queries`), counts
+//! (`sampler`, `ns_per_sample`, `evals_per_sample`, `trials_per_sample`, `samples`, `threads`,
+//! `queries`), counts
 //! that do not depend on the thread count, and bad input as exit 2 with the reason.
 
 use std::process::{Command, Output};
@@ -121,6 +122,19 @@ fn bench_fused_evaluations_and_the_batch_path() {
     }
     let batch_evals = b1[1]["evals_per_sample"].as_f64().unwrap();
     assert!(batch_evals > 1.0 && batch_evals < 2.3, "{batch_evals}");
+    // Trials are counted with the evaluations: none recorded by cosine sampling (`null`); the
+    // rejection sampler makes at least one per evaluation (a trial outside the disc evaluates
+    // nothing), the same on 1 and 2 threads.
+    for run in [&one, &b1] {
+        assert!(run[0]["trials_per_sample"].is_null(), "{}", run[0]);
+        let trials = run[1]["trials_per_sample"].as_f64().unwrap();
+        let evals = run[1]["evals_per_sample"].as_f64().unwrap();
+        assert!(
+            trials >= evals && trials < 3.0,
+            "{trials} trials, {evals} evaluations"
+        );
+    }
+    assert_eq!(b1[1]["trials_per_sample"], b2[1]["trials_per_sample"]);
 }
 
 #[test]

@@ -9,7 +9,7 @@ use common::*;
 use partition_sampler::diagnostics::AuditedDraws;
 use partition_sampler::{
     Audit, Domain, LeafChoice, QuadTreeBuilder, QuadTreeSampler, Rect, RegionStats, Sample2,
-    SampledGridDensity, Sampler2D, Scheme, SinPiRows, TabulatedDensity,
+    SampledGridDensity, Sampler2D, Scheme, SinPiRows, TabulatedDensity, thread_trials,
 };
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{Rng, SeedableRng};
@@ -43,7 +43,14 @@ fn check_same<D: RegionStats>(s: &QuadTreeSampler<D>, len: usize, seed: u64) -> 
         .map(|_| s.sample_audited(&mut one, &mut audit))
         .collect();
     s.reset_stats();
+    let trials_before = thread_trials();
     let (got, mut block) = block_samples(s, len, seed);
+    // The calling thread's trial counter (`bench`'s trials per sample) moved by the same count.
+    assert_eq!(
+        thread_trials() - trials_before,
+        audit.trials,
+        "thread_trials"
+    );
     assert_eq!(got, expected, "len {len}, seed {seed}");
     assert_eq!(block.next_u64(), one.next_u64(), "uniforms consumed differ");
     let st = s.stats();
