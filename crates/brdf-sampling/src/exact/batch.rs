@@ -34,7 +34,7 @@ pub(super) const PREPARED_RUN_MIN: usize = 512;
 
 /// Trials per block call of the wavefront ([`wavefront`]): at most this many candidates'
 /// `f` are evaluated in one [`PreparedRun::eval_block`] call.
-const WAVE: usize = 256;
+const WAVE: usize = 512;
 
 /// The stream of sample `i` of a wavefront: SplitMix64 started at `mix64(seed ⊕ mix64(i))`
 /// (test support: the wavefront makes these states in lanes, [`lanes::keys`]).
@@ -254,13 +254,6 @@ fn direct_sample(turn: Turn, ident: bool, d: Vec3, gx: f64, a: f64) -> Option<Ev
     let f = gx / (2.0 * d.z);
     let wi = if ident { d } else { turn.apply(&d) };
     (d.z > 0.0 && pdf > 0.0 && f.is_finite()).then_some(EvalSample { wi, pdf, f })
-}
-
-/// `g()` called out of line (a rare path kept out of the caller's loop).
-#[cold]
-#[inline(never)]
-fn cold_call<R>(g: impl FnOnce() -> R) -> R {
-    g()
 }
 
 #[cfg(test)]
@@ -1063,7 +1056,7 @@ impl ExactSet {
                 let same = same_brdf(brdf, self.brdf.as_ref());
                 // The run's own BRDF at the served ωo: every value is the accepted trial's,
                 // and `accepted_at` + `finish_known` reduce to `direct_sample` (their
-                // per-sample tests made once here); the other samples through them, out of line.
+                // per-sample tests made once here); the other samples through them.
                 let direct = same && served && iv.map == DiscMap::EqualArea && direct_emit_on();
                 let ident = q.turn == Turn::IDENTITY;
                 let (map, turn) = (iv.map, q.turn);
@@ -1094,7 +1087,7 @@ impl ExactSet {
                     }
                     out[run[i] as usize] = match e {
                         Some(e) => e,
-                        None => cold_call(|| general(d)),
+                        None => general(d),
                     };
                 };
                 let theta = q.cos.clamp(-1.0, 1.0).acos();
