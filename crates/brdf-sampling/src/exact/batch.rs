@@ -34,7 +34,7 @@ pub(super) const PREPARED_RUN_MIN: usize = 512;
 
 /// Trials per block call of the wavefront ([`wavefront`]): at most this many candidates'
 /// `f` are evaluated in one [`PreparedRun::eval_block`] call.
-const WAVE: usize = 256;
+const WAVE: usize = 512;
 
 /// The stream of sample `i` of a wavefront: SplitMix64 started at `mix64(seed ⊕ mix64(i))`
 /// (test support: the wavefront makes these states in lanes, [`lanes::keys`]).
@@ -235,6 +235,46 @@ fn wavefront_with<E: FnMut(usize, Option<Drawn>)>(
         };
         let _ = WAVE_ARRAYS.try_with(|s| s.set(Some(kept)));
     }
+}
+
+/// The [`EvalSample`] of an accepted trial on the **equal-area** map with direction `d` (on
+/// the set's frame), `g(d) = gx = 2 f cos θi` and normaliser `a`, when the caller's BRDF is
+/// the set's at the served `ωo`: `(turn·d, p, f)` with `p = (gx/a)/2`
+/// (`DiscMap::EqualArea.area_to_solid_angle(gx / a, d)`) and `f = gx / (2 cos θi)` — what
+/// [`accepted_at`] followed by `finish_known` with `same` and a served `ωo` returns, bit for
+/// bit, when `cos θi > 0`, `p > 0` and `f` is finite; `None` otherwise (the caller then takes
+/// that general path). `ident`: `turn` is the identity, whose `(1·x − 0·y, 0·x + 1·y)` is
+/// `(x, y)` for finite coordinates that are not `−0` (a trial's `x0 + u·dx` never is:
+/// `−0 + (+0) = +0`, and the map's `x·√(2 − r²)` keeps the sign of a nonzero `x`), so `d` is
+/// then used as it is. (The RGL sets' intervals are all on the equal-area map; a projected
+/// interval's run keeps the general emit.)
+#[inline(always)]
+fn direct_sample(turn: Turn, ident: bool, d: Vec3, gx: f64, a: f64) -> Option<EvalSample> {
+    let pdf = (gx / a) * 0.5;
+    let f = gx / (2.0 * d.z);
+    let wi = if ident { d } else { turn.apply(&d) };
+    (d.z > 0.0 && pdf > 0.0 && f.is_finite()).then_some(EvalSample { wi, pdf, f })
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Test switch: `serve_general_run`'s wavefront emits through the general path only
+    /// (no [`direct_sample`]).
+    static NO_DIRECT_EMIT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Test count of the samples emitted through [`direct_sample`], per turn (identity,
+    /// other).
+    static DIRECT_EMITS: std::cell::Cell<[u64; 2]> = const { std::cell::Cell::new([0; 2]) };
+}
+
+/// Whether `serve_general_run` may emit through [`direct_sample`] (always, but for the
+/// tests' reference runs).
+#[inline(always)]
+fn direct_emit_on() -> bool {
+    #[cfg(test)]
+    if NO_DIRECT_EMIT.with(std::cell::Cell::get) {
+        return false;
+    }
+    true
 }
 
 /// Most samples whose [`WaveArrays`] a thread keeps after a wavefront (32 bytes each, 2 MiB
@@ -1014,14 +1054,40 @@ impl ExactSet {
                 let served = q.wo == *wo;
                 // `finish`'s test of the caller's BRDF, made once for the run.
                 let same = same_brdf(brdf, self.brdf.as_ref());
-                let emit = |i: usize, d: Option<Drawn>| {
-                    out[run[i] as usize] = match d {
+                // The run's own BRDF at the served ωo: every value is the accepted trial's,
+                // and `accepted_at` + `finish_known` reduce to `direct_sample` (their
+                // per-sample tests made once here); the other samples through them.
+                let direct = same && served && iv.map == DiscMap::EqualArea && direct_emit_on();
+                let ident = q.turn == Turn::IDENTITY;
+                let (map, turn) = (iv.map, q.turn);
+                let general = |d: Option<Drawn>| -> EvalSample {
+                    match d {
                         Some((_, v, gx)) => {
-                            let (s, f) = accepted_at(iv.map, &q.turn, v, gx, a);
+                            let (s, f) = accepted_at(map, &turn, v, gx, a);
                             let f = (served && f.is_finite()).then_some(f);
                             self.finish_known(brdf, wo, s, f, same)
                         }
                         None => self.finish_known(brdf, wo, DirSample::NONE, None, same),
+                    }
+                };
+                // By value: the run's constants in the closure itself, not behind references.
+                let emit = move |i: usize, d: Option<Drawn>| {
+                    let e = match d {
+                        Some((_, v, gx)) if direct => direct_sample(turn, ident, v, gx, a),
+                        _ => None,
+                    };
+                    #[cfg(test)]
+                    if e.is_some() {
+                        let slot = usize::from(!ident);
+                        DIRECT_EMITS.with(|c| {
+                            let mut n = c.get();
+                            n[slot] += 1;
+                            c.set(n)
+                        });
+                    }
+                    out[run[i] as usize] = match e {
+                        Some(e) => e,
+                        None => general(d),
                     };
                 };
                 let theta = q.cos.clamp(-1.0, 1.0).acos();
@@ -1384,6 +1450,57 @@ pub(super) mod tests {
         }
         // Two per material at each of four served θo.
         assert_eq!(taken, 3 * 4 * 2);
+    }
+
+    /// The RGL run wavefront's direct emit (`direct_sample`) writes the samples the general
+    /// emit (`accepted_at` + `finish_known`) writes, bit for bit: the fixture at θo 0, 30, 60,
+    /// 80, 85, 88.5° and φo 0° (the identity turn) and 40°, 4 096 copies of one ωo, with the
+    /// direct emit off (`NO_DIRECT_EMIT`) and on; the generator left in the same state; the
+    /// direct emit taken for every sample (the RGL set's maps are equal-area), at both kinds
+    /// of turn; with another BRDF object as the
+    /// caller's (not the set's: never direct) the same bits too. Broken versions tried: the
+    /// rotation skipped at every turn (`wi = d`) fails ("θo 30 φo 40 query 0"); the pdf as
+    /// `(gx · (1/a))/2` fails ("θo 0 φo 0 query 8").
+    #[test]
+    fn rgl_direct_emit_writes_the_general_emits_bits() {
+        use super::{DIRECT_EMITS, NO_DIRECT_EMIT};
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let other: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let set = ExactSet::build(Arc::clone(&rgl), &ExactOptions::default(), None).unwrap();
+        let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
+        DIRECT_EMITS.with(|c| c.set([0; 2]));
+        for caller in [&rgl, &other] {
+            for theta in [0.0, 30.0, 60.0, 80.0, 85.0, 88.5] {
+                for phi in [0.0, 40.0] {
+                    let wos = vec![brdf::direction_from_angles(theta, phi); 4096];
+                    let mut draws = [0, 1].map(|off| {
+                        NO_DIRECT_EMIT.with(|c| c.set(off == 1));
+                        let mut r = Xoshiro256PlusPlus::seed_from_u64(5 + theta as u64);
+                        let mut out = Vec::new();
+                        set.sample_eval_batch(caller.as_ref(), &wos, &mut r, &mut out);
+                        (out, r)
+                    });
+                    NO_DIRECT_EMIT.with(|c| c.set(false));
+                    let [(a, ra), (b, rb)] = &mut draws;
+                    assert_eq!(a.len(), wos.len());
+                    for (k, (x, y)) in a.iter().zip(b.iter()).enumerate() {
+                        assert_eq!(key(x), key(y), "θo {theta} φo {phi} query {k}");
+                    }
+                    assert_eq!(ra.next_uniform(), rb.next_uniform(), "θo {theta} φo {phi}");
+                    assert!(a.iter().all(|s| s.pdf > 0.0), "θo {theta} φo {phi}");
+                }
+            }
+            let n = DIRECT_EMITS.with(std::cell::Cell::get);
+            if Arc::ptr_eq(caller, &rgl) {
+                // 7 of the 12 ωo have the identity turn (φo 0°, and the normal).
+                assert_eq!(n, [7 * 4096, 5 * 4096], "direct emits");
+                DIRECT_EMITS.with(|c| c.set([0; 2]));
+            } else {
+                assert_eq!(n, [0; 2], "another caller's BRDF is never direct");
+            }
+        }
     }
 
     /// The uniforms filled ahead (`Ahead`) are the trials one call each would draw: random-ωo
