@@ -120,6 +120,17 @@ pub struct ExactOptions {
     /// The narrowest θo layer of the thinning bounds (degrees, > 0), see
     /// [`ExactOptions::thinning_layers`].
     pub thinning_layer_deg: f64,
+    /// The growth of a sub-cell's rectangle before the leaf rule bounds it (in image-map
+    /// cells, `[0, 4]`): sub-cell `s` of leaf `i` gets `min(M_i, region(s grown by this many
+    /// cells on every side).max_bound)` (docs/benchmarks.md §30.7: with 0, `f` exceeded the
+    /// bare rule at one of 1.38·10⁶ checked points).
+    pub thinning_growth: f64,
+    /// Also bound each sub-cell of an RGL material's isotropic intervals rigorously (docs
+    /// §31.3): `M_is = min(M_i, R_s, B_s)` with `R_s` the grown leaf rule above and `B_s =
+    /// J · max_k RglBrdf::f_cos_bound(piece k, box of ωi over s)` over the layer's θo range in
+    /// pieces of ≤ 0.5° (`J` = 2 on the equal-area map), an upper bound of `g` over the sub-cell
+    /// at every θo the codes serve.
+    pub thinning_rigorous: bool,
 }
 
 impl ExactOptions {
@@ -143,6 +154,8 @@ impl ExactOptions {
     pub const DEFAULT_THINNING_LAYERS: usize = 4;
     /// Default narrowest θo layer of the thinning bounds (degrees).
     pub const DEFAULT_THINNING_LAYER_DEG: f64 = 1.5;
+    /// Default growth of a sub-cell before the leaf rule bounds it (image-map cells).
+    pub const DEFAULT_THINNING_GROWTH: f64 = 1.0;
     /// Default narrowest interval (degrees).
     pub const DEFAULT_MIN_WIDTH_DEG: f64 = 0.25;
 
@@ -162,6 +175,8 @@ impl ExactOptions {
             thinning: true,
             thinning_layers: Self::DEFAULT_THINNING_LAYERS,
             thinning_layer_deg: Self::DEFAULT_THINNING_LAYER_DEG,
+            thinning_growth: Self::DEFAULT_THINNING_GROWTH,
+            thinning_rigorous: true,
         }
     }
 
@@ -210,6 +225,9 @@ impl ExactOptions {
         }
         if !(self.thinning_layer_deg > 0.0 && self.thinning_layer_deg <= 90.0) {
             return bad("thinning_layer_deg (0, 90]", self.thinning_layer_deg);
+        }
+        if !(0.0..=4.0).contains(&self.thinning_growth) {
+            return bad("thinning_growth [0, 4]", self.thinning_growth);
         }
         Ok(())
     }
