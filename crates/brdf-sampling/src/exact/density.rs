@@ -884,6 +884,27 @@ mod survey {
             .split_whitespace()
             .map(|s| s.parse().expect("a number"))
             .collect();
+        // The set's own rule and its variants (docs §31.3), same trees: the codes differ.
+        let variant = |growth: f64, rigorous: bool| ExactOptions {
+            thinning_growth: growth,
+            thinning_rigorous: rigorous,
+            ..opts
+        };
+        let area_of = |w: f64, h: f64| w * h / 16.0;
+        let variants: Vec<(&str, ExactSet)> = [
+            ("grown 1 (§30.7)", variant(1.0, false)),
+            ("grown 0 (§30.1)", variant(0.0, false)),
+            ("grown 1 + rigorous", variant(1.0, true)),
+            ("default", opts),
+        ]
+        .into_iter()
+        .map(|(n, o)| {
+            (
+                n,
+                ExactSet::build(Arc::clone(&brdf), &o, None).expect("a set"),
+            )
+        })
+        .collect();
         let k = 16usize;
         let subs = [2usize, 4, 8];
         let safety = opts.set.safety_factor;
@@ -1040,6 +1061,60 @@ mod survey {
                 layer_leaf[1] / a,
                 layer_sub[0] / a,
                 layer_sub[1] / a,
+            );
+            // The stored codes (docs §31.3): `Σ M_is·|s ∩ disc| / A` of the set's layer serving
+            // θo, for the rule variants built above (same trees), and the floor `Σ max_s g ·
+            // |s ∩ disc| / A` of exact sub-cell bounds at this θo (4 × 4 points per sub-cell);
+            // points above each variant's codes.
+            let mut floor = 0.0;
+            let mut per = vec![(0.0f64, 0u64); variants.len()];
+            for (vi, (_, vset)) in variants.iter().enumerate() {
+                let viv = vset.interval(&vset.locate(&wo).expect("served"));
+                let sub = viv.sub_bounds.as_ref().expect("codes");
+                let layer = crate::exact::table::layer_of(
+                    &sub.edges,
+                    t.to_radians().min(crate::exact::THETA_TOP_DEG.to_radians()),
+                )
+                .unwrap_or(0);
+                let vleaves: Vec<_> = viv.tree.tree().leaves().collect();
+                let base = layer * vleaves.len();
+                for (li, l) in vleaves.iter().enumerate() {
+                    let r = l.rect;
+                    let (w, h) = (r.x1 - r.x0, r.y1 - r.y0);
+                    for s in 0..16 {
+                        let (sx, sy) = (s % 4, s / 4);
+                        let m =
+                            crate::exact::table::sub_bound(l.max_bound, sub.codes[base + li][s]);
+                        let (mut ins, mut mg) = (0, 0.0f64);
+                        for i in 0..4 {
+                            for j in 0..4 {
+                                let x = r.x0 + w * (sx as f64 + (i as f64 + 0.5) / 4.0) / 4.0;
+                                let y = r.y0 + h * (sy as f64 + (j as f64 + 0.5) / 4.0) / 4.0;
+                                if x * x + y * y < 1.0 {
+                                    ins += 1;
+                                    let gv = g.at([x, y]);
+                                    mg = mg.max(gv);
+                                    per[vi].1 += u64::from(gv > m);
+                                }
+                            }
+                        }
+                        let frac = area_of(w, h) * ins as f64 / 16.0;
+                        per[vi].0 += m * frac;
+                        if vi == 0 {
+                            floor += mg * frac;
+                        }
+                    }
+                }
+            }
+            let text: Vec<String> = variants
+                .iter()
+                .zip(&per)
+                .map(|((name, _), (e, n))| format!("{name} {:.3} ({n} above)", e / a))
+                .collect();
+            println!(
+                "    stored codes of the layer serving θo: {}; exact 4 × 4 sub-cell maxima at θo {:.3}",
+                text.join(", "),
+                floor / a
             );
         }
     }

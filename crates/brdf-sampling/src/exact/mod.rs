@@ -85,6 +85,7 @@ mod persist;
 mod phases;
 mod probe;
 mod report;
+mod rgl_bound;
 mod sampler;
 mod set;
 mod set_table;
