@@ -248,7 +248,12 @@ impl LeafTable {
                 let m = f64::from(e.m);
                 let top = c.iter().map(|&q| sub_bound(m, q)).fold(0.0, f64::max);
                 let ml = f32_at_least(top);
-                sub.extend(c.iter().map(|&q| sub_code(f64::from(ml), sub_bound(m, q))));
+                if ml == e.m {
+                    // The same bound: the same codes (`sub_code(m, sub_bound(m, q)) = q`).
+                    sub.extend_from_slice(c);
+                } else {
+                    sub.extend(c.iter().map(|&q| sub_code(f64::from(ml), sub_bound(m, q))));
+                }
                 entries.push(Entry { m: ml, ..*e });
             }
             let Some(mut t) = Self::of_entries(entries) else {
