@@ -14,7 +14,7 @@ use super::grid::TableVar;
 use super::lanes::{self, Trials};
 #[cfg(test)]
 use super::lanes::{GOLDEN_GAMMA, mix64, unit};
-use super::table::LeafTable;
+use super::table::{LeafTable, query_theta};
 #[cfg(test)]
 use super::wave_iso::NO_WAVE;
 use super::wave_iso::{IsoWave, wave_on, wave_seed};
@@ -952,9 +952,13 @@ impl ExactSet {
             None
         };
         let at = IsoRun { q, wo, a, turn };
+        // The table of the θo layer serving the query (`LeafTable::serving`).
+        let table = cell.tables[q.interval]
+            .as_ref()
+            .map(|t| t.serving_cos(q.cos));
         match prepared {
-            Some(p) if p.prefers_blocks() && cell.tables[q.interval].is_some() => {
-                let table = cell.tables[q.interval].as_ref().expect("checked");
+            Some(p) if p.prefers_blocks() && table.is_some() => {
+                let table = table.expect("checked");
                 // `finish_iso`'s test of the caller's BRDF, made once for the run.
                 let same = same_brdf(brdf, self.brdf.as_ref());
                 let emit = |i: usize, d: Option<Drawn>| {
@@ -965,7 +969,7 @@ impl ExactSet {
                     let f = f.is_finite().then_some(f);
                     out[run[i] as usize] = self.finish_known(brdf, at.wo, s, f, same);
                 };
-                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                let theta = query_theta(q.cos);
                 wavefront_with(
                     p.as_ref(),
                     table,
@@ -1011,7 +1015,9 @@ impl ExactSet {
         let cell = &self.cells[0];
         let iv = &cell.intervals[at.q.interval];
         let rec = &cell.iso[at.q.interval];
-        let table = cell.tables[at.q.interval].as_ref();
+        let table = cell.tables[at.q.interval]
+            .as_ref()
+            .map(|t| t.serving_cos(at.q.cos));
         for &k in run {
             let k = k as usize;
             let drawn = match table {
@@ -1040,7 +1046,8 @@ impl ExactSet {
         out: &mut [EvalSample],
     ) {
         let iv = self.interval(q);
-        let table = self.cells[q.cell].tables[q.interval].as_ref();
+        // The table of the θo layer serving the query (`ExactSet::table_of`).
+        let table = self.table_of(q);
         if let Some(table) = table.filter(|_| self.isotropic && run.len() >= PREPARED_RUN_MIN) {
             // `QueryDensity::in_frame`'s frame for an isotropic set: ωo turned back by the
             // query's rotation, the trials' directions unrotated.
@@ -1090,7 +1097,7 @@ impl ExactSet {
                         None => general(d),
                     };
                 };
-                let theta = q.cos.clamp(-1.0, 1.0).acos();
+                let theta = query_theta(q.cos);
                 wavefront_with(
                     p.as_ref(),
                     table,
@@ -1563,7 +1570,10 @@ pub(super) mod tests {
     /// finished as the one-query path finishes it —
     /// so a function of the seed, `i` and `ωo_i` only, with `draw_iso`'s law; the same when
     /// the batch's other queries change; the grazing queries (the general path) are their own
-    /// query's samples, the ones below the horizon empty.
+    /// query's samples, the ones below the horizon empty. Also on the RGL fixture with θo layer
+    /// tables built as a `cos θo`-table set (fast path): its wave groups are drawn layer by
+    /// layer, each query from the layer table `draw_iso` picks (fails with the layer's queries
+    /// drawn from the interval's table).
     #[test]
     fn random_wo_groups_draw_draw_isos_samples_from_their_own_streams() {
         use super::super::lanes::{GOLDEN_GAMMA, mix64};
@@ -1585,9 +1595,24 @@ pub(super) mod tests {
             }
         }
         let key = |s: &EvalSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf, s.f].map(f64::to_bits);
-        for spec in ["phong:n=50", "ggx:alpha=0.2"] {
-            let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
-            let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let mut cases: Vec<(&str, Arc<dyn Brdf>, ExactSet)> = ["phong:n=50", "ggx:alpha=0.2"]
+            .into_iter()
+            .map(|spec| {
+                let brdf: Arc<dyn Brdf> = Arc::from(parse_spec(spec).unwrap());
+                let set =
+                    ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+                (spec, brdf, set)
+            })
+            .collect();
+        // The RGL fixture with θo layer tables on the fast path (a `cos θo` table: built
+        // without following its kinks), so its wave groups are drawn layer by layer.
+        let (rgl, _, layered) = layered_rgl();
+        let (set, _) =
+            ExactSet::build_phased(Arc::clone(&rgl), &layered, None, None, false).unwrap();
+        assert_eq!(set.var, super::super::grid::TableVar::Cos);
+        cases.push(("rgl paper_white, layered", rgl, set));
+        for (spec, brdf, set) in cases {
+            let mut by_layer = 0;
             let mut qr = Xoshiro256PlusPlus::seed_from_u64(51);
             let mut wos = mixed_wos(&mut qr, 4000);
             let rng = Xoshiro256PlusPlus::seed_from_u64(19);
@@ -1599,6 +1624,8 @@ pub(super) mod tests {
             for (i, (wo, o)) in wos.iter().zip(&out).enumerate() {
                 match set.locate_iso(wo) {
                     Some(q) => {
+                        let table = set.cells[0].tables[q.interval].as_ref().unwrap();
+                        by_layer += usize::from(!table.layer_tables().is_empty());
                         let mut s = SplitMix(Stream::of(seed, i).0);
                         let (d, f) = set.draw_iso(&q, wo, &mut s, &mut audit);
                         let want = set.finish_iso(brdf.as_ref(), wo, d, f);
@@ -1640,6 +1667,12 @@ pub(super) mod tests {
                 }
             }
             assert!(same > 2500, "{spec}: {same}");
+            if spec.starts_with("rgl") {
+                assert!(
+                    by_layer > 1000,
+                    "{spec}: {by_layer} queries in layered intervals"
+                );
+            }
         }
     }
 
@@ -2093,9 +2126,10 @@ pub(super) mod tests {
     /// rejection loop) with the run's density and sample `i`'s own stream as the uniform
     /// source — the same point, `g`, and in total the same trial, violation and sample counts —
     /// on Phong through a block-preferring run at θo = 35° (projected map) and 85° (equal-area
-    /// map), and on the RGL fixture at 30° and 75° (the general path's frame), 3000 samples each
-    /// in blocks of 256. So the wavefront's law is `draw`'s, whatever its lanes, passes and
-    /// blocks do.
+    /// map), and on the RGL fixture with θo layers (`layered_rgl`) at 30° and 75° (the general
+    /// path's frame; the table is the serving layer's, `ExactSet::table_of`, at 30° a layer
+    /// table), 3000 samples each in blocks of 256. So the wavefront's law is `draw`'s, whatever
+    /// its lanes, passes and blocks do.
     ///
     /// [`LeafTable::draw`]: super::table::LeafTable::draw
     #[test]
@@ -2103,12 +2137,14 @@ pub(super) mod tests {
         use super::{Stream, run_density, wave_seed, wavefront};
         use partition_sampler::Audit;
         let phong: Arc<dyn Brdf> = Arc::new(WithRun::phong(true));
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
-        let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let (rgl, _, layered) = layered_rgl();
         let mut compared = 0;
-        for (brdf, angles) in [(phong, [35.0, 85.0]), (rgl, [30.0, 75.0])] {
-            let set = ExactSet::build(Arc::clone(&brdf), &ExactOptions::default(), None).unwrap();
+        let mut by_layer = 0;
+        for (brdf, angles, opts) in [
+            (phong, [35.0, 85.0], ExactOptions::default()),
+            (rgl, [30.0, 75.0], layered),
+        ] {
+            let set = ExactSet::build(Arc::clone(&brdf), &opts, None).unwrap();
             for t in angles {
                 let wo = brdf::direction_from_angles(t, 0.0);
                 let q = set.locate(&wo).expect("served");
@@ -2117,7 +2153,9 @@ pub(super) mod tests {
                 } else {
                     q.turn.undo(&q.wo)
                 };
-                let table = set.cells[q.cell].tables[q.interval].as_ref().unwrap();
+                let table = set.table_of(&q).unwrap();
+                let own = set.cells[q.cell].tables[q.interval].as_ref().unwrap();
+                by_layer += usize::from(!std::ptr::eq(table, own));
                 let map = set.interval(&q).map;
                 let run = brdf.prepare_run(&frame).unwrap();
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(31);
@@ -2149,12 +2187,14 @@ pub(super) mod tests {
             }
         }
         assert_eq!(compared, 12_000);
+        assert!(by_layer >= 1, "a layer table compared");
     }
 
     /// Thinning (docs/benchmarks.md §30.1, §30.6): on the RGL fixture built with up to 4 θo
     /// layers of ≥ 0.5°, at a θo inside every interval (its midpoint) and, for a layered one,
-    /// at its ends and at and just above each layer edge, the wavefront under the interval's table with its leaves' thinning bounds
-    /// draws, bit for bit, the samples of the same table without them — the same points and
+    /// at its ends and at and just above each layer edge, the wavefront under the table serving
+    /// θo (`ExactSet::table_of`: for a layered interval the layer's table, §31.1) with its
+    /// leaves' thinning bounds draws, bit for bit, the samples of the same table without them — the same points and
     /// `g`, the same trial and sample counts, 0 violations (`g` above the bound it was drawn
     /// under) — while evaluating `f` at least 5 % less often over the set. So the sub-cell bounds
     /// are above `g` wherever a trial was decided by them, and they pay. Fails with the bounds
@@ -2186,7 +2226,7 @@ pub(super) mod tests {
             "thinning bounds saved"
         );
         let (mut evals_thin, mut evals_plain, mut thinned) = (0u64, 0u64, 0usize);
-        let mut layered = 0;
+        let (mut layered, mut by_layer) = (0, 0);
         // Every interval at its midpoint, and a layered one also at its ends and layer edges.
         let mut thetas = Vec::new();
         for iv in &set.cells[0].intervals {
@@ -2208,8 +2248,10 @@ pub(super) mod tests {
             } else {
                 q.turn.undo(&q.wo)
             };
-            let table = set.cells[q.cell].tables[q.interval].as_ref().unwrap();
+            let table = set.table_of(&q).unwrap();
             assert!(table.thins(), "every RGL interval has thinning bounds");
+            let own = set.cells[q.cell].tables[q.interval].as_ref().unwrap();
+            by_layer += usize::from(!std::ptr::eq(table, own));
             thinned += 1;
             let plain = table.clone().with_sub_bounds(None);
             assert!(!plain.thins());
@@ -2252,11 +2294,259 @@ pub(super) mod tests {
             evals_plain += e_b;
         }
         assert!(thinned >= 40, "{thinned} angles");
+        assert!(by_layer >= 40, "{by_layer} angles drawn from layer tables");
         let ratio = evals_thin as f64 / evals_plain as f64;
         println!("thinning: {evals_thin} / {evals_plain} evaluations = {ratio:.4}");
         assert!(
             ratio < 0.95,
             "evaluations with / without thinning {ratio:.4}"
         );
+    }
+
+    /// The RGL fixture built with up to 4 θo layers of ≥ 0.5° (its default intervals are
+    /// narrower than the default's two 1.5° layers), shared by the layer-table tests.
+    fn layered_rgl() -> (Arc<dyn Brdf>, ExactSet, ExactOptions) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/measured/rgl/paper_white_rgb.bsdf");
+        let rgl: Arc<dyn Brdf> = Arc::new(brdf::RglBrdf::load(&path).unwrap());
+        let opts = ExactOptions {
+            thinning_layers: 4,
+            thinning_layer_deg: 0.5,
+            ..ExactOptions::default()
+        };
+        let set = ExactSet::build(Arc::clone(&rgl), &opts, None).unwrap();
+        (rgl, set, opts)
+    }
+
+    /// θo layer tables (docs/benchmarks.md §31.1) on the layered RGL fixture: for every layer
+    /// of every layered interval, (a) the layer table has the interval's leaves (the same
+    /// rectangles in the same order) and each leaf bound `M_il` is the smallest `f32` at least
+    /// every sub-cell bound `sub_bound(M_i, q_ils)` of the leaf in that layer (so `≥` each of
+    /// them, and `≤ M_i`); (b) its codes are the smallest whose bound `sub_bound(M_il, q')` is
+    /// at least the layer's sub-cell bound; (c) drawn at the layer's middle θo with the
+    /// query's density and the same uniforms (2000 samples), the layer table needs fewer
+    /// trials than the interval's table — the figure printed, asserted below 0.995 over the
+    /// set, as is the envelope volume `Σ dx·dy·M_il / Σ dx·dy·M_i` — with 0 violations (no `g`
+    /// above `M_il`). Fails with `M_il` rounded down (`f32_at_least`
+    /// returning `b as f32` rounded toward 0: (a)), with the codes not re-expressed (the
+    /// interval's codes kept: (b)), and with the layer tables off (`serving` returning the
+    /// interval's table: (c)).
+    #[test]
+    fn layer_tables_bound_their_sub_cells_and_cut_trials() {
+        use super::super::density::QueryDensity;
+        use super::super::table::sub_bound;
+        use partition_sampler::Audit;
+        let (rgl, set, _) = layered_rgl();
+        let top = super::super::THETA_TOP_DEG.to_radians();
+        let cell = &set.cells[0];
+        let (mut layered, mut leaves) = (0, 0usize);
+        let (mut trials_layer, mut trials_interval) = (0u64, 0u64);
+        let (mut volume_layer, mut volume_interval) = (0.0, 0.0);
+        for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
+            let table = table.as_ref().unwrap();
+            let Some(sub) = iv.sub_bounds.as_ref().filter(|s| s.layers() > 1) else {
+                assert!(table.layer_tables().is_empty());
+                continue;
+            };
+            layered += 1;
+            let layers = table.layer_tables();
+            assert_eq!(layers.len(), sub.layers());
+            let n = iv.tree.tree().leaves().len();
+            // The layers' θo ranges within the interval (an interval that inherited its
+            // parent's tree has the parent's layer edges, some outside its own range).
+            let mut ends = vec![f64::NEG_INFINITY];
+            ends.extend(sub.edges.iter().copied());
+            ends.push(f64::INFINITY);
+            for (l, lt) in layers.iter().enumerate() {
+                let codes = &sub.codes[l * n..(l + 1) * n];
+                for (k, c) in codes.iter().enumerate() {
+                    let [x0, dx, y0, dy, m] = table.leaf_record(k);
+                    let [lx0, ldx, ly0, ldy, ml] = lt.leaf_record(k);
+                    assert_eq!([x0, dx, y0, dy], [lx0, ldx, ly0, ldy], "leaf {k}");
+                    let top = c.iter().map(|&q| sub_bound(m, q)).fold(0.0, f64::max);
+                    let ml32 = ml as f32;
+                    assert_eq!(f64::from(ml32), ml);
+                    assert!(ml >= top && ml <= m, "layer {l} leaf {k}: {ml} < {top}");
+                    assert!(
+                        top == 0.0 || f64::from(ml32.next_down()) < top,
+                        "layer {l} leaf {k}: {ml} not the smallest f32 ≥ {top}"
+                    );
+                    for (s, &qs) in c.iter().enumerate() {
+                        let b = sub_bound(m, qs);
+                        let q = lt.code(k, s);
+                        assert!(sub_bound(ml, q) >= b, "layer {l} leaf {k} sub {s}");
+                        assert!(
+                            q == 0 || sub_bound(ml, q - 1) < b || ml == 0.0,
+                            "layer {l} leaf {k} sub {s}: code {q} not the smallest"
+                        );
+                    }
+                    leaves += 1;
+                }
+                // (c) At the layer's middle θo, the query's density, the same uniforms (a
+                // layer above the top angle serves no query of its own θo).
+                let (a, b) = (ends[l].max(iv.theta[0]), ends[l + 1].min(iv.theta[1]));
+                let t = 0.5 * (a + b);
+                if !(a < b) || t >= top {
+                    continue;
+                }
+                let wo = brdf::direction_from_radians(t, 0.0);
+                let q = set.locate(&wo).expect("served");
+                assert!(
+                    std::ptr::eq(set.table_of(&q).unwrap(), lt),
+                    "layer {l} serves"
+                );
+                let g = QueryDensity::in_frame(rgl.as_ref(), true, &q.wo, q.turn, iv.map);
+                let g = |p| g.at(p);
+                let draws = |tb: &super::LeafTable| {
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(61);
+                    let mut audit = Audit::default();
+                    for _ in 0..2000 {
+                        assert!(tb.draw(&g, &mut rng, &mut audit).is_some());
+                    }
+                    assert_eq!(audit.violations, 0, "θo {:.3}°", t.to_degrees());
+                    audit.trials
+                };
+                trials_layer += draws(lt);
+                trials_interval += draws(table);
+                let volume = |tb: &super::LeafTable| {
+                    (0..n)
+                        .map(|k| {
+                            let [_, dx, _, dy, m] = tb.leaf_record(k);
+                            dx * dy * m
+                        })
+                        .sum::<f64>()
+                };
+                volume_layer += volume(lt);
+                volume_interval += volume(table);
+            }
+        }
+        assert!(layered >= 4, "{layered} layered intervals");
+        let ratio = trials_layer as f64 / trials_interval as f64;
+        let volume = volume_layer / volume_interval;
+        println!(
+            "layer tables: {layered} intervals, {leaves} leaf layers; trials {trials_layer} / \
+             {trials_interval} = {ratio:.4}; envelope volume {volume:.4}"
+        );
+        // paper_white's envelope hardly changes with θo (§30.1's factor (b): 1.005–1.017), so
+        // the fall is small here (0.992 measured, ≈ 8 standard deviations of the counts); with
+        // the layer tables off the two counts are equal.
+        assert!(
+            ratio < 0.995,
+            "trials with / without layer tables {ratio:.4}"
+        );
+        assert!(
+            volume < 0.995,
+            "envelope volume with / without layer tables {volume:.4}"
+        );
+    }
+
+    /// The one-query path and the fixed-ωo wavefront pick the same θo layer, also at the layer
+    /// edges (docs/benchmarks.md §31.1): on the layered RGL fixture, for each inner edge `e` of
+    /// every layered interval (inside it and below the top angle), at the three floats
+    /// `cos θo` on each side of where [`layer_of`]`(acos(cos θo))` switches from layer `j + 1`
+    /// to `j` (both layers reached at every edge, asserted), (a) `draw_located`'s sample is, bit for bit, the rejection draw
+    /// of the table of the layer [`layer_of`] gives for `θo = acos(cos θo)` from the same
+    /// uniforms, and (b) the batch path's fixed-ωo run (a wavefront) draws, bit for bit,
+    /// [`wavefront`]'s samples under that table. Fails with the layer off by one in one path
+    /// (`table_of` taking `layer_of(θo) + 1`, clamped: (a); the batch path's table the next
+    /// layer's: (b)).
+    ///
+    /// [`layer_of`]: super::super::table::layer_of
+    /// [`wavefront`]: super::wavefront
+    #[test]
+    fn one_query_path_and_wavefront_pick_the_same_layer_at_its_edges() {
+        use super::super::density::QueryDensity;
+        use super::super::fused::{accepted, accepted_at};
+        use super::super::table::{layer_of, query_theta};
+        use super::{WAVE, wavefront_with};
+        use partition_sampler::Audit;
+        let (rgl, set, _) = layered_rgl();
+        let top = super::super::THETA_TOP_DEG.to_radians() - 1e-9;
+        let cell = &set.cells[0];
+        let key = |s: &crate::DirSample| [s.wi.x, s.wi.y, s.wi.z, s.pdf].map(f64::to_bits);
+        let (mut edges, mut compared) = (0, 0);
+        for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
+            let table = table.as_ref().unwrap();
+            let Some(sub) = iv.sub_bounds.as_ref().filter(|s| s.layers() > 1) else {
+                continue;
+            };
+            for (j, &e) in sub.edges.iter().enumerate() {
+                if !(e > iv.theta[0] && e < iv.theta[1].min(top)) {
+                    // An inherited edge outside the interval, or above the top angle: no query
+                    // of the interval has this θo.
+                    continue;
+                }
+                let layer = |c: f64| layer_of(&sub.edges, query_theta(c)).unwrap();
+                // The largest `cos θo` of layer `j + 1`, found by ulp steps from `cos e`.
+                let mut c = e.cos();
+                while layer(c) > j {
+                    c = c.next_up();
+                }
+                while layer(c) <= j {
+                    c = c.next_down();
+                }
+                // Three floats on each side of the switch.
+                for _ in 0..2 {
+                    c = c.next_down();
+                }
+                let mut seen = [false; 2];
+                for _ in 0..6 {
+                    let theta = query_theta(c);
+                    let l = layer_of(&sub.edges, theta).unwrap();
+                    assert!(l == j || l == j + 1, "edge {j}: layer {l}");
+                    seen[l - j] = true;
+                    let want_table = &table.layer_tables()[l];
+                    let wo = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
+                    let q = set.locate(&wo).expect("served");
+                    // (a) The one-query path.
+                    let g = QueryDensity::in_frame(rgl.as_ref(), true, &q.wo, q.turn, iv.map);
+                    let a = set.normaliser_of(&q);
+                    let mut r1 = Xoshiro256PlusPlus::seed_from_u64(71);
+                    let mut r2 = r1.clone();
+                    let (mut a1, mut a2) = (Audit::default(), Audit::default());
+                    for _ in 0..20 {
+                        let (got, _) = set.draw_located(&q, &wo, &mut r1, &mut a1);
+                        let (x, gx) = want_table.draw(&|p| g.at(p), &mut r2, &mut a2).unwrap();
+                        let (want, _) = accepted(iv.map, &q.turn, x, gx, a);
+                        assert_eq!(key(&got), key(&want), "edge {j}, cos {c:e}: one-query path");
+                    }
+                    // (b) The batch path's run: a wavefront.
+                    let n = super::PREPARED_RUN_MIN;
+                    let out = batch(&set, rgl.as_ref(), &vec![wo; n], 73);
+                    let run = rgl.prepare_run(&q.wo).unwrap();
+                    let mut rng = Xoshiro256PlusPlus::seed_from_u64(73);
+                    let mut want = vec![crate::DirSample::NONE; n];
+                    let mut audit = Audit::default();
+                    wavefront_with(
+                        run.as_ref(),
+                        want_table,
+                        iv.map,
+                        theta,
+                        n,
+                        WAVE,
+                        &mut rng,
+                        &mut audit,
+                        |i, d| {
+                            if let Some((_, v, gx)) = d {
+                                want[i] = accepted_at(iv.map, &q.turn, v, gx, a).0;
+                            }
+                        },
+                    );
+                    for (i, (o, w)) in out.iter().zip(&want).enumerate() {
+                        let o = crate::DirSample {
+                            wi: o.wi,
+                            pdf: o.pdf,
+                        };
+                        assert_eq!(key(&o), key(w), "edge {j}, cos {c:e}: wavefront sample {i}");
+                    }
+                    compared += 1;
+                    c = c.next_up();
+                }
+                assert_eq!(seen, [true, true], "edge {j} at {e}: both layers reached");
+                edges += 1;
+            }
+        }
+        assert!(edges >= 8, "{edges} edges");
+        println!("layer edges: {edges}, {compared} cos θo compared");
     }
 }

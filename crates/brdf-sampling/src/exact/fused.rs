@@ -74,7 +74,10 @@ impl ExactSet {
         // branch. Bit for bit the pdf's normaliser ([`IsoRecord::normaliser`]).
         let a = rec.normaliser(q.cos, iv);
         let turn = Turn::of_azimuth(wo, q.r);
-        let drawn = match &cell.tables[q.interval] {
+        let drawn = match cell.tables[q.interval]
+            .as_ref()
+            .map(|t| t.serving_cos(q.cos))
+        {
             Some(table) => table.draw(&|p| g.at(p), u, audit),
             None => {
                 use partition_sampler::diagnostics::AuditedDraws;

@@ -46,7 +46,8 @@ pub(super) struct Cell {
     /// The intervals, ordered by θ, then δ.
     pub(super) intervals: Vec<Interval>,
     /// Per interval, the compact table its samples are drawn from ([`LeafTable`]; `None`: the
-    /// tree's own walk).
+    /// tree's own walk); in isotropic cells with the θo layers' own tables
+    /// ([`LeafTable::serving`]).
     pub(super) tables: Vec<Option<LeafTable>>,
     /// Per interval, what the isotropic fast path reads besides the table
     /// ([`IsoRecord`](super::iso_record::IsoRecord); unused by anisotropic cells).
@@ -155,9 +156,22 @@ impl Cell {
                 aniso.push(rec);
             }
         }
+        // Isotropic cells: a table per θo layer of the thinning bounds as well
+        // (`LeafTable::with_layer_tables`; every isotropic path draws from the layer serving the
+        // query's θo). Anisotropic cells keep the interval's table (their paths do not pick
+        // layers).
         let tables = intervals
             .iter()
-            .map(|iv| LeafTable::of(&iv.tree).map(|t| t.with_sub_bounds(iv.sub_bounds.as_ref())))
+            .map(|iv| {
+                LeafTable::of(&iv.tree).map(|t| {
+                    let t = t.with_sub_bounds(iv.sub_bounds.as_ref());
+                    if grid.half > 0.0 {
+                        t
+                    } else {
+                        t.with_layer_tables()
+                    }
+                })
+            })
             .collect();
         let half_key = if by_tan { tan_half } else { grid.half };
         let iso = intervals

@@ -12,6 +12,7 @@ use super::grid::TableVar;
 use super::interval::{Interval, Query};
 use super::options::THETA_TOP_DEG;
 use super::set::ExactSet;
+use super::table::{LeafTable, query_theta};
 use super::walk::{rem_period, round_index};
 
 impl ExactSet {
@@ -36,6 +37,22 @@ impl ExactSet {
 
     pub(super) fn interval(&self, q: &Query) -> &Interval {
         &self.cells[q.cell].intervals[q.interval]
+    }
+
+    /// The compact table a located query draws from (`None`: the interval's tree): its
+    /// interval's [`LeafTable`], or the table of the θo layer serving the query
+    /// ([`LeafTable::serving`] at θo = [`query_theta`]`(cos θo)`; for an isotropic `θo`-table
+    /// set that is the query's table variable, the same bits).
+    #[inline]
+    pub(super) fn table_of(&self, q: &Query) -> Option<&LeafTable> {
+        let table = self.cells[q.cell].tables[q.interval].as_ref()?;
+        if self.isotropic && self.var == TableVar::Theta {
+            // `locate`'s `var` is `cos.acos()` with `cos = q.cos ∈ (0, 1]`: `query_theta`'s.
+            debug_assert!(q.var.to_bits() == query_theta(q.cos).to_bits());
+            Some(table.serving(q.var))
+        } else {
+            Some(table.serving_cos(q.cos))
+        }
     }
 
     /// Cell, interval, θo, δ and rotation of `wo`; `None` at or below the horizon.
@@ -183,7 +200,7 @@ impl ExactSet {
         let q = *q;
         let iv = self.interval(&q);
         let g = QueryDensity::in_frame(self.brdf.as_ref(), self.isotropic, &q.wo, q.turn, iv.map);
-        let drawn = match &self.cells[q.cell].tables[q.interval] {
+        let drawn = match self.table_of(&q) {
             Some(table) => table.draw(&|p| g.at(p), u, audit),
             None => iv.tree.sample_envelope_of(&|p| g.at(p), u, audit),
         };

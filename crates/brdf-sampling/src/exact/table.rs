@@ -126,6 +126,25 @@ pub(super) struct LeafTable {
     sub: Box<[u8]>,
     /// The inner θo edges of the layers ([`SubBounds::edges`]).
     edges: Box<[f64]>,
+    /// Per θo layer of the thinning bounds (`L ≥ 2`; empty: none, see
+    /// [`LeafTable::with_layer_tables`]), the layer's own table over the same leaves: leaf
+    /// bounds `M_il`, alias table and one layer of codes ([`LeafTable::serving`] picks it).
+    layers: Box<[LeafTable]>,
+}
+
+/// The smallest `f32` at least `b` (`b` finite and non-negative): a layer table's leaf bound
+/// `M_il` from the largest sub-cell bound of its leaf.
+fn f32_at_least(b: f64) -> f32 {
+    let v = b as f32;
+    if f64::from(v) < b { v.next_up() } else { v }
+}
+
+/// The θo whose layer serves a query with `cos θo = cos`: `acos(cos)` (the argument clamped
+/// to `[−1, 1]`). The one rule of every path that picks a layer ([`LeafTable::serving_cos`],
+/// the fixed-ωo wavefront's `theta`), so that they pick the same layer for the same query.
+#[inline]
+pub(super) fn query_theta(cos: f64) -> f64 {
+    cos.clamp(-1.0, 1.0).acos()
 }
 
 impl LeafTable {
@@ -135,7 +154,6 @@ impl LeafTable {
     /// interval.
     pub(super) fn of<D: RegionStats>(tree: &QuadTreeSampler<D>) -> Option<Self> {
         let mut entries = Vec::with_capacity(tree.tree().leaves().len());
-        let mut weights = Vec::with_capacity(entries.capacity());
         for l in tree.tree().leaves() {
             let r = l.rect;
             let (x0, y0) = (r.x0 as f32, r.y0 as f32);
@@ -150,7 +168,6 @@ impl LeafTable {
             if !exact {
                 return None;
             }
-            weights.push((f64::from(dx) * f64::from(dy)) * f64::from(m));
             entries.push(Entry {
                 x0,
                 y0,
@@ -161,6 +178,17 @@ impl LeafTable {
                 prob: 1.0,
             });
         }
+        Self::of_entries(entries)
+    }
+
+    /// The table of `entries` (their alias fields rewritten): the alias table of the weights
+    /// `V_i = (dx · dy) · M_i` of the records' `f32` values; `None` when their sum is not
+    /// positive and finite. No thinning bounds.
+    fn of_entries(mut entries: Vec<Entry>) -> Option<Self> {
+        let weights: Vec<f64> = entries
+            .iter()
+            .map(|e| (f64::from(e.dx) * f64::from(e.dy)) * f64::from(e.m))
+            .collect();
         let total: f64 = weights.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
             return None;
@@ -174,12 +202,15 @@ impl LeafTable {
             entries: entries.into_boxed_slice(),
             sub: Box::new([]),
             edges: Box::new([]),
+            layers: Box::new([]),
         })
     }
 
     /// The table with the leaves' thinning bounds `sub` (one per leaf in the tree's order);
-    /// ignored (no thinning) unless there is exactly one per entry.
+    /// ignored (no thinning) unless there is exactly one per entry. Without layer tables
+    /// ([`LeafTable::with_layer_tables`] makes them from these bounds).
     pub(super) fn with_sub_bounds(mut self, sub: Option<&SubBounds>) -> Self {
+        self.layers = Box::new([]);
         let sub = sub.filter(|s| s.codes.len() == s.layers() * self.entries.len());
         self.sub = sub
             .map_or_else(Vec::new, |s| s.codes.as_flattened().to_vec())
@@ -190,12 +221,104 @@ impl LeafTable {
         self
     }
 
+    /// The table with one **layer table** per θo layer of its thinning bounds when it has
+    /// `L ≥ 2` (docs/benchmarks.md §31.1; otherwise unchanged): layer `l`'s table has the same
+    /// leaves (rectangles, order), the leaf bounds
+    /// `M_il = ⌈max_s sub_bound(M_i, q_ils)⌉_f32` (the largest of leaf `i`'s sub-cell bounds in
+    /// layer `l`, rounded up to an `f32`; `≤ M_i`), its own alias table over
+    /// `V_il = (dx · dy) · M_il` (a leaf with `M_il = 0` is never picked), and one layer of
+    /// codes re-expressed relative to `M_il`: `q'_ils = sub_code(M_il, sub_bound(M_i, q_ils))`,
+    /// the smallest whose bound `sub_bound(M_il, q')` is at least the layer's sub-cell bound.
+    /// So wherever `g ≤ sub_bound(M_i, q_ils)` holds for a θo of the layer, `g ≤ M_il` and
+    /// `g ≤ sub_bound(M_il, q'_ils)` hold too: envelope rejection under a layer table samples
+    /// `g / ∫ g` exactly as under the interval's, with fewer trials (`Σ V_il ≤ Σ V_i`); the
+    /// samples drawn are other ones (another alias table). Unchanged (no layer tables) when a
+    /// layer's weights do not sum to a positive finite number.
+    pub(super) fn with_layer_tables(mut self) -> Self {
+        self.layers = Box::new([]);
+        let (l_count, n) = (self.edges.len() + 1, self.entries.len());
+        if l_count < 2 || self.sub.len() != l_count * n * SUB_CELLS {
+            return self;
+        }
+        let mut layers = Vec::with_capacity(l_count);
+        for codes in self.sub.chunks_exact(n * SUB_CELLS) {
+            let mut entries = Vec::with_capacity(n);
+            let mut sub = Vec::with_capacity(n * SUB_CELLS);
+            for (e, c) in self.entries.iter().zip(codes.chunks_exact(SUB_CELLS)) {
+                let m = f64::from(e.m);
+                let top = c.iter().map(|&q| sub_bound(m, q)).fold(0.0, f64::max);
+                let ml = f32_at_least(top);
+                if ml == e.m {
+                    // The same bound: the same codes (`sub_code(m, sub_bound(m, q)) = q`).
+                    sub.extend_from_slice(c);
+                } else {
+                    sub.extend(c.iter().map(|&q| sub_code(f64::from(ml), sub_bound(m, q))));
+                }
+                entries.push(Entry { m: ml, ..*e });
+            }
+            let Some(mut t) = Self::of_entries(entries) else {
+                return self;
+            };
+            t.sub = sub.into_boxed_slice();
+            layers.push(t);
+        }
+        self.layers = layers.into_boxed_slice();
+        self
+    }
+
+    /// The table a query at `theta` (θo, radians) draws from: the layer table of the layer
+    /// serving `theta` ([`layer_of`]) when the table has layer tables, otherwise (and for a
+    /// `theta` that is not a number) the table itself.
+    #[inline]
+    pub(super) fn serving(&self, theta: f64) -> &Self {
+        if self.layers.is_empty() {
+            return self;
+        }
+        self.serving_layer(theta).map_or(self, |l| &self.layers[l])
+    }
+
+    /// The index of the layer table [`LeafTable::serving`] picks at `theta`, `None` when it
+    /// picks the table itself.
+    #[inline]
+    pub(super) fn serving_layer(&self, theta: f64) -> Option<usize> {
+        layer_of(&self.edges, theta).filter(|&l| l < self.layers.len())
+    }
+
+    /// [`LeafTable::serving`] for a query with `cos θo = cos` (θo by [`query_theta`], computed
+    /// only for a table with layer tables).
+    #[inline]
+    pub(super) fn serving_cos(&self, cos: f64) -> &Self {
+        if self.layers.is_empty() {
+            self
+        } else {
+            self.serving(query_theta(cos))
+        }
+    }
+
+    /// The layer tables (empty: none; see [`LeafTable::with_layer_tables`]).
+    pub(super) fn layer_tables(&self) -> &[LeafTable] {
+        &self.layers
+    }
+
     /// The offset of the codes of the layer serving `theta` (θo, radians) in the table's codes
     /// (`layer · entries · SUB_CELLS`, see [`layer_of`]); for a `theta` that is not a number,
     /// an offset past every code: [`LeafTable::code_factor`] then reads 1 (`M_i` itself).
     #[inline]
     pub(super) fn layer_base(&self, theta: f64) -> usize {
         layer_of(&self.edges, theta).map_or(usize::MAX / 2, |l| l * self.entries.len() * SUB_CELLS)
+    }
+
+    /// Leaf `k`'s record as `[x0, dx, y0, dy, M_i]` (test support).
+    #[cfg(test)]
+    pub(super) fn leaf_record(&self, k: usize) -> [f64; 5] {
+        let e = &self.entries[k];
+        [e.x0, e.dx, e.y0, e.dy, e.m].map(f64::from)
+    }
+
+    /// The first layer's code of leaf `k`'s sub-cell `s` (255 without codes; test support).
+    #[cfg(test)]
+    pub(super) fn code(&self, k: usize, s: usize) -> u8 {
+        self.sub.get(k * SUB_CELLS + s).copied().unwrap_or(255)
     }
 
     /// The layer count of the thinning bounds (1 without any).
@@ -215,6 +338,7 @@ impl LeafTable {
             + std::mem::size_of_val(&*self.entries)
             + std::mem::size_of_val(&*self.sub)
             + std::mem::size_of_val(&*self.edges)
+            + self.layers.iter().map(Self::bytes_used).sum::<usize>()
     }
 
     /// One point of `g / ∫ g` on the disc by envelope rejection under the table's bounds

@@ -2,7 +2,8 @@
 //! queries of one interval group, each at its own `ωo`, drawn together — every pending query
 //! proposes one trial per pass in vector lanes ([`lanes::trials`]: its own SplitMix64 stream,
 //! the leaf pick, the point, bound, threshold and direction; the interval's one table serves
-//! all of them), the trials inside the disc are evaluated at their own query's prepared `ωo`,
+//! all of them, or with θo layer tables the layer's table serves its queries, one wavefront per
+//! layer), the trials inside the disc are evaluated at their own query's prepared `ωo`,
 //! and acceptance and the next pass's pending list are made without branches.
 //!
 //! Each query's law is [`ExactSet::draw_iso`]'s — the same trial, density, acceptance test,
@@ -24,7 +25,7 @@ use partition_sampler::{Audit, MAX_TRIALS_PER_SAMPLE, UniformSource};
 use super::ExactSet;
 use super::fused::accepted_at;
 use super::lanes::{self, Trials, mix64};
-use super::table::LeafTable;
+use super::table::{LeafTable, query_theta};
 use crate::disc::{DiscMap, count_evaluations};
 use crate::layout::Turn;
 use crate::{DirSample, EvalSample};
@@ -54,6 +55,10 @@ pub(super) struct WaveLists {
     lane: Vec<u32>,
     g: Vec<f64>,
     acc: Vec<u32>,
+    /// An interval group with θo layer tables ([`ExactSet::serve_iso_wave`]): per query its
+    /// layer, and one layer's queries.
+    layer: Vec<usize>,
+    in_layer: Vec<u32>,
 }
 
 impl Default for WaveLists {
@@ -70,6 +75,8 @@ impl Default for WaveLists {
             lane: vec![0; WAVE_BLOCK],
             g: vec![0.0; WAVE_BLOCK],
             acc: vec![0; WAVE_BLOCK],
+            layer: Vec::new(),
+            in_layer: Vec::new(),
         }
     }
 }
@@ -196,7 +203,8 @@ thread_local! {
 impl ExactSet {
     /// The isotropic fast-path queries `members` (indices into `wos` and `out`, all in
     /// interval `interval`, which has a table) drawn as one wavefront from the streams keyed by
-    /// `seed` (see the module docs): `out[i]` is [`ExactSet::draw_iso`]'s sample at `wos[i]`
+    /// `seed` (see the module docs; with θo layer tables, one wavefront per layer, each from
+    /// the layer's table as `draw_iso` picks it): `out[i]` is [`ExactSet::draw_iso`]'s sample at `wos[i]`
     /// from query `i`'s stream, finished as the one-query path finishes it (the accepted
     /// trial's `f`, or one evaluation of `brdf` when it is another object), or the empty
     /// sample after [`MAX_TRIALS_PER_SAMPLE`] trials (counted as exhausted). Trials,
@@ -214,12 +222,69 @@ impl ExactSet {
         audit: &mut Audit,
         out: &mut [EvalSample],
     ) {
+        let Some(table) = self.cells[0].tables[interval].as_ref() else {
+            return;
+        };
+        let layers = table.layer_tables();
+        if layers.is_empty() {
+            self.serve_iso_wave_in(
+                brdf, wos, interval, members, table, seed, arch, w, audit, out,
+            );
+            return;
+        }
+        // θo layer tables: one wavefront per layer over its queries (the layer `draw_iso`
+        // picks, `LeafTable::serving_cos`; past the last, the interval's own table). Each
+        // query's sample stays a function of its stream, index and `ωo` only.
+        let (mut layer, mut in_layer) = (
+            std::mem::take(&mut w.layer),
+            std::mem::take(&mut w.in_layer),
+        );
+        layer.clear();
+        layer.extend(members.iter().map(|&i| {
+            let cos = wos[i as usize].z.min(1.0);
+            table
+                .serving_layer(query_theta(cos))
+                .unwrap_or(layers.len())
+        }));
+        for l in 0..=layers.len() {
+            in_layer.clear();
+            in_layer.extend(
+                members
+                    .iter()
+                    .zip(&layer)
+                    .filter(|&(_, &k)| k == l)
+                    .map(|(&i, _)| i),
+            );
+            if !in_layer.is_empty() {
+                let t = layers.get(l).unwrap_or(table);
+                self.serve_iso_wave_in(
+                    brdf, wos, interval, &in_layer, t, seed, arch, w, audit, out,
+                );
+            }
+        }
+        w.layer = layer;
+        w.in_layer = in_layer;
+    }
+
+    /// [`ExactSet::serve_iso_wave`]'s queries `members` drawn from `table` (the interval's, or
+    /// the layer table serving every one of them).
+    #[allow(clippy::too_many_arguments)]
+    fn serve_iso_wave_in(
+        &self,
+        brdf: &dyn Brdf,
+        wos: &[Vec3],
+        interval: usize,
+        members: &[u32],
+        table: &LeafTable,
+        seed: u64,
+        arch: pulp::Arch,
+        w: &mut IsoWave,
+        audit: &mut Audit,
+        out: &mut [EvalSample],
+    ) {
         let cell = &self.cells[0];
         let iv = &cell.intervals[interval];
         let rec = &cell.iso[interval];
-        let Some(table) = cell.tables[interval].as_ref() else {
-            return;
-        };
         let map = rec.map;
         // Per query: `draw_iso`'s preparation, in the interval's frame `(r, 0, cos θo)`.
         let s = w.slots(members.len());
@@ -288,6 +353,7 @@ impl ExactSet {
             lane,
             g,
             acc,
+            ..
         } = w;
         let model = self.brdf.as_ref();
         let (mut trials, mut violations, mut pass) = (0u64, 0u64, 0u64);
