@@ -221,8 +221,10 @@ impl LeafTable {
         self
     }
 
-    /// The table with one **layer table** per θo layer of its thinning bounds when it has
-    /// `L ≥ 2` (docs/benchmarks.md §31.1; otherwise unchanged): layer `l`'s table has the same
+    /// The table with one **layer table** per θo layer of its thinning bounds when it has any
+    /// (docs/benchmarks.md §31.1; `L = 1` as well, §31.4: the single layer's table then holds
+    /// the leaf bounds tightened to the codes, e.g. §31.3's rigorous ones; without thinning
+    /// bounds unchanged): layer `l`'s table has the same
     /// leaves (rectangles, order), the leaf bounds
     /// `M_il = ⌈max_s sub_bound(M_i, q_ils)⌉_f32` (the largest of leaf `i`'s sub-cell bounds in
     /// layer `l`, rounded up to an `f32`; `≤ M_i`), its own alias table over
@@ -237,7 +239,7 @@ impl LeafTable {
     pub(super) fn with_layer_tables(mut self) -> Self {
         self.layers = Box::new([]);
         let (l_count, n) = (self.edges.len() + 1, self.entries.len());
-        if l_count < 2 || self.sub.len() != l_count * n * SUB_CELLS {
+        if self.sub.is_empty() || self.sub.len() != l_count * n * SUB_CELLS {
             return self;
         }
         let mut layers = Vec::with_capacity(l_count);
