@@ -2344,7 +2344,7 @@ pub(super) mod tests {
         let (mut volume_layer, mut volume_interval) = (0.0, 0.0);
         for (iv, table) in cell.intervals.iter().zip(&cell.tables) {
             let table = table.as_ref().unwrap();
-            // Every interval with thinning bounds has layer tables, one layer (§31.4) or more.
+            // Every interval with thinning bounds has layer tables, one layer (§31.5) or more.
             let Some(sub) = iv.sub_bounds.as_ref() else {
                 assert!(table.layer_tables().is_empty());
                 continue;

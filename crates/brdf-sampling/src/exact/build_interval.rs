@@ -233,7 +233,7 @@ fn sub_bounds(
     tree: &QuadTree,
     image: &SliceImageMap<'_>,
     growth: f64,
-    rigorous: Option<&RglRectBound<'_>>,
+    rigorous: Option<(&RglRectBound<'_>, RigorousRule)>,
 ) -> Box<[[u8; SUB_CELLS]]> {
     use partition_sampler::{Rect, RegionStats};
     let c = image.cell() * growth;
@@ -247,18 +247,26 @@ fn sub_bounds(
                     let (x0, y0) = (r.x0 + w * sx as f64, r.y0 + h * sy as f64);
                     let x1 = if sx + 1 == SUB { r.x1 } else { x0 + w };
                     let y1 = if sy + 1 == SUB { r.y1 } else { y0 + h };
+                    let grown = || {
+                        image
+                            .region(&Rect::new(
+                                (x0 - c).max(-1.0),
+                                (y0 - c).max(-1.0),
+                                (x1 + c).min(1.0),
+                                (y1 + c).min(1.0),
+                            ))
+                            .max_bound
+                    };
+                    let cell = Rect::new(x0, y0, x1, y1);
+                    // `bound_below(cell, cap)` equals the bound below `cap` and is ≥ `cap`
+                    // otherwise, so the codes are those of the full bound (§31.4).
                     let b = match rigorous {
-                        Some(rb) => rb.bound(&Rect::new(x0, y0, x1, y1)),
-                        None => {
-                            image
-                                .region(&Rect::new(
-                                    (x0 - c).max(-1.0),
-                                    (y0 - c).max(-1.0),
-                                    (x1 + c).min(1.0),
-                                    (y1 + c).min(1.0),
-                                ))
-                                .max_bound
+                        Some((rb, RigorousRule::Alone)) => rb.bound_below(&cell, l.max_bound),
+                        Some((rb, RigorousRule::WithGrown)) => {
+                            let g = grown();
+                            g.min(rb.bound_below(&cell, g.min(l.max_bound)))
                         }
+                        None => grown(),
                     };
                     codes[sy * SUB + sx] = sub_code(l.max_bound, b);
                 }
@@ -268,27 +276,47 @@ fn sub_bounds(
         .collect()
 }
 
-/// The rigorous sub-cell bound of an interval's codes over `θo ∈ range` ([`RglRectBound`]):
-/// `Some` for an RGL material with [`ExactOptions::thinning_rigorous`] in an isotropic interval of
-/// the outgoing frame at azimuth 0 (the frame [`brdf::RglBrdf::f_cos_bound`] bounds) whose codes
-/// are one layer ([`layer_count`] 1: the intervals narrower than `2 · thinning_layer_deg`, the
-/// grazing ones among them). Not for layered intervals: there it costs `L` times the bound calls
-/// over wide θo ranges (docs/benchmarks.md §31.3: min(grown, B) on every interval, builds
-/// +165 % user time).
+/// How [`sub_bounds`] uses the rigorous sub-cell bound `B_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RigorousRule {
+    /// `b_s = B_s` (one-layer intervals, docs/benchmarks.md §31.3).
+    Alone,
+    /// `b_s = min(grown rule, B_s)` (layered intervals, §31.4).
+    WithGrown,
+}
+
+/// The rigorous sub-cell bound of an interval's codes over `θo ∈ range` ([`RglRectBound`]),
+/// with the rule [`sub_bounds`] applies it by: `Some` for an RGL material with
+/// [`ExactOptions::thinning_rigorous`] in an isotropic interval of the outgoing frame at
+/// azimuth 0 (the frame [`brdf::RglBrdf::f_cos_bound`] bounds). One-layer intervals
+/// ([`layer_count`] 1: narrower than `2 · thinning_layer_deg`, the grazing ones among them) take
+/// `B_s` alone (§31.3); a layer of a layered interval takes `min(grown rule, B_s)` over the
+/// layer's θo range (docs/benchmarks.md §31.4: ibiza 1.35 → 1.2
+/// evaluations per sample at 0–60°, affordable once the bound is prepared per θo piece and
+/// stops at the cap).
 fn rect_bound<'a>(
     brdf: &'a dyn Brdf,
     options: &ExactOptions,
     ctx: &IntervalContext,
     span: &Span,
     range: [f64; 2],
-) -> Option<RglRectBound<'a>> {
+) -> Option<(RglRectBound<'a>, RigorousRule)> {
     let rgl = brdf.as_any()?.downcast_ref::<brdf::RglBrdf>()?;
-    (options.thinning_rigorous
-        && layer_count(options, span) <= 1
-        && span.isotropic
-        && ctx.phi_k == 0.0
-        && ctx.delta == [0.0, 0.0])
-    .then(|| RglRectBound::new(rgl, range, span.map))
+    let rule = if layer_count(options, span) <= 1 {
+        RigorousRule::Alone
+    } else {
+        RigorousRule::WithGrown
+    };
+    (options.thinning_rigorous && span.isotropic && ctx.phi_k == 0.0 && ctx.delta == [0.0, 0.0])
+        .then(|| {
+            let bound = match rule {
+                RigorousRule::Alone => RglRectBound::new(rgl, range, span.map),
+                RigorousRule::WithGrown => {
+                    RglRectBound::with_piece(rgl, range, span.map, super::rgl_bound::LAYER_PIECE)
+                }
+            };
+            (bound, rule)
+        })
 }
 
 /// Whether `brdf`'s intervals get thinning bounds: an RGL material with `options.thinning`.
@@ -397,8 +425,14 @@ fn layer_bounds(
             track_deltas,
             span.map,
         ));
-        // Layered: the grown leaf rule only (see `rect_bound`).
-        codes.extend(sub_bounds(tree, &image, options.thinning_growth, None));
+        // Layered: `min(grown rule, B_s)` over the layer's θo range (see `rect_bound`).
+        let rigorous = rect_bound(brdf.as_ref(), options, ctx, span, [ends[0].1, ends[1].1]);
+        codes.extend(sub_bounds(
+            tree,
+            &image,
+            options.thinning_growth,
+            rigorous.as_ref().map(|(rb, rule)| (rb, *rule)),
+        ));
     }
     Ok((
         SubBounds {
@@ -476,7 +510,7 @@ fn envelope_tree(
             &tree,
             &image,
             options.thinning_growth,
-            rigorous.as_ref(),
+            rigorous.as_ref().map(|(rb, rule)| (rb, *rule)),
         ))
     });
     drop(image);
@@ -1102,9 +1136,11 @@ mod tests {
     /// with up to 4 layers of ≥ 0.5°: (a) each layered interval's edges cut `[θ_a, θ_b]` in `L`
     /// equal parts (then clamped to the top angle); (b) the layer serving a θo at an interval's ends, at each
     /// edge (the lower layer), just above it and inside is the one whose range holds it
-    /// (`LeafTable::layer_base`); (c) each layer's codes are those of an image map built here
-    /// independently from the envelope of **both** of the layer's end nodes and the peak track
-    /// of its θo range (the build's rule for a layer); (d) at 12 × 12 points of every 8th leaf,
+    /// (`LeafTable::layer_base`); (c) each layer's codes are `min(grown rule, B_s)` (§31.4), the
+    /// grown rule that of an image map built here independently from the envelope of **both**
+    /// of the layer's end nodes and the peak track of its θo range (the build's rule for a
+    /// layer), `B_s` §31.3's unprepared bound over the layer's θo range (so the prepared, capped
+    /// bound gives the same codes), and some layer's codes are below the grown rule's; (d) at 12 × 12 points of every 8th leaf,
     /// `g(θo) ≤ M_ils` of the layer serving θo, at the layer's ends and middle, wherever `g` is
     /// within the interval's own (one-layer) code there — the layers add no point above its
     /// bound (the image-map rule has a few of its own: counted, docs §30.6). Fails (each
@@ -1139,7 +1175,7 @@ mod tests {
         let top = THETA_TOP_DEG.to_radians();
         let cell = &set.cells[0];
         let (mut old, mut new) = (0, 0);
-        let (mut layered, mut checked, mut inherited) = (0, 0, 0);
+        let (mut layered, mut checked, mut inherited, mut lowered) = (0, 0, 0, 0);
         let (mut single_checked, mut single_above, mut grazing) = (0u64, 0u64, 0);
         for ((iv, table), plain) in cell
             .intervals
@@ -1226,8 +1262,48 @@ mod tests {
                     &[0.0],
                     iv.map,
                 ));
-                // Layered: the grown rule only (`rect_bound`).
-                let want = sub_bounds(tree, &image, opts.thinning_growth, None);
+                // Layered: `min(grown rule, B_s)` (`rect_bound`, §31.4), with `B_s` as §31.3
+                // computed it (`bound_reference`: `f_cos_bound` per piece, nothing prepared
+                // or stopped at a cap), so the fast bound's codes are checked equal.
+                let rgl = brdf
+                    .as_any()
+                    .unwrap()
+                    .downcast_ref::<brdf::RglBrdf>()
+                    .unwrap();
+                let rb = RglRectBound::with_piece(
+                    rgl,
+                    [ends[l], ends[l + 1]],
+                    iv.map,
+                    super::super::rgl_bound::LAYER_PIECE,
+                );
+                let c = image.cell() * opts.thinning_growth;
+                use partition_sampler::RegionStats;
+                let want: Vec<[u8; SUB_CELLS]> = tree
+                    .leaves()
+                    .map(|leaf| {
+                        let r = leaf.rect;
+                        let (w, h) = ((r.x1 - r.x0) / SUB as f64, (r.y1 - r.y0) / SUB as f64);
+                        std::array::from_fn(|s| {
+                            let (sx, sy) = (s % SUB, s / SUB);
+                            let x0 = r.x0 + w * sx as f64;
+                            let y0 = r.y0 + h * sy as f64;
+                            let x1 = if sx + 1 == SUB { r.x1 } else { x0 + w };
+                            let y1 = if sy + 1 == SUB { r.y1 } else { y0 + h };
+                            let grown = image
+                                .region(&Rect::new(
+                                    (x0 - c).max(-1.0),
+                                    (y0 - c).max(-1.0),
+                                    (x1 + c).min(1.0),
+                                    (y1 + c).min(1.0),
+                                ))
+                                .max_bound;
+                            let b = rb.bound_reference(&Rect::new(x0, y0, x1, y1));
+                            sub_code(leaf.max_bound, grown.min(b))
+                        })
+                    })
+                    .collect();
+                let grown_only = sub_bounds(tree, &image, opts.thinning_growth, None);
+                lowered += usize::from(*grown_only != sub.codes[l * n..(l + 1) * n]);
                 assert!(
                     *want == sub.codes[l * n..(l + 1) * n],
                     "layer {l} of [{ta}, {tb}]: codes not from both end nodes"
@@ -1271,8 +1347,10 @@ mod tests {
         assert!(layered >= 4, "{layered} layered intervals");
         println!(
             "{layered} layered intervals ({inherited} inherited), {checked} points checked: \
-             {new} above their layer's bound only, {old} above the interval's code too"
+             {new} above their layer's bound only, {old} above the interval's code too; \
+             {lowered} layers whose codes the rigorous bound lowered"
         );
+        assert!(lowered > 0, "no layer's codes below the grown rule's");
         // (e) the default set's one-layer intervals (every interval narrower than 3°, the
         // grazing ones among them, with the rigorous sub-cell bound, §31.3): their codes hold at
         // 12 × 12 points of every 4th leaf at 7 θo of the range.

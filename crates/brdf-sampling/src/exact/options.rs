@@ -132,7 +132,10 @@ pub struct ExactOptions {
     /// pieces of ≤ 0.5° (`J` = 2 on the equal-area map, `1/min cos θi` projected, `+∞` at the
     /// projected rim): an upper bound of `g` over the sub-cell at every θo the codes serve, in
     /// place of the grown leaf rule ([`ExactOptions::thinning_growth`]), which `g` exceeds on
-    /// `cc_ibiza_sunset` at 84.4°. The samples do not change.
+    /// `cc_ibiza_sunset` at 84.4°. In a layered interval (docs/benchmarks.md §31.4) layer
+    /// `[θ_l, θ_{l+1}]` takes `M_ils = min(M_i, grown rule, B_s)` with `B_s` over the layer's θo
+    /// range in pieces of ≤ 1° (at most the grown rule; exceeded only where both are). The
+    /// samples do not change.
     pub thinning_rigorous: bool,
 }
 

@@ -8,7 +8,8 @@
 //! quadrature's error estimate, the build's evaluation count, the tree in partition-sampler's
 //! own versioned format ([`partition_sampler::FORMAT_VERSION`]) and the leaves' thinning bounds
 //! (16 codes per leaf in the tree's leaf order, per θo layer, and the layers' inner edges; or none;
-//! version 2, §30.1; version 3: the layers, §30.6).
+//! version 2, §30.1; version 3: the layers, §30.6; version 4: the options' `thinning_growth` and
+//! `thinning_rigorous`, §31.3 — a version-3 file would otherwise fail to decode its options).
 //!
 //! The BRDF is not stored: it is re-attached on load, which checks that the spec matches and
 //! that the BRDF reproduces the probes. The set's grid, cells, table variable and azimuth
@@ -44,7 +45,7 @@ use super::set::ExactSet;
 use super::table::{SUB_CELLS, SubBounds};
 
 /// Version of the stored `adaptive-exact` format; bumped on any incompatible change.
-pub const EXACT_FORMAT_VERSION: u32 = 3;
+pub const EXACT_FORMAT_VERSION: u32 = 4;
 
 const MAGIC: &[u8; 4] = b"BRQE";
 

@@ -11,7 +11,7 @@
 //! rectangle touching the rim of the projected map (`J` unbounded) has no bound (`+∞`).
 
 use brdf::RglBrdf;
-use brdf::measured::rgl::DirectionBox;
+use brdf::measured::rgl::{DirectionBox, ThetaPiece};
 use partition_sampler::Rect;
 
 use crate::disc::DiscMap;
@@ -19,22 +19,41 @@ use crate::disc::DiscMap;
 /// Widest piece of the θo range a bound is taken over (radians).
 pub(super) const THETA_PIECE: f64 = 0.5 * std::f64::consts::PI / 180.0;
 
+/// Widest θo piece of a layer's bound in a layered interval (radians; docs/benchmarks.md
+/// §31.4: 1° pieces cost 1.41 × main's ibiza build against 1.66 × for 0.5°, for 0.007–0.027
+/// more evaluations per sample at 0–60°).
+pub(super) const LAYER_PIECE: f64 = std::f64::consts::PI / 180.0;
+
 /// The rigorous bound of an RGL material's query densities over an isotropic interval's θo
 /// range (see the module docs): `bound(R) ≥ sup g_θo(p)` over `p ∈ R ∩ disc` and `θo ∈ [θa,
-/// θb]`.
+/// θb]`. The pieces' θo-only parts are prepared once ([`brdf::RglBrdf::f_cos_bound_piece`],
+/// docs/benchmarks.md §31.4) and reused for every rectangle.
 pub(super) struct RglRectBound<'a> {
     rgl: &'a RglBrdf,
     /// The pieces of the θo range.
-    pieces: Vec<[f64; 2]>,
+    #[cfg(test)]
+    ranges: Vec<[f64; 2]>,
+    /// Their prepared parts, in the same order.
+    pieces: Vec<ThetaPiece>,
     map: DiscMap,
 }
 
 impl<'a> RglRectBound<'a> {
     /// The bound of `rgl` over `θo ∈ [ta, tb]` (radians) on `map`, with θo pieces at most
     /// [`THETA_PIECE`] wide.
-    pub(super) fn new(rgl: &'a RglBrdf, [ta, tb]: [f64; 2], map: DiscMap) -> Self {
-        let n = (((tb - ta) / THETA_PIECE).ceil() as usize).clamp(1, 10_000);
-        let pieces = (0..n)
+    pub(super) fn new(rgl: &'a RglBrdf, range: [f64; 2], map: DiscMap) -> Self {
+        Self::with_piece(rgl, range, map, THETA_PIECE)
+    }
+
+    /// [`new`](Self::new) with θo pieces at most `piece` wide (radians).
+    pub(super) fn with_piece(
+        rgl: &'a RglBrdf,
+        [ta, tb]: [f64; 2],
+        map: DiscMap,
+        piece: f64,
+    ) -> Self {
+        let n = (((tb - ta) / piece).ceil() as usize).clamp(1, 10_000);
+        let ranges: Vec<[f64; 2]> = (0..n)
             .map(|k| {
                 let a = ta + (tb - ta) * k as f64 / n as f64;
                 let b = if k + 1 == n {
@@ -45,13 +64,61 @@ impl<'a> RglRectBound<'a> {
                 [a, b]
             })
             .collect();
-        Self { rgl, pieces, map }
+        let pieces = ranges.iter().map(|&r| rgl.f_cos_bound_piece(r)).collect();
+        Self {
+            rgl,
+            #[cfg(test)]
+            ranges,
+            pieces,
+            map,
+        }
     }
 
     /// The bound over `cell ∩ disc` for every θo of the range: `max_k B(piece k, box(cell)) ·
     /// sup J · (1 + 10⁻⁹)`; 0 when the cell misses the open disc, `+∞` where none is known
     /// (the projected map's rim, or a range that is not a number).
+    #[cfg(test)]
     pub(super) fn bound(&self, cell: &Rect) -> f64 {
+        self.bound_below(cell, f64::INFINITY)
+    }
+
+    /// [`bound`](Self::bound)`(cell)` where it is below `cap`, else some `v` with `cap ≤ v ≤
+    /// bound(cell)`: `min(v, cap) = min(bound(cell), cap)` exactly (docs/benchmarks.md §31.4).
+    /// The pieces and each piece's terms stop once the running maximum, scaled, reaches `cap`
+    /// ([`brdf::RglBrdf::f_cos_bound_below`], against `cap / (J · (1 + 10⁻⁹)) · (1 + 10⁻¹²)`,
+    /// which a partial value at or above scales to at least `cap` despite the rounding);
+    /// `cap ≤ 0` returns 0 at once. `cap = +∞` gives the bound bit for bit.
+    pub(super) fn bound_below(&self, cell: &Rect, cap: f64) -> f64 {
+        if !(cap > 0.0) {
+            return 0.0;
+        }
+        let Some((wi, jacobian)) = direction_box(self.map, [cell.x0, cell.x1], [cell.y0, cell.y1])
+        else {
+            return 0.0;
+        };
+        if !jacobian.is_finite() {
+            return f64::INFINITY;
+        }
+        let scale = jacobian * brdf::measured::rgl::BOUND_MARGIN;
+        let inner = if cap.is_finite() {
+            cap / scale * (1.0 + 1e-12)
+        } else {
+            f64::INFINITY
+        };
+        let mut b = 0.0f64;
+        for p in &self.pieces {
+            b = b.max(self.rgl.f_cos_bound_below(p, &wi, inner));
+            if b >= inner {
+                break;
+            }
+        }
+        b * jacobian * brdf::measured::rgl::BOUND_MARGIN
+    }
+
+    /// The bound as §31.3 computed it (`f_cos_bound` of every piece, nothing prepared or
+    /// skipped): the reference of the equality test.
+    #[cfg(test)]
+    pub(super) fn bound_reference(&self, cell: &Rect) -> f64 {
         let Some((wi, jacobian)) = direction_box(self.map, [cell.x0, cell.x1], [cell.y0, cell.y1])
         else {
             return 0.0;
@@ -60,7 +127,7 @@ impl<'a> RglRectBound<'a> {
             return f64::INFINITY;
         }
         let b = self
-            .pieces
+            .ranges
             .iter()
             .map(|&p| self.rgl.f_cos_bound(p, &wi))
             .fold(0.0f64, f64::max);
@@ -136,6 +203,63 @@ mod tests {
     use super::*;
     use crate::exact::density::QueryDensity;
     use brdf::direction_from_radians;
+
+    /// The prepared, capped rectangle bound (docs/benchmarks.md §31.4) equals §31.3's
+    /// (`bound_reference`: `f_cos_bound` of every piece) bit for bit with no cap, and with a cap
+    /// equals it below the cap and lies in `[cap, bound]` above, on random rectangles of 0.002,
+    /// 0.02 and 0.2 over five θo ranges (0.5° and 1° pieces), both disc maps. Fails with the
+    /// pieces' loop stopped early (`b >= 0.99 · inner`), checked (§31.4).
+    #[test]
+    fn capped_rect_bound_equals_the_reference() {
+        let Some(rgl) = crate::exact::tests::paper_white_fixture() else {
+            return;
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut checked, mut stopped) = (0, 0);
+        for map in [DiscMap::EqualArea, DiscMap::Projected] {
+            for &(a, b) in &[
+                (0.0, 3.0),
+                (28.5, 31.0),
+                (57.0, 61.0),
+                (79.76, 80.35),
+                (85.5, 86.1),
+            ] {
+                let range = [f64::to_radians(a), f64::to_radians(b)];
+                for piece in [THETA_PIECE, LAYER_PIECE] {
+                    let rb = RglRectBound::with_piece(&rgl, range, map, piece);
+                    for n in 0..300 {
+                        let h = [0.002, 0.02, 0.2][n % 3];
+                        let (cx, cy) = (-1.0 + 2.0 * next(), -1.0 + 2.0 * next());
+                        let cell = Rect::new(cx, cy, cx + h, cy + h);
+                        let exact = rb.bound_reference(&cell);
+                        assert_eq!(rb.bound(&cell).to_bits(), exact.to_bits(), "{cell:?}");
+                        checked += 1;
+                        if !exact.is_finite() {
+                            continue;
+                        }
+                        for f in [0.0, 0.3, 0.999, 1.0, 1.001, 3.0] {
+                            let cap = exact * f;
+                            let v = rb.bound_below(&cell, cap);
+                            if exact < cap {
+                                assert_eq!(v.to_bits(), exact.to_bits(), "cap {cap}");
+                            } else {
+                                assert!(cap <= v && v <= exact, "cap {cap}: {v}, {exact}");
+                                stopped += usize::from(v < exact);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        println!("{checked} rectangles equal, {stopped} capped values below the bound");
+        assert!(checked == 6000 && stopped > 100, "{checked} {stopped}");
+    }
 
     /// The rectangle bound holds on paper_white over random rectangles of sub-cell sizes (0.002,
     /// a sub-cell of a depth-8 leaf, and 0.02) at five θo ranges from 0° to 86° on both disc

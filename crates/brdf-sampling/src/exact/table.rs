@@ -222,7 +222,7 @@ impl LeafTable {
     }
 
     /// The table with one **layer table** per θo layer of its thinning bounds when it has any
-    /// (docs/benchmarks.md §31.1; `L = 1` as well, §31.4: the single layer's table then holds
+    /// (docs/benchmarks.md §31.1; `L = 1` as well, §31.5: the single layer's table then holds
     /// the leaf bounds tightened to the codes, e.g. §31.3's rigorous ones; without thinning
     /// bounds unchanged): layer `l`'s table has the same
     /// leaves (rectangles, order), the leaf bounds

@@ -40,7 +40,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::super::warp::{BilinearTable, Warp2D};
+use super::super::warp::{BilinearTable, Warp2D, Warp2DSlice};
 use super::{RglBrdf, angles::theta_to_u};
 
 /// Absolute widening of every interval the bound is made of (radians, unit-square and
@@ -121,6 +121,67 @@ fn bilinear_extreme(
     acc
 }
 
+/// [`bilinear_extreme`] over the distinct corner points only (docs/benchmarks.md §31.4): the
+/// corners of adjacent cells' parts coincide on the grid lines between them, where the two
+/// cells' bilinear forms give the same value bit for bit (with a fraction 0 or 1 the products
+/// of the finite, non-negative grid values by 0 vanish exactly and by 1 are exact), so taking
+/// each shared point once — `(k₀+1)(k₁+1)` points over `k₀ × k₁` cells instead of `4 k₀ k₁` —
+/// returns the same extreme.
+fn bilinear_extreme_points(
+    table: &BilinearTable,
+    (a, b): (usize, usize),
+    w: [f64; 2],
+    x: [f64; 2],
+    y: [f64; 2],
+    upper: bool,
+) -> f64 {
+    let (nx, ny, data) = table.parts();
+    let n = nx * ny;
+    // The points along one axis as (cell, fraction): the range's start in its first cell,
+    // the nodes between the cells (fraction 0 in the cell to their right), its end in the
+    // last cell — the fractions `bilinear_extreme` visits, each shared node once.
+    let points = |r: [f64; 2], m: usize, out: &mut [(usize, f64); 18]| -> usize {
+        let top = (m - 1) as f64;
+        let (lo, hi) = (r[0].clamp(0.0, 1.0) * top, r[1].clamp(0.0, 1.0) * top);
+        let (lo, hi) = (lo.min(hi), hi);
+        let c0 = (lo.floor() as usize).min(m - 2);
+        let c1 = (hi.ceil() as usize).clamp(c0 + 1, m - 1) - 1;
+        if c1 - c0 + 2 > out.len() {
+            return 0;
+        }
+        out[0] = (c0, (lo - c0 as f64).clamp(0.0, 1.0));
+        let mut k = 1;
+        for c in c0 + 1..=c1 {
+            out[k] = (c, 0.0);
+            k += 1;
+        }
+        out[k] = (c1, (hi - c1 as f64).clamp(0.0, 1.0));
+        k + 1
+    };
+    let (mut px, mut py) = ([(0usize, 0.0f64); 18], [(0usize, 0.0f64); 18]);
+    let (kx, ky) = (points(x, nx, &mut px), points(y, ny, &mut py));
+    if kx == 0 || ky == 0 {
+        return bilinear_extreme(table, (a, b), w, x, y, upper);
+    }
+    let (da, db) = (&data[a * n..(a + 1) * n], &data[b * n..(b + 1) * n]);
+    let mut acc = if upper { 0.0f64 } else { f64::INFINITY };
+    for &(cy, ty) in &py[..ky] {
+        for &(cx, tx) in &px[..kx] {
+            let k = cy * nx + cx;
+            let at = |d: &[f64]| {
+                let (v00, v10, v01, v11) = (d[k], d[k + 1], d[k + nx], d[k + nx + 1]);
+                (1.0 - ty) * ((1.0 - tx) * v00 + tx * v10) + ty * ((1.0 - tx) * v01 + tx * v11)
+            };
+            let (va, vb) = (at(da), at(db));
+            for &wk in &w {
+                let v = (1.0 - wk) * va + wk * vb;
+                acc = if upper { acc.max(v) } else { acc.min(v) };
+            }
+        }
+    }
+    acc
+}
+
 /// The row nodes `r/(ny − 1)` strictly inside `(y0, y1)`.
 fn row_nodes(ny: usize, y: [f64; 2]) -> impl Iterator<Item = f64> {
     let top = (ny - 1) as f64;
@@ -156,6 +217,38 @@ fn warped_box(warp: &Warp2D, i: usize, w: [f64; 2], ux: [f64; 2], uy: [f64; 2]) 
     [pad(sx), pad(sy)]
 }
 
+/// [`warped_box`] with the blends of pair `i` at the two weights given as plain slices
+/// (`blends[k]` = `warp.blend_slice(i, w[k])`, whose inversion is `invert_located`'s bit for
+/// bit) and `empty` = `warp.has_empty_row(i, w)`: both depend on the slice pair and weights
+/// only, so a [`ThetaPiece`] makes them once (docs/benchmarks.md §31.4).
+fn warped_box_known(
+    ny: usize,
+    blends: &[Warp2DSlice; 2],
+    ux: [f64; 2],
+    uy: [f64; 2],
+    empty: bool,
+) -> [[f64; 2]; 2] {
+    let mut sx = [f64::INFINITY, f64::NEG_INFINITY];
+    let mut sy = [f64::INFINITY, f64::NEG_INFINITY];
+    let ys = [uy[0], uy[1]].into_iter().chain(row_nodes(ny, uy));
+    for y in ys {
+        for slice in blends {
+            let (lo, _) = slice.invert([ux[0], y]);
+            let (hi, _) = slice.invert([ux[1], y]);
+            sx = [sx[0].min(lo[0]).min(hi[0]), sx[1].max(lo[0]).max(hi[0])];
+            sy = [sy[0].min(lo[1]).min(hi[1]), sy[1].max(lo[1]).max(hi[1])];
+        }
+    }
+    if empty || !(sx[0] <= sx[1]) {
+        sx = [0.0, 1.0];
+    }
+    if !(sy[0] <= sy[1]) {
+        sy = [0.0, 1.0];
+    }
+    let pad = |r: [f64; 2]| [(r[0] - PAD).max(0.0), (r[1] + PAD).min(1.0)];
+    [pad(sx), pad(sy)]
+}
+
 /// The ranges of `u_m.y = frac((atan2(S_y, S_x) + π)/(2π))` over the box `sx × sy` of `S`
 /// (one range, two across the branch cut, or `[0, 1]` when the box holds the origin).
 fn azimuth_ranges(sx: [f64; 2], sy: [f64; 2]) -> ([[f64; 2]; 2], usize) {
@@ -178,6 +271,162 @@ fn azimuth_ranges(sx: [f64; 2], sy: [f64; 2]) -> ([[f64; 2]; 2], usize) {
         return ([[0.0, lower[1]], [upper[0], 1.0]], 2);
     }
     ([corners(sy, sx), [0.0, 0.0]], 1)
+}
+
+/// The parts of [`RglBrdf::f_cos_bound`] that depend on the θo range only (issue 29,
+/// docs/benchmarks.md §31.4): the padded range `[θa', θb'] = [θa − PAD, θb + PAD] ∩ [0, π/2]`,
+/// the ranges of `sin θo` and `cos θo`, `4 min σ(u_o)` over the range, and the slice pairs `i`
+/// of the θ axis the range meets with their weight ranges `w_i` and whether a blend of the
+/// pair over `w_i` has an empty row. [`RglBrdf::f_cos_bound_piece`] makes it once per range;
+/// [`RglBrdf::f_cos_bound_prepared`] then returns `f_cos_bound(range, box)` bit for bit for
+/// every box.
+#[derive(Debug, Clone)]
+pub struct ThetaPiece {
+    /// `None`: the range is not finite or reversed (no bound known, `+∞`).
+    parts: Option<PieceParts>,
+}
+
+#[derive(Debug, Clone)]
+struct PieceParts {
+    so: [f64; 2],
+    co: [f64; 2],
+    /// `4 min σ` (1 without a Jacobian factor).
+    four_sigma_min: f64,
+    /// `(i, w_i, empty row, the pair's blends at the two weights)` for the slice pairs the
+    /// range meets.
+    slices: Vec<(usize, [f64; 2], bool, [Warp2DSlice; 2])>,
+    /// The θ axis has one slice.
+    one: bool,
+}
+
+impl RglBrdf {
+    /// The θo-only parts of [`f_cos_bound`](Self::f_cos_bound) over `θo ∈ [theta[0],
+    /// theta[1]]` (radians), for [`f_cos_bound_prepared`](Self::f_cos_bound_prepared).
+    pub fn f_cos_bound_piece(&self, theta: [f64; 2]) -> ThetaPiece {
+        if !theta.iter().all(|v| v.is_finite()) || !(theta[0] <= theta[1]) {
+            return ThetaPiece { parts: None };
+        }
+        let t = &self.tables;
+        let (ta, tb) = ((theta[0] - PAD).max(0.0), (theta[1] + PAD).min(FRAC_PI_2));
+        let (ta, tb) = (ta.min(tb), tb);
+        let (so, co) = (
+            [ta.sin() - PAD, tb.sin() + PAD],
+            [tb.cos() - PAD, ta.cos() + PAD],
+        );
+        let four_sigma_min = if t.jacobian {
+            let uo = [theta_to_u(ta) - PAD, theta_to_u(tb) + PAD];
+            let rows = if t.sigma_y_constant {
+                [0.5, 0.5]
+            } else {
+                [0.0, 1.0]
+            };
+            4.0 * bilinear_extreme(&t.sigma, (0, 0), [0.0, 0.0], uo, rows, false)
+        } else {
+            1.0
+        };
+        let (ia, wa) = t.theta.locate(ta);
+        let (ib, wb) = t.theta.locate(tb);
+        let slices = (ia..=ib)
+            .map(|i| {
+                let w = [
+                    if i == ia { wa } else { 0.0 },
+                    if i == ib { wb } else { 1.0 },
+                ];
+                let blends = [t.vndf.blend_slice(i, w[0]), t.vndf.blend_slice(i, w[1])];
+                (i, w, t.vndf.has_empty_row(i, w), blends)
+            })
+            .collect();
+        ThetaPiece {
+            parts: Some(PieceParts {
+                so,
+                co,
+                four_sigma_min,
+                slices,
+                one: t.theta.values().len() < 2,
+            }),
+        }
+    }
+
+    /// [`f_cos_bound`](Self::f_cos_bound) over `piece`'s θo range and the box `wi`, bit for
+    /// bit (the same arithmetic with the θo-only parts taken from `piece`), for `piece` made
+    /// by this material's [`f_cos_bound_piece`](Self::f_cos_bound_piece).
+    pub fn f_cos_bound_prepared(&self, piece: &ThetaPiece, wi: &DirectionBox) -> f64 {
+        self.f_cos_bound_below(piece, wi, f64::INFINITY)
+    }
+
+    /// `B = f_cos_bound(piece's range, wi)` when `B < cap`; otherwise some value `v` with `cap
+    /// ≤ v ≤ B` (the evaluation stops as soon as a partial maximum reaches `cap`: `B` is a
+    /// maximum of non-negative terms and the final scaling is monotone, so a partial value
+    /// never exceeds `B`). So `min(B, cap)` equals `min(v, cap)` exactly: a caller that needs
+    /// the bound only below `cap` (a thinning code, capped at the leaf bound or another
+    /// bound) gets the same result for less work. `cap = +∞` gives `B` bit for bit.
+    pub fn f_cos_bound_below(&self, piece: &ThetaPiece, wi: &DirectionBox, cap: f64) -> f64 {
+        let Some(p) = &piece.parts else {
+            return f64::INFINITY;
+        };
+        let finite = wi.x.iter().chain(&wi.y).chain(&wi.z);
+        if !finite.into_iter().all(|v| v.is_finite()) {
+            return f64::INFINITY;
+        }
+        if !(wi.z[1] > 0.0) {
+            return 0.0;
+        }
+        if !(p.four_sigma_min > 0.0) {
+            return f64::INFINITY;
+        }
+        let t = &self.tables;
+        let (so, co) = (p.so, p.co);
+        let z = [wi.z[0].max(0.0), wi.z[1]];
+        let sx = [so[0] + wi.x[0] - PAD, so[1] + wi.x[1] + PAD];
+        let sy = [wi.y[0] - PAD, wi.y[1] + PAD];
+        let sz = [(co[0] + z[0] - PAD).max(0.0), co[1] + z[1] + PAD];
+        let near = |r: [f64; 2]| {
+            if r[0] <= 0.0 && r[1] >= 0.0 {
+                0.0
+            } else {
+                r[0].abs().min(r[1].abs())
+            }
+        };
+        let far = |r: [f64; 2]| r[0].abs().max(r[1].abs());
+        let (h_lo, h_hi) = (near(sx).hypot(near(sy)), far(sx).hypot(far(sy)));
+        let theta_m = [h_lo.atan2(sz[1]), h_hi.atan2(sz[0])];
+        let umx = [
+            (theta_to_u(theta_m[0] - PAD) - PAD).max(0.0),
+            (theta_to_u(theta_m[1] + PAD) + PAD).min(1.0),
+        ];
+        let (ranges, n_ranges) = azimuth_ranges(sx, sy);
+        let value = |best: f64| MARGIN * best / p.four_sigma_min;
+        let mut best = 0.0f64;
+        for range in &ranges[..n_ranges] {
+            let umy = [(range[0] - PAD).max(0.0), (range[1] + PAD).min(1.0)];
+            let d_max = if t.jacobian {
+                bilinear_extreme_points(&t.ndf, (0, 0), [0.0, 0.0], umx, umy, true)
+            } else {
+                1.0
+            };
+            let mut l_max = 0.0f64;
+            for (i, w, empty, blends) in &p.slices {
+                let (i, w) = (*i, *w);
+                let [bx, by] = warped_box_known(t.vndf.rows(), blends, umx, umy, *empty);
+                let pair = if p.one { (0, 0) } else { (i, i + 1) };
+                let w = if p.one { [0.0, 0.0] } else { w };
+                l_max = l_max.max(bilinear_extreme_points(
+                    &t.rgb_luminance,
+                    pair,
+                    w,
+                    bx,
+                    by,
+                    true,
+                ));
+                let partial = value(best.max(l_max * d_max));
+                if partial >= cap {
+                    return partial;
+                }
+            }
+            best = best.max(l_max * d_max);
+        }
+        value(best)
+    }
 }
 
 impl RglBrdf {
@@ -381,6 +630,84 @@ mod tests {
                 "{}: loose bound, largest Y/B {worst}",
                 path.display()
             );
+        }
+    }
+
+    /// The prepared bound (docs/benchmarks.md §31.4: θo-only parts hoisted into a
+    /// [`ThetaPiece`], the warp's blends made once, shared corner points taken once) equals
+    /// `f_cos_bound` bit for bit, and `f_cos_bound_below(cap)` equals it below `cap` and lies
+    /// in `[cap, B]` otherwise, on boxes of three sizes (0.002, a depth-8 sub-cell; 0.02; 0.3,
+    /// many grid cells) at random θo pieces of ≤ 0.5° and ≤ 2° over [0°, 89.9°] (and the
+    /// degenerate ones). `RGL_DIR=…/rgl` adds the files there. Fails (each tried, §31.4):
+    /// `bilinear_extreme_points` without the range's end point; `warped_box_known` without the
+    /// row nodes; the cap's test one step early (`partial > 0.99 cap`).
+    #[test]
+    fn prepared_bound_equals_f_cos_bound() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for (path, rgl) in materials() {
+            let (mut checked, mut capped, mut positive) = (0, 0, 0);
+            for n in 0..3000 {
+                let width = if n % 2 == 0 { 0.5 } else { 2.0 } * next();
+                let a = (89.9 - width) * next();
+                let theta = [a.to_radians(), (a + width).to_radians()];
+                let h = [0.002, 0.02, 0.3][n % 3];
+                let (cx, cy) = (-1.0 + 2.0 * next(), -1.0 + 2.0 * next());
+                let r = (cx * cx + cy * cy).sqrt();
+                let (z0, z1) = (
+                    (1.0 - (r + 1.5 * h).min(1.0).powi(2)).sqrt(),
+                    (1.0 - (r - 1.5 * h).max(0.0).powi(2)).sqrt(),
+                );
+                let wi = DirectionBox {
+                    x: [cx - h, cx + h],
+                    y: [cy - h, cy + h],
+                    z: [z0, z1],
+                };
+                let exact = rgl.f_cos_bound(theta, &wi);
+                let piece = rgl.f_cos_bound_piece(theta);
+                let fast = rgl.f_cos_bound_prepared(&piece, &wi);
+                assert_eq!(
+                    fast.to_bits(),
+                    exact.to_bits(),
+                    "{}: θo {theta:?} box {wi:?}: {fast} against {exact}",
+                    path.display()
+                );
+                checked += 1;
+                positive += usize::from(exact > 0.0);
+                let caps = if exact.is_finite() { 6 } else { 0 };
+                for f in [0.0, 0.5, 0.999, 1.0, 1.001, 2.0].into_iter().take(caps) {
+                    let cap = exact * f;
+                    let v = rgl.f_cos_bound_below(&piece, &wi, cap);
+                    if exact < cap {
+                        assert_eq!(v.to_bits(), exact.to_bits(), "below cap {cap}");
+                    } else {
+                        assert!(
+                            cap <= v && v <= exact,
+                            "cap {cap}: {v} not in [cap, {exact}]"
+                        );
+                        capped += usize::from(v < exact);
+                    }
+                }
+            }
+            for bad in [[0.2, 0.1], [f64::NAN, 0.1]] {
+                let wi = DirectionBox {
+                    x: [0.0, 0.1],
+                    y: [0.0, 0.1],
+                    z: [0.9, 1.0],
+                };
+                let piece = rgl.f_cos_bound_piece(bad);
+                assert_eq!(rgl.f_cos_bound_prepared(&piece, &wi), f64::INFINITY);
+            }
+            eprintln!(
+                "{}: {checked} boxes equal ({positive} positive), {capped} stopped below B",
+                path.display()
+            );
+            assert!(positive > 1000 && capped > 50, "{positive} {capped}");
         }
     }
 
