@@ -140,22 +140,16 @@ impl<'a> RglRectBound<'a> {
 /// the rim); `None` when the part misses the open disc. Every range is widened by
 /// [`brdf::measured::rgl::BOUND_PAD`].
 fn direction_box(map: DiscMap, x: [f64; 2], y: [f64; 2]) -> Option<(DirectionBox, f64)> {
+    use brdf::measured::rgl::bound_abs_range;
     let pad = brdf::measured::rgl::BOUND_PAD;
-    let near = |r: [f64; 2]| {
-        if r[0] <= 0.0 && r[1] >= 0.0 {
-            0.0
-        } else {
-            r[0].abs().min(r[1].abs())
-        }
-    };
-    let far = |r: [f64; 2]| r[0].abs().max(r[1].abs());
-    let r2_lo = near(x).powi(2) + near(y).powi(2);
+    let ([nx, fx], [ny, fy]) = (bound_abs_range(x), bound_abs_range(y));
+    let r2_lo = nx.powi(2) + ny.powi(2);
     if !(r2_lo < 1.0) {
         return None;
     }
     let r2 = [
         (r2_lo - pad).max(0.0),
-        (far(x).powi(2) + far(y).powi(2) + pad).min(1.0),
+        (fx.powi(2) + fy.powi(2) + pad).min(1.0),
     ];
     let x = [x[0].max(-1.0) - pad, x[1].min(1.0) + pad];
     let y = [y[0].max(-1.0) - pad, y[1].min(1.0) + pad];

@@ -49,7 +49,10 @@ mod lanes;
 
 use angles::fast;
 pub use angles::{elevation, phi_to_u, theta_to_u, u_to_phi, u_to_theta};
-pub use bound::{DirectionBox, MARGIN as BOUND_MARGIN, PAD as BOUND_PAD, ThetaPiece};
+pub use bound::{
+    DirectionBox, MARGIN as BOUND_MARGIN, PAD as BOUND_PAD, ThetaPiece,
+    abs_range as bound_abs_range,
+};
 
 /// How many negative `rgb` entries were clamped to zero when reading.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -249,6 +249,39 @@ fn warped_box_known(
     [pad(sx), pad(sy)]
 }
 
+/// The smallest and largest `|v|` over the closed range `r` (the smallest 0 when `r` holds 0).
+pub fn abs_range(r: [f64; 2]) -> [f64; 2] {
+    let near = if r[0] <= 0.0 && r[1] >= 0.0 {
+        0.0
+    } else {
+        r[0].abs().min(r[1].abs())
+    };
+    [near, r[0].abs().max(r[1].abs())]
+}
+
+/// The half vector's region for `ωo`'s components `sin θo ∈ so`, `cos θo ∈ co` and `ωi` in
+/// `wi`: the range of the radial warped coordinate `u_m` (monotone in `θm`, which is monotone
+/// in `|S_xy|` and `S_z` of `S = ωo + ωi`) and the azimuth ranges ([`azimuth_ranges`]), every
+/// range widened by [`PAD`].
+fn half_vector_region(
+    so: [f64; 2],
+    co: [f64; 2],
+    wi: &DirectionBox,
+) -> ([f64; 2], ([[f64; 2]; 2], usize)) {
+    let z = [wi.z[0].max(0.0), wi.z[1]];
+    let sx = [so[0] + wi.x[0] - PAD, so[1] + wi.x[1] + PAD];
+    let sy = [wi.y[0] - PAD, wi.y[1] + PAD];
+    let sz = [(co[0] + z[0] - PAD).max(0.0), co[1] + z[1] + PAD];
+    let ([nx, fx], [ny, fy]) = (abs_range(sx), abs_range(sy));
+    let (h_lo, h_hi) = (nx.hypot(ny), fx.hypot(fy));
+    let theta_m = [h_lo.atan2(sz[1]), h_hi.atan2(sz[0])];
+    let umx = [
+        (theta_to_u(theta_m[0] - PAD) - PAD).max(0.0),
+        (theta_to_u(theta_m[1] + PAD) + PAD).min(1.0),
+    ];
+    (umx, azimuth_ranges(sx, sy))
+}
+
 /// The ranges of `u_m.y = frac((atan2(S_y, S_x) + π)/(2π))` over the box `sx × sy` of `S`
 /// (one range, two across the branch cut, or `[0, 1]` when the box holds the origin).
 fn azimuth_ranges(sx: [f64; 2], sy: [f64; 2]) -> ([[f64; 2]; 2], usize) {
@@ -376,25 +409,7 @@ impl RglBrdf {
         }
         let t = &self.tables;
         let (so, co) = (p.so, p.co);
-        let z = [wi.z[0].max(0.0), wi.z[1]];
-        let sx = [so[0] + wi.x[0] - PAD, so[1] + wi.x[1] + PAD];
-        let sy = [wi.y[0] - PAD, wi.y[1] + PAD];
-        let sz = [(co[0] + z[0] - PAD).max(0.0), co[1] + z[1] + PAD];
-        let near = |r: [f64; 2]| {
-            if r[0] <= 0.0 && r[1] >= 0.0 {
-                0.0
-            } else {
-                r[0].abs().min(r[1].abs())
-            }
-        };
-        let far = |r: [f64; 2]| r[0].abs().max(r[1].abs());
-        let (h_lo, h_hi) = (near(sx).hypot(near(sy)), far(sx).hypot(far(sy)));
-        let theta_m = [h_lo.atan2(sz[1]), h_hi.atan2(sz[0])];
-        let umx = [
-            (theta_to_u(theta_m[0] - PAD) - PAD).max(0.0),
-            (theta_to_u(theta_m[1] + PAD) + PAD).min(1.0),
-        ];
-        let (ranges, n_ranges) = azimuth_ranges(sx, sy);
+        let (umx, (ranges, n_ranges)) = half_vector_region(so, co, wi);
         let value = |best: f64| MARGIN * best / p.four_sigma_min;
         let mut best = 0.0f64;
         for range in &ranges[..n_ranges] {
@@ -453,25 +468,7 @@ impl RglBrdf {
             [ta.sin() - PAD, tb.sin() + PAD],
             [tb.cos() - PAD, ta.cos() + PAD],
         );
-        let z = [wi.z[0].max(0.0), wi.z[1]];
-        let sx = [so[0] + wi.x[0] - PAD, so[1] + wi.x[1] + PAD];
-        let sy = [wi.y[0] - PAD, wi.y[1] + PAD];
-        let sz = [(co[0] + z[0] - PAD).max(0.0), co[1] + z[1] + PAD];
-        let near = |r: [f64; 2]| {
-            if r[0] <= 0.0 && r[1] >= 0.0 {
-                0.0
-            } else {
-                r[0].abs().min(r[1].abs())
-            }
-        };
-        let far = |r: [f64; 2]| r[0].abs().max(r[1].abs());
-        let (h_lo, h_hi) = (near(sx).hypot(near(sy)), far(sx).hypot(far(sy)));
-        let theta_m = [h_lo.atan2(sz[1]), h_hi.atan2(sz[0])];
-        let umx = [
-            (theta_to_u(theta_m[0] - PAD) - PAD).max(0.0),
-            (theta_to_u(theta_m[1] + PAD) + PAD).min(1.0),
-        ];
-        let (ranges, n_ranges) = azimuth_ranges(sx, sy);
+        let (umx, (ranges, n_ranges)) = half_vector_region(so, co, wi);
         // σ(u_o) at u_o = (√(2θo/π), any azimuth): the smallest value of every row.
         let four_sigma_min = if t.jacobian {
             let uo = [theta_to_u(ta) - PAD, theta_to_u(tb) + PAD];
