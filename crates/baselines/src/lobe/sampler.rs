@@ -220,7 +220,7 @@ impl DirectionSampler for LobeSampler {
                         trials += 1;
                     }
                     // The retried lobe directions below the horizon (`bench`'s trials; the
-                    // other samples' one proposal is counted below).
+                    // first proposal is counted above).
                     count_trials(trials as u64 - 1);
                     if w.z > 0.0 {
                         w
