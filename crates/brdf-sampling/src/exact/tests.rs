@@ -166,8 +166,8 @@ fn the_node_cache_changes_nothing_but_the_cost() {
     }
 }
 
-/// The intervals are built in batches of `2 × threads` (`build::run_jobs`): the order they are
-/// kept in depends on the threads, the set does not. Phong built on pools of 1 and 3 threads:
+/// The intervals are built as tasks of one scope (`build::run_jobs`): the order they are kept
+/// in depends on the threads and the schedule, the set does not. Phong built on pools of 1 and 3 threads:
 /// the same layout and the same samples bit for bit. Fails when the kept intervals are not
 /// sorted by place before the cells are assembled (tried: sample 0 differs).
 #[test]
