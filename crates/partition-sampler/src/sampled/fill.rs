@@ -441,15 +441,8 @@ pub(super) fn refined<D: Density>(
     })
 }
 
-/// Largest half block `s/2` whose corner values [`keep_block`] tabulates on the stack (larger
-/// blocks evaluate each cell's corners, the same values).
-const KEEP_TABLE_HALF: usize = 16;
-
 /// Fills the fine cells of a block kept coarse (see [`refined`]); returns Simpson minus the
-/// 5-point rule `(mean of corners)/3 + (2/3) centre` (both exact for quadratics). A cell's
-/// maximum is `max(0, the bilinear interpolant of its stencil sub-square at its four corners)
-/// + excess`, its share the interpolant at its centre (clamped at 0) over their sum, times
-/// Simpson's integral of the block.
+/// 5-point rule `(mean of corners)/3 + (2/3) centre` (both exact for quadratics).
 #[allow(clippy::too_many_arguments)]
 fn keep_block(
     cells: &mut [[f64; 2]],
@@ -482,49 +475,16 @@ fn keep_block(
     };
     let half = s / 2;
     let mut shares = 0.0;
-    if half <= KEEP_TABLE_HALF {
-        // The interpolant at the fine lattice points of each stencil sub-square, once: a
-        // cell's four corners are points of its own sub-square, evaluated by the same
-        // expression with the same arguments (`(p + 1) as f64 == p as f64 + 1.0`), so the
-        // values are the per-cell ones bit for bit and each is shared by up to four cells.
-        let m = half + 1;
-        let mut table = [0.0f64; 4 * (KEEP_TABLE_HALF + 1) * (KEEP_TABLE_HALF + 1)];
-        for ky in 0..2 {
-            for kx in 0..2 {
-                let base = (ky * 2 + kx) * m * m;
-                for j in 0..m {
-                    for i in 0..m {
-                        let (x, y) = ((kx * half + i) as f64, (ky * half + j) as f64);
-                        table[base + j * m + i] = bilinear(x, y, kx, ky);
-                    }
-                }
-            }
-        }
-        for q in 0..s {
-            for p in 0..s {
-                let (kx, ky) = (usize::from(p >= half), usize::from(q >= half));
-                let (x, y) = (p as f64, q as f64);
-                let at = (ky * 2 + kx) * m * m + (q - ky * half) * m + (p - kx * half);
-                let corner_max = [table[at], table[at + 1], table[at + m], table[at + m + 1]]
-                    .iter()
-                    .fold(0.0f64, |mx, &c| mx.max(c));
-                let centre = bilinear(x + 0.5, y + 0.5, kx, ky).max(0.0);
-                cells[(b + q) * n + a + p] = [corner_max + excess, centre];
-                shares += centre;
-            }
-        }
-    } else {
-        for q in 0..s {
-            for p in 0..s {
-                let (kx, ky) = (usize::from(p >= half), usize::from(q >= half));
-                let (x, y) = (p as f64, q as f64);
-                let corner_max = [(x, y), (x + 1.0, y), (x, y + 1.0), (x + 1.0, y + 1.0)]
-                    .iter()
-                    .fold(0.0f64, |m, &(cx, cy)| m.max(bilinear(cx, cy, kx, ky)));
-                let centre = bilinear(x + 0.5, y + 0.5, kx, ky).max(0.0);
-                cells[(b + q) * n + a + p] = [corner_max + excess, centre];
-                shares += centre;
-            }
+    for q in 0..s {
+        for p in 0..s {
+            let (kx, ky) = (usize::from(p >= half), usize::from(q >= half));
+            let (x, y) = (p as f64, q as f64);
+            let corner_max = [(x, y), (x + 1.0, y), (x, y + 1.0), (x + 1.0, y + 1.0)]
+                .iter()
+                .fold(0.0f64, |m, &(cx, cy)| m.max(bilinear(cx, cy, kx, ky)));
+            let centre = bilinear(x + 0.5, y + 0.5, kx, ky).max(0.0);
+            cells[(b + q) * n + a + p] = [corner_max + excess, centre];
+            shares += centre;
         }
     }
     for q in 0..s {
@@ -543,113 +503,6 @@ fn keep_block(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// [`keep_block`] as it was before its corner table (docs/benchmarks.md §32.2): every
-    /// cell's four corners evaluated on their own.
-    #[allow(clippy::too_many_arguments)]
-    fn keep_block_per_cell(
-        cells: &mut [[f64; 2]],
-        n: usize,
-        a: usize,
-        b: usize,
-        s: usize,
-        v: &[[f64; 3]; 3],
-        excess: f64,
-        fine_area: f64,
-    ) -> f64 {
-        const W: [f64; 3] = [1.0, 4.0, 1.0];
-        let block_area = fine_area * (s * s) as f64;
-        let simpson: f64 = (0..3)
-            .flat_map(|l| (0..3).map(move |k| W[l] * W[k] * v[l][k]))
-            .sum::<f64>()
-            * block_area
-            / 36.0;
-        let five =
-            ((v[0][0] + v[0][2] + v[2][0] + v[2][2]) / 12.0 + v[1][1] * 2.0 / 3.0) * block_area;
-        let d = (s / 2) as f64;
-        let bilinear = |x: f64, y: f64, kx: usize, ky: usize| {
-            let u = x / d - kx as f64;
-            let w = y / d - ky as f64;
-            (1.0 - u) * (1.0 - w) * v[ky][kx]
-                + u * (1.0 - w) * v[ky][kx + 1]
-                + (1.0 - u) * w * v[ky + 1][kx]
-                + u * w * v[ky + 1][kx + 1]
-        };
-        let half = s / 2;
-        let mut shares = 0.0;
-        for q in 0..s {
-            for p in 0..s {
-                let (kx, ky) = (usize::from(p >= half), usize::from(q >= half));
-                let (x, y) = (p as f64, q as f64);
-                let corner_max = [(x, y), (x + 1.0, y), (x, y + 1.0), (x + 1.0, y + 1.0)]
-                    .iter()
-                    .fold(0.0f64, |m, &(cx, cy)| m.max(bilinear(cx, cy, kx, ky)));
-                let centre = bilinear(x + 0.5, y + 0.5, kx, ky).max(0.0);
-                cells[(b + q) * n + a + p] = [corner_max + excess, centre];
-                shares += centre;
-            }
-        }
-        for q in 0..s {
-            for p in 0..s {
-                let c = &mut cells[(b + q) * n + a + p];
-                c[1] = if shares > 0.0 {
-                    simpson * c[1] / shares
-                } else {
-                    simpson / (s * s) as f64
-                };
-            }
-        }
-        simpson - five
-    }
-
-    /// Issue 29 (docs/benchmarks.md §32.2): a kept block's cells from the tabulated corners
-    /// are the per-cell rule's bit for bit — blocks of 2 to 64 fine cells (the table and the
-    /// per-cell path above `KEEP_TABLE_HALF`), stencils of random values with negative ones,
-    /// zeros and exact ties, at an offset in a larger grid, and the returned rule difference.
-    /// Fails with the upper corners read one table entry to the left (tried: trial 0 differs).
-    /// (Reading the corner `(s/2, q)` of a left cell from the right sub-square's table was
-    /// tried too and passes: the two sub-squares' interpolants agree bit for bit on their
-    /// shared line, their other terms being exact zeros.)
-    #[test]
-    fn kept_blocks_are_the_per_cell_rule() {
-        let mut state = 5u64;
-        let mut u = move || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            (z ^ (z >> 31)) as f64 / 2f64.powi(64)
-        };
-        let n = 160;
-        for trial in 0..400 {
-            let s = [2usize, 4, 8, 16, 32, 64][trial % 6];
-            let mut v = [[0.0f64; 3]; 3];
-            for row in &mut v {
-                for x in row.iter_mut() {
-                    *x = match (u() * 10.0) as u32 {
-                        0 => 0.0,
-                        1 => -u(),
-                        2 => 0.5,
-                        _ => 10f64.powf(6.0 * u() - 3.0),
-                    };
-                }
-            }
-            let (a, b) = (3 + (u() * 40.0) as usize, 7 + (u() * 40.0) as usize);
-            let (excess, area) = (u() * 1e-3, 1.0 / (n * n) as f64);
-            let mut one = vec![[0.0f64; 2]; n * n];
-            let mut two = one.clone();
-            let r1 = keep_block(&mut one, n, a, b, s, &v, excess, area);
-            let r2 = keep_block_per_cell(&mut two, n, a, b, s, &v, excess, area);
-            assert_eq!(r1.to_bits(), r2.to_bits(), "trial {trial}");
-            for (k, (c1, c2)) in one.iter().zip(&two).enumerate() {
-                assert_eq!(
-                    [c1[0].to_bits(), c1[1].to_bits()],
-                    [c2[0].to_bits(), c2[1].to_bits()],
-                    "trial {trial} (s {s}): cell {k}"
-                );
-            }
-        }
-    }
 
     /// The boundary cell's statistics as they were computed before the gathered block: one
     /// `eval_checked` per point.
