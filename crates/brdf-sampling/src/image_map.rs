@@ -427,6 +427,55 @@ fn within_reach(dx: f64, dy: f64, reach: f64) -> bool {
     dx.hypot(dy) <= reach
 }
 
+impl SliceImageMap<'_> {
+    /// `region(cell).max_bound` bit for bit, without the integral (the grid's bound by
+    /// `SampledGridDensity::max_bound`): for callers that need the bound only, e.g. over a
+    /// grown rectangle (docs/benchmarks.md §32.2).
+    /// Not called in this crate yet: for the thinning codes' grown rule (`sub_bounds`,
+    /// `exact/build_interval.rs`), whose `region(..).max_bound` it replaces bit for bit.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) fn max_bound(&self, cell: &Rect) -> f64 {
+        self.bound_from(cell, self.grid.max_bound(cell))
+    }
+
+    /// The bound of `cell` from the grid's own bound `grid_bound` over it: the largest of it,
+    /// the grid's bound over the cell grown by the dilation, the peak (at it or nearest to it),
+    /// the members' peak track and the rim band. Every term is a maximum, so the value does not
+    /// depend on how the grid's bounds were found.
+    fn bound_from(&self, cell: &Rect, grid_bound: f64) -> f64 {
+        let mut bound = grid_bound;
+        if self.dilation > 0.0 {
+            let d = self.dilation;
+            let grown = Rect::new(
+                (cell.x0 - d).max(-1.0),
+                (cell.y0 - d).max(-1.0),
+                (cell.x1 + d).min(1.0),
+                (cell.y1 + d).min(1.0),
+            );
+            bound = bound.max(self.grid.max_bound(&grown));
+        }
+        let (at, value) = self.peak;
+        if cell.contains(at) {
+            bound = bound.max(self.safety * value);
+        } else {
+            // A lobe narrower than a fine cell spills over the edges of the cell holding its
+            // peak between the grid's points (SGD fits of chrome-steel and ss440: 1.7 % above
+            // the neighbouring leaves' bounds). A lobe that decreases away from its peak along
+            // both axes is largest, on a rectangle, at the point nearest to the peak.
+            let m = self.near_peak(cell, at, |p| self.grid.eval(p));
+            bound = bound.max(m);
+        }
+        for t in &self.track {
+            let m = self.near_peak(cell, t.at, &t.density);
+            bound = bound.max(m);
+        }
+        if let Some(m) = self.band.max_in(cell) {
+            bound = bound.max(self.safety * m);
+        }
+        bound
+    }
+}
+
 impl Density for SliceImageMap<'_> {
     #[inline]
     fn eval(&self, p: Point2) -> f64 {
@@ -441,34 +490,7 @@ impl RegionStats for SliceImageMap<'_> {
 
     fn region(&self, cell: &Rect) -> RegionEstimate {
         let mut est = self.grid.region(cell);
-        if self.dilation > 0.0 {
-            let d = self.dilation;
-            let grown = Rect::new(
-                (cell.x0 - d).max(-1.0),
-                (cell.y0 - d).max(-1.0),
-                (cell.x1 + d).min(1.0),
-                (cell.y1 + d).min(1.0),
-            );
-            est.max_bound = est.max_bound.max(self.grid.region(&grown).max_bound);
-        }
-        let (at, value) = self.peak;
-        if cell.contains(at) {
-            est.max_bound = est.max_bound.max(self.safety * value);
-        } else {
-            // A lobe narrower than a fine cell spills over the edges of the cell holding its
-            // peak between the grid's points (SGD fits of chrome-steel and ss440: 1.7 % above
-            // the neighbouring leaves' bounds). A lobe that decreases away from its peak along
-            // both axes is largest, on a rectangle, at the point nearest to the peak.
-            let m = self.near_peak(cell, at, |p| self.grid.eval(p));
-            est.max_bound = est.max_bound.max(m);
-        }
-        for t in &self.track {
-            let m = self.near_peak(cell, t.at, &t.density);
-            est.max_bound = est.max_bound.max(m);
-        }
-        if let Some(m) = self.band.max_in(cell) {
-            est.max_bound = est.max_bound.max(self.safety * m);
-        }
+        est.max_bound = self.bound_from(cell, est.max_bound);
         est
     }
 
@@ -558,6 +580,57 @@ mod tests {
             (3.0, 4.0, 5.0),
         ] {
             assert_eq!(within_reach(dx, dy, r), dx.hypot(dy) <= r, "{dx} {dy} {r}");
+        }
+    }
+
+    /// `max_bound` is `region(..).max_bound` bit for bit (docs/benchmarks.md §32.2): a
+    /// phong lobe's refined map with a dilation of one cell and a peak track (RGL envelopes
+    /// have one, Cornell and MERL maps the dilation), random rectangles from a sixteenth of a
+    /// cell to the whole disc, the rim band's cells among them.
+    #[test]
+    fn max_bound_is_the_region_bound() {
+        let b: Arc<dyn brdf::Brdf> = Arc::from(brdf::parse_spec("phong:n=80").unwrap());
+        let wo = brdf::direction_from_angles(50.0, 0.0);
+        let d = DiscBrdf::new(Arc::clone(&b), wo);
+        let counter = EvalCounter::new();
+        let options = GridOptions {
+            refinement: Some(partition_sampler::Refinement::default()),
+            ..GridOptions::default()
+        };
+        let track = (0..9)
+            .map(|k| {
+                let wk = brdf::direction_from_angles(45.0 + k as f64, 0.0);
+                let g = DiscBrdf::new(Arc::clone(&b), wk);
+                TrackPoint {
+                    at: DiscMap::Projected.to_disc(&brdf::mirror(&wk)),
+                    density: Box::new(move |p| g.eval(p)),
+                }
+            })
+            .collect();
+        let f = Counted {
+            f: &d,
+            counter: &counter,
+        };
+        let map = SliceImageMap::new(f, 128, 1.1, 1, &options)
+            .unwrap()
+            .with_track(track);
+        let mut state = 21u64;
+        let mut u = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (z ^ (z >> 31)) as f64 / 2f64.powi(64)
+        };
+        for _ in 0..4_000 {
+            let size = 2.0 * u().powi(4) + 1e-3;
+            let (x, y) = (2.0 * u() - 1.0, 2.0 * u() - 1.0);
+            let r = Rect::new(x, y, (x + size).min(1.0), (y + size).min(1.0));
+            assert_eq!(
+                map.max_bound(&r).to_bits(),
+                map.region(&r).max_bound.to_bits(),
+                "{r:?}"
+            );
         }
     }
 
