@@ -112,7 +112,8 @@ impl SubBounds {
     }
 
     /// The bound leaf `k`'s codes are relative to: `T_k` ([`SubBounds::tops`]) when the bounds
-    /// have served bounds, else its tree bound `m` (`M_k`).
+    /// have served bounds, else its tree bound `m` (`M_k`) (test support).
+    #[cfg(test)]
     pub(super) fn leaf_base(&self, k: usize, m: f64) -> f64 {
         self.tops.get(k).map_or(m, |&t| f64::from(t))
     }
