@@ -152,7 +152,10 @@ impl<'a> RglRectBound<'a> {
         r: &Refinement,
     ) -> f64 {
         let cap = fallback.unwrap_or(m);
-        let b = self.bound_below(cell, cap);
+        // At the depth limit of a part without a fallback, the bound is wanted in full above
+        // `m`: taken in full at once (below `m` the same value as the capped call's).
+        let last = fallback.is_none() && level >= r.depth_above;
+        let b = self.bound_below(cell, if last { f64::INFINITY } else { cap });
         if b.is_infinite() {
             return b;
         }
@@ -179,8 +182,8 @@ impl<'a> RglRectBound<'a> {
         if fallback.is_some() {
             return b;
         }
-        if level >= r.depth_above {
-            return self.bound_below(cell, f64::INFINITY);
+        if last {
+            return b;
         }
         quarters(cell)
             .iter()
