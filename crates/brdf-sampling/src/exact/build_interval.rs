@@ -1474,9 +1474,9 @@ mod tests {
     /// interval's range, `g` exceeds neither its sub-cell's served bound `sub_bound(M_il, q')`
     /// nor the leaf bound `M_il` of the layer table that serves θo (0 above either; before
     /// §32.1 the tree's `M_i` was exceeded at 64 points on `cc_ibiza_sunset` at 83.05°).
-    /// Fails (each tried, docs §32.1): with the refined bound × 0.97 (points above); with the
-    /// served bounds left at `M_i` (points above `M_il` on `cc_ibiza_sunset`); with the grown
-    /// rule in place of the bound (codes above the unrefined bound's).
+    /// Fails (each tried, docs §32.1): with the refined bound × 0.97 (13 831 points above on the
+    /// fixture); with the served bounds left at `M_i` (64 points above `M_il` on
+    /// `cc_ibiza_sunset` at 83.05°).
     #[test]
     fn one_layer_codes_are_the_rigorous_bound_and_hold() {
         use super::super::table::sub_factor;

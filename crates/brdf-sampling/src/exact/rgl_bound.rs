@@ -388,10 +388,8 @@ mod tests {
     /// at 0.3 / 0.8 / 1.5 × the unrefined bound `B` (parts below and above it) and refinement
     /// to depths 2 and 3 everywhere (estimate 0, volume 0), the refined value `U` satisfies
     /// `g ≤ U` at 9 × 9 points × 5 θo of the rectangle and `U ≤ B`; and `U < 0.99 B` on at
-    /// least a tenth of the rectangles (the refinement tightens). Fails (each tried, §32.1):
-    /// with a quarter left out of the maximum (values above `U`), with the children's
-    /// minimum in place of their maximum (values above), and with the parent's bound not
-    /// taken as the cap and the result (`U > B` where the quarters' bounds exceed it).
+    /// least a tenth of the rectangles (the refinement tightens). Fails with a quarter left
+    /// out of the maximum (466 values above `U`; tried, docs §32.1).
     #[test]
     fn refined_bound_holds_and_is_at_most_the_bound() {
         let Some(rgl) = crate::exact::tests::paper_white_fixture() else {
