@@ -399,11 +399,80 @@ impl<'a> SliceImageMap<'a> {
     /// within the peak reach of `at` (the point itself when `cell` holds it); 0 otherwise.
     fn near_peak(&self, cell: &Rect, at: Point2, density: impl Fn(Point2) -> f64) -> f64 {
         let near = [at[0].clamp(cell.x0, cell.x1), at[1].clamp(cell.y0, cell.y1)];
-        if (near[0] - at[0]).hypot(near[1] - at[1]) <= self.peak_reach {
+        if within_reach(near[0] - at[0], near[1] - at[1], self.peak_reach) {
             self.safety * density(near)
         } else {
             0.0
         }
+    }
+}
+
+/// `dx.hypot(dy) <= reach`, the same answer for every input, with `hypot` (≈ 50 instructions)
+/// only near the boundary: the rounded `s = dx² + dy²` is within 3 ulp (relative) of the exact
+/// sum and `hypot` within 1 ulp of the exact length, so outside the band `r²·(1 ± 10⁻⁹)` the
+/// comparison of `s` with `r²` decides as `hypot` does. `hypot` decides inside the band, when
+/// `r²` is not a normal number well above underflow, and for NaN (every comparison false).
+/// Region queries test every peak-track point of an envelope (docs/benchmarks.md §32.2).
+#[inline]
+fn within_reach(dx: f64, dy: f64, reach: f64) -> bool {
+    let (s, r2) = (dx * dx + dy * dy, reach * reach);
+    if r2 > 1e-200 && r2.is_finite() {
+        if s < r2 * (1.0 - 1e-9) {
+            return true;
+        }
+        if s > r2 * (1.0 + 1e-9) {
+            return false;
+        }
+    }
+    dx.hypot(dy) <= reach
+}
+
+impl SliceImageMap<'_> {
+    /// `region(cell).max_bound` bit for bit, without the integral (the grid's bound by
+    /// `SampledGridDensity::max_bound`): for callers that need the bound only, e.g. over a
+    /// grown rectangle (docs/benchmarks.md §32.2).
+    /// Not called in this crate yet: for the thinning codes' grown rule (`sub_bounds`,
+    /// `exact/build_interval.rs`), whose `region(..).max_bound` it replaces bit for bit.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) fn max_bound(&self, cell: &Rect) -> f64 {
+        self.bound_from(cell, self.grid.max_bound(cell))
+    }
+
+    /// The bound of `cell` from the grid's own bound `grid_bound` over it: the largest of it,
+    /// the grid's bound over the cell grown by the dilation, the peak (at it or nearest to it),
+    /// the members' peak track and the rim band. Every term is a maximum, so the value does not
+    /// depend on how the grid's bounds were found.
+    fn bound_from(&self, cell: &Rect, grid_bound: f64) -> f64 {
+        let mut bound = grid_bound;
+        if self.dilation > 0.0 {
+            let d = self.dilation;
+            let grown = Rect::new(
+                (cell.x0 - d).max(-1.0),
+                (cell.y0 - d).max(-1.0),
+                (cell.x1 + d).min(1.0),
+                (cell.y1 + d).min(1.0),
+            );
+            bound = bound.max(self.grid.max_bound(&grown));
+        }
+        let (at, value) = self.peak;
+        if cell.contains(at) {
+            bound = bound.max(self.safety * value);
+        } else {
+            // A lobe narrower than a fine cell spills over the edges of the cell holding its
+            // peak between the grid's points (SGD fits of chrome-steel and ss440: 1.7 % above
+            // the neighbouring leaves' bounds). A lobe that decreases away from its peak along
+            // both axes is largest, on a rectangle, at the point nearest to the peak.
+            let m = self.near_peak(cell, at, |p| self.grid.eval(p));
+            bound = bound.max(m);
+        }
+        for t in &self.track {
+            let m = self.near_peak(cell, t.at, &t.density);
+            bound = bound.max(m);
+        }
+        if let Some(m) = self.band.max_in(cell) {
+            bound = bound.max(self.safety * m);
+        }
+        bound
     }
 }
 
@@ -421,34 +490,7 @@ impl RegionStats for SliceImageMap<'_> {
 
     fn region(&self, cell: &Rect) -> RegionEstimate {
         let mut est = self.grid.region(cell);
-        if self.dilation > 0.0 {
-            let d = self.dilation;
-            let grown = Rect::new(
-                (cell.x0 - d).max(-1.0),
-                (cell.y0 - d).max(-1.0),
-                (cell.x1 + d).min(1.0),
-                (cell.y1 + d).min(1.0),
-            );
-            est.max_bound = est.max_bound.max(self.grid.region(&grown).max_bound);
-        }
-        let (at, value) = self.peak;
-        if cell.contains(at) {
-            est.max_bound = est.max_bound.max(self.safety * value);
-        } else {
-            // A lobe narrower than a fine cell spills over the edges of the cell holding its
-            // peak between the grid's points (SGD fits of chrome-steel and ss440: 1.7 % above
-            // the neighbouring leaves' bounds). A lobe that decreases away from its peak along
-            // both axes is largest, on a rectangle, at the point nearest to the peak.
-            let m = self.near_peak(cell, at, |p| self.grid.eval(p));
-            est.max_bound = est.max_bound.max(m);
-        }
-        for t in &self.track {
-            let m = self.near_peak(cell, t.at, &t.density);
-            est.max_bound = est.max_bound.max(m);
-        }
-        if let Some(m) = self.band.max_in(cell) {
-            est.max_bound = est.max_bound.max(self.safety * m);
-        }
+        est.max_bound = self.bound_from(cell, est.max_bound);
         est
     }
 
@@ -477,6 +519,120 @@ impl RegionStats for SliceImageMap<'_> {
 mod tests {
     use super::*;
     use std::sync::Arc;
+
+    /// `within_reach` answers as `hypot(dx, dy) <= reach` does: random offsets at random
+    /// scales, offsets on the circle `|d| = reach` and one ulp either side of it (found by
+    /// bisection of the scale), zeros, NaN and infinities. Fails with the band's margin at
+    /// 10⁻¹⁸, i.e. none (tried: a case on the circle is decided the other way).
+    #[test]
+    fn within_reach_is_the_hypot_test() {
+        // SplitMix64 uniforms in [0, 1).
+        let mut state = 11u64;
+        let mut u = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (z ^ (z >> 31)) as f64 / 2f64.powi(64)
+        };
+        let mut near = 0;
+        for _ in 0..200_000 {
+            let reach = 10f64.powf(-6.0 + 6.5 * u());
+            let a = std::f64::consts::TAU * u();
+            let (c, s) = (a.cos(), a.sin());
+            let cases = if u() < 0.5 {
+                let r = reach * 2.0 * u();
+                vec![(r * c, r * s)]
+            } else {
+                // The scale t with hypot(t·c, t·s) crossing `reach`, and its neighbours.
+                let (mut lo, mut hi) = (0.5 * reach, 2.0 * reach);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if (mid * c).hypot(mid * s) <= reach {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                near += 1;
+                [lo, hi, lo.next_down(), hi.next_up()]
+                    .iter()
+                    .map(|&t| (t * c, t * s))
+                    .collect()
+            };
+            for (dx, dy) in cases {
+                assert_eq!(
+                    within_reach(dx, dy, reach),
+                    dx.hypot(dy) <= reach,
+                    "{dx:e} {dy:e} {reach:e}"
+                );
+            }
+        }
+        assert!(near > 90_000);
+        for (dx, dy, r) in [
+            (0.0, 0.0, 0.0),
+            (0.0, -0.0, 1e-3),
+            (f64::NAN, 0.0, 1.0),
+            (0.0, 1.0, f64::NAN),
+            (f64::INFINITY, f64::NAN, 1.0),
+            (f64::INFINITY, 0.0, f64::INFINITY),
+            (1e-170, 1e-170, 1e-160),
+            (3.0, 4.0, 5.0),
+        ] {
+            assert_eq!(within_reach(dx, dy, r), dx.hypot(dy) <= r, "{dx} {dy} {r}");
+        }
+    }
+
+    /// `max_bound` is `region(..).max_bound` bit for bit (docs/benchmarks.md §32.2): a
+    /// phong lobe's refined map with a dilation of one cell and a peak track (RGL envelopes
+    /// have one, Cornell and MERL maps the dilation), random rectangles from a sixteenth of a
+    /// cell to the whole disc, the rim band's cells among them.
+    #[test]
+    fn max_bound_is_the_region_bound() {
+        let b: Arc<dyn brdf::Brdf> = Arc::from(brdf::parse_spec("phong:n=80").unwrap());
+        let wo = brdf::direction_from_angles(50.0, 0.0);
+        let d = DiscBrdf::new(Arc::clone(&b), wo);
+        let counter = EvalCounter::new();
+        let options = GridOptions {
+            refinement: Some(partition_sampler::Refinement::default()),
+            ..GridOptions::default()
+        };
+        let track = (0..9)
+            .map(|k| {
+                let wk = brdf::direction_from_angles(45.0 + k as f64, 0.0);
+                let g = DiscBrdf::new(Arc::clone(&b), wk);
+                TrackPoint {
+                    at: DiscMap::Projected.to_disc(&brdf::mirror(&wk)),
+                    density: Box::new(move |p| g.eval(p)),
+                }
+            })
+            .collect();
+        let f = Counted {
+            f: &d,
+            counter: &counter,
+        };
+        let map = SliceImageMap::new(f, 128, 1.1, 1, &options)
+            .unwrap()
+            .with_track(track);
+        let mut state = 21u64;
+        let mut u = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (z ^ (z >> 31)) as f64 / 2f64.powi(64)
+        };
+        for _ in 0..4_000 {
+            let size = 2.0 * u().powi(4) + 1e-3;
+            let (x, y) = (2.0 * u() - 1.0, 2.0 * u() - 1.0);
+            let r = Rect::new(x, y, (x + size).min(1.0), (y + size).min(1.0));
+            assert_eq!(
+                map.max_bound(&r).to_bits(),
+                map.region(&r).max_bound.to_bits(),
+                "{r:?}"
+            );
+        }
+    }
 
     #[test]
     fn band_bounds_a_rim_peak_the_grid_misses() {

@@ -1,11 +1,10 @@
 //! [`ExactSet::build`]: the intervals, built in parallel and halved until they meet the caps.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use brdf::{Brdf, direction_from_radians};
 use partition_sampler::AuditCounters;
-use rayon::prelude::*;
 
 use crate::options::SetOptions;
 use crate::set::layout_for;
@@ -251,7 +250,19 @@ impl Plan {
 }
 
 /// Builds every interval, halving those that miss the caps, and returns the kept ones with
-/// their cells (in the order they were built).
+/// their cells (in no particular order: `assemble_cells` sorts them).
+///
+/// Every interval is a task of one `rayon::scope`: a built interval that is split spawns its
+/// halves at once, so no worker waits for a batch's slowest interval (docs/benchmarks.md
+/// §32.2; before, batches of `2 × threads` intervals ended at a barrier). The initial intervals
+/// are spawned from the lowest θ up: the spawning worker takes the last (the grazing ones,
+/// whose subtrees of splits are the longest chains of dependent builds) first, the others steal
+/// from the lowest θ, and each worker goes depth first through the halves it spawned (a split
+/// parent's node values are released once its children are built). The set does not depend on
+/// the order: each interval's build depends on its own job only (the node cache's values are
+/// functions of `θo`, and its evaluation counts are charged by a fixed rule, `integrate_node`).
+/// On errors, the one of the interval first in (cell, θ, δ) order is returned (every interval
+/// that can be built is: the same error whatever the schedule).
 fn run_jobs(
     brdf: &Arc<dyn Brdf>,
     options: &ExactOptions,
@@ -259,86 +270,153 @@ fn run_jobs(
     progress: Option<crate::Progress<'_>>,
     phases: &mut BuildPhases,
 ) -> Result<Vec<(usize, Placed)>, ExactError> {
-    let mut jobs = plan.initial_jobs();
-    let mut done: Vec<(usize, Placed)> = Vec::new();
-    let (mut built, mut queued) = (0usize, jobs.len());
-    // Depth first, a few intervals at a time: a split parent's node values are released
-    // once its children are built (the set does not depend on the order).
-    jobs.reverse();
-    let batch_len = 2 * rayon::current_num_threads().max(1);
-    while !jobs.is_empty() {
-        let batch = jobs.split_off(jobs.len().saturating_sub(batch_len));
-        let results: Vec<Result<(Job, Built), ExactError>> = batch
-            .par_iter()
-            .map(|job| {
-                build_interval(brdf, options, job, &plan.context(job)).map(|b| (job.clone(), b))
-            })
-            .collect();
-        let mut next = Vec::new();
-        for r in results {
-            let (
-                job,
-                Built {
-                    interval: iv,
-                    inheritance,
-                    axis: trials_axis,
-                    phases: counts,
-                    envelope,
-                },
-            ) = r?;
-            built += 1;
-            phases.built += 1;
-            if let Some(delta) = next_axis(options, plan, &job, iv.as_ref(), trials_axis) {
-                // Too many trials (found early, or at a node of the full table), or a
-                // table's interpolation tail.
-                let by_trials = iv
-                    .as_ref()
-                    .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
-                if by_trials {
-                    phases.split.add(&counts);
-                } else {
-                    phases.split_tail.add(&counts);
-                }
-                phases.record(
-                    &plan.grid,
-                    &job,
-                    iv.as_ref(),
-                    &counts,
-                    Some((by_trials, delta)),
-                );
-                // Split for its tail: its tree bounds the halves too (`Inheritance`).
-                let mut inheritance = inheritance;
-                if let Some(envelope) = envelope {
-                    inheritance.nodes = values_of(envelope);
-                }
-                if let (false, Some(iv)) = (by_trials, iv) {
-                    inheritance.tree = Some((iv.tree.into_parts().0, iv.map, iv.sub_bounds));
-                }
-                let inheritance = Arc::new(inheritance);
-                for (num, dnum) in job.halves(delta) {
-                    next.push(Job {
-                        cell: job.cell,
-                        num,
-                        dnum,
-                        inherited: Arc::clone(&inheritance),
-                    });
-                }
-                queued += 2;
-            } else if let Some(iv) = iv {
-                phases.kept.add(&counts);
-                phases.kept_intervals += 1;
-                phases.record(&plan.grid, &job, Some(&iv), &counts, None);
-                // Only the edges are kept (the node values go with `job`).
-                done.push((job.cell, (job.num, job.dnum, iv)));
-            }
-            if let Some(p) = progress {
-                p(built, queued);
-            }
+    let jobs = plan.initial_jobs();
+    let run = Run {
+        brdf,
+        options,
+        plan,
+        progress,
+        state: Mutex::new(RunState {
+            done: Vec::new(),
+            phases: std::mem::take(phases),
+            errors: Vec::new(),
+            built: 0,
+            queued: jobs.len(),
+        }),
+    };
+    rayon::scope(|s| {
+        for job in jobs {
+            let run = &run;
+            s.spawn(move |s| run.job(s, job));
         }
-        // Children on top of the stack, the left one first.
-        jobs.extend(next.into_iter().rev());
+    });
+    let state = run.state.into_inner().unwrap_or_else(|e| e.into_inner());
+    *phases = state.phases;
+    // The log in a fixed order (it was filled in the schedule's).
+    phases.log.sort_by(|a, b| {
+        (
+            a.cell,
+            a.theta_deg[0],
+            a.delta_deg[0],
+            a.theta_deg[1],
+            a.delta_deg[1],
+        )
+            .partial_cmp(&(
+                b.cell,
+                b.theta_deg[0],
+                b.delta_deg[0],
+                b.theta_deg[1],
+                b.delta_deg[1],
+            ))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    match state.errors.into_iter().min_by_key(|(key, _)| *key) {
+        Some((_, e)) => Err(e),
+        None => Ok(state.done),
     }
-    Ok(done)
+}
+
+/// What the tasks of [`run_jobs`] share.
+struct Run<'a> {
+    brdf: &'a Arc<dyn Brdf>,
+    options: &'a ExactOptions,
+    plan: &'a Plan,
+    progress: Option<crate::Progress<'a>>,
+    state: Mutex<RunState>,
+}
+
+/// The results of [`run_jobs`]' tasks so far.
+struct RunState {
+    done: Vec<(usize, Placed)>,
+    phases: BuildPhases,
+    /// Errors by their interval's place `(cell, θ numerator, δ numerator)`.
+    errors: Vec<((usize, u64, u64), ExactError)>,
+    built: usize,
+    queued: usize,
+}
+
+impl<'a> Run<'a> {
+    /// Builds `job`, then keeps it or spawns its halves on `scope`.
+    fn job<'s>(&'s self, scope: &rayon::Scope<'s>, job: Job)
+    where
+        'a: 's,
+    {
+        let (options, plan) = (self.options, self.plan);
+        let built = build_interval(self.brdf, options, &job, &plan.context(&job));
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let Built {
+            interval: iv,
+            inheritance,
+            axis: trials_axis,
+            phases: counts,
+            envelope,
+        } = match built {
+            Ok(b) => b,
+            Err(e) => {
+                state.errors.push(((job.cell, job.num[0], job.dnum[0]), e));
+                return;
+            }
+        };
+        state.built += 1;
+        state.phases.built += 1;
+        let mut halves = None;
+        if let Some(delta) = next_axis(options, plan, &job, iv.as_ref(), trials_axis) {
+            // Too many trials (found early, or at a node of the full table), or a
+            // table's interpolation tail.
+            let by_trials = iv
+                .as_ref()
+                .is_none_or(|iv| iv.worst_trials > options.max_trials && trials_axis.is_some());
+            if by_trials {
+                state.phases.split.add(&counts);
+            } else {
+                state.phases.split_tail.add(&counts);
+            }
+            state.phases.record(
+                &plan.grid,
+                &job,
+                iv.as_ref(),
+                &counts,
+                Some((by_trials, delta)),
+            );
+            state.queued += 2;
+            halves = Some((delta, by_trials, iv));
+        } else if let Some(iv) = iv {
+            state.phases.kept.add(&counts);
+            state.phases.kept_intervals += 1;
+            state
+                .phases
+                .record(&plan.grid, &job, Some(&iv), &counts, None);
+            // Only the edges are kept (the node values go with `job`).
+            state.done.push((job.cell, (job.num, job.dnum, iv)));
+        }
+        if let Some(p) = self.progress {
+            p(state.built, state.queued);
+        }
+        drop(state);
+        let Some((delta, by_trials, iv)) = halves else {
+            return;
+        };
+        // Split for its tail: its tree bounds the halves too (`Inheritance`).
+        let mut inheritance = inheritance;
+        if let Some(envelope) = envelope {
+            inheritance.nodes = values_of(envelope);
+        }
+        if let (false, Some(iv)) = (by_trials, iv) {
+            inheritance.tree = Some((iv.tree.into_parts().0, iv.map, iv.sub_bounds));
+        }
+        let inheritance = Arc::new(inheritance);
+        // The right half spawned first: this worker takes the left one next (the order
+        // of the batches before), a thief the right one.
+        for (num, dnum) in job.halves(delta).into_iter().rev() {
+            let child = Job {
+                cell: job.cell,
+                num,
+                dnum,
+                inherited: Arc::clone(&inheritance),
+            };
+            scope.spawn(move |s| self.job(s, child));
+        }
+    }
 }
 
 /// The axis to halve (`Some(true)`: δ), if any: too many trials (either axis, `trials_axis`

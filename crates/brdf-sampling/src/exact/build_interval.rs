@@ -585,9 +585,14 @@ fn normaliser_table(
     tree: &QuadTree,
     axis: Option<bool>,
     normalisers: &mut Vec<(NormaliserKey, Normaliser)>,
+    evaluations: &mut u64,
 ) -> Result<TableOutcome, ExactError> {
     let (var, [da, db]) = (ctx.var, ctx.delta);
     let (va, vb) = (var.of(span.ta), var.of(span.tb));
+    // A shared node of the build's cache is charged to one interval whatever the schedule:
+    // not to the interval whose upper θ end it is (unless that end is the grid's last), but to
+    // its neighbour above, whose lower end it is (`integrate_node`).
+    let upper_shared = (job.num[1] < ctx.grid.den).then_some(vb.to_bits());
     // Nodes integrated in the table's cells are exact to ~1e-6 but cost ~10⁵ lookups each;
     // `A(θo)` of the MERL layout interpolates to < 1e-5 on 5 of them (`tabulated.rs`).
     let n_theta = if ctx.table_nodes && ctx.set_table.is_none() {
@@ -654,7 +659,12 @@ fn normaliser_table(
                             total: it.table.eval(theta_nodes[i], d) / cos,
                             rel_err: it.rel_err,
                         },
-                        None => integrate_node(brdf, ctx, span, tree, t, d),
+                        None => {
+                            let charge = upper_shared != Some(theta_nodes[i].to_bits());
+                            let (r, e) = integrate_node(brdf, ctx, span, tree, (t, d), charge);
+                            *evaluations += e;
+                            r
+                        }
                     };
                     normalisers.push(((theta_nodes[i].to_bits(), d.to_bits()), r));
                     r
@@ -691,7 +701,8 @@ fn normaliser_table(
                 let (table, fine_err) =
                     extended_table(&theta_nodes, &values, quad_err, var, |theta| {
                         let t = var.theta(theta);
-                        let r = integrate_node(brdf, ctx, span, tree, t, 0.0);
+                        let (r, e) = integrate_node(brdf, ctx, span, tree, (t, 0.0), true);
+                        *evaluations += e;
                         if !(r.total.is_finite() && r.total > 0.0) {
                             return Err(ExactError::Normaliser {
                                 value: r.total,
@@ -777,30 +788,41 @@ fn extended_table(
 
 /// `A` at the outgoing direction `(t, φ_k + d)`: over the BRDF's own bins for the MERL layout,
 /// by the reference rule for Cornell data (`tabulated.rs`), by the leaf quadrature of `tree`
-/// otherwise.
+/// otherwise; with the BRDF evaluations charged to the interval. A node of the build's
+/// [`tabulated::NodeCache`] costs its rule's evaluations `E(t)` when `charge` is set (whether
+/// this call integrated it or found it), 0 otherwise: the count depends on the interval and
+/// the node alone, never on which interval reached the node first (docs/benchmarks.md §32.2).
+/// The leaf quadrature's evaluations are counted on the calling thread (the rule runs no
+/// parallel work, so no other job can run on this thread meanwhile).
 fn integrate_node(
     brdf: &dyn Brdf,
     ctx: &IntervalContext,
     span: &Span,
     tree: &QuadTree,
-    t: f64,
-    d: f64,
-) -> Normaliser {
+    (t, d): (f64, f64),
+    charge: bool,
+) -> (Normaliser, u64) {
     if let Some(table) = &ctx.set_table {
         let (total, rel_err) = table.at(t);
-        return Normaliser { total, rel_err };
+        return (Normaliser { total, rel_err }, 0);
     }
     if ctx.table_nodes {
-        let (total, rel_err) = ctx.node_cache.get(brdf, t).unwrap_or((f64::NAN, 0.0));
-        return Normaliser { total, rel_err };
+        let (total, rel_err, evaluations) =
+            ctx.node_cache.get(brdf, t).unwrap_or((f64::NAN, 0.0, 0));
+        let charged = if charge { evaluations } else { 0 };
+        return (Normaliser { total, rel_err }, charged);
     }
+    let before = crate::disc::thread_evaluations();
     let q = QueryDensity::new(brdf, direction_from_radians(t, ctx.phi_k + d), d, span.map);
     // The graded leaf quadrature, its budget by the BRDF (`tabulated.rs`).
     let r = tabulated::node_quadrature(brdf, &q, tree.leaves(), tree.integral(), span.mirror_y);
-    Normaliser {
-        total: r.total,
-        rel_err: r.rel_err,
-    }
+    (
+        Normaliser {
+            total: r.total,
+            rel_err: r.rel_err,
+        },
+        crate::disc::thread_evaluations() - before,
+    )
 }
 
 /// Builds the tree and normaliser table of one interval (`None`: its mean trials exceed the cap
@@ -855,8 +877,10 @@ pub(super) fn build_interval(
     // Node evaluations: the cached nodes counted their misses, the others every point.
     let cached = envelope.nodes.iter().filter(|n| n.caches()).count() as u64;
     let build_evals = points * (n_nodes - cached) + envelope.evaluations();
-    let before = crate::disc::thread_evaluations();
     let mut normalisers = Vec::new();
+    // Counted per node (not as the thread's counter's difference: the RGL node rule runs
+    // parallel work, during which this thread may run another interval's job).
+    let mut quad_evals = 0;
     let outcome = normaliser_table(
         brdf.as_ref(),
         options,
@@ -866,8 +890,8 @@ pub(super) fn build_interval(
         &tree,
         axis,
         &mut normalisers,
+        &mut quad_evals,
     )?;
-    let quad_evals = crate::disc::thread_evaluations() - before;
     phases.quadrature = lap.take();
     phases.nodes = normalisers.len() as u64;
     let (interval, table) = match outcome {

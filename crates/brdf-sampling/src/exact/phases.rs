@@ -65,7 +65,8 @@ pub struct BuildPhases {
     /// ([`ExactSet::build_counted`]; 0 otherwise): equal to [`BuildPhases::total`] when the
     /// phases miss none.
     pub counted: u64,
-    /// Every interval built, in the order the build decided its fate.
+    /// Every interval built, sorted by cell, θ and δ (the build decides their fates in the
+    /// schedule's order).
     pub log: Vec<IntervalRecord>,
 }
 

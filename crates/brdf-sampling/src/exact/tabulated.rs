@@ -106,8 +106,18 @@ pub(crate) const CORNELL_TAIL_CAP: f64 = 2e-5;
 /// `(A, relative error estimate)` at the outgoing polar angle `theta` (radians) by a rule
 /// that does not depend on the interval (the MERL layout's integral in its own cells; the
 /// reference rule for Cornell data); `None` for every other BRDF (the caller integrates on
-/// the tree's leaves). The evaluations are counted as evaluations of the build.
+/// the tree's leaves). The evaluations are counted as evaluations of the build (on the
+/// calling thread's [`crate::thread_evaluations`]).
 pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)> {
+    let (value, rel, evaluations) = table_normaliser_uncounted(brdf, theta)?;
+    count_evaluations(evaluations);
+    Some((value, rel))
+}
+
+/// [`table_normaliser`] with its BRDF evaluations returned, `(A, relative error estimate,
+/// evaluations)`, and not added to the thread's counter (the node cache charges them to an
+/// interval by a rule that does not depend on the build's schedule, [`NodeCache::get`]).
+fn table_normaliser_uncounted(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64, u64)> {
     let any = brdf.as_any()?;
     let (value, abs_err, evaluations) = if let Some(merl) = any.downcast_ref::<MerlBrdf>() {
         let a = merl.albedo_in_bins(theta, MERL_REL_TOL, MERL_BUDGET);
@@ -136,13 +146,12 @@ pub(crate) fn table_normaliser(brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)
     } else {
         return None;
     };
-    count_evaluations(evaluations);
     let rel = if value > 0.0 {
         abs_err / value
     } else {
         f64::INFINITY
     };
-    Some((value, rel))
+    Some((value, rel, evaluations))
 }
 
 /// Whether [`table_normaliser`] serves `brdf`.
@@ -171,18 +180,24 @@ pub(crate) fn tail_cap(brdf: &dyn Brdf) -> f64 {
 /// The [`table_normaliser`] values a build has integrated, by the bits of `θo`: shared by
 /// its intervals (adjacent intervals share their ends, a split interval's middle is its
 /// children's end). The values depend on `θo` alone, so the set does not depend on which
-/// interval integrated a node first.
+/// interval integrated a node first. Each entry also keeps the node's evaluation count `E(θo)`
+/// (a function of `θo` alone too), so that a build can charge it to an interval by a fixed
+/// rule rather than to whichever interval asked first (docs/benchmarks.md §32.2).
 #[derive(Default)]
-pub(crate) struct NodeCache(Mutex<HashMap<u64, (f64, f64)>>);
+pub(crate) struct NodeCache(Mutex<HashMap<u64, (f64, f64, u64)>>);
 
 impl NodeCache {
-    /// [`table_normaliser`] at `theta`, integrated once per build.
-    pub(crate) fn get(&self, brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64)> {
+    /// `(A, relative error, E)` at `theta`: [`table_normaliser`]'s value and error, and the
+    /// evaluations `E` its rule makes at `theta` — whether this call integrated the node or
+    /// found it integrated (nothing is added to the thread's counter: the caller charges `E`).
+    /// Integrated once per build (two calls racing on a new node may both integrate it; they
+    /// store the same bits).
+    pub(crate) fn get(&self, brdf: &dyn Brdf, theta: f64) -> Option<(f64, f64, u64)> {
         let key = theta.to_bits();
         if let Some(v) = self.0.lock().ok().and_then(|m| m.get(&key).copied()) {
             return Some(v);
         }
-        let v = table_normaliser(brdf, theta)?;
+        let v = table_normaliser_uncounted(brdf, theta)?;
         if let Ok(mut m) = self.0.lock() {
             m.insert(key, v);
         }

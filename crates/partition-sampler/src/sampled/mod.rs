@@ -199,6 +199,27 @@ impl<D: Density> SampledGridDensity<D> {
     }
 }
 
+impl<D> SampledGridDensity<D> {
+    /// `region(cell).max_bound` bit for bit, without the integral: `safety ·` the largest
+    /// fine-cell maximum over the cells meeting `cell` with positive area (grid coordinates
+    /// snapped as `region` snaps them); `+∞` once compacted. For callers that need the bound
+    /// only (a bound over a grown rectangle), at a fraction of `region`'s cost on rectangles
+    /// not aligned on the pyramid's blocks (docs/benchmarks.md §32.2).
+    pub fn max_bound(&self, cell: &Rect) -> f64 {
+        if self.cells.is_empty() {
+            return f64::INFINITY;
+        }
+        let nf = self.n as f64;
+        let xa = snap((cell.x0 - self.grid.x0) * self.sx, nf);
+        let xb = snap((cell.x1 - self.grid.x0) * self.sx, nf);
+        let ya = snap((cell.y0 - self.grid.y0) * self.sy, nf);
+        let yb = snap((cell.y1 - self.grid.y0) * self.sy, nf);
+        self.pyramid
+            .query_max(&Level0(&self.cells, self.n), xa, xb, ya, yb)
+            * self.safety
+    }
+}
+
 impl<D> std::fmt::Debug for SampledGridDensity<D> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SampledGridDensity")
@@ -323,6 +344,43 @@ mod tests {
         let s: f64 = q.iter().map(|r| x2.region(r).integral).sum();
         assert!((s - x2.total_integral()).abs() < 1e-12);
         assert!(x2.region(&q[3]).max_bound >= DEFAULT_SAFETY_FACTOR * (1.0 - 1e-3));
+    }
+
+    /// [`SampledGridDensity::max_bound`] is `region(..).max_bound` bit for bit on a refined
+    /// disc grid (kept blocks, boundary cells), for random rectangles inside and across the
+    /// disc, tiny to whole, and on the compacted density.
+    #[test]
+    fn max_bound_is_the_region_bound() {
+        let f = |p: Point2| (-30.0 * ((p[0] - 0.3).powi(2) + (p[1] + 0.2).powi(2))).exp() + 0.1;
+        let options = GridOptions {
+            refinement: Some(Refinement::default()),
+            ..GridOptions::default()
+        };
+        let d = SampledGridDensity::with_options(f, Domain::UnitDisc, 128, &options)
+            .unwrap()
+            .with_safety_factor(1.1)
+            .unwrap();
+        let mut state = 9u64;
+        let mut u = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (z ^ (z >> 31)) as f64 / 2f64.powi(64)
+        };
+        for _ in 0..5_000 {
+            let size = 2.2 * u().powi(4) + 1e-4;
+            let (x, y) = (2.4 * u() - 1.2, 2.4 * u() - 1.2);
+            let r = Rect::new(x, y, x + size, y + size * (0.3 + u()));
+            assert_eq!(
+                d.max_bound(&r).to_bits(),
+                d.region(&r).max_bound.to_bits(),
+                "{r:?}"
+            );
+        }
+        let c = d.compact();
+        let r = Rect::new(0.0, 0.0, 0.1, 0.1);
+        assert_eq!(c.max_bound(&r), c.region(&r).max_bound);
     }
 
     #[test]

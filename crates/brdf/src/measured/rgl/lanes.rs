@@ -213,6 +213,18 @@ fn axis_cell(pos: f64, n: usize) -> (f64, f64) {
     (c, s - c)
 }
 
+/// `2⁵²`: the `f64`s in `[2⁵², 2⁵³)` are the integers, spaced by 1.
+const TWO52: f64 = 4_503_599_627_370_496.0;
+
+/// The `usize` of an **integral** `c ∈ [0, 2⁵²)` (a cell index, or a row-major grid index
+/// `cy·nx + cx` made of them, exact in `f64`): `c + 2⁵²` is exact and its bits are those of
+/// `2⁵²` plus `c`. The value of `c as usize` for such `c`, in vector lanes (an integer
+/// subtraction) where the saturating cast costs a dozen scalar instructions per lane.
+#[inline(always)]
+fn index(c: f64) -> u64 {
+    (c + TWO52).to_bits().wrapping_sub(TWO52.to_bits())
+}
+
 /// The bilinear interpolant of corners `v = [v00, v10, v01, v11]` at fractions `(fx, fy)`:
 /// `BilinearTable::eval_single`'s expression.
 #[inline(always)]
@@ -221,16 +233,19 @@ fn bilinear(v: [f64; 4], fx: f64, fy: f64) -> f64 {
     (1.0 - fy) * ((1.0 - fx) * v00 + fx * v10) + fy * ((1.0 - fx) * v01 + fx * v11)
 }
 
-/// The four corners of cell `(cx, cy)` of a row-major grid of `nx` columns.
+/// The four corners of the cell at row-major grid index `k` of a grid of `nx` columns.
 #[inline(always)]
-fn corners(d: &[f64], nx: usize, cx: f64, cy: f64) -> [f64; 4] {
-    let k = cy as usize * nx + cx as usize;
+fn corners(d: &[f64], nx: usize, k: u64) -> [f64; 4] {
     // One slice over both rows: two bounds checks instead of four.
-    let w = &d[k..][..nx + 2];
+    let w = &d[k as usize..][..nx + 2];
     [w[0], w[1], w[nx], w[nx + 1]]
 }
 
-/// One block of at most [`LANES`] directions (see the module docs).
+/// One block of at most [`LANES`] directions (see the module docs). The passes are written
+/// so that each is one loop over all [`LANES`] lanes without a branch on lane data (the
+/// compiler vectorises them; a branch on the run's constants is taken once per pass): the
+/// cells' grid indices are made in the lanes by [`index`], and only the gathers read lane by
+/// lane.
 #[inline(always)]
 fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
     let n = wi.len().min(out.len()).min(LANES);
@@ -263,53 +278,67 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
         norms[j] = norm;
     }
     let valid = |j: usize| run.valid && wz[j] > 0.0 && norms[j] > 1e-12;
-    // msun's special cases, one lane at a time, by the scalar path's functions.
-    for j in 0..n {
-        if special[j] != 0 && valid(j) {
-            let s = run.wo + wi[j];
-            let h = s / s.norm();
-            let y = cos_o * s.y - sin_o * s.x;
-            let x = cos_o * s.x + sin_o * s.y;
-            u0[j] = theta_to_u(fast::elevation(&h));
-            u1[j] = fast::unit_azimuth(fast::atan2(y, x));
+    // msun's special cases, one lane at a time, by the scalar path's functions (rare: one
+    // test per block when there are none).
+    if special.iter().fold(0, |a, &s| a | s) != 0 {
+        for j in 0..n {
+            if special[j] != 0 && valid(j) {
+                let s = run.wo + wi[j];
+                let h = s / s.norm();
+                let y = cos_o * s.y - sin_o * s.x;
+                let x = cos_o * s.x + sin_o * s.y;
+                u0[j] = theta_to_u(fast::elevation(&h));
+                u1[j] = fast::unit_azimuth(fast::atan2(y, x));
+            }
         }
     }
-    // Pass 2: cells of u_m on the vndf slice and on ndf.
-    let (vnx, vny, area_scale, cells, rows) = run.vndf.parts();
-    let _ = area_scale;
+    // Pass 2: cells of u_m on the vndf slice and on ndf, as grid indices.
+    let (vnx, vny, _area_scale, cells, rows) = run.vndf.parts();
     let (nnx, nny, ndf) = run.ndf.parts();
-    let (mut cx, mut cy, mut fx, mut fy) = (z0, z0, z0, z0);
-    let (mut ncx, mut ncy, mut nfx, mut nfy) = (z0, z0, z0, z0);
+    let (mut fx, mut fy) = (z0, z0);
+    let (mut nfx, mut nfy) = (z0, z0);
+    let (mut vk, mut vrow, mut nk) = ([0u64; LANES], [0u64; LANES], [0u64; LANES]);
+    let (vnx_f, nnx_f) = (vnx as f64, nnx as f64);
     for j in 0..LANES {
-        (cx[j], fx[j]) = axis_cell(u0[j], vnx);
-        (cy[j], fy[j]) = axis_cell(u1[j], vny);
-        (ncx[j], nfx[j]) = axis_cell(u0[j], nnx);
-        (ncy[j], nfy[j]) = axis_cell(u1[j], nny);
+        let (cx, fxj) = axis_cell(u0[j], vnx);
+        let (cy, fyj) = axis_cell(u1[j], vny);
+        let (ncx, nfxj) = axis_cell(u0[j], nnx);
+        let (ncy, nfyj) = axis_cell(u1[j], nny);
+        (fx[j], fy[j], nfx[j], nfy[j]) = (fxj, fyj, nfxj, nfyj);
+        vk[j] = index(cy * vnx_f + cx);
+        vrow[j] = index(cy);
+        nk[j] = index(ncy * nnx_f + ncx);
     }
     // Gather: the inversion's grid points and rows, ndf's corners.
     let mut v = [[0.0; 4]; LANES];
     let mut along = [[0.0; 2]; LANES];
     let mut row = [[0.0; 3]; LANES];
-    let mut nd = [[0.0; 4]; LANES];
     for j in 0..LANES {
-        let (x, y) = (cx[j] as usize, cy[j] as usize);
-        let k = y * vnx + x;
         // One slice over both rows: two bounds checks instead of four.
-        let w = &cells[k..][..vnx + 2];
+        let w = &cells[vk[j] as usize..][..vnx + 2];
         let [v00, a0] = w[0];
         let [v01, a1] = w[vnx];
         v[j] = [v00, w[1][0], v01, w[vnx + 1][0]];
         along[j] = [a0, a1];
-        let [m0, r0] = rows[y];
-        row[j] = [m0, r0, rows[y + 1][1]];
-        if run.jacobian {
-            nd[j] = corners(ndf, nnx, ncx[j], ncy[j]);
+        let r = &rows[vrow[j] as usize..][..2];
+        let [m0, r0] = r[0];
+        row[j] = [m0, r0, r[1][1]];
+    }
+    // Pass 3: D/(4σ) (its corners gathered first), the inversion, the cell of s on the
+    // luminance slice.
+    let mut factor = [1.0; LANES];
+    if run.jacobian {
+        let mut nd = [[0.0; 4]; LANES];
+        for j in 0..LANES {
+            nd[j] = corners(ndf, nnx, nk[j]);
+        }
+        for j in 0..LANES {
+            factor[j] = bilinear(nd[j], nfx[j], nfy[j]) / run.four_sigma;
         }
     }
-    // Pass 3: the inversion, D/(4σ), the cell of s on the luminance slice.
     let (lnx, lny, lum) = run.lum.parts();
-    let mut factor = z0;
-    let (mut lcx, mut lcy, mut lfx, mut lfy) = (z0, z0, z0, z0);
+    let lnx_f = lnx as f64;
+    let (mut lk, mut lfx, mut lfy) = ([0u64; LANES], z0, z0);
     for j in 0..LANES {
         let (fx, fy) = (fx[j], fy[j]);
         let [v00, v10, v01, v11] = v[j];
@@ -319,31 +348,38 @@ fn block(run: &BlockRun<'_>, wi: &[Vec3], out: &mut [f64]) {
         let c1 = (1.0 - fy) * v10 + fy * v11;
         let row_total = (1.0 - fy) * r0 + fy * r1;
         let al = fx * (c0 + 0.5 * fx * (c1 - c0)) + (1.0 - fy) * along0 + fy * along1;
-        let ux = if row_total > 0.0 { al / row_total } else { 0.0 };
+        // The quotient in every lane, kept where the row has mass (a select, no branch).
+        let q = al / row_total;
+        let ux = if row_total > 0.0 { q } else { 0.0 };
         let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
-        factor[j] = if run.jacobian {
-            bilinear(nd[j], nfx[j], nfy[j]) / run.four_sigma
-        } else {
-            1.0
-        };
-        (lcx[j], lfx[j]) = axis_cell(ux, lnx);
-        (lcy[j], lfy[j]) = axis_cell(uy, lny);
+        let (lcx, lfxj) = axis_cell(ux, lnx);
+        let (lcy, lfyj) = axis_cell(uy, lny);
+        (lfx[j], lfy[j]) = (lfxj, lfyj);
+        lk[j] = index(lcy * lnx_f + lcx);
     }
     // Gather: the luminance corners; pass 4: the value.
     let mut lc = [[0.0; 4]; LANES];
     for j in 0..LANES {
-        lc[j] = corners(lum, lnx, lcx[j], lcy[j]);
+        lc[j] = corners(lum, lnx, lk[j]);
     }
     let mut f = z0;
     for j in 0..LANES {
         let y = bilinear(lc[j], lfx[j], lfy[j]);
-        f[j] = if run.valid && wz[j] > 0.0 && norms[j] > 1e-12 {
-            (y * factor[j]).max(0.0) / wz[j]
+        let value = (y * factor[j]).max(0.0) / wz[j];
+        f[j] = if wz[j] > 0.0 && norms[j] > 1e-12 {
+            value
         } else {
             0.0
         };
     }
-    out[..n].copy_from_slice(&f[..n]);
+    if !run.valid {
+        f = z0;
+    }
+    if n == LANES {
+        out[..LANES].copy_from_slice(&f);
+    } else {
+        out[..n].copy_from_slice(&f[..n]);
+    }
 }
 
 /// Every block of `wi` through [`block`].
