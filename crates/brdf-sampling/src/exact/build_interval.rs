@@ -244,7 +244,7 @@ fn sub_bounds(
     safety: f64,
     rigorous: Option<(&RglRectBound<'_>, RigorousRule)>,
 ) -> (Box<[[u8; SUB_CELLS]]>, Box<[f32]>) {
-    use partition_sampler::{Rect, RegionStats};
+    use partition_sampler::Rect;
     let c = image.cell() * growth;
     // The mean sub-cell volume `Σ_i |leaf i| · M_i / (16 · leaves)`.
     let mean_volume = tree
@@ -253,7 +253,7 @@ fn sub_bounds(
         .sum::<f64>()
         / (SUB_CELLS * tree.leaves().len().max(1)) as f64;
     let refinement = super::rgl_bound::Refinement::one_layer(mean_volume);
-    let est = |r: &Rect| image.region(r).max_bound / safety;
+    let est = |r: &Rect| image.max_bound(r) / safety;
     let mut tops = Vec::new();
     let codes = tree
         .leaves()
@@ -267,14 +267,12 @@ fn sub_bounds(
                     let x1 = if sx + 1 == SUB { r.x1 } else { x0 + w };
                     let y1 = if sy + 1 == SUB { r.y1 } else { y0 + h };
                     let grown = || {
-                        image
-                            .region(&Rect::new(
-                                (x0 - c).max(-1.0),
-                                (y0 - c).max(-1.0),
-                                (x1 + c).min(1.0),
-                                (y1 + c).min(1.0),
-                            ))
-                            .max_bound
+                        image.max_bound(&Rect::new(
+                            (x0 - c).max(-1.0),
+                            (y0 - c).max(-1.0),
+                            (x1 + c).min(1.0),
+                            (y1 + c).min(1.0),
+                        ))
                     };
                     let cell = Rect::new(x0, y0, x1, y1);
                     // `bound_below(cell, cap)` equals the bound below `cap` and is ≥ `cap`
