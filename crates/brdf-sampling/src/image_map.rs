@@ -431,9 +431,8 @@ impl SliceImageMap<'_> {
     /// `region(cell).max_bound` bit for bit, without the integral (the grid's bound by
     /// `SampledGridDensity::max_bound`): for callers that need the bound only, e.g. over a
     /// grown rectangle (docs/benchmarks.md §32.2).
-    /// Not called in this crate yet: for the thinning codes' grown rule (`sub_bounds`,
-    /// `exact/build_interval.rs`), whose `region(..).max_bound` it replaces bit for bit.
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// Used by the thinning codes' rules (`sub_bounds`, `exact/build_interval.rs`), where it
+    /// replaces `region(..).max_bound` bit for bit.
     pub(crate) fn max_bound(&self, cell: &Rect) -> f64 {
         self.bound_from(cell, self.grid.max_bound(cell))
     }

@@ -2364,6 +2364,8 @@ pub(super) mod tests {
                     let [x0, dx, y0, dy, m] = table.leaf_record(k);
                     let [lx0, ldx, ly0, ldy, ml] = lt.leaf_record(k);
                     assert_eq!([x0, dx, y0, dy], [lx0, ldx, ly0, ldy], "leaf {k}");
+                    // The codes' base: `M_i`, or a one-layer interval's served bound (§32.1).
+                    let m = sub.leaf_base(k, m);
                     let top = c.iter().map(|&q| sub_bound(m, q)).fold(0.0, f64::max);
                     let ml32 = ml as f32;
                     assert_eq!(f64::from(ml32), ml);

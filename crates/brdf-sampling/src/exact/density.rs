@@ -1083,8 +1083,10 @@ mod survey {
                     let (w, h) = (r.x1 - r.x0, r.y1 - r.y0);
                     for s in 0..16 {
                         let (sx, sy) = (s % 4, s / 4);
-                        let m =
-                            crate::exact::table::sub_bound(l.max_bound, sub.codes[base + li][s]);
+                        let m = crate::exact::table::sub_bound(
+                            sub.leaf_base(li, l.max_bound),
+                            sub.codes[base + li][s],
+                        );
                         let (mut ins, mut mg) = (0, 0.0f64);
                         for i in 0..4 {
                             for j in 0..4 {

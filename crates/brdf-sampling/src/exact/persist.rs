@@ -9,7 +9,8 @@
 //! own versioned format ([`partition_sampler::FORMAT_VERSION`]) and the leaves' thinning bounds
 //! (16 codes per leaf in the tree's leaf order, per θo layer, and the layers' inner edges; or none;
 //! version 2, §30.1; version 3: the layers, §30.6; version 4: the options' `thinning_growth` and
-//! `thinning_rigorous`, §31.3 — a version-3 file would otherwise fail to decode its options).
+//! `thinning_rigorous`, §31.3 — a version-3 file would otherwise fail to decode its options;
+//! version 5: the one-layer codes' served bounds per leaf, an `f32` each or none, §32.1).
 //!
 //! The BRDF is not stored: it is re-attached on load, which checks that the spec matches and
 //! that the BRDF reproduces the probes. The set's grid, cells, table variable and azimuth
@@ -45,7 +46,7 @@ use super::set::ExactSet;
 use super::table::{SUB_CELLS, SubBounds};
 
 /// Version of the stored `adaptive-exact` format; bumped on any incompatible change.
-pub const EXACT_FORMAT_VERSION: u32 = 4;
+pub const EXACT_FORMAT_VERSION: u32 = 5;
 
 const MAGIC: &[u8; 4] = b"BRQE";
 
@@ -75,6 +76,8 @@ struct StoredInterval {
     sub_bounds: Vec<u8>,
     /// The thinning layers' inner θo edges (radians; empty: one layer).
     sub_edges: Vec<f64>,
+    /// The served bounds of one layer's codes, one per leaf (empty: none; [`SubBounds::tops`]).
+    sub_tops: Vec<f32>,
 }
 
 impl StoredInterval {
@@ -96,6 +99,10 @@ impl StoredInterval {
                 .sub_bounds
                 .as_ref()
                 .map_or_else(Vec::new, |s| s.edges.to_vec()),
+            sub_tops: iv
+                .sub_bounds
+                .as_ref()
+                .map_or_else(Vec::new, |s| s.tops.to_vec()),
         }
     }
 }
@@ -298,6 +305,13 @@ fn load_interval(
     if !iv.sub_edges.is_sorted_by(|a, b| a < b) || iv.sub_edges.iter().any(|e| !e.is_finite()) {
         return Err(bad("thinning layer edges not finite and increasing".into()));
     }
+    if !(iv.sub_tops.is_empty() || iv.sub_tops.len() == leaves && layers == 1)
+        || iv.sub_tops.iter().any(|t| !(t.is_finite() && *t >= 0.0))
+    {
+        return Err(bad(
+            "thinning served bounds: not one finite value per leaf".into()
+        ));
+    }
     let sub_bounds: Option<SubBounds> = match iv.sub_bounds.len() {
         0 => None,
         n if n == layers * leaves * SUB_CELLS => Some(SubBounds {
@@ -311,6 +325,7 @@ fn load_interval(
                 })
                 .collect(),
             edges: iv.sub_edges.clone().into_boxed_slice(),
+            tops: iv.sub_tops.clone().into_boxed_slice(),
         }),
         n => {
             return Err(bad(format!(

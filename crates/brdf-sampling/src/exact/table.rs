@@ -87,6 +87,12 @@ pub(super) struct SubBounds {
     pub(super) codes: Box<[[u8; SUB_CELLS]]>,
     /// The `L − 1` inner layer edges (radians, increasing; empty: one layer).
     pub(super) edges: Box<[f64]>,
+    /// Per leaf (`L = 1` only; empty: none), the **served bound** `T_i ≥ M_i` the codes are
+    /// relative to in place of `m_i = M_i` (docs/benchmarks.md §32.1: the rigorous sub-cell
+    /// bounds of a one-layer interval, which may exceed the tree's image-map bound `M_i`): the
+    /// sub-cell bound is `sub_bound(T_i, q)`, and the layer table's leaf bound `M_il` is taken
+    /// from these ([`LeafTable::with_layer_tables`]).
+    pub(super) tops: Box<[f32]>,
 }
 
 impl SubBounds {
@@ -95,7 +101,21 @@ impl SubBounds {
         Self {
             codes,
             edges: Box::new([]),
+            tops: Box::new([]),
         }
+    }
+
+    /// The bounds with the served bounds `tops` (one per leaf, `L = 1`; empty: none).
+    pub(super) fn with_tops(mut self, tops: Box<[f32]>) -> Self {
+        self.tops = tops;
+        self
+    }
+
+    /// The bound leaf `k`'s codes are relative to: `T_k` ([`SubBounds::tops`]) when the bounds
+    /// have served bounds, else its tree bound `m` (`M_k`) (test support).
+    #[cfg(test)]
+    pub(super) fn leaf_base(&self, k: usize, m: f64) -> f64 {
+        self.tops.get(k).map_or(m, |&t| f64::from(t))
     }
 
     /// The layer count `L = edges.len() + 1`.
@@ -126,6 +146,12 @@ pub(super) struct LeafTable {
     sub: Box<[u8]>,
     /// The inner θo edges of the layers ([`SubBounds::edges`]).
     edges: Box<[f64]>,
+    /// The served bounds `T_i` of one layer's codes ([`SubBounds::tops`]) and those codes
+    /// relative to them, kept where some `T_i > M_i` (empty otherwise: `sub` is relative to
+    /// `M_i`) for [`LeafTable::with_layer_tables`]; `sub` then holds them re-expressed
+    /// relative to `M_i` and capped at it (255).
+    tops: Box<[f32]>,
+    top_codes: Box<[u8]>,
     /// Per θo layer of the thinning bounds (`L ≥ 2`; empty: none, see
     /// [`LeafTable::with_layer_tables`]), the layer's own table over the same leaves: leaf
     /// bounds `M_il`, alias table and one layer of codes ([`LeafTable::serving`] picks it).
@@ -134,7 +160,7 @@ pub(super) struct LeafTable {
 
 /// The smallest `f32` at least `b` (`b` finite and non-negative): a layer table's leaf bound
 /// `M_il` from the largest sub-cell bound of its leaf.
-fn f32_at_least(b: f64) -> f32 {
+pub(super) fn f32_at_least(b: f64) -> f32 {
     let v = b as f32;
     if f64::from(v) < b { v.next_up() } else { v }
 }
@@ -202,6 +228,8 @@ impl LeafTable {
             entries: entries.into_boxed_slice(),
             sub: Box::new([]),
             edges: Box::new([]),
+            tops: Box::new([]),
+            top_codes: Box::new([]),
             layers: Box::new([]),
         })
     }
@@ -218,6 +246,32 @@ impl LeafTable {
         self.edges = sub
             .map_or_else(Vec::new, |s| s.edges.to_vec())
             .into_boxed_slice();
+        (self.tops, self.top_codes) = (Box::new([]), Box::new([]));
+        let tops = sub
+            .map(|s| &*s.tops)
+            .filter(|t| t.len() == self.entries.len() && self.edges.is_empty());
+        if let Some(tops) = tops
+            && tops.iter().zip(&self.entries).any(|(&t, e)| t != e.m)
+        {
+            // The codes relative to `T_i`; `sub` relative to `M_i`, capped at it.
+            let capped: Vec<u8> = self
+                .sub
+                .chunks_exact(SUB_CELLS)
+                .zip(tops.iter().zip(&self.entries))
+                .flat_map(|(c, (&t, e))| {
+                    let m = f64::from(e.m);
+                    c.iter().map(move |&q| {
+                        if t == e.m {
+                            q
+                        } else {
+                            sub_code(m, sub_bound(f64::from(t), q))
+                        }
+                    })
+                })
+                .collect();
+            self.top_codes = std::mem::replace(&mut self.sub, capped.into_boxed_slice());
+            self.tops = tops.into();
+        }
         self
     }
 
@@ -226,12 +280,15 @@ impl LeafTable {
     /// the leaf bounds tightened to the codes, e.g. §31.3's rigorous ones; without thinning
     /// bounds unchanged): layer `l`'s table has the same
     /// leaves (rectangles, order), the leaf bounds
-    /// `M_il = ⌈max_s sub_bound(M_i, q_ils)⌉_f32` (the largest of leaf `i`'s sub-cell bounds in
-    /// layer `l`, rounded up to an `f32`; `≤ M_i`), its own alias table over
-    /// `V_il = (dx · dy) · M_il` (a leaf with `M_il = 0` is never picked), and one layer of
-    /// codes re-expressed relative to `M_il`: `q'_ils = sub_code(M_il, sub_bound(M_i, q_ils))`,
+    /// `M_il = ⌈max_s sub_bound(m_i, q_ils)⌉_f32` (the largest of leaf `i`'s sub-cell bounds in
+    /// layer `l`, rounded up to an `f32`; `≤ m_i`), with `m_i = M_i`, or the served bound `T_i ≥
+    /// M_i` of a one-layer interval's rigorous codes ([`SubBounds::tops`], docs/benchmarks.md
+    /// §32.1: then `M_il` may exceed `M_i`, and bounds `g` on the whole leaf), its own alias
+    /// table over `V_il = (dx · dy) · M_il` (a leaf with `M_il = 0` is never picked), and one
+    /// layer of codes re-expressed relative to `M_il`: `q'_ils = sub_code(M_il, sub_bound(m_i,
+    /// q_ils))`,
     /// the smallest whose bound `sub_bound(M_il, q')` is at least the layer's sub-cell bound.
-    /// So wherever `g ≤ sub_bound(M_i, q_ils)` holds for a θo of the layer, `g ≤ M_il` and
+    /// So wherever `g ≤ sub_bound(m_i, q_ils)` holds for a θo of the layer, `g ≤ M_il` and
     /// `g ≤ sub_bound(M_il, q'_ils)` hold too: envelope rejection under a layer table samples
     /// `g / ∫ g` exactly as under the interval's, with fewer trials (`Σ V_il ≤ Σ V_i`); the
     /// samples drawn are other ones (another alias table). Unchanged (no layer tables) when a
@@ -243,14 +300,26 @@ impl LeafTable {
             return self;
         }
         let mut layers = Vec::with_capacity(l_count);
-        for codes in self.sub.chunks_exact(n * SUB_CELLS) {
+        // One layer with served bounds `T_i`: its codes relative to them.
+        let (all, tops): (&[u8], &[f32]) = if self.top_codes.is_empty() {
+            (&self.sub, &[])
+        } else {
+            (&self.top_codes, &self.tops)
+        };
+        for codes in all.chunks_exact(n * SUB_CELLS) {
             let mut entries = Vec::with_capacity(n);
             let mut sub = Vec::with_capacity(n * SUB_CELLS);
-            for (e, c) in self.entries.iter().zip(codes.chunks_exact(SUB_CELLS)) {
-                let m = f64::from(e.m);
+            for (k, (e, c)) in self
+                .entries
+                .iter()
+                .zip(codes.chunks_exact(SUB_CELLS))
+                .enumerate()
+            {
+                let base = tops.get(k).copied().unwrap_or(e.m);
+                let m = f64::from(base);
                 let top = c.iter().map(|&q| sub_bound(m, q)).fold(0.0, f64::max);
                 let ml = f32_at_least(top);
-                if ml == e.m {
+                if ml == base {
                     // The same bound: the same codes (`sub_code(m, sub_bound(m, q)) = q`).
                     sub.extend_from_slice(c);
                 } else {
@@ -340,6 +409,8 @@ impl LeafTable {
             + std::mem::size_of_val(&*self.entries)
             + std::mem::size_of_val(&*self.sub)
             + std::mem::size_of_val(&*self.edges)
+            + std::mem::size_of_val(&*self.tops)
+            + std::mem::size_of_val(&*self.top_codes)
             + self.layers.iter().map(Self::bytes_used).sum::<usize>()
     }
 

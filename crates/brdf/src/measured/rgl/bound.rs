@@ -233,10 +233,9 @@ fn warped_box_known(
     let ys = [uy[0], uy[1]].into_iter().chain(row_nodes(ny, uy));
     for y in ys {
         for slice in blends {
-            let (lo, _) = slice.invert([ux[0], y]);
-            let (hi, _) = slice.invert([ux[1], y]);
-            sx = [sx[0].min(lo[0]).min(hi[0]), sx[1].max(lo[0]).max(hi[0])];
-            sy = [sy[0].min(lo[1]).min(hi[1]), sy[1].max(lo[1]).max(hi[1])];
+            let ([lo, hi], v) = invert_pair(slice, ux, y);
+            sx = [sx[0].min(lo).min(hi), sx[1].max(lo).max(hi)];
+            sy = [sy[0].min(v), sy[1].max(v)];
         }
     }
     if empty || !(sx[0] <= sx[1]) {
@@ -247,6 +246,42 @@ fn warped_box_known(
     }
     let pad = |r: [f64; 2]| [(r[0] - PAD).max(0.0), (r[1] + PAD).min(1.0)];
     [pad(sx), pad(sy)]
+}
+
+/// `slice.invert([x, y])` at the two `x` of `ux` and one `y`: the two first coordinates and
+/// the (shared) second, bit for bit (the same arithmetic as `Warp2DSlice::invert`, the row's
+/// part done once and the density not formed; docs/benchmarks.md §32.1).
+#[inline(always)]
+fn invert_pair(slice: &Warp2DSlice, ux: [f64; 2], y: f64) -> ([f64; 2], f64) {
+    let (nx, ny, _, cells, rows) = slice.parts();
+    let sy = y.clamp(0.0, 1.0) * (ny - 1) as f64;
+    let sy = if sy.is_nan() { 0.0 } else { sy };
+    let cy = (sy as usize).min(ny - 2);
+    let fy = sy - cy as f64;
+    let [m0, r0] = rows[cy];
+    let [_, r1] = rows[cy + 1];
+    let row_total = (1.0 - fy) * r0 + fy * r1;
+    let uy = fy * (r0 + 0.5 * fy * (r1 - r0)) + m0;
+    let at = |x: f64| {
+        let sx = x.clamp(0.0, 1.0) * (nx - 1) as f64;
+        let sx = if sx.is_nan() { 0.0 } else { sx };
+        let cx = (sx as usize).min(nx - 2);
+        let fx = sx - cx as f64;
+        let k = cy * nx + cx;
+        let [v00, along0] = cells[k];
+        let [v10, _] = cells[k + 1];
+        let [v01, along1] = cells[k + nx];
+        let [v11, _] = cells[k + nx + 1];
+        let c0 = (1.0 - fy) * v00 + fy * v01;
+        let c1 = (1.0 - fy) * v10 + fy * v11;
+        let along = fx * (c0 + 0.5 * fx * (c1 - c0)) + (1.0 - fy) * along0 + fy * along1;
+        if row_total > 0.0 {
+            along / row_total
+        } else {
+            0.0
+        }
+    };
+    ([at(ux[0]), at(ux[1])], uy)
 }
 
 /// The smallest and largest `|v|` over the closed range `r` (the smallest 0 when `r` holds 0).
