@@ -141,24 +141,12 @@ impl Pyramid {
             + self.levels.capacity() * std::mem::size_of::<Level>()
     }
 
-    /// `(max, integral)` over `[xa, xb] × [ya, yb]` in grid coordinates (clamped to the grid).
-    /// `(0, 0)` for an empty rectangle.
-    pub(crate) fn query<S: CellSource>(
-        &self,
-        src: &S,
-        xa: f64,
-        xb: f64,
-        ya: f64,
-        yb: f64,
-    ) -> (f64, f64) {
-        let (wf, hf) = (self.w as f64, self.h as f64);
-        let xa = xa.max(0.0);
-        let ya = ya.max(0.0);
-        let xb = xb.min(wf);
-        let yb = yb.min(hf);
-        if !(xa < xb && ya < yb) {
-            return (0.0, 0.0);
-        }
+    /// The start of a descent over the clamped, non-empty `[xa, xb] × [ya, yb]`: the query's
+    /// span and a stack holding the blocks that cover it on the coarsest level whose block side
+    /// is at least the rectangle's larger extent (shared by [`Pyramid::query`] and
+    /// [`Pyramid::query_max`]).
+    #[inline(always)]
+    fn descent(&self, xa: f64, xb: f64, ya: f64, yb: f64) -> (Span, Stack) {
         let top = self.levels.len() - 1;
         let ext = (xb - xa).max(yb - ya);
         let mut k = 0usize;
@@ -179,6 +167,28 @@ impl Pyramid {
             let j1 = ((yb / size).ceil() as usize).min(lv.h);
             stack.push_blocks(k, &q, [i0, i1], [j0, j1]);
         }
+        (q, stack)
+    }
+
+    /// `(max, integral)` over `[xa, xb] × [ya, yb]` in grid coordinates (clamped to the grid).
+    /// `(0, 0)` for an empty rectangle.
+    pub(crate) fn query<S: CellSource>(
+        &self,
+        src: &S,
+        xa: f64,
+        xb: f64,
+        ya: f64,
+        yb: f64,
+    ) -> (f64, f64) {
+        let (wf, hf) = (self.w as f64, self.h as f64);
+        let xa = xa.max(0.0);
+        let ya = ya.max(0.0);
+        let xb = xb.min(wf);
+        let yb = yb.min(hf);
+        if !(xa < xb && ya < yb) {
+            return (0.0, 0.0);
+        }
+        let (q, mut stack) = self.descent(xa, xb, ya, yb);
         let mut max = 0.0f64;
         let mut sum = 0.0f64;
         while let Some((lvl, bi, bj)) = stack.pop() {
@@ -252,26 +262,7 @@ impl Pyramid {
             }
             return max;
         }
-        let top = self.levels.len() - 1;
-        let ext = (xb - xa).max(yb - ya);
-        let mut k = 0usize;
-        while k < top && ((1u64 << k) as f64) < ext {
-            k += 1;
-        }
-        let q = Span { xa, xb, ya, yb };
-        let mut stack = Stack {
-            items: [(0u8, 0u32, 0u32); STACK],
-            n: 0,
-        };
-        {
-            let lv = self.levels[k];
-            let size = (1u64 << k) as f64;
-            let i0 = (xa / size) as usize;
-            let i1 = ((xb / size).ceil() as usize).min(lv.w);
-            let j0 = (ya / size) as usize;
-            let j1 = ((yb / size).ceil() as usize).min(lv.h);
-            stack.push_blocks(k, &q, [i0, i1], [j0, j1]);
-        }
+        let (q, mut stack) = self.descent(xa, xb, ya, yb);
         while let Some((lvl, bi, bj)) = stack.pop() {
             if lvl == 0 {
                 max = max.max(src.full(bi, bj).0);
